@@ -1,0 +1,275 @@
+//! The dictionary blob: how dictionaries sit in flash.
+//!
+//! One format serves a single [`Dictionary`] and an [`Ensemble`] of K members. All
+//! integers and floats are little-endian:
+//!
+//! | offset | size | field |
+//! | --- | --- | --- |
+//! | 0 | 4 | magic `b"SLFD"` |
+//! | 4 | 2 | format version, [`BLOB_VERSION`] (= 1) |
+//! | 6 | 2 | reserved, 0 |
+//! | 8 | 10 | patch dimensions `PS, PT, PU, PV, B` (u16 each) |
+//! | 18 | 2 | member count K (u16, >= 1) |
+//! | 20 | 4 | payload length in bytes (u32) = `K * 4 * (PS^2 + PT^2 + PU^2 + PV^2 + B^2)` |
+//! | 24 | payload | per member, `D_1 .. D_5` (synthesis matrices, columns are atoms), each row-major f32 |
+//! | 24 + payload | 4 | CRC-32/ISO-HDLC (zlib's, PNG's) of every byte before it |
+//!
+//! [`Ensemble::new`] checks, in this order: length, magic, version, reserved, dimensions,
+//! member count, payload length, checksum, then every matrix for non-finite values and
+//! orthonormality. Each failure is its own [`DictionaryError`] variant. After that,
+//! [`Ensemble::member`] only copies one member's 1 KiB out of flash.
+
+use crc::{CRC_32_ISO_HDLC, Crc};
+
+use crate::dictionary::{Dictionary, DictionaryError, Factors, Matrix};
+
+/// The magic bytes at the start of a blob.
+pub const BLOB_MAGIC: [u8; 4] = *b"SLFD";
+/// The format version this decoder reads and writes.
+pub const BLOB_VERSION: u16 = 1;
+/// Header length in bytes.
+pub const HEADER_LEN: usize = 24;
+/// Checksum length in bytes.
+pub const CHECKSUM_LEN: usize = 4;
+
+const CRC32: Crc<u32> = Crc::<u32>::new(&CRC_32_ISO_HDLC);
+
+// Header field offsets.
+const VERSION_AT: usize = 4;
+const RESERVED_AT: usize = 6;
+const DIMS_AT: usize = 8;
+const MEMBERS_AT: usize = 18;
+const PAYLOAD_LEN_AT: usize = 20;
+
+/// Bytes of one member of a `PS x PT x PU x PV x B` dictionary.
+pub const fn member_len(dims: [usize; 5]) -> usize {
+    4 * (dims[0] * dims[0]
+        + dims[1] * dims[1]
+        + dims[2] * dims[2]
+        + dims[3] * dims[3]
+        + dims[4] * dims[4])
+}
+
+/// Total bytes of a blob of `members` members.
+pub const fn blob_len(dims: [usize; 5], members: usize) -> usize {
+    HEADER_LEN + members * member_len(dims) + CHECKSUM_LEN
+}
+
+fn u16_at(b: &[u8], at: usize) -> u16 {
+    match b.get(at..at + 2) {
+        Some(&[x, y]) => u16::from_le_bytes([x, y]),
+        _ => 0,
+    }
+}
+
+fn u32_at(b: &[u8], at: usize) -> u32 {
+    match b.get(at..at + 4) {
+        Some(&[w, x, y, z]) => u32::from_le_bytes([w, x, y, z]),
+        _ => 0,
+    }
+}
+
+fn read_matrix<const D: usize>(bytes: &[u8]) -> Matrix<D> {
+    let mut m = [[0.0f32; D]; D];
+    let (words, _) = bytes.as_chunks::<4>();
+    for (x, w) in m.as_flattened_mut().iter_mut().zip(words) {
+        *x = f32::from_le_bytes(*w);
+    }
+    m
+}
+
+fn write_matrix<const D: usize>(m: &Matrix<D>, out: &mut [u8]) -> usize {
+    let (words, _) = out.as_chunks_mut::<4>();
+    for (w, x) in words.iter_mut().zip(m.as_flattened()) {
+        *w = x.to_le_bytes();
+    }
+    4 * D * D
+}
+
+/// A validated blob of K >= 1 members, read in place from flash.
+#[derive(Clone, Copy, Debug)]
+pub struct Ensemble<
+    'a,
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+> {
+    payload: &'a [u8],
+    members: u16,
+}
+
+impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>
+    Ensemble<'a, PS, PT, PU, PV, B>
+{
+    const DIMS: [usize; 5] = [PS, PT, PU, PV, B];
+    const MEMBER_LEN: usize = member_len(Self::DIMS);
+
+    /// Checks a blob completely (see the module docs for the order of checks).
+    ///
+    /// # Errors
+    /// The first [`DictionaryError`] the blob fails.
+    pub fn new(blob: &'a [u8]) -> Result<Self, DictionaryError> {
+        let len = blob.len();
+        if len < HEADER_LEN + CHECKSUM_LEN {
+            return Err(DictionaryError::TooShort { len: len as u32 });
+        }
+        if blob.get(..4) != Some(&BLOB_MAGIC[..]) {
+            return Err(DictionaryError::BadMagic);
+        }
+        let version = u16_at(blob, VERSION_AT);
+        if version != BLOB_VERSION {
+            return Err(DictionaryError::UnsupportedVersion { found: version });
+        }
+        if u16_at(blob, RESERVED_AT) != 0 {
+            return Err(DictionaryError::ReservedNotZero);
+        }
+        let mut dims = [0u16; 5];
+        for (i, d) in dims.iter_mut().enumerate() {
+            *d = u16_at(blob, DIMS_AT + 2 * i);
+        }
+        if dims.iter().zip(Self::DIMS).any(|(&a, b)| a as usize != b) {
+            return Err(DictionaryError::ShapeMismatch { found: dims });
+        }
+        let members = u16_at(blob, MEMBERS_AT);
+        if members == 0 {
+            return Err(DictionaryError::MemberCount { found: 0 });
+        }
+        let payload_len = members as usize * Self::MEMBER_LEN;
+        let expected = HEADER_LEN + payload_len + CHECKSUM_LEN;
+        if u32_at(blob, PAYLOAD_LEN_AT) as usize != payload_len || len != expected {
+            return Err(DictionaryError::LengthMismatch {
+                expected: expected as u32,
+                found: len as u32,
+            });
+        }
+        let body_len = len - CHECKSUM_LEN;
+        let stored = u32_at(blob, body_len);
+        let computed = CRC32.checksum(blob.get(..body_len).unwrap_or(&[]));
+        if stored != computed {
+            return Err(DictionaryError::Checksum { stored, computed });
+        }
+        let ensemble = Self {
+            payload: blob.get(HEADER_LEN..body_len).unwrap_or(&[]),
+            members,
+        };
+        for m in 0..members {
+            ensemble.factors(m).validate(m)?;
+        }
+        Ok(ensemble)
+    }
+
+    /// Number of members K.
+    pub fn len(&self) -> usize {
+        self.members as usize
+    }
+
+    /// Always false: a validated ensemble has at least one member.
+    pub fn is_empty(&self) -> bool {
+        self.members == 0
+    }
+
+    fn factors(&self, member: u16) -> Factors<PS, PT, PU, PV, B> {
+        let start = member as usize * Self::MEMBER_LEN;
+        let bytes = self
+            .payload
+            .get(start..start + Self::MEMBER_LEN)
+            .unwrap_or(&[]);
+        let mut at = 0;
+        let mut next = |n: usize| {
+            let s = bytes.get(at..at + 4 * n * n).unwrap_or(&[]);
+            at += 4 * n * n;
+            s
+        };
+        Factors {
+            m1: read_matrix::<PS>(next(PS)),
+            m2: read_matrix::<PT>(next(PT)),
+            m3: read_matrix::<PU>(next(PU)),
+            m4: read_matrix::<PV>(next(PV)),
+            m5: read_matrix::<B>(next(B)),
+        }
+    }
+
+    /// Member `index`, copied out of the blob (validated by [`new`](Self::new)).
+    ///
+    /// # Errors
+    /// [`DictionaryError::NoSuchMember`] past the end.
+    pub fn member(&self, index: usize) -> Result<Dictionary<PS, PT, PU, PV, B>, DictionaryError> {
+        if index >= self.len() {
+            return Err(DictionaryError::NoSuchMember {
+                index: index.min(u16::MAX as usize) as u16,
+                members: self.members,
+            });
+        }
+        Ok(Dictionary::from_validated(self.factors(index as u16)))
+    }
+}
+
+impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>
+    Dictionary<PS, PT, PU, PV, B>
+{
+    /// Reads a blob that holds exactly one member.
+    ///
+    /// # Errors
+    /// Any [`Ensemble::new`] error, or [`DictionaryError::MemberCount`] for K != 1.
+    pub fn from_blob(blob: &[u8]) -> Result<Self, DictionaryError> {
+        let e = Ensemble::<PS, PT, PU, PV, B>::new(blob)?;
+        if e.len() != 1 {
+            return Err(DictionaryError::MemberCount { found: e.members });
+        }
+        e.member(0)
+    }
+}
+
+/// Writes `members` as a blob into `out`; returns the number of bytes written.
+///
+/// # Errors
+/// [`DictionaryError::MemberCount`] for no members (or more than 65535),
+/// [`DictionaryError::BufferTooSmall`] when `out` is shorter than [`blob_len`].
+pub fn write_blob<
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+>(
+    members: &[Dictionary<PS, PT, PU, PV, B>],
+    out: &mut [u8],
+) -> Result<usize, DictionaryError> {
+    let dims = [PS, PT, PU, PV, B];
+    if members.is_empty() || members.len() > u16::MAX as usize {
+        return Err(DictionaryError::MemberCount {
+            found: members.len().min(u16::MAX as usize) as u16,
+        });
+    }
+    let total = blob_len(dims, members.len());
+    let Some(out) = out.get_mut(..total) else {
+        return Err(DictionaryError::BufferTooSmall {
+            needed: total as u32,
+        });
+    };
+    out.fill(0);
+    let (header, rest) = out.split_at_mut(HEADER_LEN);
+    header[..4].copy_from_slice(&BLOB_MAGIC);
+    header[VERSION_AT..VERSION_AT + 2].copy_from_slice(&BLOB_VERSION.to_le_bytes());
+    for (i, d) in dims.iter().enumerate() {
+        header[DIMS_AT + 2 * i..DIMS_AT + 2 * i + 2].copy_from_slice(&(*d as u16).to_le_bytes());
+    }
+    header[MEMBERS_AT..MEMBERS_AT + 2].copy_from_slice(&(members.len() as u16).to_le_bytes());
+    let payload_len = members.len() * member_len(dims);
+    header[PAYLOAD_LEN_AT..PAYLOAD_LEN_AT + 4].copy_from_slice(&(payload_len as u32).to_le_bytes());
+    let mut at = 0;
+    for m in members {
+        let d = &m.d;
+        at += write_matrix(&d.m1, &mut rest[at..]);
+        at += write_matrix(&d.m2, &mut rest[at..]);
+        at += write_matrix(&d.m3, &mut rest[at..]);
+        at += write_matrix(&d.m4, &mut rest[at..]);
+        at += write_matrix(&d.m5, &mut rest[at..]);
+    }
+    let body_len = total - CHECKSUM_LEN;
+    let crc = CRC32.checksum(&out[..body_len]);
+    out[body_len..].copy_from_slice(&crc.to_le_bytes());
+    Ok(total)
+}

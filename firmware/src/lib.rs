@@ -1,0 +1,81 @@
+//! The decoder of the slf compressive multispectral light-field camera.
+//!
+//! A lenslet array and a one-hot spectral filter mask over a monochrome sensor record a 5D
+//! light field (2 spatial, 2 angular, `B` spectral bands) as one raw frame per snapshot.
+//! This crate recovers the full spectral light field patch by patch by compressed sensing
+//! in the signal's own five dimensions: a small orthonormal matrix per dimension, separable
+//! operators, and the nD smoothed-l0 solver of Algorithm 1 of the seed paper. It is
+//! `no_std`, needs no heap, and is the code the host simulator calls, so host results are
+//! the device's results.
+//!
+//! # Layers
+//!
+//! From the sensor to decoded patches, one module each:
+//!
+//! - **raw frame** ([`raw`], [`defects`]): samples, which of them are measurements, frames
+//!   in memory.
+//! - **sensing** ([`mask`]): which band each pixel sees in each snapshot; the three mask
+//!   families `kronecker`, `lenslet`, `pixel`.
+//! - **operators** ([`shape`], [`dct`], [`dictionary`], [`blob`], [`transform`]): the patch
+//!   geometry in the types, dictionaries (the 5D DCT and blobs in flash) and the separable
+//!   synthesis and analysis transforms.
+//! - **solver** ([`sl0`], [`pinv`]): nD SL0 with the orthonormal fast path, and the paper's
+//!   general pseudo-inverse path for kronecker masks.
+//! - **tile decoder** ([`tile`]): a rectangle of the raw frame, patch by patch, from a
+//!   [`TileSource`] to a [`PatchSink`], into a caller-owned [`Workspace`].
+//!
+//! The device application (the Cortex-M binary) sits on top of the tile decoder.
+//!
+//! # Memory
+//!
+//! Configuration (dictionaries, masks, defect lists, solver parameters) is immutable and
+//! can live in flash; all mutable state is one caller-owned [`Workspace`], whose size is the
+//! decoder's whole RAM need besides the stack: three patch buffers and a flag per value,
+//! 67,604 bytes for the paper's 5 x 5 x 4 x 4 x 13 patch.
+//!
+//! # Errors
+//!
+//! One small `Copy` error enum per layer ([`DictionaryError`], [`SensingError`],
+//! [`SolveError`], [`ConfigError`], [`TileError`]), each with `Display`,
+//! `core::error::Error`, and `defmt::Format` with the `defmt` feature. Nothing reachable
+//! from the public API panics on any input, and every loop is bounded: a solve that does
+//! not converge says so in its [`Outcome`].
+//!
+//! # Features
+//!
+//! - `defmt`: log through defmt and derive `defmt::Format` on errors and reports. Off by
+//!   default (host builds that call defmt need a global logger to link).
+#![no_std]
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+#![allow(missing_docs)] // fields and variants are documented where they need it; see module docs
+
+mod log;
+
+pub mod blob;
+pub mod dct;
+pub mod defects;
+pub mod dictionary;
+pub mod mask;
+pub mod pinv;
+pub mod raw;
+pub mod shape;
+pub mod sl0;
+pub mod tile;
+pub mod transform;
+pub mod workspace;
+
+pub use blob::{Ensemble, write_blob};
+pub use defects::{DefectList, Pixel};
+pub use dictionary::{Dictionary, DictionaryError, Factors, Matrix};
+pub use mask::{BandTile, KroneckerPhi, LensletSize, Mask, MaskFamily, SensingError};
+pub use pinv::{PinvOperator, solve_pinv};
+pub use raw::{FrameSource, RawFormat, RawFrame};
+pub use shape::{FullViewShape, PaperShape, PatchShape};
+pub use sl0::{Ended, Outcome, Sl0Config, SolveError, solve};
+pub use tile::{
+    ConfigError, DecoderConfig, PatchFlags, PatchOrigin, PatchReport, PatchSink, SensorGeometry,
+    Tile, TileDecoder, TileError, TileReport, TileSource,
+};
+pub use transform::{analyze, synthesize};
+pub use workspace::{Measurements, PaperWorkspace, Workspace};

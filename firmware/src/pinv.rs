@@ -1,0 +1,221 @@
+//! The paper's general projection path: per-mode pseudo-inverses, for kronecker masks.
+//!
+//! Algorithm 1 as the paper writes it, with `A_i = Phi_i D_i`:
+//! `S0 = I x_i A_i^+`, and each step `S <- S - (S x_i A_i - I) x_i A_i^+`. It does not need
+//! orthonormal matrices, which is why it is kept; with orthonormal ones it equals the fast
+//! path of [`crate::sl0`] (a test shows it). The pseudo-inverses are computed once, in
+//! [`PinvOperator::new`] (an SVD each, in f64, via nalgebra), never per patch.
+//!
+//! `Phi5` is `k x B`; here it is padded to `B x B` with zero rows (and `I` with zero
+//! slices), which keeps every mode square and leaves the algebra unchanged: the
+//! pseudo-inverse of `[A; 0]` is `[A^+, 0]`. The mode products run in place one fibre at a
+//! time, so this path needs the same [`Workspace`] as the fast path; it is slower, being
+//! the reference and not the product.
+
+use nalgebra::{SMatrix, SVD};
+
+use crate::dictionary::{Dictionary, Factors, Matrix};
+use crate::mask::KroneckerPhi;
+use crate::shape::PatchShape;
+use crate::sl0::{Outcome, Sl0Config, SolveError, ascend, max_abs, run_schedule};
+use crate::transform::{apply_in_place, synthesize};
+use crate::workspace::{Measurements, Workspace};
+
+/// Largest mode size the general path handles (its SVDs run at this fixed size).
+pub const PINV_MAX_DIM: usize = 16;
+
+type Padded = SMatrix<f64, PINV_MAX_DIM, PINV_MAX_DIM>;
+
+/// The Moore-Penrose pseudo-inverse of a `D x D` matrix, via an f64 SVD.
+fn pseudo_inverse<const D: usize>(a: &Matrix<D>, mode: u8) -> Result<Matrix<D>, SolveError> {
+    const { assert!(D <= PINV_MAX_DIM, "mode larger than PINV_MAX_DIM") };
+    let fail = SolveError::PseudoInverse { mode };
+    // Zero padding: pinv(diag(A, 0)) = diag(pinv(A), 0).
+    let mut m = Padded::zeros();
+    for (i, row) in a.iter().enumerate() {
+        for (j, &x) in row.iter().enumerate() {
+            m[(i, j)] = f64::from(x);
+        }
+    }
+    let svd = SVD::try_new(m, true, true, f64::EPSILON, 10_000).ok_or(fail)?;
+    let tol = svd.singular_values.max() * 1e-9;
+    let p = svd.pseudo_inverse(tol).map_err(|_| fail)?;
+    let mut out = [[0.0f32; D]; D];
+    for (i, row) in out.iter_mut().enumerate() {
+        for (j, x) in row.iter_mut().enumerate() {
+            *x = p[(i, j)] as f32;
+        }
+    }
+    Ok(out)
+}
+
+/// `Phi D` for a row-shuffled identity `Phi`: row `r` is row `shuffle[r]` of `D`.
+fn shuffled_rows<const D: usize>(d: &Matrix<D>, shuffle: &[u8; D]) -> Matrix<D> {
+    let mut a = [[0.0f32; D]; D];
+    for (row, &p) in a.iter_mut().zip(shuffle) {
+        *row = d[p as usize % D];
+    }
+    a
+}
+
+/// The operators `A_i = Phi_i D_i` and their pseudo-inverses for one kronecker block.
+/// Config: built once, used for every patch the block's `Phi` describes.
+#[derive(Clone, Debug)]
+pub struct PinvOperator<
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+> {
+    a: Factors<PS, PT, PU, PV, B>,
+    a_pinv: Factors<PS, PT, PU, PV, B>,
+    phi: KroneckerPhi<PS, PT, PU, PV>,
+    dict: Dictionary<PS, PT, PU, PV, B>,
+}
+
+impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>
+    PinvOperator<PS, PT, PU, PV, B>
+{
+    /// Forms `A_i = Phi_i D_i` and computes each `A_i^+` once.
+    ///
+    /// # Errors
+    /// [`SolveError::PseudoInverse`] if an SVD does not converge.
+    pub fn new(
+        dict: &Dictionary<PS, PT, PU, PV, B>,
+        phi: &KroneckerPhi<PS, PT, PU, PV>,
+    ) -> Result<Self, SolveError> {
+        let d = &dict.d;
+        let mut a5 = [[0.0f32; B]; B];
+        for (row, &band) in a5.iter_mut().zip(&phi.bands) {
+            *row = d.m5[band as usize % B];
+        }
+        let a = Factors {
+            m1: shuffled_rows(&d.m1, &phi.shuffle1),
+            m2: shuffled_rows(&d.m2, &phi.shuffle2),
+            m3: shuffled_rows(&d.m3, &phi.shuffle3),
+            m4: shuffled_rows(&d.m4, &phi.shuffle4),
+            m5: a5,
+        };
+        let a_pinv = Factors {
+            m1: pseudo_inverse(&a.m1, 1)?,
+            m2: pseudo_inverse(&a.m2, 2)?,
+            m3: pseudo_inverse(&a.m3, 3)?,
+            m4: pseudo_inverse(&a.m4, 4)?,
+            m5: pseudo_inverse(&a.m5, 5)?,
+        };
+        Ok(Self {
+            a,
+            a_pinv,
+            phi: phi.clone(),
+            dict: dict.clone(),
+        })
+    }
+
+    /// [`PatchShape::index`] (which does not depend on `N`).
+    const fn index(s: usize, t: usize, u: usize, v: usize, b: usize) -> usize {
+        PatchShape::<PS, PT, PU, PV, B, 0>::index(s, t, u, v, b)
+    }
+
+    /// For every entry of the padded measurement tensor `I` (in the patch layout, with the
+    /// snapshot `j` in place of the band), the patch entry it measures: `f(i_index, entry)`.
+    fn for_each_selected(&self, mut f: impl FnMut(usize, usize)) {
+        let p = &self.phi;
+        for (s, &ps) in p.shuffle1.iter().enumerate() {
+            for (t, &pt) in p.shuffle2.iter().enumerate() {
+                for (u, &pu) in p.shuffle3.iter().enumerate() {
+                    for (v, &pv) in p.shuffle4.iter().enumerate() {
+                        for (j, &band) in p.bands.iter().enumerate() {
+                            let (ps, pt, pu, pv) =
+                                (ps as usize, pt as usize, pu as usize, pv as usize);
+                            f(
+                                Self::index(s, t, u, v, j),
+                                Self::index(ps, pt, pu, pv, band as usize),
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// `t -= I` (or `t = I` with `assign`); `I` read from the measurements.
+    fn subtract_measurements<const N: usize>(
+        &self,
+        m: &Measurements<N>,
+        t: &mut [f32; N],
+        assign: bool,
+    ) {
+        self.for_each_selected(|i, e| {
+            let y = m.values.get(e).copied().unwrap_or(0.0);
+            if let Some(x) = t.get_mut(i) {
+                *x = if assign { y } else { *x - y };
+            }
+        });
+    }
+}
+
+/// Decodes the patch whose measurements are in `ws` by the paper's general path. The
+/// measurements must be exactly the entries `op`'s `Phi` selects (no defects).
+///
+/// # Errors
+/// [`SolveError::InvalidConfig`], [`SolveError::NoMeasurements`],
+/// [`SolveError::IncompleteKronecker`], [`SolveError::NonFiniteResult`].
+pub fn solve_pinv<
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+    const N: usize,
+>(
+    op: &PinvOperator<PS, PT, PU, PV, B>,
+    cfg: &Sl0Config,
+    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+) -> Result<Outcome, SolveError> {
+    cfg.validate()?;
+    let Workspace {
+        coeffs,
+        signal,
+        measurements: m,
+    } = ws;
+    if m.count == 0 {
+        return Err(SolveError::NoMeasurements);
+    }
+    let mut complete = true;
+    op.for_each_selected(|_, e| complete &= m.measured.get(e).copied().unwrap_or(false));
+    if !complete || m.count() != PatchShape::<PS, PT, PU, PV, B, N>::PIXELS * op.phi.bands.len() {
+        return Err(SolveError::IncompleteKronecker);
+    }
+    let eps = cfg.noise * libm::sqrtf(m.count as f32);
+
+    // S0 = I x_i A_i^+ (zero-padded I).
+    coeffs.fill(0.0);
+    op.subtract_measurements(m, coeffs, true);
+    apply_in_place(&op.a_pinv, coeffs);
+    let sigma0 = max_abs(coeffs);
+
+    let outcome = run_schedule(cfg, sigma0, |inv| {
+        ascend(coeffs, cfg.mu, inv);
+        // R = S x_i A_i - I
+        signal.copy_from_slice(coeffs);
+        apply_in_place(&op.a, signal);
+        op.subtract_measurements(m, signal, false);
+        let norm = libm::sqrtf(signal.iter().map(|r| r * r).sum());
+        if eps == 0.0 || norm > eps {
+            // S <- S - R' x_i A_i^+, R' = R, or R shrunk to the noise ball's surface.
+            let scale = if eps == 0.0 { 1.0 } else { 1.0 - eps / norm };
+            apply_in_place(&op.a_pinv, signal);
+            for (s, r) in coeffs.iter_mut().zip(signal.iter()) {
+                *s -= scale * r;
+            }
+        }
+        norm
+    });
+
+    synthesize(&op.dict, coeffs, signal);
+    if signal.iter().any(|x| !x.is_finite()) {
+        return Err(SolveError::NonFiniteResult);
+    }
+    Ok(outcome)
+}

@@ -1,0 +1,190 @@
+//! Raw frames: sensor samples, what makes one a measurement, and frames held in RAM.
+//!
+//! The decoder works in normalised units: `(raw - black) / (white - black)`, so a white
+//! surface reads 1. A sample is a measurement only if it is finite, not negative and not
+//! above `max_valid` (a clipped, saturated pixel says only "at least this bright", and
+//! fed in as a value it would pull the solution down). Samples between 0 and the black
+//! level are dark noise and are kept. Anything else is left out of the constraints and
+//! the patch is flagged (see [`crate::tile::PatchFlags`]).
+
+use crate::mask::SensingError;
+use crate::tile::TileSource;
+
+/// How raw sample values map to the decoder's normalised units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct RawFormat {
+    /// Raw value of no light.
+    pub black: f32,
+    /// Raw value of a white (reflectance 1) surface.
+    pub white: f32,
+    /// Largest raw value that is still a measurement; above it a pixel is saturated.
+    pub max_valid: f32,
+}
+
+impl RawFormat {
+    /// Samples already normalised: black 0, white 1, anything up to 1 valid.
+    pub const NORMALISED: Self = Self {
+        black: 0.0,
+        white: 1.0,
+        max_valid: 1.0,
+    };
+
+    /// A `bits`-bit sensor with the given black level; the top code is saturated.
+    pub fn bits(bits: u8, black: f32) -> Self {
+        let top = ((1u32 << bits.clamp(1, 24)) - 1) as f32;
+        Self {
+            black,
+            white: top,
+            max_valid: top - 1.0,
+        }
+    }
+
+    /// Whether the format can normalise anything: finite, `white > black`, `max_valid >= 0`.
+    pub fn is_valid(&self) -> bool {
+        self.black.is_finite()
+            && self.white.is_finite()
+            && self.max_valid.is_finite()
+            && self.white > self.black
+            && self.max_valid >= 0.0
+    }
+
+    /// A sample as a measurement in normalised units, or why it is not one.
+    #[inline]
+    pub fn classify(&self, raw: f32) -> Result<f32, Invalid> {
+        if !raw.is_finite() {
+            Err(Invalid::NonFinite)
+        } else if raw < 0.0 {
+            Err(Invalid::Negative)
+        } else if raw > self.max_valid {
+            Err(Invalid::OverRange)
+        } else {
+            Ok((raw - self.black) / (self.white - self.black))
+        }
+    }
+}
+
+/// Why a sample is not a measurement.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Invalid {
+    NonFinite,
+    Negative,
+    OverRange,
+}
+
+/// A sample type of a raw frame.
+pub trait Sample: Copy {
+    fn to_f32(self) -> f32;
+}
+
+impl Sample for u16 {
+    #[inline]
+    fn to_f32(self) -> f32 {
+        f32::from(self)
+    }
+}
+
+impl Sample for f32 {
+    #[inline]
+    fn to_f32(self) -> f32 {
+        self
+    }
+}
+
+/// One snapshot's raw frame, row-major, `rows x cols` samples. Checked at construction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RawFrame<'a, T: Sample> {
+    data: &'a [T],
+    rows: usize,
+    cols: usize,
+}
+
+impl<'a, T: Sample> RawFrame<'a, T> {
+    /// # Errors
+    /// [`SensingError::FrameSize`] if `data.len() != rows * cols`.
+    pub fn new(data: &'a [T], rows: usize, cols: usize) -> Result<Self, SensingError> {
+        let expected = rows.saturating_mul(cols);
+        if data.len() != expected {
+            return Err(SensingError::FrameSize {
+                expected: expected.min(u32::MAX as usize) as u32,
+                found: data.len().min(u32::MAX as usize) as u32,
+            });
+        }
+        Ok(Self { data, rows, cols })
+    }
+
+    /// Rows (sensor height).
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// Columns (sensor width).
+    pub fn cols(&self) -> usize {
+        self.cols
+    }
+}
+
+/// Why a read from an in-memory frame failed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ReadError {
+    /// No frame for this snapshot.
+    NoSuchSnapshot { snapshot: u8 },
+    /// The requested samples run outside the frame.
+    OutOfBounds { row: u32, col: u32 },
+}
+
+impl core::fmt::Display for ReadError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            Self::NoSuchSnapshot { snapshot } => write!(f, "no raw frame for snapshot {snapshot}"),
+            Self::OutOfBounds { row, col } => {
+                write!(f, "read outside the raw frame at ({row}, {col})")
+            }
+        }
+    }
+}
+
+impl core::error::Error for ReadError {}
+
+/// A [`TileSource`] over raw frames in RAM (or flash), one per snapshot.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameSource<'a, T: Sample> {
+    frames: &'a [RawFrame<'a, T>],
+}
+
+impl<'a, T: Sample> FrameSource<'a, T> {
+    pub fn new(frames: &'a [RawFrame<'a, T>]) -> Self {
+        Self { frames }
+    }
+}
+
+impl<T: Sample> TileSource for FrameSource<'_, T> {
+    type Error = ReadError;
+
+    fn read(
+        &mut self,
+        snapshot: usize,
+        row: usize,
+        col: usize,
+        out: &mut [f32],
+    ) -> Result<(), ReadError> {
+        let frame = self.frames.get(snapshot).ok_or(ReadError::NoSuchSnapshot {
+            snapshot: snapshot.min(255) as u8,
+        })?;
+        let oob = ReadError::OutOfBounds {
+            row: row.min(u32::MAX as usize) as u32,
+            col: col.min(u32::MAX as usize) as u32,
+        };
+        if row >= frame.rows || col.saturating_add(out.len()) > frame.cols {
+            return Err(oob);
+        }
+        let start = row * frame.cols + col;
+        let src = frame.data.get(start..start + out.len()).ok_or(oob)?;
+        for (o, s) in out.iter_mut().zip(src) {
+            *o = s.to_f32();
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,305 @@
+//! nD smoothed-l0 (SL0): the paper's Algorithm 1 on one patch, orthonormal fast path.
+//!
+//! SL0 approximates the l0 norm by `N - sum exp(-s^2 / (2 sigma^2))` and follows its
+//! maximiser as `sigma` falls: at each `sigma`, `L` times, a steepest-ascent step
+//! `S <- S - mu * S * exp(-S^2 / (2 sigma^2))` followed by a projection back onto the
+//! measurements; then `sigma <- sigma_f * sigma`, until `sigma <= sigma_min`.
+//!
+//! **Fast path.** With an orthonormal dictionary and one-hot (selection) measurements the
+//! projection `S - A^+(A S - I)` is exactly: synthesise `X`, overwrite the measured entries
+//! of `X` with the measurements, analyse back. The start, the minimum-norm solution
+//! `A^+ I`, is the analysis of the measurements with zeros elsewhere. This holds for every
+//! mask family; the paper's general pseudo-inverse form is in [`crate::pinv`], and a test
+//! shows the two agree on kronecker masks.
+//!
+//! **Noise-aware mode.** With a noise level `noise > 0` (standard deviation per
+//! measurement, normalised units) the projection is onto the ball `||A S - I|| <= eps`,
+//! `eps = noise * sqrt(m)` for `m` measurements, as SL0 does for noisy data: a point inside
+//! the ball is left alone, one outside is moved to its surface. It stops fitting the noise.
+//!
+//! Every loop is bounded by [`Sl0Config::max_iterations`]; how a solve ended is in its
+//! [`Outcome`], never a hang.
+
+use core::fmt;
+
+use crate::dictionary::Dictionary;
+use crate::transform::{analyze, synthesize};
+use crate::workspace::{Measurements, Workspace};
+
+/// Parameters of SL0 (Algorithm 1). Defaults in [`Sl0Config::DEFAULT`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Sl0Config {
+    /// `sigma_f`: factor by which sigma falls per level, in (0, 1).
+    pub sigma_f: f32,
+    /// `L`: steepest-ascent + projection steps per sigma level, >= 1.
+    pub steps: u16,
+    /// `mu`: step size, > 0 (2 as in Mohimani et al.'s reference code).
+    pub mu: f32,
+    /// `sigma_min`: the last sigma, > 0, in normalised units (white = 1).
+    pub sigma_min: f32,
+    /// Hard bound on steps (ascent + projection) per solve, >= 1.
+    pub max_iterations: u32,
+    /// Noise standard deviation per measurement (normalised units), >= 0; 0 forces
+    /// equality with the measurements.
+    pub noise: f32,
+}
+
+impl Sl0Config {
+    /// The defaults: `sigma_f = 0.7`, `L = 3`, `mu = 2`, `sigma_min = 1e-3`, at most 300
+    /// steps, exact projection. The start is `sigma0 = max |S0|` of the minimum-norm
+    /// solution `S0`; from a patch of mean brightness 0.5 that is about 20 levels (60 steps).
+    pub const DEFAULT: Self = Self {
+        sigma_f: 0.7,
+        steps: 3,
+        mu: 2.0,
+        sigma_min: 1e-3,
+        max_iterations: 300,
+        noise: 0.0,
+    };
+
+    /// Checks every field's range.
+    ///
+    /// # Errors
+    /// [`SolveError::InvalidConfig`] naming the first bad field.
+    pub fn validate(&self) -> Result<(), SolveError> {
+        let bad = |field| Err(SolveError::InvalidConfig { field });
+        if !(self.sigma_f > 0.0 && self.sigma_f < 1.0) {
+            return bad("sigma_f");
+        }
+        if self.steps == 0 {
+            return bad("steps");
+        }
+        if !(self.mu > 0.0 && self.mu.is_finite()) {
+            return bad("mu");
+        }
+        if !(self.sigma_min > 0.0 && self.sigma_min.is_finite()) {
+            return bad("sigma_min");
+        }
+        if self.max_iterations == 0 {
+            return bad("max_iterations");
+        }
+        if !(self.noise >= 0.0 && self.noise.is_finite()) {
+            return bad("noise");
+        }
+        Ok(())
+    }
+}
+
+impl Default for Sl0Config {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
+
+/// Errors of the solver layer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum SolveError {
+    /// The patch has no valid measurement: nothing to decode.
+    NoMeasurements,
+    /// A config field is out of range.
+    InvalidConfig { field: &'static str },
+    /// A measurement index past the end of the patch.
+    IndexOutOfRange,
+    /// A measurement value that is NaN or infinite.
+    NonFiniteMeasurement,
+    /// The solution went non-finite (not expected for finite input; reported, not output).
+    NonFiniteResult,
+    /// The general (pseudo-inverse) path needs every entry its kronecker `Phi` selects
+    /// measured, and nothing else.
+    IncompleteKronecker,
+    /// The SVD behind a pseudo-inverse did not converge (`mode` 1..=5).
+    PseudoInverse { mode: u8 },
+}
+
+impl fmt::Display for SolveError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Self::NoMeasurements => f.write_str("patch has no valid measurement"),
+            Self::InvalidConfig { field } => {
+                write!(f, "solver config field `{field}` out of range")
+            }
+            Self::IndexOutOfRange => f.write_str("measurement index outside the patch"),
+            Self::NonFiniteMeasurement => f.write_str("measurement is not finite"),
+            Self::NonFiniteResult => f.write_str("solution is not finite"),
+            Self::IncompleteKronecker => {
+                f.write_str("general path needs exactly the entries the kronecker mask selects")
+            }
+            Self::PseudoInverse { mode } => {
+                write!(f, "pseudo-inverse of mode {mode} did not converge")
+            }
+        }
+    }
+}
+
+impl core::error::Error for SolveError {}
+
+/// Why a solve stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Ended {
+    /// `sigma` reached `sigma_min`: the normal end.
+    SigmaMin,
+    /// `max_iterations` steps were taken first.
+    IterationBound,
+    /// `sigma` fell so far that `1 / sigma^2` is not an f32 (only with a `sigma_min`
+    /// below f32 resolution); the solution is as good as it gets.
+    SigmaUnderflow,
+}
+
+/// How a solve ended.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Outcome {
+    /// Steps (ascent + projection) taken.
+    pub iterations: u32,
+    /// Sigma levels completed.
+    pub levels: u32,
+    /// `sigma0 = max |S0|` of the minimum-norm solution.
+    pub sigma0: f32,
+    /// l2 norm of measurements minus synthesis before the last projection (normalised
+    /// units): how far the last ascent step moved off the data.
+    pub residual: f32,
+    /// Why it stopped.
+    pub ended: Ended,
+}
+
+impl Outcome {
+    /// Whether the hard iteration bound stopped the solve.
+    pub fn hit_bound(&self) -> bool {
+        self.ended == Ended::IterationBound
+    }
+}
+
+/// The ascent step `s <- s - mu * s * exp(-s^2 * inv)`, `inv = 1 / (2 sigma^2)`.
+#[inline]
+pub(crate) fn ascend(coeffs: &mut [f32], mu: f32, inv: f32) {
+    for s in coeffs {
+        let e = libm::expf(-(*s * *s) * inv);
+        *s -= mu * *s * e;
+    }
+}
+
+/// The largest absolute value.
+pub(crate) fn max_abs(x: &[f32]) -> f32 {
+    x.iter().fold(0.0f32, |m, v| m.max(v.abs()))
+}
+
+/// Moves `x` onto the measurements (exactly, or to the noise ball of radius `eps`);
+/// returns the residual norm before the move.
+fn project<const N: usize>(x: &mut [f32; N], m: &Measurements<N>, eps: f32) -> f32 {
+    let mut r2 = 0.0f32;
+    for ((x, &y), &k) in x.iter().zip(&m.values).zip(&m.measured) {
+        if k {
+            let r = y - x;
+            r2 += r * r;
+        }
+    }
+    let norm = libm::sqrtf(r2);
+    if eps == 0.0 {
+        for ((x, &y), &k) in x.iter_mut().zip(&m.values).zip(&m.measured) {
+            if k {
+                *x = y;
+            }
+        }
+    } else if norm > eps {
+        let scale = 1.0 - eps / norm;
+        for ((x, &y), &k) in x.iter_mut().zip(&m.values).zip(&m.measured) {
+            if k {
+                *x += scale * (y - *x);
+            }
+        }
+    }
+    norm
+}
+
+/// The sigma schedule of Algorithm 1, shared by both projection paths: runs `step` (one
+/// ascent + projection, returning the residual) `L` times per level until `sigma_min`, the
+/// iteration bound, or sigma underflow.
+pub(crate) fn run_schedule(
+    cfg: &Sl0Config,
+    sigma0: f32,
+    mut step: impl FnMut(f32) -> f32,
+) -> Outcome {
+    let mut out = Outcome {
+        iterations: 0,
+        levels: 0,
+        sigma0,
+        residual: 0.0,
+        ended: Ended::SigmaMin,
+    };
+    let mut sigma = sigma0;
+    out.ended = 'levels: loop {
+        if sigma.is_nan() || sigma <= cfg.sigma_min {
+            break Ended::SigmaMin;
+        }
+        let inv = 1.0 / (2.0 * sigma * sigma);
+        if !inv.is_finite() {
+            break Ended::SigmaUnderflow;
+        }
+        for _ in 0..cfg.steps {
+            if out.iterations >= cfg.max_iterations {
+                break 'levels Ended::IterationBound;
+            }
+            out.residual = step(inv);
+            out.iterations += 1;
+        }
+        out.levels += 1;
+        sigma *= cfg.sigma_f;
+    };
+    out
+}
+
+/// Decodes the patch whose measurements are in `ws`, with an orthonormal dictionary (the
+/// fast path). On success the patch is in [`Workspace::patch`]; it matches every
+/// measurement (to the noise ball in noise-aware mode) and holds no NaN or infinity.
+///
+/// # Errors
+/// [`SolveError::InvalidConfig`], [`SolveError::NoMeasurements`], or
+/// [`SolveError::NonFiniteResult`] (then `ws.patch()` is not a decode).
+pub fn solve<
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+    const N: usize,
+>(
+    dict: &Dictionary<PS, PT, PU, PV, B>,
+    cfg: &Sl0Config,
+    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+) -> Result<Outcome, SolveError> {
+    cfg.validate()?;
+    let Workspace {
+        coeffs,
+        signal,
+        measurements: m,
+    } = ws;
+    if m.count == 0 {
+        return Err(SolveError::NoMeasurements);
+    }
+    let eps = cfg.noise * libm::sqrtf(m.count as f32);
+
+    // Minimum-norm start: S0 = analysis of the measurements, zeros elsewhere.
+    for ((x, &y), &k) in signal.iter_mut().zip(&m.values).zip(&m.measured) {
+        *x = if k { y } else { 0.0 };
+    }
+    analyze(dict, signal, coeffs);
+    let sigma0 = max_abs(coeffs);
+
+    let outcome = run_schedule(cfg, sigma0, |inv| {
+        ascend(coeffs, cfg.mu, inv);
+        synthesize(dict, coeffs, signal);
+        let r = project(signal, m, eps);
+        analyze(dict, signal, coeffs);
+        r
+    });
+
+    synthesize(dict, coeffs, signal);
+    project(signal, m, eps);
+    if signal.iter().any(|x| !x.is_finite()) {
+        return Err(SolveError::NonFiniteResult);
+    }
+    Ok(outcome)
+}

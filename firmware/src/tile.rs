@@ -1,0 +1,535 @@
+//! Tiles: decoding a rectangle of the raw frame patch by patch.
+//!
+//! A [`Tile`] is a rectangle of lenslets holding whole patches, with all snapshots. Its
+//! samples come from a [`TileSource`] and its decoded patches go to a [`PatchSink`]; both
+//! are traits so the same decoder reads a frame in RAM today and a sensor or an external
+//! frame buffer over `embedded-hal` later. A source is asked for short runs of one row
+//! (`PV` samples of one lenslet's view row, per snapshot), which maps onto both random
+//! access into RAM and addressed reads of a serial frame buffer; a sequential-only sensor
+//! FIFO is buffered tile by tile by its source.
+//!
+//! Where a patch has fewer views than a lenslet (`PU < U`), each spatial block is decoded
+//! in overlapping angular windows that together cover every view; the sink sees each
+//! window's origin and can average the overlaps.
+//!
+//! Bad input loses only itself: an invalid sample (defective pixel, non-finite, negative,
+//! saturated) is left out of the patch's constraints and flags the patch; a patch with no
+//! valid sample is reported to the sink as an error and the tile goes on; a source error
+//! ends that tile only, and [`TileDecoder::decode_frame`] goes on with the next tile.
+
+use core::fmt;
+
+use crate::defects::DefectList;
+use crate::dictionary::Dictionary;
+use crate::log::log;
+use crate::mask::{LensletSize, Mask, MaskFamily};
+use crate::raw::{Invalid, RawFormat};
+use crate::shape::PatchShape;
+use crate::sl0::{Outcome, Sl0Config, SolveError, solve};
+use crate::workspace::Workspace;
+
+/// Where raw samples come from.
+pub trait TileSource {
+    /// A read failure (bus error, short read, out of range). `Copy`, to travel in errors.
+    type Error: Copy + fmt::Debug;
+
+    /// Fills `out` with the `out.len()` consecutive samples of `snapshot`'s raw frame that
+    /// start at sensor pixel `(row, col)` and run along the row.
+    ///
+    /// # Errors
+    /// The source's own error; the decoder then abandons the current tile only.
+    fn read(
+        &mut self,
+        snapshot: usize,
+        row: usize,
+        col: usize,
+        out: &mut [f32],
+    ) -> Result<(), Self::Error>;
+}
+
+/// Where decoded patches go.
+pub trait PatchSink<const N: usize> {
+    /// A write failure. `Copy`, to travel in errors.
+    type Error: Copy + fmt::Debug;
+
+    /// A decoded patch (layout of [`PatchShape::index`]) at `origin`, with its report.
+    ///
+    /// # Errors
+    /// The sink's own error; the decoder then abandons the current tile.
+    fn accept(
+        &mut self,
+        origin: PatchOrigin,
+        patch: &[f32; N],
+        report: &PatchReport,
+    ) -> Result<(), Self::Error>;
+
+    /// A patch that could not be decoded; the decoder goes on with the next one.
+    ///
+    /// # Errors
+    /// The sink's own error; the decoder then abandons the current tile.
+    fn reject(&mut self, origin: PatchOrigin, error: SolveError) -> Result<(), Self::Error> {
+        let _ = (origin, error);
+        Ok(())
+    }
+}
+
+/// The sensor: `lenslets` rows x cols of lenslets, each `lenslet` views.
+/// The raw frame is `lenslets.0 * lenslet.rows` x `lenslets.1 * lenslet.cols` pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct SensorGeometry {
+    pub lenslets: (u16, u16),
+    pub lenslet: LensletSize,
+}
+
+impl SensorGeometry {
+    /// Raw frame rows and columns.
+    pub fn frame_size(&self) -> (usize, usize) {
+        (
+            self.lenslets.0 as usize * self.lenslet.rows as usize,
+            self.lenslets.1 as usize * self.lenslet.cols as usize,
+        )
+    }
+}
+
+/// A rectangle of lenslets: origin and size, in lenslets.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Tile {
+    pub lenslet_row: u16,
+    pub lenslet_col: u16,
+    pub lenslet_rows: u16,
+    pub lenslet_cols: u16,
+}
+
+/// Where a patch sits: its first lenslet and its angular window's first view.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct PatchOrigin {
+    pub lenslet_row: u16,
+    pub lenslet_col: u16,
+    pub view_row: u8,
+    pub view_col: u8,
+}
+
+/// Why samples of a patch were left out, as bits.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct PatchFlags(u8);
+
+impl PatchFlags {
+    /// A pixel of the defect list.
+    pub const DEFECTIVE: Self = Self(1);
+    /// A NaN or infinite sample.
+    pub const NON_FINITE: Self = Self(2);
+    /// A negative raw sample.
+    pub const NEGATIVE: Self = Self(4);
+    /// A sample above `max_valid` (saturated).
+    pub const OVER_RANGE: Self = Self(8);
+
+    /// Whether every bit of `other` is set.
+    pub fn contains(self, other: Self) -> bool {
+        self.0 & other.0 == other.0
+    }
+
+    /// No flag set: every sample of the patch was a measurement.
+    pub fn is_empty(self) -> bool {
+        self.0 == 0
+    }
+
+    /// The raw bits.
+    pub fn bits(self) -> u8 {
+        self.0
+    }
+
+    fn insert(&mut self, other: Self) {
+        self.0 |= other.0;
+    }
+}
+
+impl From<Invalid> for PatchFlags {
+    fn from(i: Invalid) -> Self {
+        match i {
+            Invalid::NonFinite => Self::NON_FINITE,
+            Invalid::Negative => Self::NEGATIVE,
+            Invalid::OverRange => Self::OVER_RANGE,
+        }
+    }
+}
+
+/// What happened to one decoded patch.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct PatchReport {
+    /// How the solve ended.
+    pub outcome: Outcome,
+    /// Why samples were left out, if any were.
+    pub flags: PatchFlags,
+    /// Samples used as measurements.
+    pub measured: u16,
+    /// Samples left out.
+    pub excluded: u16,
+}
+
+/// Counts for one tile or frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct TileReport {
+    /// Patches decoded and accepted by the sink.
+    pub decoded: u32,
+    /// Of those, patches with samples left out.
+    pub flagged: u32,
+    /// Patches that could not be decoded (rejected to the sink).
+    pub failed: u32,
+}
+
+impl TileReport {
+    fn add(&mut self, o: &Self) {
+        self.decoded += o.decoded;
+        self.flagged += o.flagged;
+        self.failed += o.failed;
+    }
+}
+
+/// Errors of the tile layer: decoder set-up.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ConfigError {
+    /// The mask's lenslet size differs from the sensor's.
+    LensletMismatch,
+    /// The patch has more views than a lenslet.
+    PatchViews,
+    /// The mask's band count differs from the patch type's `B`.
+    BandMismatch,
+    /// A kronecker mask whose block is not the patch type's `PS x PT`.
+    BlockMismatch,
+    /// The raw format cannot normalise (not finite, or `white <= black`).
+    RawFormat,
+    /// The solver config is out of range.
+    Solver(SolveError),
+}
+
+impl fmt::Display for ConfigError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Self::LensletMismatch => f.write_str("mask and sensor disagree on the lenslet size"),
+            Self::PatchViews => f.write_str("patch has more views than a lenslet"),
+            Self::BandMismatch => f.write_str("mask and patch disagree on the band count"),
+            Self::BlockMismatch => {
+                f.write_str("kronecker mask block differs from the patch's lenslets")
+            }
+            Self::RawFormat => f.write_str("raw format: need finite levels with white > black"),
+            Self::Solver(e) => write!(f, "solver: {e}"),
+        }
+    }
+}
+
+impl core::error::Error for ConfigError {}
+
+/// Errors of one tile decode. The patches delivered before it stay delivered.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum TileError<S, K> {
+    /// The tile is empty, not made of whole patches on the patch grid, or outside the sensor.
+    Geometry,
+    /// The source failed; the rest of the tile was not decoded.
+    Source(S),
+    /// The sink failed; the rest of the tile was not decoded.
+    Sink(K),
+}
+
+impl<S: fmt::Debug, K: fmt::Debug> fmt::Display for TileError<S, K> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Geometry => f.write_str("tile is not whole patches inside the sensor"),
+            Self::Source(e) => write!(f, "tile source failed: {e:?}"),
+            Self::Sink(e) => write!(f, "patch sink failed: {e:?}"),
+        }
+    }
+}
+
+impl<S: fmt::Debug, K: fmt::Debug> core::error::Error for TileError<S, K> {}
+
+/// Counts for a frame, and the first tile that failed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FrameReport<S, K> {
+    /// Patch counts over all tiles.
+    pub patches: TileReport,
+    /// Tiles attempted.
+    pub tiles: u32,
+    /// Tiles abandoned by a source or sink error.
+    pub failed_tiles: u32,
+    /// The first abandoned tile and why.
+    pub first_failure: Option<(Tile, TileError<S, K>)>,
+}
+
+/// Everything a tile decode needs besides the dictionary and the workspace. Immutable.
+#[derive(Clone, Copy, Debug)]
+pub struct DecoderConfig<'a> {
+    pub sensor: SensorGeometry,
+    pub mask: Mask<'a>,
+    pub raw: RawFormat,
+    pub defects: DefectList<'a>,
+    pub sl0: Sl0Config,
+}
+
+/// The tile decoder for patches of `PS x PT x PU x PV x B` (N values): a checked
+/// [`DecoderConfig`]. Stateless; all mutable state is in the caller's [`Workspace`].
+#[derive(Clone, Copy, Debug)]
+pub struct TileDecoder<
+    'a,
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+    const N: usize,
+> {
+    config: DecoderConfig<'a>,
+}
+
+/// Origins of the angular windows along one axis: `ceil(views / patch)` windows of
+/// `patch` views, evenly stepped and ending at the last view.
+fn window_origins(views: usize, patch: usize) -> impl Iterator<Item = usize> {
+    let count = views.div_ceil(patch.max(1));
+    let last = views.saturating_sub(patch);
+    (0..count).map(move |i| (i * patch).min(last))
+}
+
+impl<
+    'a,
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+    const N: usize,
+> TileDecoder<'a, PS, PT, PU, PV, B, N>
+{
+    /// Checks that the parts of `config` agree with each other and with the patch type.
+    ///
+    /// # Errors
+    /// The first [`ConfigError`] found.
+    pub fn new(config: DecoderConfig<'a>) -> Result<Self, ConfigError> {
+        const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
+        let DecoderConfig {
+            sensor,
+            mask,
+            raw,
+            sl0,
+            ..
+        } = &config;
+        if mask.lenslet_size() != sensor.lenslet {
+            return Err(ConfigError::LensletMismatch);
+        }
+        if PU > sensor.lenslet.rows as usize || PV > sensor.lenslet.cols as usize {
+            return Err(ConfigError::PatchViews);
+        }
+        if mask.bands() != B {
+            return Err(ConfigError::BandMismatch);
+        }
+        if mask.family() == MaskFamily::Kronecker
+            && mask.kronecker_phi::<PS, PT, PU, PV>(0, 0).is_err()
+        {
+            return Err(ConfigError::BlockMismatch);
+        }
+        if !raw.is_valid() {
+            return Err(ConfigError::RawFormat);
+        }
+        sl0.validate().map_err(ConfigError::Solver)?;
+        Ok(Self { config })
+    }
+
+    /// The checked config.
+    pub fn config(&self) -> &DecoderConfig<'a> {
+        &self.config
+    }
+
+    /// Patch origins of one spatial block: every angular window.
+    pub fn windows(&self) -> impl Iterator<Item = (u8, u8)> + use<'a, PS, PT, PU, PV, B, N> {
+        let l = self.config.sensor.lenslet;
+        window_origins(l.rows as usize, PU)
+            .flat_map(move |u| window_origins(l.cols as usize, PV).map(move |v| (u as u8, v as u8)))
+    }
+
+    /// The sensor cut into tiles of at most `patches` = (rows, cols) patches each, on the
+    /// patch grid, row by row. Lenslets past the last whole patch are not covered.
+    pub fn tiles(
+        &self,
+        patches: (u16, u16),
+    ) -> impl Iterator<Item = Tile> + use<'a, PS, PT, PU, PV, B, N> {
+        let (rows, cols) = self.config.sensor.lenslets;
+        let (br, bc) = (rows as usize / PS, cols as usize / PT);
+        let (tr, tc) = (patches.0.max(1) as usize, patches.1.max(1) as usize);
+        (0..br.div_ceil(tr)).flat_map(move |i| {
+            (0..bc.div_ceil(tc)).map(move |j| {
+                let (r0, c0) = (i * tr, j * tc);
+                Tile {
+                    lenslet_row: (r0 * PS) as u16,
+                    lenslet_col: (c0 * PT) as u16,
+                    lenslet_rows: ((tr.min(br - r0)) * PS) as u16,
+                    lenslet_cols: ((tc.min(bc - c0)) * PT) as u16,
+                }
+            })
+        })
+    }
+
+    fn check_tile(&self, tile: &Tile) -> bool {
+        let (rows, cols) = self.config.sensor.lenslets;
+        tile.lenslet_rows > 0
+            && tile.lenslet_cols > 0
+            && (tile.lenslet_row as usize).is_multiple_of(PS)
+            && (tile.lenslet_col as usize).is_multiple_of(PT)
+            && (tile.lenslet_rows as usize).is_multiple_of(PS)
+            && (tile.lenslet_cols as usize).is_multiple_of(PT)
+            && tile.lenslet_row as u32 + tile.lenslet_rows as u32 <= rows as u32
+            && tile.lenslet_col as u32 + tile.lenslet_cols as u32 <= cols as u32
+    }
+
+    /// Reads the patch at `origin` into the workspace's measurements; returns the flags
+    /// and the number of samples left out.
+    fn read_patch<S: TileSource>(
+        &self,
+        origin: PatchOrigin,
+        source: &mut S,
+        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ) -> Result<(PatchFlags, u16), S::Error> {
+        let c = &self.config;
+        let (lu, lv) = (
+            c.sensor.lenslet.rows as usize,
+            c.sensor.lenslet.cols as usize,
+        );
+        let k = c.mask.snapshots();
+        let m = ws.measurements_mut();
+        m.clear();
+        let mut flags = PatchFlags::default();
+        let mut excluded = 0u16;
+        let mut run = [[0.0f32; PV]; B];
+        for s in 0..PS {
+            for u in 0..PU {
+                let row = (origin.lenslet_row as usize + s) * lu + origin.view_row as usize + u;
+                for t in 0..PT {
+                    let col0 = (origin.lenslet_col as usize + t) * lv + origin.view_col as usize;
+                    for (j, r) in run.iter_mut().enumerate().take(k) {
+                        source.read(j, row, col0, r)?;
+                    }
+                    for v in 0..PV {
+                        let col = col0 + v;
+                        if c.defects.contains(row, col) {
+                            flags.insert(PatchFlags::DEFECTIVE);
+                            excluded += k as u16;
+                            continue;
+                        }
+                        for (band, r) in c.mask.bands_at(row, col).iter().zip(&run) {
+                            let at = PatchShape::<PS, PT, PU, PV, B, N>::index(
+                                s,
+                                t,
+                                u,
+                                v,
+                                *band as usize,
+                            );
+                            let ok = match c.raw.classify(r[v]) {
+                                Ok(y) => m.set(at, y).map_err(|_| Invalid::NonFinite),
+                                Err(e) => Err(e),
+                            };
+                            if let Err(e) = ok {
+                                flags.insert(e.into());
+                                excluded += 1;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        Ok((flags, excluded))
+    }
+
+    /// Decodes every patch of `tile` with `dict`, sending each to `sink`.
+    ///
+    /// # Errors
+    /// [`TileError::Geometry`] before anything is read; [`TileError::Source`] or
+    /// [`TileError::Sink`] abandon the rest of the tile (what was sent stays sent).
+    pub fn decode_tile<S: TileSource, K: PatchSink<N>>(
+        &self,
+        dict: &Dictionary<PS, PT, PU, PV, B>,
+        tile: Tile,
+        source: &mut S,
+        sink: &mut K,
+        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ) -> Result<TileReport, TileError<S::Error, K::Error>> {
+        if !self.check_tile(&tile) {
+            return Err(TileError::Geometry);
+        }
+        let mut report = TileReport::default();
+        for bs in 0..tile.lenslet_rows as usize / PS {
+            for bt in 0..tile.lenslet_cols as usize / PT {
+                for (view_row, view_col) in self.windows() {
+                    let origin = PatchOrigin {
+                        lenslet_row: tile.lenslet_row + (bs * PS) as u16,
+                        lenslet_col: tile.lenslet_col + (bt * PT) as u16,
+                        view_row,
+                        view_col,
+                    };
+                    let (flags, excluded) = self
+                        .read_patch(origin, source, ws)
+                        .map_err(TileError::Source)?;
+                    match solve(dict, &self.config.sl0, ws) {
+                        Ok(outcome) => {
+                            let r = PatchReport {
+                                outcome,
+                                flags,
+                                measured: ws.measurements().count() as u16,
+                                excluded,
+                            };
+                            if !flags.is_empty() {
+                                report.flagged += 1;
+                                log!(warn, "patch flagged: {} samples left out", excluded);
+                            }
+                            report.decoded += 1;
+                            sink.accept(origin, ws.patch(), &r)
+                                .map_err(TileError::Sink)?;
+                        }
+                        Err(e) => {
+                            report.failed += 1;
+                            log!(warn, "patch not decoded: {}", e);
+                            sink.reject(origin, e).map_err(TileError::Sink)?;
+                        }
+                    }
+                }
+            }
+        }
+        Ok(report)
+    }
+
+    /// Decodes every tile of the sensor (see [`tiles`](Self::tiles)); a tile that fails
+    /// is counted and the next one is decoded.
+    pub fn decode_frame<S: TileSource, K: PatchSink<N>>(
+        &self,
+        dict: &Dictionary<PS, PT, PU, PV, B>,
+        tile_patches: (u16, u16),
+        source: &mut S,
+        sink: &mut K,
+        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ) -> FrameReport<S::Error, K::Error> {
+        let mut frame = FrameReport {
+            patches: TileReport::default(),
+            tiles: 0,
+            failed_tiles: 0,
+            first_failure: None,
+        };
+        for tile in self.tiles(tile_patches) {
+            frame.tiles += 1;
+            match self.decode_tile(dict, tile, source, sink, ws) {
+                Ok(r) => frame.patches.add(&r),
+                Err(e) => {
+                    frame.failed_tiles += 1;
+                    log!(error, "tile abandoned");
+                    if frame.first_failure.is_none() {
+                        frame.first_failure = Some((tile, e));
+                    }
+                }
+            }
+        }
+        frame
+    }
+}

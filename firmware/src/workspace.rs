@@ -1,0 +1,142 @@
+//! The caller-owned workspace: every buffer the decoder needs for one patch.
+//!
+//! `size_of::<Workspace<..>>()` is the decoder's whole RAM need besides the stack (a test
+//! pins it at or under 96 KiB for the paper's patch). It is three patch-sized buffers and
+//! one flag per patch value: coefficients, signal, and the measurements. `new` is a
+//! `const fn`, so a device can place it in a `static`.
+
+use crate::shape::PatchShape;
+use crate::sl0::SolveError;
+
+/// The measurements of one patch, dense in the patch layout: entry `i` is measured (with
+/// its value in normalised units) or not. A one-hot mask measures each entry at most once.
+#[derive(Clone, Debug)]
+pub struct Measurements<const N: usize> {
+    pub(crate) values: [f32; N],
+    pub(crate) measured: [bool; N],
+    pub(crate) count: u32,
+}
+
+impl<const N: usize> Measurements<N> {
+    /// Nothing measured.
+    pub const fn new() -> Self {
+        Self {
+            values: [0.0; N],
+            measured: [false; N],
+            count: 0,
+        }
+    }
+
+    /// Forgets every measurement.
+    pub fn clear(&mut self) {
+        self.values.fill(0.0);
+        self.measured.fill(false);
+        self.count = 0;
+    }
+
+    /// Records that patch entry `index` measured `value` (normalised units).
+    ///
+    /// # Errors
+    /// [`SolveError::IndexOutOfRange`] or [`SolveError::NonFiniteMeasurement`]; nothing is
+    /// recorded then.
+    pub fn set(&mut self, index: usize, value: f32) -> Result<(), SolveError> {
+        if !value.is_finite() {
+            return Err(SolveError::NonFiniteMeasurement);
+        }
+        let (Some(v), Some(m)) = (self.values.get_mut(index), self.measured.get_mut(index)) else {
+            return Err(SolveError::IndexOutOfRange);
+        };
+        *v = value;
+        if !*m {
+            *m = true;
+            self.count += 1;
+        }
+        Ok(())
+    }
+
+    /// The value measured at `index`, if any.
+    pub fn get(&self, index: usize) -> Option<f32> {
+        match self.measured.get(index) {
+            Some(true) => self.values.get(index).copied(),
+            _ => None,
+        }
+    }
+
+    /// Number of measured entries.
+    pub fn count(&self) -> usize {
+        self.count as usize
+    }
+}
+
+impl<const N: usize> Default for Measurements<N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// Every buffer of one patch decode. Mutable state, apart from the immutable config.
+#[derive(Clone, Debug)]
+pub struct Workspace<
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+    const N: usize,
+> {
+    pub(crate) coeffs: [f32; N],
+    pub(crate) signal: [f32; N],
+    pub(crate) measurements: Measurements<N>,
+}
+
+impl<
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+    const N: usize,
+> Workspace<PS, PT, PU, PV, B, N>
+{
+    /// A zeroed workspace.
+    pub const fn new() -> Self {
+        const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
+        Self {
+            coeffs: [0.0; N],
+            signal: [0.0; N],
+            measurements: Measurements::new(),
+        }
+    }
+
+    /// The measurements the next solve uses.
+    pub fn measurements(&self) -> &Measurements<N> {
+        &self.measurements
+    }
+
+    /// The measurements, to fill before a solve.
+    pub fn measurements_mut(&mut self) -> &mut Measurements<N> {
+        &mut self.measurements
+    }
+
+    /// The decoded patch after a successful solve (layout of [`PatchShape::index`]).
+    pub fn patch(&self) -> &[f32; N] {
+        &self.signal
+    }
+}
+
+impl<
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+    const N: usize,
+> Default for Workspace<PS, PT, PU, PV, B, N>
+{
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// The workspace of the paper's patch.
+pub type PaperWorkspace = Workspace<5, 5, 4, 4, 13, 5200>;

@@ -1,0 +1,1 @@
+//! End to end: raw frames through the tile decoder (filled in below).
