@@ -1,0 +1,205 @@
+//! Slow, obvious references shared by the firmware's tests.
+#![allow(dead_code)]
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use slf_firmware::{Dictionary, Factors, Mask, Matrix, PatchShape, Workspace};
+
+pub fn rng(seed: u64) -> ChaCha8Rng {
+    ChaCha8Rng::seed_from_u64(seed)
+}
+
+/// A random orthonormal `D x D` matrix: Gram-Schmidt in f64 on a Gaussian-ish matrix.
+pub fn random_orthonormal<const D: usize>(rng: &mut ChaCha8Rng) -> Matrix<D> {
+    let mut rows: Vec<[f64; D]> = Vec::new();
+    while rows.len() < D {
+        let mut v = [0.0f64; D];
+        for x in v.iter_mut() {
+            *x = rng.random_range(-1.0..1.0);
+        }
+        for _ in 0..2 {
+            for r in &rows {
+                let d: f64 = r.iter().zip(&v).map(|(a, b)| a * b).sum();
+                for (x, a) in v.iter_mut().zip(r) {
+                    *x -= d * a;
+                }
+            }
+        }
+        let n = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if n > 1e-3 {
+            rows.push(v.map(|x| x / n));
+        }
+    }
+    let mut m = [[0.0f32; D]; D];
+    for (mr, r) in m.iter_mut().zip(&rows) {
+        for (a, b) in mr.iter_mut().zip(r) {
+            *a = *b as f32;
+        }
+    }
+    m
+}
+
+pub fn random_dictionary<
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+>(
+    seed: u64,
+) -> Dictionary<PS, PT, PU, PV, B> {
+    let mut r = rng(seed);
+    Dictionary::new(Factors {
+        m1: random_orthonormal(&mut r),
+        m2: random_orthonormal(&mut r),
+        m3: random_orthonormal(&mut r),
+        m4: random_orthonormal(&mut r),
+        m5: random_orthonormal(&mut r),
+    })
+    .expect("Gram-Schmidt output is orthonormal")
+}
+
+fn flat<const D: usize>(m: &Matrix<D>) -> Vec<f64> {
+    m.iter().flatten().map(|&x| f64::from(x)).collect()
+}
+
+/// The dense N x N matrix of a separable operator, in f64: row-major vec of the patch layout
+/// (band fastest), so `K = M1 (x) M2 (x) M3 (x) M4 (x) M5` by the Kronecker product.
+pub fn dense_kronecker<
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+>(
+    f: &Factors<PS, PT, PU, PV, B>,
+) -> (Vec<f64>, usize) {
+    fn kron(a: &[f64], ad: usize, b: &[f64], bd: usize) -> Vec<f64> {
+        let d = ad * bd;
+        let mut k = vec![0.0; d * d];
+        for i in 0..ad {
+            for j in 0..ad {
+                let x = a[i * ad + j];
+                for p in 0..bd {
+                    for q in 0..bd {
+                        k[(i * bd + p) * d + j * bd + q] = x * b[p * bd + q];
+                    }
+                }
+            }
+        }
+        k
+    }
+    let k = kron(&flat(&f.m1), PS, &flat(&f.m2), PT);
+    let k = kron(&k, PS * PT, &flat(&f.m3), PU);
+    let k = kron(&k, PS * PT * PU, &flat(&f.m4), PV);
+    let k = kron(&k, PS * PT * PU * PV, &flat(&f.m5), B);
+    (k, PS * PT * PU * PV * B)
+}
+
+/// `y = K x` in f64.
+pub fn dense_apply(k: &[f64], n: usize, x: &[f32]) -> Vec<f64> {
+    (0..n)
+        .map(|i| {
+            k[i * n..(i + 1) * n]
+                .iter()
+                .zip(x)
+                .map(|(a, &b)| a * f64::from(b))
+                .sum()
+        })
+        .collect()
+}
+
+pub fn rel_err(a: &[f32], reference: &[f64]) -> f64 {
+    let num: f64 = a
+        .iter()
+        .zip(reference)
+        .map(|(&x, y)| (f64::from(x) - y).powi(2))
+        .sum();
+    let den: f64 = reference.iter().map(|y| y * y).sum();
+    (num / den.max(1e-300)).sqrt()
+}
+
+pub fn rel_err32(a: &[f32], reference: &[f32]) -> f64 {
+    let r: Vec<f64> = reference.iter().map(|&x| f64::from(x)).collect();
+    rel_err(a, &r)
+}
+
+pub fn max_abs_diff(a: &[f32], b: &[f32]) -> f32 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f32::max)
+}
+
+/// A smooth, positive, natural-ish patch: low-order trends in every dimension plus a
+/// little texture, in [0.05, 0.95].
+pub fn smooth_patch<
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+    const N: usize,
+>(
+    seed: u64,
+) -> Vec<f32> {
+    let mut r = rng(seed);
+    let c: [f32; 8] = core::array::from_fn(|_| r.random_range(-1.0..1.0));
+    let mut x = vec![0.0f32; N];
+    for (i, v) in x.iter_mut().enumerate() {
+        let [s, t, u, v_, b] = PatchShape::<PS, PT, PU, PV, B, N>::coordinates(i);
+        let (s, t, u, vv, b) = (
+            s as f32 / PS as f32,
+            t as f32 / PT as f32,
+            u as f32 / PU as f32,
+            v_ as f32 / PV as f32,
+            b as f32 / B as f32,
+        );
+        let val = 0.5
+            + 0.15 * c[0] * s
+            + 0.15 * c[1] * t
+            + 0.03 * c[2] * u
+            + 0.03 * c[3] * vv
+            + 0.2 * c[4] * (3.0 * b).sin()
+            + 0.05 * c[5] * (s * t * 6.0).cos()
+            + 0.02 * c[6] * r.random_range(-1.0f32..1.0);
+        *v = val.clamp(0.05, 0.95);
+    }
+    x
+}
+
+/// Fills `ws`'s measurements as the camera would: patch pixel `(s, t, u, v)` at sensor
+/// pixel `(row0 + s*U + u, col0 + t*V + v)` sees `mask`'s bands there.
+pub fn measure<
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+    const N: usize,
+>(
+    mask: &Mask,
+    lenslet_origin: (usize, usize),
+    truth: &[f32],
+    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+) {
+    let l = mask.lenslet_size();
+    let (lu, lv) = (l.rows as usize, l.cols as usize);
+    let m = ws.measurements_mut();
+    m.clear();
+    for s in 0..PS {
+        for t in 0..PT {
+            for u in 0..PU {
+                for v in 0..PV {
+                    let row = (lenslet_origin.0 + s) * lu + u;
+                    let col = (lenslet_origin.1 + t) * lv + v;
+                    for &band in mask.bands_at(row, col).iter() {
+                        let i =
+                            PatchShape::<PS, PT, PU, PV, B, N>::index(s, t, u, v, band as usize);
+                        m.set(i, truth[i]).expect("finite truth");
+                    }
+                }
+            }
+        }
+    }
+}
