@@ -26,6 +26,28 @@
 //!
 //! The device application (the Cortex-M binary) sits on top of the tile decoder.
 //!
+//! # Example
+//!
+//! Decode one patch whose every pixel saw three bands, with the 5D DCT:
+//!
+//! ```
+//! use slf_firmware::{Dictionary, PaperShape, PaperWorkspace, Sl0Config, solve};
+//!
+//! static DCT: Dictionary<5, 5, 4, 4, 13> = Dictionary::dct(); // a table in flash
+//! let mut ws = Box::new(PaperWorkspace::new()); // on a device: a `static`
+//! let truth = |b: usize| 0.2 + 0.05 * b as f32; // a smooth spectrum everywhere
+//! for p in 0..PaperShape::PIXELS {
+//!     for b in [(p * 5) % 13, (p * 5 + 4) % 13, (p * 5 + 9) % 13] {
+//!         ws.measurements_mut().set(p * 13 + b, truth(b))?;
+//!     }
+//! }
+//! let outcome = solve(&DCT, &Sl0Config::DEFAULT, &mut ws)?;
+//! assert!(!outcome.hit_bound());
+//! let worst = (0..5200).map(|i| (ws.patch()[i] - truth(i % 13)).abs()).fold(0.0, f32::max);
+//! assert!(worst < 0.01, "max error {worst}");
+//! # Ok::<(), slf_firmware::SolveError>(())
+//! ```
+//!
 //! # Memory
 //!
 //! Configuration (dictionaries, masks, defect lists, solver parameters) is immutable and

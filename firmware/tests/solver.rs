@@ -337,12 +337,11 @@ fn decode_checked(truth: &[f32], mask: &Mask, cfg: &Sl0Config) -> (f64, Vec<f32>
     let max_y = (0..5200)
         .filter_map(|i| w.measurements().get(i))
         .fold(0.0f32, |m, y| m.max(y.abs()));
-    for i in 0..5200 {
+    for (i, &x) in p.iter().enumerate() {
         if let Some(y) = w.measurements().get(i) {
             assert!(
-                (p[i] - y).abs() <= 1e-5 * max_y.max(f32::MIN_POSITIVE),
-                "entry {i}: {} vs measured {y}",
-                p[i]
+                (x - y).abs() <= 1e-5 * max_y.max(f32::MIN_POSITIVE),
+                "entry {i}: {x} vs measured {y}"
             );
         }
     }
@@ -410,7 +409,7 @@ fn hard_one_bright_pixel_stays_bounded() {
 #[test]
 fn hard_full_scale_checkerboards_stay_bounded() {
     let spatial: Vec<f32> = (0..5200)
-        .map(|i| Paper::coordinates(i))
+        .map(Paper::coordinates)
         .map(|[s, t, ..]| ((s + t) % 2) as f32)
         .collect();
     let spectral: Vec<f32> = (0..5200)

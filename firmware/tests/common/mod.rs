@@ -168,8 +168,8 @@ pub fn smooth_patch<
     x
 }
 
-/// Fills `ws`'s measurements as the camera would: patch pixel `(s, t, u, v)` at sensor
-/// pixel `(row0 + s*U + u, col0 + t*V + v)` sees `mask`'s bands there.
+/// Fills `ws`'s measurements as the camera would: patch pixel `(s, t, u, v)` of the patch
+/// whose first lenslet is `lenslet_origin` sees `mask`'s bands at its sensor pixel.
 pub fn measure<
     const PS: usize,
     const PT: usize,
@@ -183,6 +183,24 @@ pub fn measure<
     truth: &[f32],
     ws: &mut Workspace<PS, PT, PU, PV, B, N>,
 ) {
+    measure_window(mask, lenslet_origin, (0, 0), truth, ws);
+}
+
+/// [`measure`] for the angular window whose first view is `view_origin`.
+pub fn measure_window<
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+    const N: usize,
+>(
+    mask: &Mask,
+    lenslet_origin: (usize, usize),
+    view_origin: (usize, usize),
+    truth: &[f32],
+    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+) {
     let l = mask.lenslet_size();
     let (lu, lv) = (l.rows as usize, l.cols as usize);
     let m = ws.measurements_mut();
@@ -191,8 +209,8 @@ pub fn measure<
         for t in 0..PT {
             for u in 0..PU {
                 for v in 0..PV {
-                    let row = (lenslet_origin.0 + s) * lu + u;
-                    let col = (lenslet_origin.1 + t) * lv + v;
+                    let row = (lenslet_origin.0 + s) * lu + view_origin.0 + u;
+                    let col = (lenslet_origin.1 + t) * lv + view_origin.1 + v;
                     for &band in mask.bands_at(row, col).iter() {
                         let i =
                             PatchShape::<PS, PT, PU, PV, B, N>::index(s, t, u, v, band as usize);
