@@ -57,7 +57,10 @@ fn mode_last<const D: usize>(mt: &Matrix<D>, src: &[f32], dst: &mut [f32]) {
 }
 
 /// The five mode products `m` (with `mt5 = m.m5^T`) from `a` into `b`; `a` is clobbered.
-#[inline(always)]
+///
+/// Kept out of line: synthesis and analysis share one copy per patch shape, which keeps
+/// the device image small (inlined at each call site it tripled `solve` to 79 KB).
+#[inline(never)]
 fn chain<
     const PS: usize,
     const PT: usize,

@@ -1,0 +1,11 @@
+//! Links the device binary with cortex-m-rt's `link.x` (which includes the top-level
+//! `memory.x`) when building for a Cortex-M target; host builds are untouched.
+
+fn main() {
+    let target = std::env::var("TARGET").unwrap_or_default();
+    if target.starts_with("thumb") {
+        println!("cargo:rustc-link-arg-bins=-Tlink.x");
+    }
+    println!("cargo:rerun-if-changed=../memory.x");
+    println!("cargo:rerun-if-changed=build.rs");
+}
