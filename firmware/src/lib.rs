@@ -69,8 +69,6 @@
 //!   default (host builds that call defmt need a global logger to link).
 #![no_std]
 #![forbid(unsafe_code)]
-#![warn(missing_docs)]
-#![allow(missing_docs)] // fields and variants are documented where they need it; see module docs
 
 mod log;
 
