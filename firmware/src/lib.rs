@@ -34,7 +34,7 @@
 //! use slf_firmware::{Dictionary, PaperShape, PaperWorkspace, Sl0Config, solve};
 //!
 //! static DCT: Dictionary<5, 5, 4, 4, 13> = Dictionary::dct(); // a table in flash
-//! let mut ws = Box::new(PaperWorkspace::new()); // on a device: a `static`
+//! let mut ws = PaperWorkspace::new(); // 66 KiB; on a device, a `static`
 //! let truth = |b: usize| 0.2 + 0.05 * b as f32; // a smooth spectrum everywhere
 //! for p in 0..PaperShape::PIXELS {
 //!     for b in [(p * 5) % 13, (p * 5 + 4) % 13, (p * 5 + 9) % 13] {

@@ -24,12 +24,10 @@
 
 use core::fmt;
 
-use heapless::Vec;
-
 use crate::shape::MAX_BANDS;
 
 /// The bands one sensor position sees, in snapshot order (distinct).
-pub type BandList = Vec<u8, MAX_BANDS>;
+pub type BandList = heapless::Vec<u8, MAX_BANDS>;
 
 /// Which mask family (see the module docs).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
