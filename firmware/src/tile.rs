@@ -92,7 +92,8 @@ impl SensorGeometry {
     }
 }
 
-/// A rectangle of lenslets: origin and size, in lenslets.
+/// A rectangle of lenslets holding whole patches: origin and size, in lenslets. Its origin
+/// need not be on the patch grid (edge tiles are aligned to the sensor's far edge).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Tile {
@@ -230,7 +231,7 @@ impl core::error::Error for ConfigError {}
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum TileError<S, K> {
-    /// The tile is empty, not made of whole patches on the patch grid, or outside the sensor.
+    /// The tile is empty, not made of whole patches, or outside the sensor.
     Geometry,
     /// The source failed; the rest of the tile was not decoded.
     Source(S),
@@ -296,6 +297,18 @@ fn window_origins(views: usize, patch: usize) -> impl Iterator<Item = usize> {
     (0..count).map(move |i| (i * patch).min(last))
 }
 
+/// Spans `(start, length)` of tiles along one axis of `total` lenslets for patches of
+/// `patch` lenslets, `per_tile` patches a tile: the grid, then an end-aligned strip.
+fn spans(total: usize, patch: usize, per_tile: usize) -> impl Iterator<Item = (usize, usize)> {
+    let whole = total / patch;
+    let grid = (0..whole.div_ceil(per_tile)).map(move |i| {
+        let first = i * per_tile;
+        (first * patch, per_tile.min(whole - first) * patch)
+    });
+    let edge = (whole > 0 && total % patch != 0).then_some((total - patch, patch));
+    grid.chain(edge)
+}
+
 impl<
     'a,
     const PS: usize,
@@ -352,24 +365,26 @@ impl<
             .flat_map(move |u| window_origins(l.cols as usize, PV).map(move |v| (u as u8, v as u8)))
     }
 
-    /// The sensor cut into tiles of at most `patches` = (rows, cols) patches each, on the
-    /// patch grid, row by row. Lenslets past the last whole patch are not covered.
+    /// The sensor cut into tiles of at most `patches` = (rows, cols) patches each, row by
+    /// row: first the patch grid from lenslet (0, 0), then, where the lenslet count is not a
+    /// multiple of the patch, one strip of patches aligned to the last lenslet row or
+    /// column (overlapping the grid), so every lenslet is covered. Empty if the sensor is
+    /// smaller than one patch.
     pub fn tiles(
         &self,
         patches: (u16, u16),
     ) -> impl Iterator<Item = Tile> + use<'a, PS, PT, PU, PV, B, N> {
-        let (rows, cols) = self.config.sensor.lenslets;
-        let (br, bc) = (rows as usize / PS, cols as usize / PT);
-        let (tr, tc) = (patches.0.max(1) as usize, patches.1.max(1) as usize);
-        (0..br.div_ceil(tr)).flat_map(move |i| {
-            (0..bc.div_ceil(tc)).map(move |j| {
-                let (r0, c0) = (i * tr, j * tc);
-                Tile {
-                    lenslet_row: (r0 * PS) as u16,
-                    lenslet_col: (c0 * PT) as u16,
-                    lenslet_rows: ((tr.min(br - r0)) * PS) as u16,
-                    lenslet_cols: ((tc.min(bc - c0)) * PT) as u16,
-                }
+        let (rows, cols) = (
+            self.config.sensor.lenslets.0 as usize,
+            self.config.sensor.lenslets.1 as usize,
+        );
+        let per = (patches.0.max(1) as usize, patches.1.max(1) as usize);
+        spans(rows, PS, per.0).flat_map(move |(r0, nr)| {
+            spans(cols, PT, per.1).map(move |(c0, nc)| Tile {
+                lenslet_row: r0 as u16,
+                lenslet_col: c0 as u16,
+                lenslet_rows: nr as u16,
+                lenslet_cols: nc as u16,
             })
         })
     }
@@ -378,8 +393,6 @@ impl<
         let (rows, cols) = self.config.sensor.lenslets;
         tile.lenslet_rows > 0
             && tile.lenslet_cols > 0
-            && (tile.lenslet_row as usize).is_multiple_of(PS)
-            && (tile.lenslet_col as usize).is_multiple_of(PT)
             && (tile.lenslet_rows as usize).is_multiple_of(PS)
             && (tile.lenslet_cols as usize).is_multiple_of(PT)
             && tile.lenslet_row as u32 + tile.lenslet_rows as u32 <= rows as u32

@@ -394,7 +394,7 @@ fn tile_geometry_is_checked() {
     let dict = Dictionary::dct();
     for tile in [
         Tile {
-            lenslet_row: 1,
+            lenslet_row: 6,
             lenslet_col: 0,
             lenslet_rows: 5,
             lenslet_cols: 5,
@@ -547,4 +547,50 @@ fn full_view_patches_need_one_window() {
         (mean - truth_mean).abs() < 0.01,
         "mean {mean} vs {truth_mean}"
     );
+}
+
+#[test]
+fn tiles_cover_every_lenslet_of_any_sensor() {
+    for (rows, cols) in [(10u16, 15u16), (12, 13), (5, 9), (4, 20), (7, 7)] {
+        let sensor = SensorGeometry {
+            lenslets: (rows, cols),
+            lenslet: L5,
+        };
+        let mask = Mask::pixel(1, 1, 13, L5).unwrap();
+        let dec = Decoder::new(DecoderConfig {
+            sensor,
+            ..config(mask)
+        })
+        .unwrap();
+        for per in [(1u16, 1u16), (2, 3), (100, 100)] {
+            let mut covered = vec![0u32; rows as usize * cols as usize];
+            for t in dec.tiles(per) {
+                assert!(t.lenslet_rows % 5 == 0 && t.lenslet_cols % 5 == 0, "{t:?}");
+                assert!(
+                    t.lenslet_row + t.lenslet_rows <= rows
+                        && t.lenslet_col + t.lenslet_cols <= cols,
+                    "{t:?}"
+                );
+                assert!(t.lenslet_rows <= 5 * per.0 && t.lenslet_cols <= 5 * per.1);
+                for r in t.lenslet_row..t.lenslet_row + t.lenslet_rows {
+                    for c in t.lenslet_col..t.lenslet_col + t.lenslet_cols {
+                        covered[r as usize * cols as usize + c as usize] += 1;
+                    }
+                }
+            }
+            if rows < 5 || cols < 5 {
+                assert!(
+                    covered.iter().all(|&c| c == 0),
+                    "sensor smaller than a patch"
+                );
+            } else {
+                assert!(
+                    covered.iter().all(|&c| c >= 1),
+                    "{rows}x{cols} per {per:?}: uncovered lenslet"
+                );
+                // Grid, row strip, column strip and their corner at most.
+                assert!(covered.iter().all(|&c| c <= 4));
+            }
+        }
+    }
 }
