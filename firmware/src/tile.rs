@@ -305,7 +305,7 @@ fn spans(total: usize, patch: usize, per_tile: usize) -> impl Iterator<Item = (u
         let first = i * per_tile;
         (first * patch, per_tile.min(whole - first) * patch)
     });
-    let edge = (whole > 0 && total % patch != 0).then(|| (total - patch, patch));
+    let edge = (whole > 0 && !total.is_multiple_of(patch)).then(|| (total - patch, patch));
     grid.chain(edge)
 }
 
