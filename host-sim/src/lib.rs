@@ -1,6 +1,27 @@
-//! The workstation side of slf: it decodes with the firmware crate's own code, so host
-//! results are the device's results. The simulator, training, metrics and the full `slf`
-//! command arrive with the host-simulator issue; today this crate holds the command's
-//! entry point and the dictionary blob inspection it already offers.
+//! The workstation side of slf. It decodes with the firmware crate's own code
+//! ([`slf_firmware`]), so host results are the device's results.
+//!
+//! From a scene to numbers:
+//!
+//! - [`scene`] renders synthetic spectral light fields ([`spectra`] holds measured and
+//!   synthetic spectra); [`lightfield`] reads and writes them as `.npy`.
+//! - [`camera`] turns a light field into raw frames with the firmware's masks, noise,
+//!   black level, quantisation, saturation and defects; [`capture`] is the folder format.
+//! - [`decode`] runs the firmware's tile decoder over a capture in parallel.
+//! - [`metrics`] (PSNR, SSIM, SA), [`preview`] (sRGB PNGs) and [`baseline`] (the paper's 1D
+//!   method) evaluate it.
+//!
+//! The `slf` command (`src/main.rs`) puts these together.
 
 pub use slf_firmware as firmware;
+
+pub mod baseline;
+pub mod camera;
+pub mod capture;
+pub mod decode;
+pub mod lightfield;
+pub mod metrics;
+pub mod preview;
+pub mod scene;
+pub mod spectra;
+pub mod spectra_data;

@@ -1,8 +1,496 @@
-//! `slf`: the command-line tool (grows with the host-simulator issue).
+//! `slf`: simulate captures of the compressive spectral light-field camera, decode them
+//! with the firmware decoder, and measure the result. `slf --help` lists the commands.
 
-fn main() {
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use clap::{Parser, Subcommand, ValueEnum};
+use slf_host::baseline::{Dense1D, solve_5d};
+use slf_host::camera::{CameraConfig, simulate};
+use slf_host::capture::{Capture, MaskDescription, MaskSource};
+use slf_host::decode::{DecodeOptions, PaperDictionary, decode};
+use slf_host::firmware::{
+    Dictionary, LensletSize, Mask, PaperShape, PaperWorkspace, Sl0Config, solve,
+};
+use slf_host::lightfield::{Dtype, LightField, read_npy, write_npy};
+use slf_host::metrics::{Metrics, evaluate};
+use slf_host::preview::write_comparison;
+use slf_host::scene::{self, SceneSize};
+
+#[derive(Parser)]
+#[command(
+    name = "slf",
+    version,
+    about = "Compressive spectral light-field camera: simulate, decode, measure"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum Family {
+    Pixel,
+    Lenslet,
+    Kronecker,
+}
+
+impl Family {
+    fn mask(self, seed: u64, k: u8) -> MaskDescription {
+        let src = MaskSource {
+            snapshots: Some(k),
+            seed: Some(seed),
+            tile: None,
+        };
+        match self {
+            Family::Pixel => MaskDescription::Pixel(src),
+            Family::Lenslet => MaskDescription::Lenslet(src),
+            Family::Kronecker => MaskDescription::Kronecker {
+                snapshots: k,
+                seed,
+                block: [5, 5],
+            },
+        }
+    }
+}
+
+#[derive(clap::Args, Clone, Debug)]
+struct SolverArgs {
+    /// SL0 sigma decrease factor per level, in (0, 1).
+    #[arg(long, default_value_t = Sl0Config::DEFAULT.sigma_f)]
+    sigma_f: f32,
+    /// SL0 steps per sigma level (L).
+    #[arg(long, default_value_t = Sl0Config::DEFAULT.steps)]
+    steps: u16,
+    /// SL0 step size mu.
+    #[arg(long, default_value_t = Sl0Config::DEFAULT.mu)]
+    mu: f32,
+    /// SL0 smallest sigma (normalised units, white = 1).
+    #[arg(long, default_value_t = Sl0Config::DEFAULT.sigma_min)]
+    sigma_min: f32,
+    /// Hard bound on SL0 steps per patch.
+    #[arg(long, default_value_t = Sl0Config::DEFAULT.max_iterations)]
+    max_iterations: u32,
+    /// Noise standard deviation per measurement (normalised units); 0 forces equality.
+    #[arg(long, default_value_t = 0.0)]
+    noise: f32,
+}
+
+impl SolverArgs {
+    fn config(&self) -> Result<Sl0Config> {
+        let c = Sl0Config {
+            sigma_f: self.sigma_f,
+            steps: self.steps,
+            mu: self.mu,
+            sigma_min: self.sigma_min,
+            max_iterations: self.max_iterations,
+            noise: self.noise,
+        };
+        c.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
+        Ok(c)
+    }
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Simulate a default scene with the pixel mask at k = 1 and k = 3, decode, report, preview.
+    Demo {
+        /// Where previews and files go.
+        #[arg(long, default_value = "slf-demo")]
+        out: PathBuf,
+        /// Named scene.
+        #[arg(long, default_value = "depth")]
+        scene: String,
+        /// Spatial size (lenslets per side).
+        #[arg(long, default_value_t = 100)]
+        size: usize,
+    },
+    /// Write a named test scene or a random training scene as a (U, V, H, W, B) .npy.
+    Scene {
+        /// A name (smooth, texture, depth, saturated, dark) or `random`.
+        name: String,
+        /// Output .npy file.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Seed of a random scene.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Spatial rows and columns.
+        #[arg(long, default_value_t = 100)]
+        size: usize,
+        /// Views per side.
+        #[arg(long, default_value_t = 5)]
+        views: usize,
+        /// Stored dtype.
+        #[arg(long, value_enum, default_value_t = Dtype::F32)]
+        dtype: Dtype,
+    },
+    /// Record a light field with the camera model: writes a capture folder.
+    Simulate {
+        /// Light field .npy (U, V, H, W, 13).
+        input: PathBuf,
+        /// Capture folder to write.
+        #[arg(short, long)]
+        output: PathBuf,
+        #[arg(long, value_enum, default_value_t = Family::Pixel)]
+        mask: Family,
+        /// Snapshots k (1..=13).
+        #[arg(short, long, default_value_t = 1)]
+        snapshots: u8,
+        /// Seed of the mask, noise and defects.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Read noise, DN.
+        #[arg(long, default_value_t = 2.0)]
+        read_noise: f32,
+        /// Electrons at white (shot noise).
+        #[arg(long, default_value_t = 20_000.0)]
+        full_well: f32,
+        /// No shot or read noise.
+        #[arg(long)]
+        no_noise: bool,
+        /// Fraction of defective pixels.
+        #[arg(long, default_value_t = 0.0)]
+        defects: f64,
+        /// Frame file format: pgm, png or npy.
+        #[arg(long, default_value = "pgm")]
+        format: String,
+    },
+    /// Decode a capture folder into a light field .npy.
+    Decode {
+        /// Capture folder (capture.json and frames).
+        capture: PathBuf,
+        /// Output .npy file.
+        #[arg(short, long)]
+        output: PathBuf,
+        #[command(flatten)]
+        solver: SolverArgs,
+        /// Stored dtype.
+        #[arg(long, value_enum, default_value_t = Dtype::F32)]
+        dtype: Dtype,
+        /// No progress bar.
+        #[arg(short, long)]
+        quiet: bool,
+    },
+    /// PSNR, SSIM and spectral angle of a reconstruction against the ground truth.
+    Eval { truth: PathBuf, recon: PathBuf },
+    /// The paper's 1D method against the 5D decoder on the same patches: time and memory.
+    Baseline {
+        /// Patches (each a fresh measurement of a test patch).
+        #[arg(long, default_value_t = 3)]
+        patches: usize,
+        #[arg(long, value_enum, default_value_t = Family::Pixel)]
+        mask: Family,
+        #[arg(short, long, default_value_t = 1)]
+        snapshots: u8,
+    },
+    /// PSNR / SSIM / SA of every test scene x mask family x k, with the DCT; a markdown table.
+    Sweep {
+        /// Spatial size (lenslets per side).
+        #[arg(long, default_value_t = 60)]
+        size: usize,
+        /// Snapshot counts.
+        #[arg(long, value_delimiter = ',', default_value = "1,3,5,7")]
+        k: Vec<u8>,
+        /// Also write the table to this file.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
+}
+
+fn main() -> ExitCode {
+    match run(Cli::parse()) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Demo { out, scene, size } => demo(&out, &scene, size),
+        Command::Scene {
+            name,
+            output,
+            seed,
+            size,
+            views,
+            dtype,
+        } => {
+            let s = if name == "random" {
+                scene::random(seed)
+            } else {
+                scene::named(&name).with_context(|| {
+                    format!(
+                        "unknown scene {name:?}: one of {:?} or random",
+                        scene::NAMES
+                    )
+                })?
+            };
+            let lf = s.render(SceneSize {
+                views: (views, views),
+                rows: size,
+                cols: size,
+            });
+            write_npy(&output, &lf, dtype)?;
+            println!("wrote {} ({:?})", output.display(), lf.shape());
+            Ok(())
+        }
+        Command::Simulate {
+            input,
+            output,
+            mask,
+            snapshots,
+            seed,
+            read_noise,
+            full_well,
+            no_noise,
+            defects,
+            format,
+        } => {
+            let lf = read_npy(&input)?;
+            let mut cam =
+                CameraConfig::pixel(seed, snapshots).with_mask(mask.mask(seed, snapshots));
+            cam.read_noise = read_noise;
+            cam.full_well = Some(full_well);
+            cam.defect_fraction = defects;
+            cam.frame_ext = format;
+            if no_noise {
+                cam = cam.noiseless();
+            }
+            let capture = simulate(&lf, &cam)?;
+            capture.save(&output)?;
+            println!(
+                "wrote {} ({} snapshots)",
+                output.display(),
+                capture.frames.len()
+            );
+            Ok(())
+        }
+        Command::Decode {
+            capture,
+            output,
+            solver,
+            dtype,
+            quiet,
+        } => {
+            let cap = Capture::load(&capture)?;
+            let opts = DecodeOptions {
+                sl0: solver.config()?,
+                progress: !quiet,
+                ..DecodeOptions::default()
+            };
+            let (lf, r) = decode(&cap, &Dictionary::dct(), &opts)?;
+            write_npy(&output, &lf, dtype)?;
+            println!(
+                "decoded {} patches ({} flagged, {} failed, {} tiles failed) in {:.2} s; wrote {}",
+                r.patches.decoded,
+                r.patches.flagged,
+                r.patches.failed,
+                r.failed_tiles,
+                r.seconds,
+                output.display()
+            );
+            Ok(())
+        }
+        Command::Eval { truth, recon } => {
+            let m = evaluate(&read_npy(&truth)?, &read_npy(&recon)?)?;
+            println!(
+                "PSNR {:.3} dB (data range {:.6} = max of ground truth)",
+                m.psnr, m.data_range
+            );
+            println!("SSIM {:.4}", m.ssim);
+            println!("SA   {:.3} deg", m.sa);
+            Ok(())
+        }
+        Command::Baseline {
+            patches,
+            mask,
+            snapshots,
+        } => baseline(patches, mask, snapshots),
+        Command::Sweep { size, k, output } => sweep(size, &k, output.as_deref()),
+    }
+}
+
+fn row(scene: &str, family: &str, k: u8, m: &Metrics, seconds: f64) -> String {
+    format!(
+        "| {scene} | {family} | {k} | {:.2} | {:.4} | {:.2} | {:.2} |",
+        m.psnr, m.ssim, m.sa, seconds
+    )
+}
+
+const HEADER: &str = "| scene | mask | k | PSNR dB | SSIM | SA deg | decode s |\n| --- | --- | --- | --- | --- | --- | --- |";
+
+fn run_one(
+    truth: &LightField,
+    cam: &CameraConfig,
+    dict: &PaperDictionary,
+    progress: bool,
+) -> Result<(LightField, Metrics, f64)> {
+    let capture = simulate(truth, cam)?;
+    let opts = DecodeOptions {
+        progress,
+        ..DecodeOptions::default()
+    };
+    let (recon, report) = decode(&capture, dict, &opts)?;
+    if report.failed_tiles > 0 || report.uncovered > 0 {
+        bail!(
+            "decode lost {} tiles, {} values uncovered",
+            report.failed_tiles,
+            report.uncovered
+        );
+    }
+    Ok((recon.clone(), evaluate(truth, &recon)?, report.seconds))
+}
+
+fn demo(out: &Path, name: &str, size: usize) -> Result<()> {
+    let start = Instant::now();
+    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+    let s = scene::named(name)
+        .with_context(|| format!("unknown scene {name:?}: one of {:?}", scene::NAMES))?;
+    let truth = s.render(SceneSize {
+        views: (5, 5),
+        rows: size,
+        cols: size,
+    });
+    write_npy(&out.join("truth.npy"), &truth, Dtype::F32)?;
+    let dict = Dictionary::dct();
     println!(
-        "slf {}: decoder core only; see README.md",
-        env!("CARGO_PKG_VERSION")
+        "scene {name}: {size} x {size} lenslets, 5 x 5 views, 13 bands; pixel mask; 5D DCT; {} threads",
+        rayon::current_num_threads()
     );
+    println!("{HEADER}");
+    for k in [1u8, 3] {
+        let cam = CameraConfig::pixel(7, k);
+        let (recon, m, secs) = run_one(&truth, &cam, &dict, true)?;
+        println!("{}", row(name, "pixel", k, &m, secs));
+        write_npy(&out.join(format!("recon_k{k}.npy")), &recon, Dtype::F32)?;
+        write_comparison(&out.join(format!("preview_k{k}.png")), &truth, &recon)?;
+    }
+    println!(
+        "PSNR data range = max of ground truth ({:.4}).",
+        truth.max()
+    );
+    println!(
+        "previews (truth | reconstruction | error) in {}; total {:.1} s",
+        out.display(),
+        start.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+fn sweep(size: usize, ks: &[u8], output: Option<&Path>) -> Result<()> {
+    let dict = Dictionary::dct();
+    let mut lines = vec![HEADER.to_string()];
+    println!("{HEADER}");
+    for name in scene::NAMES {
+        let truth = scene::named(name)
+            .context("named scene")?
+            .render(SceneSize {
+                views: (5, 5),
+                rows: size,
+                cols: size,
+            });
+        for family in [Family::Pixel, Family::Lenslet, Family::Kronecker] {
+            for &k in ks {
+                let cam = CameraConfig::pixel(7, k).with_mask(family.mask(7, k));
+                let (_, m, secs) = run_one(&truth, &cam, &dict, false)?;
+                let fam = format!("{family:?}").to_lowercase();
+                let line = row(name, &fam, k, &m, secs);
+                println!("{line}");
+                lines.push(line);
+            }
+        }
+    }
+    if let Some(p) = output {
+        std::fs::write(p, lines.join("\n") + "\n")
+            .with_context(|| format!("cannot write {}", p.display()))?;
+    }
+    Ok(())
+}
+
+fn baseline(patches: usize, family: Family, k: u8) -> Result<()> {
+    let dict: PaperDictionary = Dictionary::dct();
+    let cfg = Sl0Config::DEFAULT;
+    let truth = scene::named("texture").context("scene")?.render(SceneSize {
+        views: (4, 4),
+        rows: 5 * patches,
+        cols: 5,
+    });
+    let lenslet = LensletSize { rows: 4, cols: 4 };
+    let mask = match family {
+        Family::Pixel => Mask::pixel(3, k, 13, lenslet),
+        Family::Lenslet => Mask::lenslet(3, k, 13, lenslet),
+        Family::Kronecker => Mask::kronecker(3, k, 13, lenslet, (5, 5)),
+    }
+    .map_err(|e| anyhow::anyhow!("{e}"))?;
+    let (mut t5, mut t1, mut mem1) = (0.0, 0.0, 0usize);
+    let mut worst = 0.0f32;
+    for p in 0..patches {
+        let mut ws = Box::new(PaperWorkspace::new());
+        let mut measured = Vec::new();
+        for i in 0..5200 {
+            let [s, t, u, v, b] = PaperShape::coordinates(i);
+            if mask
+                .bands_at((5 * p + s) * 4 + u, t * 4 + v)
+                .contains(&(b as u8))
+            {
+                let y = truth.get(u, v, 5 * p + s, t, b);
+                ws.measurements_mut()
+                    .set(i, y)
+                    .map_err(|e| anyhow::anyhow!("{e}"))?;
+                measured.push((i, y));
+            }
+        }
+        let start = Instant::now();
+        solve(&dict, &cfg, &mut ws).map_err(|e| anyhow::anyhow!("{e}"))?;
+        t5 += start.elapsed().as_secs_f64();
+        let idx: Vec<usize> = measured.iter().map(|m| m.0).collect();
+        let y: Vec<f32> = measured.iter().map(|m| m.1).collect();
+        let start = Instant::now();
+        let one = Dense1D::<f32>::new(&dict, &idx).context("A A^T is singular")?;
+        let setup = start.elapsed().as_secs_f64();
+        let start = Instant::now();
+        let (x1, _) = one.solve(&y, &cfg);
+        t1 += start.elapsed().as_secs_f64();
+        mem1 = mem1.max(one.memory_bytes());
+        worst = worst.max(
+            x1.iter()
+                .zip(ws.patch())
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f32::max),
+        );
+        if p == 0 {
+            println!("1D set-up (D, A, A^+ for one mask): {setup:.2} s");
+        }
+    }
+    let mem5 = std::mem::size_of::<PaperDictionary>() / 2 + std::mem::size_of::<PaperWorkspace>();
+    let dict5 = (25 + 25 + 16 + 16 + 169) * 4;
+    println!(
+        "{patches} patches, {family:?} mask, k = {k}, default SL0; 1D vs 5D max abs difference {worst:.2e}"
+    );
+    println!("| method | time per patch | memory |\n| --- | --- | --- |");
+    println!(
+        "| 5D | {:.2} ms | {} B dictionary, {} B workspace |",
+        1e3 * t5 / patches as f64,
+        dict5,
+        mem5 - dict5.min(mem5)
+    );
+    println!(
+        "| 1D | {:.2} ms | {} B (D, A, A^+) |",
+        1e3 * t1 / patches as f64,
+        mem1
+    );
+    println!("time ratio 1D/5D {:.1}x (paper: 106x)", t1 / t5);
+    let d1 = 5200usize * 5200 * 4;
+    println!(
+        "dictionary memory ratio 1D/5D {:.0} (paper: 107,729)",
+        d1 as f64 / dict5 as f64
+    );
+    let _ = solve_5d::<f64>;
+    Ok(())
 }

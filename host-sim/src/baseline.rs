@@ -1,0 +1,175 @@
+//! The paper's "1D" method, host only: the same SL0 with the explicit `N x N` Kronecker
+//! dictionary `D = D1 (x) .. (x) D5` and the dense sensing matrix, for the equivalence,
+//! speed and memory claims (the paper: 106x time, 1/107,729 memory).
+//!
+//! Also a 5D SL0 in f64 (the fast path, mode products in f64) as the f64 reference: the
+//! firmware is f32 only, as the device is.
+
+use nalgebra::{DMatrix, DVector, RealField};
+use slf_firmware::{Dictionary, Ended, Sl0Config};
+
+/// A scalar for both paths: f32 or f64.
+pub trait Real: RealField + Copy + From<f32> {}
+impl Real for f32 {}
+impl Real for f64 {}
+
+/// The dictionary's five matrices in `T`, row-major, with their sizes.
+fn factors<T: Real>(dict: &Dictionary<5, 5, 4, 4, 13>) -> Vec<(usize, Vec<T>)> {
+    let d = dict.synthesis();
+    let conv = |m: &[f32], n: usize| (n, m.iter().map(|&x| T::from(x)).collect());
+    vec![
+        conv(d.m1.as_flattened(), 5),
+        conv(d.m2.as_flattened(), 5),
+        conv(d.m3.as_flattened(), 4),
+        conv(d.m4.as_flattened(), 4),
+        conv(d.m5.as_flattened(), 13),
+    ]
+}
+
+/// The Kronecker product of the five matrices (row-major patch layout): `N x N`.
+pub fn kronecker<T: Real>(dict: &Dictionary<5, 5, 4, 4, 13>) -> DMatrix<T> {
+    let mut k = DMatrix::<T>::identity(1, 1);
+    for (n, m) in factors::<T>(dict) {
+        let m = DMatrix::from_row_slice(n, n, &m);
+        k = k.kronecker(&m);
+    }
+    k
+}
+
+/// The sigma schedule of Algorithm 1, the same as the firmware's (`sl0::run_schedule`).
+fn schedule<T: Real>(cfg: &Sl0Config, sigma0: T, mut step: impl FnMut(T)) -> (u32, Ended) {
+    let (sigma_min, sigma_f) = (T::from(cfg.sigma_min), T::from(cfg.sigma_f));
+    let mut sigma = sigma0;
+    let mut iterations = 0u32;
+    loop {
+        if sigma <= sigma_min {
+            return (iterations, Ended::SigmaMin);
+        }
+        let inv = T::one() / (T::from(2.0) * sigma * sigma);
+        if !inv.is_finite() {
+            return (iterations, Ended::SigmaUnderflow);
+        }
+        for _ in 0..cfg.steps {
+            if iterations >= cfg.max_iterations {
+                return (iterations, Ended::IterationBound);
+            }
+            step(inv);
+            iterations += 1;
+        }
+        sigma *= sigma_f;
+    }
+}
+
+fn ascend<T: Real>(s: &mut [T], mu: T, inv: T) {
+    for x in s {
+        *x -= mu * *x * (-(*x * *x) * inv).exp();
+    }
+}
+
+fn max_abs<T: Real>(s: &[T]) -> T {
+    s.iter().fold(T::zero(), |m, x| m.max(x.abs()))
+}
+
+/// The 1D method on one patch: dense `N x N` dictionary, sensing matrix `A` (the rows of
+/// `D` the measurements select) and its pseudo-inverse, all precomputed.
+pub struct Dense1D<T: Real> {
+    pub d: DMatrix<T>,
+    pub a: DMatrix<T>,
+    pub a_pinv: DMatrix<T>,
+    measured: Vec<usize>,
+}
+
+impl<T: Real> Dense1D<T> {
+    /// Builds `D`, `A = Phi D` for the measured entries, and `A^+ = A^T (A A^T)^-1`.
+    pub fn new(dict: &Dictionary<5, 5, 4, 4, 13>, measured: &[usize]) -> Option<Self> {
+        let d = kronecker::<T>(dict);
+        let a = d.select_rows(measured);
+        let gram = &a * a.transpose();
+        let a_pinv = a.transpose() * gram.cholesky()?.inverse();
+        Some(Self {
+            d,
+            a,
+            a_pinv,
+            measured: measured.to_vec(),
+        })
+    }
+
+    /// Bytes of the dense matrices (D, A, A^+).
+    pub fn memory_bytes(&self) -> usize {
+        (self.d.len() + self.a.len() + self.a_pinv.len()) * std::mem::size_of::<T>()
+    }
+
+    /// SL0 with the 1D operators; returns the patch `x = D s`.
+    pub fn solve(&self, y: &[T], cfg: &Sl0Config) -> (Vec<T>, u32) {
+        let y = DVector::from_column_slice(y);
+        let mut s = &self.a_pinv * &y;
+        let (mu, _) = (T::from(cfg.mu), ());
+        let (iterations, _) = schedule(cfg, max_abs(s.as_slice()), |inv| {
+            ascend(s.as_mut_slice(), mu, inv);
+            let r = &self.a * &s - &y;
+            s -= &self.a_pinv * r;
+        });
+        ((&self.d * s).as_slice().to_vec(), iterations)
+    }
+
+    /// The measured entries.
+    pub fn measured(&self) -> &[usize] {
+        &self.measured
+    }
+}
+
+/// `buf x_i M_i` for all five modes in f64 (out of place, one mode at a time).
+fn modes<T: Real>(f: &[(usize, Vec<T>)], x: &[T], transpose: bool) -> Vec<T> {
+    let dims: Vec<usize> = f.iter().map(|(n, _)| *n).collect();
+    let mut cur = x.to_vec();
+    for (i, (n, m)) in f.iter().enumerate() {
+        let inner: usize = dims[i + 1..].iter().product();
+        let outer: usize = dims[..i].iter().product();
+        let mut next = vec![T::zero(); cur.len()];
+        for o in 0..outer {
+            for a in 0..*n {
+                for c in 0..*n {
+                    let w = if transpose {
+                        m[c * n + a]
+                    } else {
+                        m[a * n + c]
+                    };
+                    for j in 0..inner {
+                        next[(o * n + a) * inner + j] += w * cur[(o * n + c) * inner + j];
+                    }
+                }
+            }
+        }
+        cur = next;
+    }
+    cur
+}
+
+/// 5D SL0 (fast path) in `T`: the reference for the firmware's f32 decoder and for the
+/// 1D method. `measured[i]` is `Some(y)` for a measured entry.
+pub fn solve_5d<T: Real>(
+    dict: &Dictionary<5, 5, 4, 4, 13>,
+    measured: &[Option<T>],
+    cfg: &Sl0Config,
+) -> (Vec<T>, u32) {
+    let f = factors::<T>(dict);
+    let project = |x: &mut [T]| {
+        for (x, y) in x.iter_mut().zip(measured) {
+            if let Some(y) = y {
+                *x = *y;
+            }
+        }
+    };
+    let mut x: Vec<T> = measured.iter().map(|y| y.unwrap_or(T::zero())).collect();
+    let mut s = modes(&f, &x, true);
+    let mu = T::from(cfg.mu);
+    let (iterations, _) = schedule(cfg, max_abs(&s), |inv| {
+        ascend(&mut s, mu, inv);
+        x = modes(&f, &s, false);
+        project(&mut x);
+        s = modes(&f, &x, true);
+    });
+    x = modes(&f, &s, false);
+    project(&mut x);
+    (x, iterations)
+}

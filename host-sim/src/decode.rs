@@ -1,0 +1,240 @@
+//! Decoding a capture on the workstation with the firmware's own tile decoder, in parallel
+//! over tiles (rayon), one [`PaperWorkspace`] per worker thread.
+//!
+//! Where a patch has fewer views than a lenslet, the decoder's overlapping angular windows
+//! each give an estimate of the shared views; so do the end-aligned edge tiles for the
+//! lenslets they share with the grid. Every estimate is averaged into the light field.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use anyhow::{Result, anyhow, ensure};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use rayon::prelude::*;
+use slf_firmware::{
+    DecoderConfig, Dictionary, FrameSource, PaperShape, PaperWorkspace, PatchOrigin, PatchReport,
+    PatchSink, RawFrame, Sl0Config, SolveError, Tile, TileDecoder, TileReport,
+};
+
+use crate::capture::Capture;
+use crate::lightfield::LightField;
+
+/// The decoder's patch: the paper's 5 x 5 lenslets x 4 x 4 views x 13 bands.
+pub type PaperDictionary = Dictionary<5, 5, 4, 4, 13>;
+
+/// How to decode.
+#[derive(Clone, Copy, Debug)]
+pub struct DecodeOptions {
+    pub sl0: Sl0Config,
+    /// Patches per tile (rows, cols): the unit of parallel work.
+    pub tile_patches: (u16, u16),
+    /// Show a progress bar once the run has taken a second.
+    pub progress: bool,
+}
+
+impl Default for DecodeOptions {
+    fn default() -> Self {
+        Self {
+            sl0: Sl0Config::DEFAULT,
+            tile_patches: (2, 2),
+            progress: false,
+        }
+    }
+}
+
+/// What a decode did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct DecodeReport {
+    pub patches: TileReport,
+    pub tiles: usize,
+    pub failed_tiles: usize,
+    /// SL0 steps over all patches.
+    pub steps: u64,
+    /// Light-field values no decoded patch covered (left at 0).
+    pub uncovered: usize,
+    /// Wall time, seconds.
+    pub seconds: f64,
+}
+
+/// Sums of the patch estimates over one tile's lenslets, all views and bands.
+struct TileSums {
+    tile: Tile,
+    views: (usize, usize),
+    sum: Vec<f32>,
+    count: Vec<u16>,
+    steps: u64,
+}
+
+impl TileSums {
+    fn new(tile: Tile, views: (usize, usize)) -> Self {
+        let n = tile.lenslet_rows as usize * tile.lenslet_cols as usize * views.0 * views.1 * 13;
+        Self {
+            tile,
+            views,
+            sum: vec![0.0; n],
+            count: vec![0; n],
+            steps: 0,
+        }
+    }
+
+    /// Index in the tile's `(s, t, u, v, b)` buffer.
+    fn at(&self, s: usize, t: usize, u: usize, v: usize, b: usize) -> usize {
+        (((s * self.tile.lenslet_cols as usize + t) * self.views.0 + u) * self.views.1 + v) * 13 + b
+    }
+}
+
+impl PatchSink<5200> for TileSums {
+    type Error = core::convert::Infallible;
+
+    fn accept(
+        &mut self,
+        o: PatchOrigin,
+        patch: &[f32; 5200],
+        report: &PatchReport,
+    ) -> Result<(), Self::Error> {
+        self.steps += u64::from(report.outcome.iterations);
+        let (s0, t0) = (
+            (o.lenslet_row - self.tile.lenslet_row) as usize,
+            (o.lenslet_col - self.tile.lenslet_col) as usize,
+        );
+        for (i, &x) in patch.iter().enumerate() {
+            let [s, t, u, v, b] = PaperShape::coordinates(i);
+            let j = self.at(
+                s0 + s,
+                t0 + t,
+                o.view_row as usize + u,
+                o.view_col as usize + v,
+                b,
+            );
+            self.sum[j] += x;
+            self.count[j] += 1;
+        }
+        Ok(())
+    }
+
+    fn reject(&mut self, _: PatchOrigin, _: SolveError) -> Result<(), Self::Error> {
+        Ok(())
+    }
+}
+
+/// Decodes every tile of `capture` with `dict`; returns the light field `(U, V, S, T, 13)`.
+///
+/// # Errors
+/// A capture the decoder cannot take (band count, views, mask), with the reason.
+pub fn decode(
+    capture: &Capture,
+    dict: &PaperDictionary,
+    opts: &DecodeOptions,
+) -> Result<(LightField, DecodeReport)> {
+    let start = Instant::now();
+    let d = &capture.description;
+    ensure!(
+        d.bands_nm.len() == 13,
+        "the decoder's patch has 13 bands, the capture {}",
+        d.bands_nm.len()
+    );
+    let config = DecoderConfig {
+        sensor: capture.sensor(),
+        mask: capture.mask()?,
+        raw: capture.raw_format(),
+        defects: capture.defects(),
+        sl0: opts.sl0,
+    };
+    let decoder =
+        TileDecoder::<5, 5, 4, 4, 13, 5200>::new(config).map_err(|e| anyhow!("decoder: {e}"))?;
+    let (rows, cols) = capture.frame_size();
+    let raw: Vec<RawFrame<u16>> = capture
+        .frames
+        .iter()
+        .map(|f| RawFrame::new(f, rows, cols))
+        .collect::<Result<_, _>>()
+        .map_err(|e| anyhow!("{e}"))?;
+    let tiles: Vec<Tile> = decoder.tiles(opts.tile_patches).collect();
+    ensure!(
+        !tiles.is_empty(),
+        "the sensor ({} x {} lenslets) is smaller than one 5 x 5 patch",
+        d.lenslets[0],
+        d.lenslets[1]
+    );
+    let views = (d.views[0], d.views[1]);
+
+    let bar = ProgressBar::with_draw_target(Some(tiles.len() as u64), ProgressDrawTarget::hidden());
+    bar.set_style(
+        ProgressStyle::with_template(
+            "decoding {bar:40} {pos}/{len} tiles, {elapsed} elapsed, {eta} left",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let shown = AtomicBool::new(false);
+    let results: Vec<(TileSums, Result<TileReport, String>)> = tiles
+        .par_iter()
+        .map_init(
+            || Box::new(PaperWorkspace::new()),
+            |ws, &tile| {
+                let mut sums = TileSums::new(tile, views);
+                let mut source = FrameSource::new(&raw);
+                let r = decoder
+                    .decode_tile(dict, tile, &mut source, &mut sums, ws)
+                    .map_err(|e| e.to_string());
+                bar.inc(1);
+                if opts.progress
+                    && start.elapsed().as_secs_f64() > 1.0
+                    && !shown.swap(true, Ordering::Relaxed)
+                {
+                    bar.set_draw_target(ProgressDrawTarget::stderr());
+                }
+                (sums, r)
+            },
+        )
+        .collect();
+    bar.finish_and_clear();
+
+    let mut lf = LightField::zeros(views, d.lenslets[0], d.lenslets[1], 13);
+    let mut sum = vec![0.0f32; lf.data.len()];
+    let mut count = vec![0u16; lf.data.len()];
+    let mut report = DecodeReport {
+        tiles: tiles.len(),
+        ..DecodeReport::default()
+    };
+    for (sums, r) in &results {
+        match r {
+            Ok(t) => {
+                report.patches.decoded += t.decoded;
+                report.patches.flagged += t.flagged;
+                report.patches.failed += t.failed;
+            }
+            Err(_) => report.failed_tiles += 1,
+        }
+        report.steps += sums.steps;
+        let tile = sums.tile;
+        for s in 0..tile.lenslet_rows as usize {
+            for t in 0..tile.lenslet_cols as usize {
+                for u in 0..views.0 {
+                    for v in 0..views.1 {
+                        let src = sums.at(s, t, u, v, 0);
+                        let dst = lf.index(
+                            u,
+                            v,
+                            tile.lenslet_row as usize + s,
+                            tile.lenslet_col as usize + t,
+                            0,
+                        );
+                        for b in 0..13 {
+                            sum[dst + b] += sums.sum[src + b];
+                            count[dst + b] += sums.count[src + b];
+                        }
+                    }
+                }
+            }
+        }
+    }
+    for ((x, &s), &c) in lf.data.iter_mut().zip(&sum).zip(&count) {
+        if c > 0 {
+            *x = s / f32::from(c);
+        } else {
+            report.uncovered += 1;
+        }
+    }
+    report.seconds = start.elapsed().as_secs_f64();
+    Ok((lf, report))
+}

@@ -1,0 +1,416 @@
+//! Synthetic spectral light fields: layered Lambertian surfaces.
+//!
+//! A scene is a stack of fronto-parallel layers, far to near. Each has a shape, a disparity
+//! (pixels of shift per view step, -1.5..+1.5), a texture that mixes two reflectance spectra,
+//! and is lit by D65. View `(u, v)` sees the point `(y + d du, x + d dv)` of a layer of
+//! disparity `d`, with `(du, dv)` its offset from the central view; the nearest layer that
+//! covers that point wins, so occlusion is correct in every view. Each pixel averages 2 x 2
+//! samples, so edges are anti-aliased. Everything is seeded and deterministic.
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use crate::lightfield::LightField;
+use crate::spectra::{
+    BANDS, COLORCHECKER, Spectrum, colorchecker, narrow_band, smooth_random, under_d65,
+};
+
+/// The region a layer covers, in reference-view coordinates normalised to `[0, 1]`.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Shape {
+    Everywhere,
+    Rect { y0: f32, x0: f32, y1: f32, x1: f32 },
+    Disc { cy: f32, cx: f32, r: f32 },
+}
+
+impl Shape {
+    fn contains(&self, y: f32, x: f32) -> bool {
+        match *self {
+            Shape::Everywhere => true,
+            Shape::Rect { y0, x0, y1, x1 } => (y0..y1).contains(&y) && (x0..x1).contains(&x),
+            Shape::Disc { cy, cx, r } => (y - cy).powi(2) + (x - cx).powi(2) < r * r,
+        }
+    }
+}
+
+/// How a layer mixes its two reflectances, as a weight in `[0, 1]`; lengths in pixels.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Texture {
+    Flat,
+    /// Smooth value noise with lattice spacing `cell`.
+    Noise {
+        cell: f32,
+        seed: u64,
+    },
+    Stripes {
+        period: f32,
+        angle: f32,
+    },
+    Checks {
+        period: f32,
+    },
+    /// Pixel-scale value noise: fine detail.
+    Fine {
+        seed: u64,
+    },
+}
+
+fn hash01(seed: u64, ix: i64, iy: i64) -> f32 {
+    let mut z = seed
+        ^ (ix as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+        ^ (iy as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
+}
+
+fn value_noise(seed: u64, y: f32, x: f32) -> f32 {
+    let (fy, fx) = (y.floor(), x.floor());
+    let (ty, tx) = (y - fy, x - fx);
+    let (sy, sx) = (ty * ty * (3.0 - 2.0 * ty), tx * tx * (3.0 - 2.0 * tx));
+    let (iy, ix) = (fy as i64, fx as i64);
+    let a = hash01(seed, ix, iy) * (1.0 - sx) + hash01(seed, ix + 1, iy) * sx;
+    let b = hash01(seed, ix, iy + 1) * (1.0 - sx) + hash01(seed, ix + 1, iy + 1) * sx;
+    a * (1.0 - sy) + b * sy
+}
+
+impl Texture {
+    fn weight(&self, y: f32, x: f32) -> f32 {
+        match *self {
+            Texture::Flat => 0.0,
+            Texture::Noise { cell, seed } => value_noise(seed, y / cell, x / cell),
+            Texture::Stripes { period, angle } => {
+                0.5 + 0.5
+                    * (std::f32::consts::TAU * (x * angle.cos() + y * angle.sin()) / period).sin()
+            }
+            Texture::Checks { period } => {
+                ((y / period).floor() + (x / period).floor()).rem_euclid(2.0)
+            }
+            Texture::Fine { seed } => value_noise(seed, y, x),
+        }
+    }
+}
+
+/// One surface.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Layer {
+    /// Pixels of shift per view step (positive = nearer).
+    pub disparity: f32,
+    pub shape: Shape,
+    pub texture: Texture,
+    /// The two reflectances the texture mixes.
+    pub reflectance: [Spectrum; 2],
+}
+
+/// A scene: layers (any order; rendered by disparity) and an exposure gain.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    pub name: String,
+    pub layers: Vec<Layer>,
+    /// Scales all radiance: 1 for a normal exposure, small for low light.
+    pub gain: f32,
+}
+
+/// The size of a rendered light field.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SceneSize {
+    pub views: (usize, usize),
+    pub rows: usize,
+    pub cols: usize,
+}
+
+impl Default for SceneSize {
+    /// 5 x 5 views of 100 x 100 pixels.
+    fn default() -> Self {
+        Self {
+            views: (5, 5),
+            rows: 100,
+            cols: 100,
+        }
+    }
+}
+
+impl Scene {
+    /// Renders the light field `(U, V, H, W, 13)`.
+    pub fn render(&self, size: SceneSize) -> LightField {
+        let mut lf = LightField::zeros(size.views, size.rows, size.cols, BANDS);
+        let mut layers: Vec<&Layer> = self.layers.iter().collect();
+        layers.sort_by(|a, b| b.disparity.total_cmp(&a.disparity)); // nearest first
+        let radiance: Vec<[Spectrum; 2]> = layers
+            .iter()
+            .map(|l| l.reflectance.map(|r| under_d65(&r).map(|x| x * self.gain)))
+            .collect();
+        let (cu, cv) = (
+            (size.views.0 as f32 - 1.0) / 2.0,
+            (size.views.1 as f32 - 1.0) / 2.0,
+        );
+        let (h, w) = (size.rows as f32, size.cols as f32);
+        for u in 0..size.views.0 {
+            for v in 0..size.views.1 {
+                let (du, dv) = (u as f32 - cu, v as f32 - cv);
+                for y in 0..size.rows {
+                    for x in 0..size.cols {
+                        let mut acc = [0.0f32; BANDS];
+                        for (sy, sx) in [(0.25, 0.25), (0.25, 0.75), (0.75, 0.25), (0.75, 0.75)] {
+                            let (py, px) = (y as f32 + sy, x as f32 + sx);
+                            for (layer, rad) in layers.iter().zip(&radiance) {
+                                let (ly, lx) =
+                                    (py + layer.disparity * du, px + layer.disparity * dv);
+                                if layer.shape.contains(ly / h, lx / w) {
+                                    let t = layer.texture.weight(ly, lx);
+                                    for (a, (r0, r1)) in
+                                        acc.iter_mut().zip(rad[0].iter().zip(&rad[1]))
+                                    {
+                                        *a += 0.25 * (r0 + t * (r1 - r0));
+                                    }
+                                    break;
+                                }
+                            }
+                        }
+                        let i = lf.index(u, v, y, x, 0);
+                        lf.data[i..i + BANDS].copy_from_slice(&acc);
+                    }
+                }
+            }
+        }
+        lf
+    }
+}
+
+fn cc(name: &str) -> Spectrum {
+    colorchecker(name).unwrap_or_else(|| panic!("no ColorChecker patch named {name:?}"))
+}
+
+fn rect(y0: f32, x0: f32, y1: f32, x1: f32) -> Shape {
+    Shape::Rect { y0, x0, y1, x1 }
+}
+
+/// The named test scenes, each of a distinct character.
+pub const NAMES: [&str; 5] = ["smooth", "texture", "depth", "saturated", "dark"];
+
+/// A named test scene (see [`NAMES`]); `None` for an unknown name.
+pub fn named(name: &str) -> Option<Scene> {
+    let layer = |disparity, shape, texture, r0, r1| Layer {
+        disparity,
+        shape,
+        texture,
+        reflectance: [r0, r1],
+    };
+    let layers = match name {
+        // Broad gradients and soft noise: what compressed sensing finds easiest.
+        "smooth" => vec![
+            layer(
+                -0.5,
+                Shape::Everywhere,
+                Texture::Noise {
+                    cell: 40.0,
+                    seed: 1,
+                },
+                cc("blue sky"),
+                cc("foliage"),
+            ),
+            layer(
+                0.5,
+                Shape::Disc {
+                    cy: 0.5,
+                    cx: 0.5,
+                    r: 0.3,
+                },
+                Texture::Noise {
+                    cell: 25.0,
+                    seed: 2,
+                },
+                cc("light skin"),
+                cc("orange yellow"),
+            ),
+        ],
+        // Stripes, checks and pixel-scale noise at three depths.
+        "texture" => vec![
+            layer(
+                -1.0,
+                Shape::Everywhere,
+                Texture::Stripes {
+                    period: 3.0,
+                    angle: 0.4,
+                },
+                cc("neutral 8 (.23 D)"),
+                cc("moderate red"),
+            ),
+            layer(
+                0.0,
+                rect(0.15, 0.1, 0.6, 0.55),
+                Texture::Checks { period: 2.0 },
+                cc("white 9.5 (.05 D)"),
+                cc("black 2 (1.5 D)"),
+            ),
+            layer(
+                1.0,
+                Shape::Disc {
+                    cy: 0.65,
+                    cx: 0.65,
+                    r: 0.25,
+                },
+                Texture::Fine { seed: 3 },
+                cc("yellow green"),
+                cc("purple"),
+            ),
+        ],
+        // Flat surfaces whose edges jump in disparity: occlusion boundaries in every view.
+        "depth" => vec![
+            layer(
+                -1.5,
+                Shape::Everywhere,
+                Texture::Noise {
+                    cell: 30.0,
+                    seed: 4,
+                },
+                cc("neutral 5 (.70 D)"),
+                cc("neutral 6.5 (.44 D)"),
+            ),
+            layer(
+                -0.5,
+                rect(0.1, 0.1, 0.7, 0.45),
+                Texture::Flat,
+                cc("red"),
+                cc("red"),
+            ),
+            layer(
+                0.5,
+                rect(0.3, 0.3, 0.9, 0.7),
+                Texture::Flat,
+                cc("blue"),
+                cc("blue"),
+            ),
+            layer(
+                1.5,
+                Shape::Disc {
+                    cy: 0.35,
+                    cx: 0.7,
+                    r: 0.18,
+                },
+                Texture::Flat,
+                cc("yellow"),
+                cc("yellow"),
+            ),
+        ],
+        // Saturated chart colours and narrow-band lines.
+        "saturated" => {
+            let mut l = vec![layer(
+                0.0,
+                Shape::Everywhere,
+                Texture::Flat,
+                cc("black 2 (1.5 D)"),
+                cc("black 2 (1.5 D)"),
+            )];
+            let colours = [
+                cc("red"),
+                cc("green"),
+                cc("blue"),
+                cc("yellow"),
+                cc("magenta"),
+                cc("cyan"),
+            ];
+            for (i, c) in colours.iter().enumerate() {
+                let (y, x) = ((i / 3) as f32 * 0.5, (i % 3) as f32 / 3.0);
+                l.push(layer(
+                    0.4,
+                    rect(y + 0.05, x + 0.03, y + 0.45, x + 0.3),
+                    Texture::Flat,
+                    *c,
+                    *c,
+                ));
+            }
+            for (i, nm) in [450.0, 530.0, 610.0, 660.0].iter().enumerate() {
+                let c = narrow_band(*nm, 12.0);
+                l.push(layer(
+                    1.0,
+                    Shape::Disc {
+                        cy: 0.25 + 0.5 * (i / 2) as f32,
+                        cx: 0.2 + 0.6 * (i % 2) as f32,
+                        r: 0.08,
+                    },
+                    Texture::Flat,
+                    c,
+                    c,
+                ));
+            }
+            l
+        }
+        // The depth scene at 4 % exposure: low light.
+        "dark" => {
+            return named("depth").map(|s| Scene {
+                name: "dark".into(),
+                gain: 0.04,
+                ..s
+            });
+        }
+        _ => return None,
+    };
+    Some(Scene {
+        name: name.into(),
+        layers,
+        gain: 1.0,
+    })
+}
+
+/// A random training scene: a textured background and 2 to 5 shapes at distinct
+/// disparities, with ColorChecker, smooth random and narrow-band spectra.
+pub fn random(seed: u64) -> Scene {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let spectrum = |rng: &mut ChaCha8Rng| match rng.random_range(0..3) {
+        0 => COLORCHECKER[rng.random_range(0..COLORCHECKER.len())].1,
+        1 => smooth_random(rng),
+        _ => narrow_band(rng.random_range(420.0..690.0), rng.random_range(8.0..30.0)),
+    };
+    let texture = |rng: &mut ChaCha8Rng| match rng.random_range(0..5) {
+        0 => Texture::Flat,
+        1 => Texture::Noise {
+            cell: rng.random_range(4.0..40.0),
+            seed: rng.random(),
+        },
+        2 => Texture::Stripes {
+            period: rng.random_range(2.0..12.0),
+            angle: rng.random_range(0.0..3.14),
+        },
+        3 => Texture::Checks {
+            period: rng.random_range(1.0..8.0),
+        },
+        _ => Texture::Fine { seed: rng.random() },
+    };
+    let count = rng.random_range(3..=6);
+    // Distinct disparities, evenly spread over -1.5..1.5 with jitter, far to near.
+    let mut layers = Vec::with_capacity(count);
+    for i in 0..count {
+        let d = -1.5 + 3.0 * (i as f32 + rng.random_range(0.1..0.9)) / count as f32;
+        let shape = if i == 0 {
+            Shape::Everywhere
+        } else if rng.random_bool(0.5) {
+            let (y0, x0) = (rng.random_range(-0.1..0.7), rng.random_range(-0.1..0.7));
+            rect(
+                y0,
+                x0,
+                y0 + rng.random_range(0.15..0.6),
+                x0 + rng.random_range(0.15..0.6),
+            )
+        } else {
+            Shape::Disc {
+                cy: rng.random_range(0.0..1.0),
+                cx: rng.random_range(0.0..1.0),
+                r: rng.random_range(0.08..0.35),
+            }
+        };
+        let tex = texture(&mut rng);
+        let r = [spectrum(&mut rng), spectrum(&mut rng)];
+        layers.push(Layer {
+            disparity: d,
+            shape,
+            texture: tex,
+            reflectance: r,
+        });
+    }
+    Scene {
+        name: format!("random-{seed}"),
+        layers,
+        gain: rng.random_range(0.5..1.0),
+    }
+}
