@@ -5,33 +5,96 @@
 //! Also a 5D SL0 in f64 (the fast path, mode products in f64) as the f64 reference: the
 //! firmware is f32 only, as the device is.
 
-use nalgebra::{DMatrix, DVector, RealField};
+use nalgebra::{DMatrix, RealField};
 use slf_firmware::{Dictionary, Ended, Sl0Config};
 
 /// A scalar for both paths: f32 or f64.
-pub trait Real: RealField + Copy + From<f32> {}
-impl Real for f32 {}
-impl Real for f64 {}
+pub trait Real: RealField + Copy + From<f32> {
+    fn to_f64(self) -> f64;
+    fn from_f64(x: f64) -> Self;
+}
+impl Real for f32 {
+    fn to_f64(self) -> f64 {
+        f64::from(self)
+    }
+    fn from_f64(x: f64) -> Self {
+        x as f32
+    }
+}
+impl Real for f64 {
+    fn to_f64(self) -> f64 {
+        self
+    }
+    fn from_f64(x: f64) -> Self {
+        x
+    }
+}
 
-/// The dictionary's five matrices in `T`, row-major, with their sizes.
-fn factors<T: Real>(dict: &Dictionary<5, 5, 4, 4, 13>) -> Vec<(usize, Vec<T>)> {
-    let d = dict.synthesis();
-    let conv = |m: &[f32], n: usize| (n, m.iter().map(|&x| T::from(x)).collect());
-    vec![
-        conv(d.m1.as_flattened(), 5),
-        conv(d.m2.as_flattened(), 5),
-        conv(d.m3.as_flattened(), 4),
-        conv(d.m4.as_flattened(), 4),
-        conv(d.m5.as_flattened(), 13),
-    ]
+/// `m x`, each dot product accumulated in f64 and rounded once to `T`: the dense 1D
+/// products sum thousands of terms, and plain f32 sums would make the 1D method's rounding
+/// (not the method) dominate any comparison.
+pub fn matvec<T: Real>(m: &DMatrix<T>, x: &[T]) -> Vec<T> {
+    let (rows, cols) = m.shape();
+    let mut acc = vec![0.0f64; rows];
+    // Column-major storage: accumulate column by column.
+    for c in 0..cols {
+        let xc = x[c].to_f64();
+        for (a, v) in acc.iter_mut().zip(m.column(c).iter()) {
+            *a += v.to_f64() * xc;
+        }
+    }
+    acc.into_iter().map(<T as Real>::from_f64).collect()
+}
+
+/// The five synthesis matrices of a patch `5 x 5 x 4 x 4 x 13`, row-major, in `T`.
+#[derive(Clone, Debug)]
+pub struct Factors<T: Real>(pub Vec<(usize, Vec<T>)>);
+
+impl<T: Real> Factors<T> {
+    /// A firmware dictionary's matrices (f32 values, widened to `T`).
+    pub fn from_dictionary(dict: &Dictionary<5, 5, 4, 4, 13>) -> Self {
+        let d = dict.synthesis();
+        let conv = |m: &[f32], n: usize| (n, m.iter().map(|&x| T::from(x)).collect());
+        Self(vec![
+            conv(d.m1.as_flattened(), 5),
+            conv(d.m2.as_flattened(), 5),
+            conv(d.m3.as_flattened(), 4),
+            conv(d.m4.as_flattened(), 4),
+            conv(d.m5.as_flattened(), 13),
+        ])
+    }
+}
+
+impl Factors<f64> {
+    /// The 5D DCT computed in f64, orthonormal to f64 precision (the f32 tables are
+    /// orthonormal only to about 1e-7, which an f64 comparison would see).
+    pub fn dct_f64() -> Self {
+        let dct = |n: usize| -> (usize, Vec<f64>) {
+            let mut m = vec![0.0; n * n];
+            for k in 0..n {
+                let a = if k == 0 {
+                    (1.0 / n as f64).sqrt()
+                } else {
+                    (2.0 / n as f64).sqrt()
+                };
+                for i in 0..n {
+                    // Synthesis: columns are atoms, D[i][k] = C[k][i].
+                    m[i * n + k] = a
+                        * (std::f64::consts::PI * (2 * i + 1) as f64 * k as f64 / (2 * n) as f64)
+                            .cos();
+                }
+            }
+            (n, m)
+        };
+        Self(vec![dct(5), dct(5), dct(4), dct(4), dct(13)])
+    }
 }
 
 /// The Kronecker product of the five matrices (row-major patch layout): `N x N`.
-pub fn kronecker<T: Real>(dict: &Dictionary<5, 5, 4, 4, 13>) -> DMatrix<T> {
+pub fn kronecker<T: Real>(f: &Factors<T>) -> DMatrix<T> {
     let mut k = DMatrix::<T>::identity(1, 1);
-    for (n, m) in factors::<T>(dict) {
-        let m = DMatrix::from_row_slice(n, n, &m);
-        k = k.kronecker(&m);
+    for (n, m) in &f.0 {
+        k = k.kronecker(&DMatrix::from_row_slice(*n, *n, m));
     }
     k
 }
@@ -81,8 +144,8 @@ pub struct Dense1D<T: Real> {
 
 impl<T: Real> Dense1D<T> {
     /// Builds `D`, `A = Phi D` for the measured entries, and `A^+ = A^T (A A^T)^-1`.
-    pub fn new(dict: &Dictionary<5, 5, 4, 4, 13>, measured: &[usize]) -> Option<Self> {
-        let d = kronecker::<T>(dict);
+    pub fn new(factors: &Factors<T>, measured: &[usize]) -> Option<Self> {
+        let d = kronecker(factors);
         let a = d.select_rows(measured);
         let gram = &a * a.transpose();
         let a_pinv = a.transpose() * gram.cholesky()?.inverse();
@@ -101,15 +164,20 @@ impl<T: Real> Dense1D<T> {
 
     /// SL0 with the 1D operators; returns the patch `x = D s`.
     pub fn solve(&self, y: &[T], cfg: &Sl0Config) -> (Vec<T>, u32) {
-        let y = DVector::from_column_slice(y);
-        let mut s = &self.a_pinv * &y;
-        let (mu, _) = (T::from(cfg.mu), ());
-        let (iterations, _) = schedule(cfg, max_abs(s.as_slice()), |inv| {
-            ascend(s.as_mut_slice(), mu, inv);
-            let r = &self.a * &s - &y;
-            s -= &self.a_pinv * r;
+        let mut s = matvec(&self.a_pinv, y);
+        let mu = T::from(cfg.mu);
+        let (iterations, _) = schedule(cfg, max_abs(&s), |inv| {
+            ascend(&mut s, mu, inv);
+            let r: Vec<T> = matvec(&self.a, &s)
+                .iter()
+                .zip(y)
+                .map(|(&a, &b)| a - b)
+                .collect();
+            for (x, c) in s.iter_mut().zip(matvec(&self.a_pinv, &r)) {
+                *x -= c;
+            }
         });
-        ((&self.d * s).as_slice().to_vec(), iterations)
+        (matvec(&self.d, &s), iterations)
     }
 
     /// The measured entries.
@@ -118,7 +186,7 @@ impl<T: Real> Dense1D<T> {
     }
 }
 
-/// `buf x_i M_i` for all five modes in f64 (out of place, one mode at a time).
+/// `x x_i M_i` (or `M_i^T`) for all five modes (out of place, one mode at a time).
 fn modes<T: Real>(f: &[(usize, Vec<T>)], x: &[T], transpose: bool) -> Vec<T> {
     let dims: Vec<usize> = f.iter().map(|(n, _)| *n).collect();
     let mut cur = x.to_vec();
@@ -148,11 +216,11 @@ fn modes<T: Real>(f: &[(usize, Vec<T>)], x: &[T], transpose: bool) -> Vec<T> {
 /// 5D SL0 (fast path) in `T`: the reference for the firmware's f32 decoder and for the
 /// 1D method. `measured[i]` is `Some(y)` for a measured entry.
 pub fn solve_5d<T: Real>(
-    dict: &Dictionary<5, 5, 4, 4, 13>,
+    factors: &Factors<T>,
     measured: &[Option<T>],
     cfg: &Sl0Config,
 ) -> (Vec<T>, u32) {
-    let f = factors::<T>(dict);
+    let f = &factors.0;
     let project = |x: &mut [T]| {
         for (x, y) in x.iter_mut().zip(measured) {
             if let Some(y) = y {
@@ -161,15 +229,15 @@ pub fn solve_5d<T: Real>(
         }
     };
     let mut x: Vec<T> = measured.iter().map(|y| y.unwrap_or(T::zero())).collect();
-    let mut s = modes(&f, &x, true);
+    let mut s = modes(f, &x, true);
     let mu = T::from(cfg.mu);
     let (iterations, _) = schedule(cfg, max_abs(&s), |inv| {
         ascend(&mut s, mu, inv);
-        x = modes(&f, &s, false);
+        x = modes(f, &s, false);
         project(&mut x);
-        s = modes(&f, &x, true);
+        s = modes(f, &x, true);
     });
-    x = modes(&f, &s, false);
+    x = modes(f, &s, false);
     project(&mut x);
     (x, iterations)
 }

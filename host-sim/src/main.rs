@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
-use slf_host::baseline::{Dense1D, solve_5d};
+use slf_host::baseline::{Dense1D, Factors};
 use slf_host::camera::{CameraConfig, simulate};
 use slf_host::capture::{Capture, MaskDescription, MaskSource};
 use slf_host::decode::{DecodeOptions, PaperDictionary, decode};
@@ -452,7 +452,8 @@ fn baseline(patches: usize, family: Family, k: u8) -> Result<()> {
         let idx: Vec<usize> = measured.iter().map(|m| m.0).collect();
         let y: Vec<f32> = measured.iter().map(|m| m.1).collect();
         let start = Instant::now();
-        let one = Dense1D::<f32>::new(&dict, &idx).context("A A^T is singular")?;
+        let one = Dense1D::<f32>::new(&Factors::from_dictionary(&dict), &idx)
+            .context("A A^T is singular")?;
         let setup = start.elapsed().as_secs_f64();
         let start = Instant::now();
         let (x1, _) = one.solve(&y, &cfg);
@@ -491,6 +492,5 @@ fn baseline(patches: usize, family: Family, k: u8) -> Result<()> {
         "dictionary memory ratio 1D/5D {:.0} (paper: 107,729)",
         d1 as f64 / dict5 as f64
     );
-    let _ = solve_5d::<f64>;
     Ok(())
 }
