@@ -34,12 +34,11 @@ impl Real for f64 {
 /// products sum thousands of terms, and plain f32 sums would make the 1D method's rounding
 /// (not the method) dominate any comparison.
 pub fn matvec<T: Real>(m: &DMatrix<T>, x: &[T]) -> Vec<T> {
-    let (rows, cols) = m.shape();
-    let mut acc = vec![0.0f64; rows];
+    let mut acc = vec![0.0f64; m.nrows()];
     // Column-major storage: accumulate column by column.
-    for c in 0..cols {
-        let xc = x[c].to_f64();
-        for (a, v) in acc.iter_mut().zip(m.column(c).iter()) {
+    for (col, xc) in m.column_iter().zip(x) {
+        let xc = xc.to_f64();
+        for (a, v) in acc.iter_mut().zip(col.iter()) {
             *a += v.to_f64() * xc;
         }
     }

@@ -370,7 +370,7 @@ pub fn random(seed: u64) -> Scene {
         },
         2 => Texture::Stripes {
             period: rng.random_range(2.0..12.0),
-            angle: rng.random_range(0.0..3.14),
+            angle: rng.random_range(0.0..std::f32::consts::PI),
         },
         3 => Texture::Checks {
             period: rng.random_range(1.0..8.0),

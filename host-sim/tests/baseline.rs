@@ -44,14 +44,14 @@ fn five_d_equals_one_d_for_every_mask_family() {
             let mut ws = Box::new(PaperWorkspace::new());
             let mut idx = Vec::new();
             let mut meas64 = vec![None; 5200];
-            for i in 0..5200 {
+            for (i, m) in meas64.iter_mut().enumerate() {
                 let [s, t, u, v, b] = PaperShape::coordinates(i);
                 let (row, col) = ((5 + s) * 4 + u, (10 + t) * 4 + v);
                 if mask.bands_at(row, col).contains(&(b as u8)) {
                     let y = lf.get(u, v, 5 + s, 10 + t, b);
                     ws.measurements_mut().set(i, y).unwrap();
                     idx.push(i);
-                    meas64[i] = Some(f64::from(y));
+                    *m = Some(f64::from(y));
                 }
             }
             let y32: Vec<f32> = idx.iter().map(|&i| meas64[i].unwrap() as f32).collect();

@@ -107,7 +107,8 @@ fn saved_capture() -> (tempfile::TempDir, serde_json::Value) {
 
 #[test]
 fn bad_captures_say_what_and_where() {
-    let cases: Vec<(&str, Box<dyn Fn(&mut serde_json::Value)>, &str)> = vec![
+    type Edit = Box<dyn Fn(&mut serde_json::Value)>;
+    let cases: Vec<(&str, Edit, &str)> = vec![
         (
             "format",
             Box::new(|j| j["format"] = "other".into()),
