@@ -139,7 +139,14 @@ fn bad_files_and_arguments_are_one_line_errors() {
             .args(["-s", "14"]),
     );
     assert!(e.contains("14 snapshots"), "{e}");
-    // clap's own errors: unknown flag, bad value.
-    failure(slf().args(["decode", "--bogus"]));
-    failure(slf().args(["simulate", "x.npy", "-o", "y", "--mask", "stripes"]));
+    // clap's own errors: unknown flag, bad value, missing argument; one line each.
+    for args in [
+        &["decode", "--bogus"][..],
+        &["simulate", "x.npy", "-o", "y", "--mask", "stripes"],
+        &["eval", "a.npy"],
+        &[],
+    ] {
+        let e = failure(slf().args(args));
+        assert_eq!(e.lines().count(), 1, "{args:?}: {e}");
+    }
 }
