@@ -17,7 +17,7 @@ use nalgebra::{SMatrix, SVD};
 use crate::dictionary::{Dictionary, Factors, Matrix};
 use crate::mask::KroneckerPhi;
 use crate::shape::PatchShape;
-use crate::sl0::{Outcome, Sl0Config, SolveError, ascend, max_abs, run_schedule};
+use crate::sl0::{Outcome, Sl0Config, SolveError, ascend, max_abs, run_schedule, start};
 use crate::transform::{apply_in_place, synthesize};
 use crate::workspace::{Measurements, Workspace};
 
@@ -173,21 +173,17 @@ pub fn solve_pinv<
     cfg: &Sl0Config,
     ws: &mut Workspace<PS, PT, PU, PV, B, N>,
 ) -> Result<Outcome, SolveError> {
-    cfg.validate()?;
     let Workspace {
         coeffs,
         signal,
         measurements: m,
     } = ws;
-    if m.count == 0 {
-        return Err(SolveError::NoMeasurements);
-    }
+    let eps = start(cfg, m)?;
     let mut complete = true;
     op.for_each_selected(|_, e| complete &= m.measured.get(e).copied().unwrap_or(false));
     if !complete || m.count() != PatchShape::<PS, PT, PU, PV, B, N>::PIXELS * op.phi.bands.len() {
         return Err(SolveError::IncompleteKronecker);
     }
-    let eps = cfg.noise * libm::sqrtf(m.count as f32);
 
     // S0 = I x_i A_i^+ (zero-padded I).
     coeffs.fill(0.0);

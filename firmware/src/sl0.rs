@@ -214,6 +214,19 @@ fn project<const N: usize>(x: &mut [f32; N], m: &Measurements<N>, eps: f32) -> f
     norm
 }
 
+/// The checks both projection paths start with; returns the noise-ball radius
+/// `eps = noise * sqrt(m)` (0 for exact projection).
+pub(crate) fn start<const N: usize>(
+    cfg: &Sl0Config,
+    m: &Measurements<N>,
+) -> Result<f32, SolveError> {
+    cfg.validate()?;
+    if m.count == 0 {
+        return Err(SolveError::NoMeasurements);
+    }
+    Ok(cfg.noise * libm::sqrtf(m.count as f32))
+}
+
 /// The sigma schedule of Algorithm 1, shared by both projection paths: runs `step` (one
 /// ascent + projection, returning the residual) `L` times per level until `sigma_min`, the
 /// iteration bound, or sigma underflow.
@@ -270,16 +283,12 @@ pub fn solve<
     cfg: &Sl0Config,
     ws: &mut Workspace<PS, PT, PU, PV, B, N>,
 ) -> Result<Outcome, SolveError> {
-    cfg.validate()?;
     let Workspace {
         coeffs,
         signal,
         measurements: m,
     } = ws;
-    if m.count == 0 {
-        return Err(SolveError::NoMeasurements);
-    }
-    let eps = cfg.noise * libm::sqrtf(m.count as f32);
+    let eps = start(cfg, m)?;
 
     // Minimum-norm start: S0 = analysis of the measurements, zeros elsewhere.
     for ((x, &y), &k) in signal.iter_mut().zip(&m.values).zip(&m.measured) {

@@ -365,7 +365,8 @@ fn run_one(
             report.uncovered
         );
     }
-    Ok((recon.clone(), evaluate(truth, &recon)?, report.seconds))
+    let metrics = evaluate(truth, &recon)?;
+    Ok((recon, metrics, report.seconds))
 }
 
 fn demo(out: &Path, name: &str, size: usize) -> Result<()> {
