@@ -19,8 +19,9 @@
 //! - **operators** ([`shape`], [`dct`], [`dictionary`], [`blob`], [`transform`]): the patch
 //!   geometry in the types, dictionaries (the 5D DCT and blobs in flash) and the separable
 //!   synthesis and analysis transforms.
-//! - **solver** ([`sl0`], [`pinv`]): nD SL0 with the orthonormal fast path, and the paper's
-//!   general pseudo-inverse path for kronecker masks.
+//! - **solver** ([`sl0`], [`pinv`], [`choice`]): nD SL0 with the orthonormal fast path, the
+//!   paper's general pseudo-inverse path for kronecker masks, and the choice of an ensemble
+//!   member per patch (exhaustive or screened).
 //! - **tile decoder** ([`tile`]): a rectangle of the raw frame, patch by patch, from a
 //!   [`TileSource`] to a [`PatchSink`], into a caller-owned [`Workspace`].
 //!
@@ -73,6 +74,7 @@
 mod log;
 
 pub mod blob;
+pub mod choice;
 pub mod dct;
 pub mod defects;
 pub mod dictionary;
@@ -86,6 +88,7 @@ pub mod transform;
 pub mod workspace;
 
 pub use blob::{Ensemble, write_blob};
+pub use choice::{ChoiceRule, EnsembleModel, MemberChoice, ModelOutcome, PatchModel};
 pub use defects::{DefectList, Pixel};
 pub use dictionary::{Dictionary, DictionaryError, Factors, Matrix};
 pub use mask::{BandTile, KroneckerPhi, LensletSize, Mask, MaskFamily, SensingError};

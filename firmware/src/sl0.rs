@@ -111,6 +111,8 @@ pub enum SolveError {
     IncompleteKronecker,
     /// The SVD behind a pseudo-inverse did not converge (`mode` 1..=5).
     PseudoInverse { mode: u8 },
+    /// An ensemble member could not be read (not expected of a validated ensemble).
+    NoSuchMember,
 }
 
 impl fmt::Display for SolveError {
@@ -129,6 +131,7 @@ impl fmt::Display for SolveError {
             Self::PseudoInverse { mode } => {
                 write!(f, "pseudo-inverse of mode {mode} did not converge")
             }
+            Self::NoSuchMember => f.write_str("ensemble member could not be read"),
         }
     }
 }

@@ -19,13 +19,13 @@
 
 use core::fmt;
 
+use crate::choice::PatchModel;
 use crate::defects::DefectList;
-use crate::dictionary::Dictionary;
 use crate::log::log;
 use crate::mask::{LensletSize, Mask, MaskFamily};
 use crate::raw::{Invalid, RawFormat};
 use crate::shape::PatchShape;
-use crate::sl0::{Outcome, Sl0Config, SolveError, solve};
+use crate::sl0::{Outcome, Sl0Config, SolveError};
 use crate::workspace::Workspace;
 
 /// Where raw samples come from.
@@ -162,8 +162,12 @@ impl From<Invalid> for PatchFlags {
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct PatchReport {
-    /// How the solve ended.
+    /// How the (last) solve ended.
     pub outcome: Outcome,
+    /// The ensemble member used (none for a single dictionary).
+    pub member: Option<u16>,
+    /// Solves the patch cost.
+    pub solves: u16,
     /// Why samples were left out, if any were.
     pub flags: PatchFlags,
     /// Samples used as measurements.
@@ -457,14 +461,15 @@ impl<
         Ok((flags, excluded))
     }
 
-    /// Decodes every patch of `tile` with `dict`, sending each to `sink`.
+    /// Decodes every patch of `tile` with `model` (a dictionary or an ensemble), sending
+    /// each to `sink`.
     ///
     /// # Errors
     /// [`TileError::Geometry`] before anything is read; [`TileError::Source`] or
     /// [`TileError::Sink`] abandon the rest of the tile (what was sent stays sent).
-    pub fn decode_tile<S: TileSource, K: PatchSink<N>>(
+    pub fn decode_tile<M: PatchModel<PS, PT, PU, PV, B, N>, S: TileSource, K: PatchSink<N>>(
         &self,
-        dict: &Dictionary<PS, PT, PU, PV, B>,
+        model: &M,
         tile: Tile,
         source: &mut S,
         sink: &mut K,
@@ -486,10 +491,12 @@ impl<
                     let (flags, excluded) = self
                         .read_patch(origin, source, ws)
                         .map_err(TileError::Source)?;
-                    match solve(dict, &self.config.sl0, ws) {
-                        Ok(outcome) => {
+                    match model.decode(&self.config.sl0, ws) {
+                        Ok(done) => {
                             let r = PatchReport {
-                                outcome,
+                                outcome: done.outcome,
+                                member: done.member,
+                                solves: done.solves,
                                 flags,
                                 measured: ws.measurements().count() as u16,
                                 excluded,
@@ -516,9 +523,9 @@ impl<
 
     /// Decodes every tile of the sensor (see [`tiles`](Self::tiles)); a tile that fails
     /// is counted and the next one is decoded.
-    pub fn decode_frame<S: TileSource, K: PatchSink<N>>(
+    pub fn decode_frame<M: PatchModel<PS, PT, PU, PV, B, N>, S: TileSource, K: PatchSink<N>>(
         &self,
-        dict: &Dictionary<PS, PT, PU, PV, B>,
+        model: &M,
         tile_patches: (u16, u16),
         source: &mut S,
         sink: &mut K,
@@ -532,7 +539,7 @@ impl<
         };
         for tile in self.tiles(tile_patches) {
             frame.tiles += 1;
-            match self.decode_tile(dict, tile, source, sink, ws) {
+            match self.decode_tile(model, tile, source, sink, ws) {
                 Ok(r) => frame.patches.add(&r),
                 Err(e) => {
                     frame.failed_tiles += 1;
