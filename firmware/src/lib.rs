@@ -87,7 +87,7 @@ pub mod tile;
 pub mod transform;
 pub mod workspace;
 
-pub use blob::{Ensemble, write_blob};
+pub use blob::{DEFAULT_ENSEMBLE, Ensemble, write_blob};
 pub use choice::{ChoiceRule, EnsembleModel, MemberChoice, ModelOutcome, PatchModel};
 pub use defects::{DefectList, Pixel};
 pub use dictionary::{Dictionary, DictionaryError, Factors, Matrix};

@@ -12,8 +12,8 @@ use anyhow::{Result, anyhow, ensure};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use slf_firmware::{
-    DecoderConfig, Dictionary, FrameSource, PaperShape, PaperWorkspace, PatchOrigin, PatchReport,
-    PatchSink, RawFrame, Sl0Config, SolveError, Tile, TileDecoder, TileReport,
+    DecoderConfig, Dictionary, FrameSource, PaperShape, PaperWorkspace, PatchModel, PatchOrigin,
+    PatchReport, PatchSink, RawFrame, Sl0Config, SolveError, Tile, TileDecoder, TileReport,
 };
 
 use crate::capture::Capture;
@@ -21,6 +21,66 @@ use crate::lightfield::LightField;
 
 /// The decoder's patch: the paper's 5 x 5 lenslets x 4 x 4 views x 13 bands.
 pub type PaperDictionary = Dictionary<5, 5, 4, 4, 13>;
+
+/// Which basis decodes: the 5D DCT, or an ensemble with a member choice.
+#[derive(Clone, Debug)]
+pub enum Basis {
+    Dct,
+    /// A blob (the shipped [`slf_firmware::DEFAULT_ENSEMBLE`] unless told otherwise) and how
+    /// members are chosen.
+    Ensemble {
+        blob: Vec<u8>,
+        choice: slf_firmware::MemberChoice,
+    },
+}
+
+impl Basis {
+    /// The shipped ensemble with screened member choice: the default.
+    pub fn default_ensemble() -> Self {
+        Self::Ensemble {
+            blob: slf_firmware::DEFAULT_ENSEMBLE.to_vec(),
+            choice: slf_firmware::MemberChoice::Screened(slf_firmware::ChoiceRule::DEFAULT),
+        }
+    }
+
+    /// A short name for reports.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Dct => "DCT",
+            Self::Ensemble {
+                choice: slf_firmware::MemberChoice::Screened(_),
+                ..
+            } => "ensemble screened",
+            Self::Ensemble {
+                choice: slf_firmware::MemberChoice::Exhaustive(_),
+                ..
+            } => "ensemble exhaustive",
+        }
+    }
+}
+
+/// Decodes `capture` with `basis` (see [`decode`]).
+///
+/// # Errors
+/// An invalid blob, or what [`decode`] reports.
+pub fn decode_with(
+    capture: &Capture,
+    basis: &Basis,
+    opts: &DecodeOptions,
+) -> Result<(LightField, DecodeReport)> {
+    match basis {
+        Basis::Dct => decode(capture, &Dictionary::dct(), opts),
+        Basis::Ensemble { blob, choice } => {
+            let ensemble = slf_firmware::Ensemble::<5, 5, 4, 4, 13>::new(blob)
+                .map_err(|e| anyhow!("dictionary blob: {e}"))?;
+            decode(
+                capture,
+                &slf_firmware::EnsembleModel::new(ensemble, *choice),
+                opts,
+            )
+        }
+    }
+}
 
 /// How to decode.
 #[derive(Clone, Copy, Debug)]
@@ -43,13 +103,18 @@ impl Default for DecodeOptions {
 }
 
 /// What a decode did.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct DecodeReport {
     pub patches: TileReport,
     pub tiles: usize,
     pub failed_tiles: usize,
-    /// SL0 steps over all patches.
+    /// SL0 steps over all patches (the last solve of each).
     pub steps: u64,
+    /// Solves over all patches (more than one per patch with an ensemble).
+    pub solves: u64,
+    /// The ensemble member each decoded patch used, by patch origin (empty for a single
+    /// dictionary).
+    pub member_map: Vec<(PatchOrigin, u16)>,
     /// Light-field values no decoded patch covered (left at 0).
     pub uncovered: usize,
     /// Wall time, seconds.
@@ -63,6 +128,8 @@ struct TileSums {
     sum: Vec<f32>,
     count: Vec<u16>,
     steps: u64,
+    solves: u64,
+    members: Vec<(PatchOrigin, u16)>,
 }
 
 impl TileSums {
@@ -74,6 +141,8 @@ impl TileSums {
             sum: vec![0.0; n],
             count: vec![0; n],
             steps: 0,
+            solves: 0,
+            members: Vec::new(),
         }
     }
 
@@ -93,6 +162,10 @@ impl PatchSink<5200> for TileSums {
         report: &PatchReport,
     ) -> Result<(), Self::Error> {
         self.steps += u64::from(report.outcome.iterations);
+        self.solves += u64::from(report.solves);
+        if let Some(m) = report.member {
+            self.members.push((o, m));
+        }
         let (s0, t0) = (
             (o.lenslet_row - self.tile.lenslet_row) as usize,
             (o.lenslet_col - self.tile.lenslet_col) as usize,
@@ -117,13 +190,14 @@ impl PatchSink<5200> for TileSums {
     }
 }
 
-/// Decodes every tile of `capture` with `dict`; returns the light field `(U, V, S, T, 13)`.
+/// Decodes every tile of `capture` with `model` (a dictionary or an ensemble); returns the
+/// light field `(U, V, S, T, 13)`.
 ///
 /// # Errors
 /// A capture the decoder cannot take (band count, views, mask), with the reason.
-pub fn decode(
+pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
     capture: &Capture,
-    dict: &PaperDictionary,
+    model: &M,
     opts: &DecodeOptions,
 ) -> Result<(LightField, DecodeReport)> {
     let start = Instant::now();
@@ -174,7 +248,7 @@ pub fn decode(
                 let mut sums = TileSums::new(tile, views);
                 let mut source = FrameSource::new(&raw);
                 let r = decoder
-                    .decode_tile(dict, tile, &mut source, &mut sums, ws)
+                    .decode_tile(model, tile, &mut source, &mut sums, ws)
                     .map_err(|e| e.to_string());
                 bar.inc(1);
                 if opts.progress
@@ -206,6 +280,8 @@ pub fn decode(
             Err(_) => report.failed_tiles += 1,
         }
         report.steps += sums.steps;
+        report.solves += sums.solves;
+        report.member_map.extend_from_slice(&sums.members);
         let tile = sums.tile;
         for s in 0..tile.lenslet_rows as usize {
             for t in 0..tile.lenslet_cols as usize {

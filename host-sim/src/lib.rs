@@ -25,3 +25,4 @@ pub mod preview;
 pub mod scene;
 pub mod spectra;
 pub mod spectra_data;
+pub mod train;

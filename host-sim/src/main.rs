@@ -10,14 +10,16 @@ use clap::{Parser, Subcommand, ValueEnum};
 use slf_host::baseline::{Dense1D, Factors};
 use slf_host::camera::{CameraConfig, simulate};
 use slf_host::capture::{Capture, MaskDescription, MaskSource};
-use slf_host::decode::{DecodeOptions, PaperDictionary, decode};
+use slf_host::decode::{Basis, DecodeOptions, DecodeReport, PaperDictionary, decode_with};
 use slf_host::firmware::{
-    Dictionary, LensletSize, Mask, PaperShape, PaperWorkspace, Sl0Config, blob, solve,
+    ChoiceRule, DEFAULT_ENSEMBLE, Dictionary, LensletSize, Mask, MemberChoice, PaperShape,
+    PaperWorkspace, Sl0Config, blob, solve, write_blob,
 };
 use slf_host::lightfield::{Dtype, LightField, read_npy, write_npy};
 use slf_host::metrics::{Metrics, evaluate};
 use slf_host::preview::write_comparison;
 use slf_host::scene::{self, SceneSize};
+use slf_host::train;
 
 #[derive(Parser)]
 #[command(
@@ -53,6 +55,57 @@ impl Family {
                 block: [5, 5],
             },
         }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum DictionaryKind {
+    /// The 5D DCT.
+    Dct,
+    /// A learned ensemble (the shipped one unless --blob says otherwise).
+    Ensemble,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum Choice {
+    /// Solve with the DCT, pick the member that best represents it, solve with that (2 solves).
+    Screened,
+    /// Solve with every member, keep the sparsest (K + 1 solves).
+    Exhaustive,
+}
+
+#[derive(clap::Args, Clone, Debug)]
+struct BasisArgs {
+    /// Basis to decode with.
+    #[arg(long, value_enum, default_value_t = DictionaryKind::Ensemble)]
+    dictionary: DictionaryKind,
+    /// How an ensemble member is chosen per patch.
+    #[arg(long, value_enum, default_value_t = Choice::Screened)]
+    choice: Choice,
+    /// Ensemble blob (default: the shipped 8-member ensemble).
+    #[arg(long)]
+    blob: Option<PathBuf>,
+}
+
+impl BasisArgs {
+    fn basis(&self) -> Result<Basis> {
+        Ok(match self.dictionary {
+            DictionaryKind::Dct => Basis::Dct,
+            DictionaryKind::Ensemble => {
+                let blob = match &self.blob {
+                    Some(p) => {
+                        std::fs::read(p).with_context(|| format!("cannot read {}", p.display()))?
+                    }
+                    None => DEFAULT_ENSEMBLE.to_vec(),
+                };
+                let rule = ChoiceRule::DEFAULT;
+                let choice = match self.choice {
+                    Choice::Screened => MemberChoice::Screened(rule),
+                    Choice::Exhaustive => MemberChoice::Exhaustive(rule),
+                };
+                Basis::Ensemble { blob, choice }
+            }
+        })
     }
 }
 
@@ -106,6 +159,8 @@ enum Command {
         /// Spatial size (lenslets per side).
         #[arg(long, default_value_t = 100)]
         size: usize,
+        #[command(flatten)]
+        basis: BasisArgs,
     },
     /// Write a named test scene or a random training scene as a (U, V, H, W, B) .npy.
     Scene {
@@ -167,6 +222,11 @@ enum Command {
         output: PathBuf,
         #[command(flatten)]
         solver: SolverArgs,
+        #[command(flatten)]
+        basis: BasisArgs,
+        /// Also write which ensemble member each patch used (CSV).
+        #[arg(long)]
+        member_map: Option<PathBuf>,
         /// Stored dtype.
         #[arg(long, value_enum, default_value_t = Dtype::F32)]
         dtype: Dtype,
@@ -186,6 +246,37 @@ enum Command {
         #[arg(short, long, default_value_t = 1)]
         snapshots: u8,
     },
+    /// Learn a dictionary ensemble from light fields (or random training scenes); writes a blob.
+    Train {
+        /// Output blob (the firmware's format).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Training light fields (.npy); without them, random training scenes are rendered.
+        #[arg(long, num_args = 1..)]
+        input: Vec<PathBuf>,
+        /// Random training scenes to render when no --input is given.
+        #[arg(long, default_value_t = 24)]
+        scenes: usize,
+        /// Spatial size of each rendered training scene.
+        #[arg(long, default_value_t = 60)]
+        size: usize,
+        /// Patches sampled for training.
+        #[arg(long, default_value_t = 6000)]
+        patches: usize,
+        /// Members K.
+        #[arg(long, default_value_t = 8)]
+        members: usize,
+        /// Coefficients kept per patch when coding.
+        #[arg(long, default_value_t = 260)]
+        tau: usize,
+        #[arg(long, default_value_t = 10)]
+        iterations: usize,
+        /// Patches per member for the HOSVD initialisation.
+        #[arg(long, default_value_t = 32)]
+        group: usize,
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
     /// PSNR / SSIM / SA of every test scene x mask family x k, with the DCT; a markdown table.
     Sweep {
         /// Spatial size (lenslets per side).
@@ -197,6 +288,23 @@ enum Command {
         /// Also write the table to this file.
         #[arg(short, long)]
         output: Option<PathBuf>,
+        #[command(flatten)]
+        basis: BasisArgs,
+    },
+    /// Mean PSNR / SSIM / SA over the test scenes for {DCT, ensemble exhaustive, ensemble
+    /// screened} x {pixel, lenslet, kronecker} x k, and time per patch; a markdown table.
+    Compare {
+        /// Spatial size (lenslets per side).
+        #[arg(long, default_value_t = 40)]
+        size: usize,
+        #[arg(long, value_delimiter = ',', default_value = "1,3,5,7")]
+        k: Vec<u8>,
+        /// Also write the table to this file.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// Ensemble blob (default: the shipped one).
+        #[arg(long)]
+        blob: Option<PathBuf>,
     },
 }
 
@@ -233,7 +341,12 @@ fn main() -> ExitCode {
 
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
-        Command::Demo { out, scene, size } => demo(&out, &scene, size),
+        Command::Demo {
+            out,
+            scene,
+            size,
+            basis,
+        } => demo(&out, &scene, size, &basis.basis()?),
         Command::Scene {
             name,
             output,
@@ -296,6 +409,8 @@ fn run(cli: Cli) -> Result<()> {
             capture,
             output,
             solver,
+            basis,
+            member_map,
             dtype,
             quiet,
         } => {
@@ -305,7 +420,22 @@ fn run(cli: Cli) -> Result<()> {
                 progress: !quiet,
                 ..DecodeOptions::default()
             };
-            let (lf, r) = decode(&cap, &Dictionary::dct(), &opts)?;
+            let (lf, r) = decode_with(&cap, &basis.basis()?, &opts)?;
+            if let Some(path) = member_map {
+                let mut csv = String::from(
+                    "lenslet_row,lenslet_col,view_row,view_col,member
+",
+                );
+                for (o, m) in &r.member_map {
+                    csv += &format!(
+                        "{},{},{},{},{m}
+",
+                        o.lenslet_row, o.lenslet_col, o.view_row, o.view_col
+                    );
+                }
+                std::fs::write(&path, csv)
+                    .with_context(|| format!("cannot write {}", path.display()))?;
+            }
             write_npy(&output, &lf, dtype)?;
             println!(
                 "decoded {} patches ({} flagged, {} failed, {} tiles failed) in {:.2} s; wrote {}",
@@ -333,7 +463,86 @@ fn run(cli: Cli) -> Result<()> {
             mask,
             snapshots,
         } => baseline(patches, mask, snapshots),
-        Command::Sweep { size, k, output } => sweep(size, &k, output.as_deref()),
+        Command::Sweep {
+            size,
+            k,
+            output,
+            basis,
+        } => sweep(size, &k, output.as_deref(), &basis.basis()?),
+        Command::Compare {
+            size,
+            k,
+            output,
+            blob,
+        } => compare(size, &k, output.as_deref(), blob.as_deref()),
+        Command::Train {
+            output,
+            input,
+            scenes,
+            size,
+            patches,
+            members,
+            tau,
+            iterations,
+            group,
+            seed,
+        } => {
+            let start = Instant::now();
+            let fields = if input.is_empty() {
+                train::training_fields(scenes, size, 1000 + seed)
+            } else {
+                input
+                    .iter()
+                    .map(|p| read_npy(p))
+                    .collect::<Result<Vec<_>, _>>()?
+            };
+            for (i, f) in fields.iter().enumerate() {
+                anyhow::ensure!(
+                    f.bands == 13 && f.views.0 >= 4 && f.views.1 >= 4 && f.rows >= 5 && f.cols >= 5,
+                    "training light field {i} is too small for 5x5x4x4x13 patches: {:?}",
+                    f.shape()
+                );
+            }
+            let data = train::sample_patches(&fields, patches, seed);
+            let cfg = train::TrainConfig {
+                members,
+                tau,
+                iterations,
+                group,
+                seed,
+                progress: true,
+            };
+            let (dicts, reports) = train::train(&data, &cfg);
+            println!(
+                "| iteration | members | ensemble coding error | DCT coding error |\n| --- | --- | --- | --- |"
+            );
+            for (i, r) in reports.iter().enumerate() {
+                println!(
+                    "| {} | {} | {:.5} | {:.5} |",
+                    i + 1,
+                    r.members,
+                    r.ensemble_error,
+                    r.dct_error
+                );
+            }
+            let final_err = train::ensemble_error(&data, &dicts, tau);
+            println!(
+                "final: {} members, coding error {final_err:.5} vs DCT {:.5} (tau {tau}, relative energy)",
+                dicts.len(),
+                reports.first().map_or(0.0, |r| r.dct_error)
+            );
+            let mut blob = vec![0u8; blob::blob_len(PaperShape::DIMS, dicts.len())];
+            write_blob(&dicts, &mut blob).map_err(|e| anyhow::anyhow!("{e}"))?;
+            std::fs::write(&output, &blob)
+                .with_context(|| format!("cannot write {}", output.display()))?;
+            println!(
+                "wrote {} ({} bytes) in {:.1} s",
+                output.display(),
+                blob.len(),
+                start.elapsed().as_secs_f64()
+            );
+            Ok(())
+        }
     }
 }
 
@@ -349,15 +558,15 @@ const HEADER: &str = "| scene | mask | k | PSNR dB | SSIM | SA deg | decode s |\
 fn run_one(
     truth: &LightField,
     cam: &CameraConfig,
-    dict: &PaperDictionary,
+    basis: &Basis,
     progress: bool,
-) -> Result<(LightField, Metrics, f64)> {
+) -> Result<(LightField, Metrics, DecodeReport)> {
     let capture = simulate(truth, cam)?;
     let opts = DecodeOptions {
         progress,
         ..DecodeOptions::default()
     };
-    let (recon, report) = decode(&capture, dict, &opts)?;
+    let (recon, report) = decode_with(&capture, basis, &opts)?;
     if report.failed_tiles > 0 || report.uncovered > 0 {
         bail!(
             "decode lost {} tiles, {} values uncovered",
@@ -366,10 +575,10 @@ fn run_one(
         );
     }
     let metrics = evaluate(truth, &recon)?;
-    Ok((recon, metrics, report.seconds))
+    Ok((recon, metrics, report))
 }
 
-fn demo(out: &Path, name: &str, size: usize) -> Result<()> {
+fn demo(out: &Path, name: &str, size: usize, basis: &Basis) -> Result<()> {
     let start = Instant::now();
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let s = scene::named(name)
@@ -380,16 +589,16 @@ fn demo(out: &Path, name: &str, size: usize) -> Result<()> {
         cols: size,
     });
     write_npy(&out.join("truth.npy"), &truth, Dtype::F32)?;
-    let dict = Dictionary::dct();
     println!(
-        "scene {name}: {size} x {size} lenslets, 5 x 5 views, 13 bands; pixel mask; 5D DCT; {} threads",
+        "scene {name}: {size} x {size} lenslets, 5 x 5 views, 13 bands; pixel mask; {}; {} threads",
+        basis.name(),
         rayon::current_num_threads()
     );
     println!("{HEADER}");
     for k in [1u8, 3] {
         let cam = CameraConfig::pixel(7, k);
-        let (recon, m, secs) = run_one(&truth, &cam, &dict, true)?;
-        println!("{}", row(name, "pixel", k, &m, secs));
+        let (recon, m, r) = run_one(&truth, &cam, basis, true)?;
+        println!("{}", row(name, "pixel", k, &m, r.seconds));
         write_npy(&out.join(format!("recon_k{k}.npy")), &recon, Dtype::F32)?;
         write_comparison(&out.join(format!("preview_k{k}.png")), &truth, &recon)?;
     }
@@ -405,8 +614,7 @@ fn demo(out: &Path, name: &str, size: usize) -> Result<()> {
     Ok(())
 }
 
-fn sweep(size: usize, ks: &[u8], output: Option<&Path>) -> Result<()> {
-    let dict = Dictionary::dct();
+fn sweep(size: usize, ks: &[u8], output: Option<&Path>, basis: &Basis) -> Result<()> {
     let mut lines = vec![HEADER.to_string()];
     println!("{HEADER}");
     for name in scene::NAMES {
@@ -420,9 +628,9 @@ fn sweep(size: usize, ks: &[u8], output: Option<&Path>) -> Result<()> {
         for family in [Family::Pixel, Family::Lenslet, Family::Kronecker] {
             for &k in ks {
                 let cam = CameraConfig::pixel(7, k).with_mask(family.mask(7, k));
-                let (_, m, secs) = run_one(&truth, &cam, &dict, false)?;
+                let (_, m, r) = run_one(&truth, &cam, basis, false)?;
                 let fam = format!("{family:?}").to_lowercase();
-                let line = row(name, &fam, k, &m, secs);
+                let line = row(name, &fam, k, &m, r.seconds);
                 println!("{line}");
                 lines.push(line);
             }
@@ -431,6 +639,82 @@ fn sweep(size: usize, ks: &[u8], output: Option<&Path>) -> Result<()> {
     if let Some(p) = output {
         std::fs::write(p, lines.join("\n") + "\n")
             .with_context(|| format!("cannot write {}", p.display()))?;
+    }
+    Ok(())
+}
+
+fn compare(size: usize, ks: &[u8], output: Option<&Path>, blob: Option<&Path>) -> Result<()> {
+    let blob = match blob {
+        Some(p) => std::fs::read(p).with_context(|| format!("cannot read {}", p.display()))?,
+        None => DEFAULT_ENSEMBLE.to_vec(),
+    };
+    let rule = ChoiceRule::DEFAULT;
+    let bases = [
+        Basis::Dct,
+        Basis::Ensemble {
+            blob: blob.clone(),
+            choice: MemberChoice::Exhaustive(rule),
+        },
+        Basis::Ensemble {
+            blob,
+            choice: MemberChoice::Screened(rule),
+        },
+    ];
+    let truths: Vec<LightField> = scene::NAMES
+        .iter()
+        .map(|n| {
+            scene::named(n).map(|s| {
+                s.render(SceneSize {
+                    views: (5, 5),
+                    rows: size,
+                    cols: size,
+                })
+            })
+        })
+        .collect::<Option<_>>()
+        .context("named scene")?;
+    let mut lines = vec![
+        format!(
+            "| basis | mask | k | PSNR dB | SSIM | SA deg | solves / patch | ms / patch (1 core) |"
+        ),
+        "| --- | --- | --- | --- | --- | --- | --- | --- |".to_string(),
+    ];
+    lines.iter().for_each(|l| println!("{l}"));
+    let threads = rayon::current_num_threads() as f64;
+    for family in [Family::Pixel, Family::Lenslet, Family::Kronecker] {
+        for &k in ks {
+            for basis in &bases {
+                let cam = CameraConfig::pixel(7, k).with_mask(family.mask(7, k));
+                let (mut p, mut s, mut a, mut secs, mut solves, mut patches) =
+                    (0.0, 0.0, 0.0, 0.0, 0u64, 0u64);
+                for truth in &truths {
+                    let (_, m, r) = run_one(truth, &cam, basis, false)?;
+                    p += m.psnr;
+                    s += m.ssim;
+                    a += m.sa;
+                    secs += r.seconds;
+                    solves += r.solves;
+                    patches += u64::from(r.patches.decoded);
+                }
+                let n = truths.len() as f64;
+                let line = format!(
+                    "| {} | {} | {k} | {:.2} | {:.4} | {:.2} | {:.1} | {:.2} |",
+                    basis.name(),
+                    format!("{family:?}").to_lowercase(),
+                    p / n,
+                    s / n,
+                    a / n,
+                    solves as f64 / patches as f64,
+                    1e3 * secs * threads / patches as f64
+                );
+                println!("{line}");
+                lines.push(line);
+            }
+        }
+    }
+    if let Some(path) = output {
+        std::fs::write(path, lines.join("\n") + "\n")
+            .with_context(|| format!("cannot write {}", path.display()))?;
     }
     Ok(())
 }

@@ -1,0 +1,397 @@
+//! Training a learned 5D dictionary ensemble (AMDE-style) from light-field patches.
+//!
+//! K members, each five orthonormal matrices (5x5, 5x5, 4x4, 4x4, 13x13):
+//!
+//! 1. **Initialise** each member from the HOSVD of a small random group of patches (a few
+//!    dozen): per mode, the eigenvectors of the summed mode-unfolding Gram matrix. Small
+//!    random groups make the members differ; a partition of all patches makes them alike.
+//! 2. **Code** every patch in every member with its `tau` largest coefficients; the coding
+//!    error is the energy of the rest (the members are orthonormal).
+//! 3. **Assign** each patch to the member with the least error at `tau`; drop members that
+//!    code no patch.
+//! 4. **Update** each mode of each member by orthogonal Procrustes on the mode unfolding of
+//!    its patches, with the sparse codes fixed: minimise `sum ||X - S x_i U_i||` over an
+//!    orthonormal `U_n`: `M = U_n G`, `G = sum S_full(n) S_sparse(n)^T`, `U_n <- A B^T` for
+//!    `M = A Sigma B^T` (a small SVD, nalgebra). Then re-code. Neither step can increase
+//!    the coding error at fixed assignments; a test holds it to that.
+//!
+//! Parallel over patches (rayon) in fixed chunks summed in order, so the result does not
+//! depend on the thread count: the same seed and patches give the same blob bytes.
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use nalgebra::{DMatrix, SymmetricEigen};
+use rand::seq::index::sample;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use slf_firmware::{Dictionary, Factors, PaperShape, analyze};
+
+use crate::decode::PaperDictionary;
+use crate::lightfield::LightField;
+
+/// Values of one patch.
+pub const N: usize = 5200;
+/// The patch's mode sizes.
+pub const DIMS: [usize; 5] = [5, 5, 4, 4, 13];
+const CHUNK: usize = 64;
+
+/// Training parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TrainConfig {
+    /// Members K.
+    pub members: usize,
+    /// Coefficients kept per patch when coding.
+    pub tau: usize,
+    /// Alternations of coding, assignment and update.
+    pub iterations: usize,
+    /// Patches per member for the HOSVD initialisation.
+    pub group: usize,
+    pub seed: u64,
+    /// Show a progress bar.
+    pub progress: bool,
+}
+
+impl Default for TrainConfig {
+    fn default() -> Self {
+        Self {
+            members: 8,
+            tau: 260,
+            iterations: 10,
+            group: 32,
+            seed: 1,
+            progress: false,
+        }
+    }
+}
+
+/// Coding error of one iteration, mean over patches of the relative error
+/// `||X - X_tau||^2 / ||X||^2`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IterationReport {
+    pub ensemble_error: f64,
+    pub dct_error: f64,
+    pub members: usize,
+}
+
+/// Patches sampled uniformly from light fields: `count` patches of 5 x 5 lenslets x 4 x 4
+/// views x 13 bands at random positions and angular windows, flat in the patch layout.
+pub fn sample_patches(fields: &[LightField], count: usize, seed: u64) -> Vec<f32> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut out = Vec::with_capacity(count * N);
+    for _ in 0..count {
+        let lf = &fields[rng.random_range(0..fields.len())];
+        let (r, c) = (
+            rng.random_range(0..=lf.rows - 5),
+            rng.random_range(0..=lf.cols - 5),
+        );
+        let (u0, v0) = (
+            rng.random_range(0..=lf.views.0 - 4),
+            rng.random_range(0..=lf.views.1 - 4),
+        );
+        for i in 0..N {
+            let [s, t, u, v, b] = PaperShape::coordinates(i);
+            out.push(lf.get(u0 + u, v0 + v, r + s, c + t, b));
+        }
+    }
+    out
+}
+
+/// One member's matrices in f64 (synthesis: columns are atoms), row-major.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Member(pub [Vec<f64>; 5]);
+
+impl Member {
+    /// The f32 dictionary (checked orthonormal by the firmware).
+    pub fn dictionary(&self) -> PaperDictionary {
+        fn m<const D: usize>(v: &[f64]) -> [[f32; D]; D] {
+            core::array::from_fn(|i| core::array::from_fn(|j| v[i * D + j] as f32))
+        }
+        let f = Factors {
+            m1: m::<5>(&self.0[0]),
+            m2: m::<5>(&self.0[1]),
+            m3: m::<4>(&self.0[2]),
+            m4: m::<4>(&self.0[3]),
+            m5: m::<13>(&self.0[4]),
+        };
+        // Procrustes and eigenvectors are orthonormal to ~1e-15 in f64; f32 rounding keeps
+        // them within 1e-6, far inside the firmware's 1e-4.
+        Dictionary::new(f).unwrap_or_else(|e| panic!("learned member not orthonormal: {e}"))
+    }
+}
+
+/// Index stride of mode `n` in the patch layout.
+fn stride(n: usize) -> usize {
+    DIMS[n + 1..].iter().product()
+}
+
+/// `buf x_n R` for a `d x d` matrix `R` (row-major), in place.
+fn mode_product(buf: &mut [f32], n: usize, r: &[f64]) {
+    let d = DIMS[n];
+    let st = stride(n);
+    let outer = N / (d * st);
+    let mut fibre = vec![0.0f64; d];
+    for o in 0..outer {
+        for i in 0..st {
+            let base = o * d * st + i;
+            for (c, f) in fibre.iter_mut().enumerate() {
+                *f = f64::from(buf[base + c * st]);
+            }
+            for a in 0..d {
+                buf[base + a * st] = (0..d).map(|c| r[a * d + c] * fibre[c]).sum::<f64>() as f32;
+            }
+        }
+    }
+}
+
+/// The HOSVD of a group of patches: per mode, eigenvectors of the summed unfolding Gram.
+fn hosvd(patches: &[f32], group: &[usize]) -> Member {
+    Member(core::array::from_fn(|n| {
+        let (d, st) = (DIMS[n], stride(n));
+        let mut gram = DMatrix::<f64>::zeros(d, d);
+        for &p in group {
+            let x = &patches[p * N..(p + 1) * N];
+            for o in 0..N / (d * st) {
+                for i in 0..st {
+                    let base = o * d * st + i;
+                    for a in 0..d {
+                        for c in 0..d {
+                            gram[(a, c)] +=
+                                f64::from(x[base + a * st]) * f64::from(x[base + c * st]);
+                        }
+                    }
+                }
+            }
+        }
+        let eig = SymmetricEigen::new(gram);
+        let mut order: Vec<usize> = (0..d).collect();
+        order.sort_by(|&a, &b| eig.eigenvalues[b].total_cmp(&eig.eigenvalues[a]));
+        let mut u = vec![0.0; d * d];
+        for (k, &j) in order.iter().enumerate() {
+            let col = eig.eigenvectors.column(j);
+            // Deterministic sign: the largest entry positive.
+            let big = col
+                .iter()
+                .fold(0.0f64, |m, &x| if x.abs() > m.abs() { x } else { m });
+            let sign = if big < 0.0 { -1.0 } else { 1.0 };
+            for i in 0..d {
+                u[i * d + k] = sign * col[i];
+            }
+        }
+        u
+    }))
+}
+
+/// The relative energy outside the `tau` largest magnitudes, and their indices.
+pub fn top_tau(s: &[f32], tau: usize) -> (f64, Vec<u16>) {
+    let mut idx: Vec<u16> = (0..s.len() as u16).collect();
+    let total: f64 = s.iter().map(|&x| f64::from(x) * f64::from(x)).sum();
+    if tau < s.len() {
+        idx.select_nth_unstable_by(tau, |&a, &b| {
+            s[b as usize]
+                .abs()
+                .total_cmp(&s[a as usize].abs())
+                .then(a.cmp(&b))
+        });
+        idx.truncate(tau);
+    }
+    idx.sort_unstable();
+    let kept: f64 = idx.iter().map(|&i| f64::from(s[i as usize]).powi(2)).sum();
+    let err = if total > 0.0 {
+        ((total - kept) / total).max(0.0)
+    } else {
+        0.0
+    };
+    (err, idx)
+}
+
+/// Coefficients of patch `p` in `dict`.
+fn coefficients(patches: &[f32], p: usize, dict: &PaperDictionary) -> Box<[f32; N]> {
+    let mut x: Box<[f32; N]> = Box::new([0.0; N]);
+    x.copy_from_slice(&patches[p * N..(p + 1) * N]);
+    let mut s = Box::new([0.0; N]);
+    analyze(dict, &mut x, &mut s);
+    s
+}
+
+/// Mean relative coding error of every patch in `dict` at `tau`.
+pub fn coding_error(patches: &[f32], dict: &PaperDictionary, tau: usize) -> f64 {
+    let count = patches.len() / N;
+    let sum: f64 = (0..count)
+        .into_par_iter()
+        .map(|p| top_tau(&coefficients(patches, p, dict)[..], tau).0)
+        .sum();
+    sum / count as f64
+}
+
+/// Mean relative coding error with each patch in its best member: the ensemble's error.
+pub fn ensemble_error(patches: &[f32], members: &[PaperDictionary], tau: usize) -> f64 {
+    let count = patches.len() / N;
+    let sum: f64 = (0..count)
+        .into_par_iter()
+        .map(|p| {
+            members
+                .iter()
+                .map(|d| top_tau(&coefficients(patches, p, d)[..], tau).0)
+                .fold(f64::INFINITY, f64::min)
+        })
+        .sum();
+    sum / count as f64
+}
+
+/// Each patch's best member and its error.
+pub fn assign(patches: &[f32], members: &[PaperDictionary], tau: usize) -> Vec<(usize, f64)> {
+    (0..patches.len() / N)
+        .into_par_iter()
+        .map(|p| {
+            members
+                .iter()
+                .enumerate()
+                .map(|(k, d)| (k, top_tau(&coefficients(patches, p, d)[..], tau).0))
+                .fold(
+                    (0, f64::INFINITY),
+                    |best, c| if c.1 < best.1 { c } else { best },
+                )
+        })
+        .collect()
+}
+
+/// Mean coding error of the patches assigned to `k` (`assignment[p] == k`) in `member`.
+pub fn member_error(patches: &[f32], member: &Member, which: &[usize], tau: usize) -> f64 {
+    let d = member.dictionary();
+    which
+        .iter()
+        .map(|&p| top_tau(&coefficients(patches, p, &d)[..], tau).0)
+        .sum::<f64>()
+        / which.len().max(1) as f64
+}
+
+/// One Procrustes update of every mode of `member` on its patches `which`, codes fixed
+/// at the start (the `tau` largest coefficients in the current member).
+pub fn update_member(patches: &[f32], member: &Member, which: &[usize], tau: usize) -> Member {
+    let dict = member.dictionary();
+    // Per patch: the full coefficients (kept current as modes change) and the fixed code.
+    let mut state: Vec<(Box<[f32; N]>, Vec<(u16, f32)>)> = which
+        .par_iter()
+        .map(|&p| {
+            let s = coefficients(patches, p, &dict);
+            let (_, idx) = top_tau(&s[..], tau);
+            let code = idx.iter().map(|&i| (i, s[i as usize])).collect();
+            (s, code)
+        })
+        .collect();
+    let mut next = member.clone();
+    for n in 0..5 {
+        let (d, st) = (DIMS[n], stride(n));
+        // G = sum_p S_full(n) S_sparse(n)^T, in fixed chunks summed in order.
+        let parts: Vec<Vec<f64>> = state
+            .par_chunks(CHUNK)
+            .map(|chunk| {
+                let mut g = vec![0.0f64; d * d];
+                for (full, code) in chunk {
+                    for &(i, v) in code {
+                        let i = i as usize;
+                        let c = (i / st) % d;
+                        let base = i - c * st;
+                        for a in 0..d {
+                            g[a * d + c] += f64::from(full[base + a * st]) * f64::from(v);
+                        }
+                    }
+                }
+                g
+            })
+            .collect();
+        let mut g = DMatrix::<f64>::zeros(d, d);
+        for part in &parts {
+            for a in 0..d {
+                for c in 0..d {
+                    g[(a, c)] += part[a * d + c];
+                }
+            }
+        }
+        let u_cur = DMatrix::from_row_slice(d, d, &next.0[n]);
+        let m = &u_cur * g;
+        let svd = m.svd(true, true);
+        let (Some(a), Some(bt)) = (svd.u, svd.v_t) else {
+            continue;
+        };
+        let u_new = a * bt;
+        // Keep S_full current: S <- S x_n (U_new^T U_cur).
+        let r = u_new.transpose() * &u_cur;
+        let r_rows: Vec<f64> = (0..d * d).map(|k| r[(k / d, k % d)]).collect();
+        state
+            .par_iter_mut()
+            .for_each(|(full, _)| mode_product(&mut full[..], n, &r_rows));
+        next.0[n] = (0..d * d).map(|k| u_new[(k / d, k % d)]).collect();
+    }
+    next
+}
+
+/// Trains an ensemble on `patches`; returns its members (empty ones dropped) and the
+/// coding error per iteration against the DCT's.
+pub fn train(patches: &[f32], cfg: &TrainConfig) -> (Vec<PaperDictionary>, Vec<IterationReport>) {
+    let count = patches.len() / N;
+    let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed);
+    let mut members: Vec<Member> = (0..cfg.members)
+        .map(|_| {
+            hosvd(
+                patches,
+                &sample(&mut rng, count, cfg.group.min(count)).into_vec(),
+            )
+        })
+        .collect();
+    let dct_error = coding_error(patches, &Dictionary::dct(), cfg.tau);
+    let bar =
+        ProgressBar::with_draw_target(Some(cfg.iterations as u64), ProgressDrawTarget::hidden());
+    if cfg.progress {
+        bar.set_draw_target(ProgressDrawTarget::stderr());
+        bar.set_style(
+            ProgressStyle::with_template("training {bar:40} {pos}/{len} iterations {msg}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+    }
+    let mut reports = Vec::new();
+    for _ in 0..cfg.iterations {
+        let dicts: Vec<PaperDictionary> = members.iter().map(Member::dictionary).collect();
+        let assignment = assign(patches, &dicts, cfg.tau);
+        let ensemble_error = assignment.iter().map(|a| a.1).sum::<f64>() / count as f64;
+        let groups: Vec<Vec<usize>> = (0..members.len())
+            .map(|k| (0..count).filter(|&p| assignment[p].0 == k).collect())
+            .collect();
+        // Drop members that code no patch.
+        let kept: Vec<(Member, Vec<usize>)> = members
+            .into_iter()
+            .zip(groups)
+            .filter(|(_, g)| !g.is_empty())
+            .collect();
+        reports.push(IterationReport {
+            ensemble_error,
+            dct_error,
+            members: kept.len(),
+        });
+        bar.set_message(format!(
+            "ensemble {ensemble_error:.4} vs DCT {dct_error:.4}"
+        ));
+        members = kept
+            .iter()
+            .map(|(m, g)| update_member(patches, m, g, cfg.tau))
+            .collect();
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    (members.iter().map(Member::dictionary).collect(), reports)
+}
+
+/// Random light fields from `scene::random` for training (seeds `seed..seed + count`,
+/// never the named test scenes).
+pub fn training_fields(count: usize, size: usize, seed: u64) -> Vec<LightField> {
+    (0..count as u64)
+        .into_par_iter()
+        .map(|i| {
+            crate::scene::random(seed + i).render(crate::scene::SceneSize {
+                views: (5, 5),
+                rows: size,
+                cols: size,
+            })
+        })
+        .collect()
+}
