@@ -26,35 +26,19 @@ use slf_host::metrics::evaluate;
 use slf_host::scene::{self, SceneSize};
 
 fn mask(family: &str, k: u8) -> MaskDescription {
-    let src = MaskSource {
-        snapshots: Some(k),
-        seed: Some(7),
-        tile: None,
-    };
+    let src = MaskSource { snapshots: Some(k), seed: Some(7), tile: None };
     match family {
         "pixel" => MaskDescription::Pixel(src),
         "lenslet" => MaskDescription::Lenslet(src),
-        _ => MaskDescription::Kronecker {
-            snapshots: k,
-            seed: 7,
-            block: [5, 5],
-        },
+        _ => MaskDescription::Kronecker { snapshots: k, seed: 7, block: [5, 5] },
     }
 }
 
 #[test]
 fn scene_to_metrics_for_every_mask_family() {
-    let truth = scene::named("depth").unwrap().render(SceneSize {
-        views: (5, 5),
-        rows: 40,
-        cols: 40,
-    });
+    let truth = scene::named("depth").unwrap().render(SceneSize { views: (5, 5), rows: 40, cols: 40 });
     let dict = Dictionary::dct();
-    let floors = [
-        ("pixel", [21.0, 28.0]),
-        ("lenslet", [13.0, 23.5]),
-        ("kronecker", [5.5, 5.5]),
-    ];
+    let floors = [("pixel", [21.0, 28.0]), ("lenslet", [13.0, 23.5]), ("kronecker", [5.5, 5.5])];
     let mut psnr_k3 = std::collections::HashMap::new();
     for (family, floor) in floors {
         for (i, k) in [1u8, 3].into_iter().enumerate() {
@@ -63,36 +47,18 @@ fn scene_to_metrics_for_every_mask_family() {
             simulate(&truth, &cam).unwrap().save(dir.path()).unwrap();
             let capture = Capture::load(dir.path()).unwrap();
             let (recon, report) = decode(&capture, &dict, &DecodeOptions::default()).unwrap();
-            assert_eq!(
-                (report.failed_tiles, report.patches.failed, report.uncovered),
-                (0, 0, 0)
-            );
-            assert_eq!(
-                report.patches.decoded,
-                8 * 8 * 4,
-                "every block in four angular windows"
-            );
+            assert_eq!((report.failed_tiles, report.patches.failed, report.uncovered), (0, 0, 0));
+            assert_eq!(report.patches.decoded, 8 * 8 * 4, "every block in four angular windows");
             let m = evaluate(&truth, &recon).unwrap();
-            eprintln!(
-                "{family} k={k}: PSNR {:.2} dB, SSIM {:.4}, SA {:.2} deg",
-                m.psnr, m.ssim, m.sa
-            );
-            assert!(
-                m.psnr >= floor[i],
-                "{family} k={k}: PSNR {:.2} below the floor {}",
-                m.psnr,
-                floor[i]
-            );
+            eprintln!("{family} k={k}: PSNR {:.2} dB, SSIM {:.4}, SA {:.2} deg", m.psnr, m.ssim, m.sa);
+            assert!(m.psnr >= floor[i], "{family} k={k}: PSNR {:.2} below the floor {}", m.psnr, floor[i]);
             assert!(recon.data.iter().all(|x| x.is_finite()));
             if k == 3 {
                 psnr_k3.insert(family, m.psnr);
             }
         }
     }
-    assert!(
-        psnr_k3["pixel"] >= psnr_k3["kronecker"] + 15.0,
-        "{psnr_k3:?}"
-    );
+    assert!(psnr_k3["pixel"] >= psnr_k3["kronecker"] + 15.0, "{psnr_k3:?}");
     assert!(psnr_k3["pixel"] > psnr_k3["lenslet"], "{psnr_k3:?}");
 }
 
@@ -100,11 +66,7 @@ fn scene_to_metrics_for_every_mask_family() {
 fn defects_and_noise_are_survived() {
     // 1 % defective pixels and heavy read noise: every patch still decodes, flagged where a
     // defect fell, and the result stays useful.
-    let truth = scene::named("smooth").unwrap().render(SceneSize {
-        views: (5, 5),
-        rows: 20,
-        cols: 20,
-    });
+    let truth = scene::named("smooth").unwrap().render(SceneSize { views: (5, 5), rows: 20, cols: 20 });
     let mut cam = CameraConfig::pixel(3, 3);
     cam.defect_fraction = 0.01;
     cam.read_noise = 20.0;

@@ -7,10 +7,7 @@ use slf_firmware::*;
 const L5: LensletSize = LensletSize { rows: 5, cols: 5 };
 const S: usize = 10;
 const T: usize = 10;
-const SENSOR: SensorGeometry = SensorGeometry {
-    lenslets: (S as u16, T as u16),
-    lenslet: L5,
-};
+const SENSOR: SensorGeometry = SensorGeometry { lenslets: (S as u16, T as u16), lenslet: L5 };
 
 fn at(s: usize, t: usize, u: usize, v: usize, b: usize) -> usize {
     (((s * T + t) * 5 + u) * 5 + v) * 13 + b
@@ -25,10 +22,7 @@ fn light_field() -> Vec<f32> {
             for u in 0..5 {
                 for v in 0..5 {
                     for b in 0..13 {
-                        let (x, y) = (
-                            t as f32 + 0.3 * (v as f32 - 2.0),
-                            s as f32 + 0.3 * (u as f32 - 2.0),
-                        );
+                        let (x, y) = (t as f32 + 0.3 * (v as f32 - 2.0), s as f32 + 0.3 * (u as f32 - 2.0));
                         let w = b as f32 / 12.0;
                         let val = if x < 4.5 {
                             0.3 + 0.4 * w + 0.05 * (0.7 * y).sin()
@@ -51,12 +45,7 @@ struct Average {
 
 impl PatchSink<5200> for Average {
     type Error = core::convert::Infallible;
-    fn accept(
-        &mut self,
-        o: PatchOrigin,
-        p: &[f32; 5200],
-        _: &PatchReport,
-    ) -> Result<(), Self::Error> {
+    fn accept(&mut self, o: PatchOrigin, p: &[f32; 5200], _: &PatchReport) -> Result<(), Self::Error> {
         for (i, &x) in p.iter().enumerate() {
             let [s, t, u, v, b] = PaperShape::coordinates(i);
             let j = at(
@@ -86,38 +75,19 @@ fn decode_psnr(l: &[f32], mask: Mask<'static>) -> f64 {
                 .collect()
         })
         .collect();
-    let raw: Vec<RawFrame<u16>> = frames
-        .iter()
-        .map(|f| RawFrame::new(f, rows, cols).unwrap())
-        .collect();
+    let raw: Vec<RawFrame<u16>> = frames.iter().map(|f| RawFrame::new(f, rows, cols).unwrap()).collect();
     let config = DecoderConfig {
         sensor: SENSOR,
         mask,
-        raw: RawFormat {
-            black: 0.0,
-            white: 4000.0,
-            max_valid: 4094.0,
-        },
+        raw: RawFormat { black: 0.0, white: 4000.0, max_valid: 4094.0 },
         defects: DefectList::EMPTY,
         sl0: Sl0Config::DEFAULT,
     };
     let decoder = TileDecoder::<5, 5, 4, 4, 13, 5200>::new(config).unwrap();
-    let mut sink = Average {
-        sum: vec![0.0; l.len()],
-        count: vec![0; l.len()],
-    };
+    let mut sink = Average { sum: vec![0.0; l.len()], count: vec![0; l.len()] };
     let mut ws = Box::new(PaperWorkspace::new());
-    let r = decoder.decode_frame(
-        &Dictionary::dct(),
-        (1, 2),
-        &mut FrameSource::new(&raw),
-        &mut sink,
-        &mut ws,
-    );
-    assert_eq!(
-        (r.failed_tiles, r.patches.failed, r.patches.decoded),
-        (0, 0, 16)
-    );
+    let r = decoder.decode_frame(&Dictionary::dct(), (1, 2), &mut FrameSource::new(&raw), &mut sink, &mut ws);
+    assert_eq!((r.failed_tiles, r.patches.failed, r.patches.decoded), (0, 0, 16));
     // Every view of every lenslet is covered by at least one window.
     assert!(sink.count.iter().all(|&c| c >= 1));
     let mse = sink
@@ -139,19 +109,11 @@ fn pixel_mask_decodes_a_frame_far_better_than_the_kronecker_mask() {
     let lenslet = decode_psnr(&l, Mask::lenslet(1, 3, 13, L5).unwrap());
     let pixel = decode_psnr(&l, Mask::pixel(1, 3, 13, L5).unwrap());
     let all = decode_psnr(&l, Mask::pixel(1, 13, 13, L5).unwrap());
-    eprintln!(
-        "PSNR k=3: kronecker {kron:.2} dB, lenslet {lenslet:.2} dB, pixel {pixel:.2} dB; k=13 {all:.2} dB"
-    );
+    eprintln!("PSNR k=3: kronecker {kron:.2} dB, lenslet {lenslet:.2} dB, pixel {pixel:.2} dB; k=13 {all:.2} dB");
     // k = 13 is limited only by 12-bit-ish quantisation (1/8000 of the peak: ~78 dB).
     assert!(all > 70.0, "k = 13: {all:.2} dB");
     // DESIGN.md section 3: per-pixel masks decode far better than one band per patch.
-    assert!(
-        pixel > kron + 6.0,
-        "pixel {pixel:.2} dB vs kronecker {kron:.2} dB"
-    );
-    assert!(
-        pixel > lenslet,
-        "pixel {pixel:.2} dB vs lenslet {lenslet:.2} dB"
-    );
+    assert!(pixel > kron + 6.0, "pixel {pixel:.2} dB vs kronecker {kron:.2} dB");
+    assert!(pixel > lenslet, "pixel {pixel:.2} dB vs lenslet {lenslet:.2} dB");
     assert!(pixel > 30.0, "pixel {pixel:.2} dB");
 }

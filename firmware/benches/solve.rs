@@ -5,10 +5,7 @@
 //! the core's f32 FMA peak: `macs / time / peak`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use slf_firmware::{
-    Dictionary, LensletSize, Mask, PaperShape, PaperWorkspace, Sl0Config, analyze, solve,
-    synthesize,
-};
+use slf_firmware::{Dictionary, LensletSize, Mask, PaperShape, PaperWorkspace, Sl0Config, analyze, solve, synthesize};
 use std::hint::black_box;
 
 const L5: LensletSize = LensletSize { rows: 5, cols: 5 };
@@ -43,12 +40,8 @@ fn benches(c: &mut Criterion) {
 
     let mut a = Box::new([0.5f32; 5200]);
     let mut b = Box::new([0.0f32; 5200]);
-    c.bench_function("synthesize 5x5x4x4x13", |bench| {
-        bench.iter(|| synthesize(&dict, black_box(&mut a), &mut b))
-    });
-    c.bench_function("analyze 5x5x4x4x13", |bench| {
-        bench.iter(|| analyze(&dict, black_box(&mut b), &mut a))
-    });
+    c.bench_function("synthesize 5x5x4x4x13", |bench| bench.iter(|| synthesize(&dict, black_box(&mut a), &mut b)));
+    c.bench_function("analyze 5x5x4x4x13", |bench| bench.iter(|| analyze(&dict, black_box(&mut b), &mut a)));
     eprintln!("transform: {macs} multiply-adds");
 
     for k in [1u8, 3] {

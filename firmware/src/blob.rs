@@ -50,11 +50,7 @@ const PAYLOAD_LEN_AT: usize = 20;
 
 /// Bytes of one member of a `PS x PT x PU x PV x B` dictionary.
 pub const fn member_len(dims: [usize; 5]) -> usize {
-    4 * (dims[0] * dims[0]
-        + dims[1] * dims[1]
-        + dims[2] * dims[2]
-        + dims[3] * dims[3]
-        + dims[4] * dims[4])
+    4 * (dims[0] * dims[0] + dims[1] * dims[1] + dims[2] * dims[2] + dims[3] * dims[3] + dims[4] * dims[4])
 }
 
 /// Total bytes of a blob of `members` members.
@@ -95,14 +91,7 @@ fn write_matrix<const D: usize>(m: &Matrix<D>, out: &mut [u8]) -> usize {
 
 /// A validated blob of K >= 1 members, read in place from flash.
 #[derive(Clone, Copy, Debug)]
-pub struct Ensemble<
-    'a,
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-> {
+pub struct Ensemble<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> {
     payload: &'a [u8],
     members: u16,
 }
@@ -146,10 +135,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let payload_len = members as usize * Self::MEMBER_LEN;
         let expected = HEADER_LEN + payload_len + CHECKSUM_LEN;
         if u32_at(blob, PAYLOAD_LEN_AT) as usize != payload_len || len != expected {
-            return Err(DictionaryError::LengthMismatch {
-                expected: expected as u32,
-                found: len as u32,
-            });
+            return Err(DictionaryError::LengthMismatch { expected: expected as u32, found: len as u32 });
         }
         let body_len = len - CHECKSUM_LEN;
         let stored = u32_at(blob, body_len);
@@ -157,10 +143,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         if stored != computed {
             return Err(DictionaryError::Checksum { stored, computed });
         }
-        let ensemble = Self {
-            payload: blob.get(HEADER_LEN..body_len).unwrap_or(&[]),
-            members,
-        };
+        let ensemble = Self { payload: blob.get(HEADER_LEN..body_len).unwrap_or(&[]), members };
         for m in 0..members {
             ensemble.factors(m).validate(m)?;
         }
@@ -179,10 +162,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
 
     fn factors(&self, member: u16) -> Factors<PS, PT, PU, PV, B> {
         let start = member as usize * Self::MEMBER_LEN;
-        let bytes = self
-            .payload
-            .get(start..start + Self::MEMBER_LEN)
-            .unwrap_or(&[]);
+        let bytes = self.payload.get(start..start + Self::MEMBER_LEN).unwrap_or(&[]);
         let mut at = 0;
         let mut next = |n: usize| {
             let s = bytes.get(at..at + 4 * n * n).unwrap_or(&[]);
@@ -213,9 +193,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     }
 }
 
-impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>
-    Dictionary<PS, PT, PU, PV, B>
-{
+impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> Dictionary<PS, PT, PU, PV, B> {
     /// Reads a blob that holds exactly one member.
     ///
     /// # Errors
@@ -234,27 +212,17 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
 /// # Errors
 /// [`DictionaryError::MemberCount`] for no members (or more than 65535),
 /// [`DictionaryError::BufferTooSmall`] when `out` is shorter than [`blob_len`].
-pub fn write_blob<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
->(
+pub fn write_blob<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
     members: &[Dictionary<PS, PT, PU, PV, B>],
     out: &mut [u8],
 ) -> Result<usize, DictionaryError> {
     let dims = [PS, PT, PU, PV, B];
     if members.is_empty() || members.len() > u16::MAX as usize {
-        return Err(DictionaryError::MemberCount {
-            found: members.len().min(u16::MAX as usize) as u16,
-        });
+        return Err(DictionaryError::MemberCount { found: members.len().min(u16::MAX as usize) as u16 });
     }
     let total = blob_len(dims, members.len());
     let Some(out) = out.get_mut(..total) else {
-        return Err(DictionaryError::BufferTooSmall {
-            needed: total as u32,
-        });
+        return Err(DictionaryError::BufferTooSmall { needed: total as u32 });
     };
     out.fill(0);
     let (header, rest) = out.split_at_mut(HEADER_LEN);

@@ -94,59 +94,27 @@ pub struct ModelOutcome {
 
 /// Something that decodes the patch in a workspace: a single [`Dictionary`] or an
 /// [`EnsembleModel`]. The tile decoder takes either.
-pub trait PatchModel<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
->
+pub trait PatchModel<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
 {
     /// Decodes the patch whose measurements are in `ws` into `ws.patch()`.
     ///
     /// # Errors
     /// As [`solve`].
-    fn decode(
-        &self,
-        cfg: &Sl0Config,
-        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
-    ) -> Result<ModelOutcome, SolveError>;
+    fn decode(&self, cfg: &Sl0Config, ws: &mut Workspace<PS, PT, PU, PV, B, N>) -> Result<ModelOutcome, SolveError>;
 }
 
-impl<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
-> PatchModel<PS, PT, PU, PV, B, N> for Dictionary<PS, PT, PU, PV, B>
+impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
+    PatchModel<PS, PT, PU, PV, B, N> for Dictionary<PS, PT, PU, PV, B>
 {
-    fn decode(
-        &self,
-        cfg: &Sl0Config,
-        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
-    ) -> Result<ModelOutcome, SolveError> {
+    fn decode(&self, cfg: &Sl0Config, ws: &mut Workspace<PS, PT, PU, PV, B, N>) -> Result<ModelOutcome, SolveError> {
         let outcome = solve(self, cfg, ws)?;
-        Ok(ModelOutcome {
-            outcome,
-            member: None,
-            solves: 1,
-        })
+        Ok(ModelOutcome { outcome, member: None, solves: 1 })
     }
 }
 
 /// An ensemble with its member choice. Config: immutable, the blob stays in flash.
 #[derive(Clone, Debug)]
-pub struct EnsembleModel<
-    'a,
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-> {
+pub struct EnsembleModel<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> {
     ensemble: Ensemble<'a, PS, PT, PU, PV, B>,
     screen: Dictionary<PS, PT, PU, PV, B>,
     choice: MemberChoice,
@@ -157,11 +125,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
 {
     /// An ensemble that screens with the 5D DCT.
     pub fn new(ensemble: Ensemble<'a, PS, PT, PU, PV, B>, choice: MemberChoice) -> Self {
-        Self {
-            ensemble,
-            screen: Dictionary::dct(),
-            choice,
-        }
+        Self { ensemble, screen: Dictionary::dct(), choice }
     }
 
     /// The ensemble.
@@ -201,10 +165,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     ) -> Result<u16, SolveError> {
         let mut best = (f32::INFINITY, 0u16);
         for k in 0..self.ensemble.len() {
-            let member = self
-                .ensemble
-                .member(k)
-                .map_err(|_| SolveError::NoSuchMember)?;
+            let member = self.ensemble.member(k).map_err(|_| SolveError::NoSuchMember)?;
             solve_each(&member, ws)?;
             let s = self.score(&member, rule, ws);
             if s < best.0 || k == 0 {
@@ -215,40 +176,20 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     }
 }
 
-impl<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
-> PatchModel<PS, PT, PU, PV, B, N> for EnsembleModel<'_, PS, PT, PU, PV, B>
+impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
+    PatchModel<PS, PT, PU, PV, B, N> for EnsembleModel<'_, PS, PT, PU, PV, B>
 {
-    fn decode(
-        &self,
-        cfg: &Sl0Config,
-        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
-    ) -> Result<ModelOutcome, SolveError> {
+    fn decode(&self, cfg: &Sl0Config, ws: &mut Workspace<PS, PT, PU, PV, B, N>) -> Result<ModelOutcome, SolveError> {
         let k = self.ensemble.len() as u16;
         let (member, solves) = match self.choice {
-            MemberChoice::Exhaustive(rule) => (
-                self.best(&rule, ws, |m, ws| solve(m, cfg, ws).map(|_| ()))?,
-                k + 1,
-            ),
+            MemberChoice::Exhaustive(rule) => (self.best(&rule, ws, |m, ws| solve(m, cfg, ws).map(|_| ()))?, k + 1),
             MemberChoice::Screened(rule) => {
                 solve(&self.screen, cfg, ws)?;
                 (self.best(&rule, ws, |_, _| Ok(()))?, 2)
             }
         };
-        let dict = self
-            .ensemble
-            .member(member as usize)
-            .map_err(|_| SolveError::NoSuchMember)?;
+        let dict = self.ensemble.member(member as usize).map_err(|_| SolveError::NoSuchMember)?;
         let outcome = solve(&dict, cfg, ws)?;
-        Ok(ModelOutcome {
-            outcome,
-            member: Some(member),
-            solves,
-        })
+        Ok(ModelOutcome { outcome, member: Some(member), solves })
     }
 }

@@ -25,9 +25,7 @@ impl<'a> DefectList<'a> {
     /// [`SensingError::DefectsUnsorted`] if the list is not strictly increasing.
     pub fn new(pixels: &'a [Pixel]) -> Result<Self, SensingError> {
         if let Some(i) = pixels.windows(2).position(|w| w[0] >= w[1]) {
-            return Err(SensingError::DefectsUnsorted {
-                index: i as u32 + 1,
-            });
+            return Err(SensingError::DefectsUnsorted { index: i as u32 + 1 });
         }
         Ok(Self { pixels })
     }

@@ -58,23 +58,19 @@ impl fmt::Display for DictionaryError {
             Self::UnsupportedVersion { found } => {
                 write!(f, "unsupported dictionary blob version {found}")
             }
-            Self::ReservedNotZero => {
-                f.write_str("dictionary blob header has a non-zero reserved field")
-            }
+            Self::ReservedNotZero => f.write_str("dictionary blob header has a non-zero reserved field"),
             Self::ShapeMismatch { found } => write!(
                 f,
                 "dictionary blob is for patches of {}x{}x{}x{}x{}, not this decoder's",
                 found[0], found[1], found[2], found[3], found[4]
             ),
             Self::MemberCount { found } => write!(f, "dictionary blob has {found} members"),
-            Self::LengthMismatch { expected, found } => write!(
-                f,
-                "dictionary blob is {found} bytes, its header implies {expected}"
-            ),
-            Self::Checksum { stored, computed } => write!(
-                f,
-                "dictionary blob checksum mismatch (stored {stored:#010x}, computed {computed:#010x})"
-            ),
+            Self::LengthMismatch { expected, found } => {
+                write!(f, "dictionary blob is {found} bytes, its header implies {expected}")
+            }
+            Self::Checksum { stored, computed } => {
+                write!(f, "dictionary blob checksum mismatch (stored {stored:#010x}, computed {computed:#010x})")
+            }
             Self::NonFinite { member, mode } => {
                 write!(f, "member {member} mode {mode} holds a non-finite value")
             }
@@ -95,13 +91,7 @@ impl core::error::Error for DictionaryError {}
 
 /// Five matrices, one per mode: the dimensions of a patch in the types.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Factors<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-> {
+pub struct Factors<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> {
     pub m1: Matrix<PS>,
     pub m2: Matrix<PT>,
     pub m3: Matrix<PU>,
@@ -109,9 +99,7 @@ pub struct Factors<
     pub m5: Matrix<B>,
 }
 
-impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>
-    Factors<PS, PT, PU, PV, B>
-{
+impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> Factors<PS, PT, PU, PV, B> {
     /// Every matrix transposed.
     pub const fn transposed(&self) -> Self {
         Self {
@@ -154,15 +142,8 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
         if let Some(mode) = self.first_non_finite() {
             return Err(DictionaryError::NonFinite { member, mode });
         }
-        match self
-            .orthonormality_errors()
-            .iter()
-            .position(|&e| e.is_nan() || e > ORTHONORMAL_TOLERANCE)
-        {
-            Some(i) => Err(DictionaryError::NotOrthonormal {
-                member,
-                mode: i as u8 + 1,
-            }),
+        match self.orthonormality_errors().iter().position(|&e| e.is_nan() || e > ORTHONORMAL_TOLERANCE) {
+            Some(i) => Err(DictionaryError::NotOrthonormal { member, mode: i as u8 + 1 }),
             None => Ok(()),
         }
     }
@@ -201,22 +182,14 @@ pub fn orthonormality_error<const D: usize>(m: &Matrix<D>) -> f32 {
 
 /// One member of the signal model: an orthonormal matrix per mode, with its transposes.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Dictionary<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-> {
+pub struct Dictionary<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> {
     /// `D_i`: synthesis matrices (columns are atoms).
     pub(crate) d: Factors<PS, PT, PU, PV, B>,
     /// `D_i^T`: analysis matrices.
     pub(crate) t: Factors<PS, PT, PU, PV, B>,
 }
 
-impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>
-    Dictionary<PS, PT, PU, PV, B>
-{
+impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> Dictionary<PS, PT, PU, PV, B> {
     /// The separable orthonormal 5D DCT; a `const fn`, so a `static` of it is a flash table.
     pub const fn dct() -> Self {
         // Synthesis is the inverse DCT: D_i = C^T (columns of D_i are the cosine atoms).
@@ -227,10 +200,7 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
             m4: dct_matrix::<PV>(),
             m5: dct_matrix::<B>(),
         };
-        Self {
-            d: c.transposed(),
-            t: c,
-        }
+        Self { d: c.transposed(), t: c }
     }
 
     /// A dictionary from its synthesis matrices `D_1..D_5`.

@@ -97,8 +97,8 @@ pub use raw::{FrameSource, RawFormat, RawFrame};
 pub use shape::{FullViewShape, PaperShape, PatchShape};
 pub use sl0::{Ended, Outcome, Sl0Config, SolveError, solve};
 pub use tile::{
-    ConfigError, DecoderConfig, PatchFlags, PatchOrigin, PatchReport, PatchSink, SensorGeometry,
-    Tile, TileDecoder, TileError, TileReport, TileSource,
+    ConfigError, DecoderConfig, PatchFlags, PatchOrigin, PatchReport, PatchSink, SensorGeometry, Tile, TileDecoder,
+    TileError, TileReport, TileSource,
 };
 pub use transform::{analyze, synthesize};
 pub use workspace::{Measurements, PaperWorkspace, Workspace};

@@ -13,9 +13,7 @@ mod device {
     use cortex_m_rt::entry;
     use cortex_m_semihosting::{debug, hprintln};
     use panic_semihosting as _;
-    use slf_firmware::{
-        Dictionary, LensletSize, Mask, PaperShape, PaperWorkspace, Sl0Config, solve,
-    };
+    use slf_firmware::{Dictionary, LensletSize, Mask, PaperShape, PaperWorkspace, Sl0Config, solve};
 
     /// The 5D DCT: a compile-time table in flash.
     static DCT: Dictionary<5, 5, 4, 4, 13> = Dictionary::dct();
@@ -52,19 +50,9 @@ mod device {
         }
         match solve(&DCT, &Sl0Config::DEFAULT, ws) {
             Ok(outcome) => {
-                let sum = ws
-                    .patch()
-                    .iter()
-                    .fold(0u32, |h, x| h.rotate_left(5) ^ x.to_bits());
-                let worst = (0..5200)
-                    .map(|i| (ws.patch()[i] - truth(i)).abs())
-                    .fold(0.0f32, f32::max);
-                hprintln!(
-                    "steps {} checksum {:#010x} max-error-e6 {}",
-                    outcome.iterations,
-                    sum,
-                    (worst * 1e6) as u32
-                );
+                let sum = ws.patch().iter().fold(0u32, |h, x| h.rotate_left(5) ^ x.to_bits());
+                let worst = (0..5200).map(|i| (ws.patch()[i] - truth(i)).abs()).fold(0.0f32, f32::max);
+                hprintln!("steps {} checksum {:#010x} max-error-e6 {}", outcome.iterations, sum, (worst * 1e6) as u32);
                 debug::EXIT_SUCCESS
             }
             Err(_) => debug::EXIT_FAILURE,

@@ -67,10 +67,9 @@ pub enum SensingError {
 impl fmt::Display for SensingError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match *self {
-            Self::Snapshots { snapshots, bands } => write!(
-                f,
-                "{snapshots} snapshots with {bands} bands (need 1..=bands distinct bands per pixel)"
-            ),
+            Self::Snapshots { snapshots, bands } => {
+                write!(f, "{snapshots} snapshots with {bands} bands (need 1..=bands distinct bands per pixel)")
+            }
             Self::Bands { bands } => write!(f, "{bands} bands (need 1..={MAX_BANDS})"),
             Self::EmptySize => f.write_str("a lenslet, block or tile size is zero"),
             Self::TileLength { expected, found } => {
@@ -80,10 +79,7 @@ impl fmt::Display for SensingError {
                 write!(f, "band {band} out of range at tile cell ({row}, {col})")
             }
             Self::RepeatedBand { band, row, col } => {
-                write!(
-                    f,
-                    "band {band} repeated across snapshots at tile cell ({row}, {col})"
-                )
+                write!(f, "band {band} repeated across snapshots at tile cell ({row}, {col})")
             }
             Self::NotKronecker => f.write_str("not a kronecker mask"),
             Self::BlockMismatch => f.write_str("patch block differs from the kronecker mask's"),
@@ -123,13 +119,7 @@ pub struct BandTile<'a> {
 impl<'a> BandTile<'a> {
     /// # Errors
     /// [`SensingError`] for a zero size, a wrong length, an out-of-range or repeated band.
-    pub fn new(
-        rows: u16,
-        cols: u16,
-        snapshots: u8,
-        band_count: u8,
-        bands: &'a [u8],
-    ) -> Result<Self, SensingError> {
+    pub fn new(rows: u16, cols: u16, snapshots: u8, band_count: u8, bands: &'a [u8]) -> Result<Self, SensingError> {
         check_counts(snapshots, band_count)?;
         if rows == 0 || cols == 0 {
             return Err(SensingError::EmptySize);
@@ -137,10 +127,7 @@ impl<'a> BandTile<'a> {
         let cells = rows as usize * cols as usize;
         let expected = cells * snapshots as usize;
         if bands.len() != expected {
-            return Err(SensingError::TileLength {
-                expected: expected as u32,
-                found: bands.len() as u32,
-            });
+            return Err(SensingError::TileLength { expected: expected as u32, found: bands.len() as u32 });
         }
         for cell in 0..cells {
             let (row, col) = ((cell / cols as usize) as u16, (cell % cols as usize) as u16);
@@ -156,12 +143,7 @@ impl<'a> BandTile<'a> {
                 seen |= 1 << band;
             }
         }
-        Ok(Self {
-            rows,
-            cols,
-            snapshots,
-            bands,
-        })
+        Ok(Self { rows, cols, snapshots, bands })
     }
 
     fn bands_at(&self, row: usize, col: usize) -> BandList {
@@ -259,12 +241,7 @@ impl<'a> Mask<'a> {
     ///
     /// # Errors
     /// [`SensingError`] for bad counts or an empty lenslet.
-    pub fn pixel(
-        seed: u64,
-        snapshots: u8,
-        bands: u8,
-        lenslet: LensletSize,
-    ) -> Result<Self, SensingError> {
+    pub fn pixel(seed: u64, snapshots: u8, bands: u8, lenslet: LensletSize) -> Result<Self, SensingError> {
         Self::seeded(MaskFamily::Pixel, seed, snapshots, bands, lenslet, (1, 1))
     }
 
@@ -272,12 +249,7 @@ impl<'a> Mask<'a> {
     ///
     /// # Errors
     /// [`SensingError`] for bad counts or an empty lenslet.
-    pub fn lenslet(
-        seed: u64,
-        snapshots: u8,
-        bands: u8,
-        lenslet: LensletSize,
-    ) -> Result<Self, SensingError> {
+    pub fn lenslet(seed: u64, snapshots: u8, bands: u8, lenslet: LensletSize) -> Result<Self, SensingError> {
         Self::seeded(MaskFamily::Lenslet, seed, snapshots, bands, lenslet, (1, 1))
     }
 
@@ -296,14 +268,7 @@ impl<'a> Mask<'a> {
         if block.0 == 0 || block.1 == 0 {
             return Err(SensingError::EmptySize);
         }
-        Self::seeded(
-            MaskFamily::Kronecker,
-            seed,
-            snapshots,
-            bands,
-            lenslet,
-            block,
-        )
+        Self::seeded(MaskFamily::Kronecker, seed, snapshots, bands, lenslet, block)
     }
 
     fn seeded(
@@ -316,25 +281,14 @@ impl<'a> Mask<'a> {
     ) -> Result<Self, SensingError> {
         check_counts(snapshots, bands)?;
         check_lenslet(lenslet)?;
-        Ok(Self {
-            family,
-            pattern: Pattern::Seeded(seed),
-            snapshots,
-            bands,
-            lenslet,
-            block,
-        })
+        Ok(Self { family, pattern: Pattern::Seeded(seed), snapshots, bands, lenslet, block })
     }
 
     /// `pixel` family from an explicit tile whose period is in sensor pixels.
     ///
     /// # Errors
     /// [`SensingError::EmptySize`] for an empty lenslet.
-    pub fn pixel_tile(
-        tile: BandTile<'a>,
-        bands: u8,
-        lenslet: LensletSize,
-    ) -> Result<Self, SensingError> {
+    pub fn pixel_tile(tile: BandTile<'a>, bands: u8, lenslet: LensletSize) -> Result<Self, SensingError> {
         Self::tiled(MaskFamily::Pixel, tile, bands, lenslet)
     }
 
@@ -342,32 +296,16 @@ impl<'a> Mask<'a> {
     ///
     /// # Errors
     /// [`SensingError::EmptySize`] for an empty lenslet.
-    pub fn lenslet_tile(
-        tile: BandTile<'a>,
-        bands: u8,
-        lenslet: LensletSize,
-    ) -> Result<Self, SensingError> {
+    pub fn lenslet_tile(tile: BandTile<'a>, bands: u8, lenslet: LensletSize) -> Result<Self, SensingError> {
         Self::tiled(MaskFamily::Lenslet, tile, bands, lenslet)
     }
 
-    fn tiled(
-        family: MaskFamily,
-        tile: BandTile<'a>,
-        bands: u8,
-        lenslet: LensletSize,
-    ) -> Result<Self, SensingError> {
+    fn tiled(family: MaskFamily, tile: BandTile<'a>, bands: u8, lenslet: LensletSize) -> Result<Self, SensingError> {
         check_counts(tile.snapshots, bands)?;
         check_lenslet(lenslet)?;
         // The tile was checked against its own band count; re-check against this one.
         let tile = BandTile::new(tile.rows, tile.cols, tile.snapshots, bands, tile.bands)?;
-        Ok(Self {
-            family,
-            pattern: Pattern::Tile(tile),
-            snapshots: tile.snapshots,
-            bands,
-            lenslet,
-            block: (1, 1),
-        })
+        Ok(Self { family, pattern: Pattern::Tile(tile), snapshots: tile.snapshots, bands, lenslet, block: (1, 1) })
     }
 
     /// The mask family.
@@ -400,21 +338,14 @@ impl<'a> Mask<'a> {
 
     /// The `k` distinct bands sensor pixel `(row, col)` sees, in snapshot order.
     pub fn bands_at(&self, row: usize, col: usize) -> BandList {
-        let (lr, lc) = (
-            row / self.lenslet.rows as usize,
-            col / self.lenslet.cols as usize,
-        );
+        let (lr, lc) = (row / self.lenslet.rows as usize, col / self.lenslet.cols as usize);
         let k = self.snapshots as usize;
         let n = self.bands as usize;
         match (self.pattern, self.family) {
             (Pattern::Tile(t), MaskFamily::Pixel) => t.bands_at(row, col),
             (Pattern::Tile(t), _) => t.bands_at(lr, lc),
-            (Pattern::Seeded(seed), MaskFamily::Pixel) => {
-                Stream::new(seed, TAG_PIXEL, row, col).distinct(k, n)
-            }
-            (Pattern::Seeded(seed), MaskFamily::Lenslet) => {
-                Stream::new(seed, TAG_LENSLET, lr, lc).distinct(k, n)
-            }
+            (Pattern::Seeded(seed), MaskFamily::Pixel) => Stream::new(seed, TAG_PIXEL, row, col).distinct(k, n),
+            (Pattern::Seeded(seed), MaskFamily::Lenslet) => Stream::new(seed, TAG_LENSLET, lr, lc).distinct(k, n),
             (Pattern::Seeded(seed), MaskFamily::Kronecker) => {
                 let (br, bc) = (lr / self.block.0 as usize, lc / self.block.1 as usize);
                 Stream::new(seed, TAG_BLOCK, br, bc).distinct(k, n)

@@ -61,13 +61,7 @@ fn shuffled_rows<const D: usize>(d: &Matrix<D>, shuffle: &[u8; D]) -> Matrix<D> 
 /// The operators `A_i = Phi_i D_i` and their pseudo-inverses for one kronecker block.
 /// Config: built once, used for every patch the block's `Phi` describes.
 #[derive(Clone, Debug)]
-pub struct PinvOperator<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-> {
+pub struct PinvOperator<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> {
     a: Factors<PS, PT, PU, PV, B>,
     a_pinv: Factors<PS, PT, PU, PV, B>,
     phi: KroneckerPhi<PS, PT, PU, PV>,
@@ -81,10 +75,7 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
     ///
     /// # Errors
     /// [`SolveError::PseudoInverse`] if an SVD does not converge.
-    pub fn new(
-        dict: &Dictionary<PS, PT, PU, PV, B>,
-        phi: &KroneckerPhi<PS, PT, PU, PV>,
-    ) -> Result<Self, SolveError> {
+    pub fn new(dict: &Dictionary<PS, PT, PU, PV, B>, phi: &KroneckerPhi<PS, PT, PU, PV>) -> Result<Self, SolveError> {
         let d = &dict.d;
         let mut a5 = [[0.0f32; B]; B];
         for (row, &band) in a5.iter_mut().zip(&phi.bands) {
@@ -104,12 +95,7 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
             m4: pseudo_inverse(&a.m4, 4)?,
             m5: pseudo_inverse(&a.m5, 5)?,
         };
-        Ok(Self {
-            a,
-            a_pinv,
-            phi: phi.clone(),
-            dict: dict.clone(),
-        })
+        Ok(Self { a, a_pinv, phi: phi.clone(), dict: dict.clone() })
     }
 
     /// [`PatchShape::index`] (which does not depend on `N`).
@@ -126,12 +112,8 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
                 for (u, &pu) in p.shuffle3.iter().enumerate() {
                     for (v, &pv) in p.shuffle4.iter().enumerate() {
                         for (j, &band) in p.bands.iter().enumerate() {
-                            let (ps, pt, pu, pv) =
-                                (ps as usize, pt as usize, pu as usize, pv as usize);
-                            f(
-                                Self::index(s, t, u, v, j),
-                                Self::index(ps, pt, pu, pv, band as usize),
-                            );
+                            let (ps, pt, pu, pv) = (ps as usize, pt as usize, pu as usize, pv as usize);
+                            f(Self::index(s, t, u, v, j), Self::index(ps, pt, pu, pv, band as usize));
                         }
                     }
                 }
@@ -140,12 +122,7 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
     }
 
     /// `t -= I` (or `t = I` with `assign`); `I` read from the measurements.
-    fn subtract_measurements<const N: usize>(
-        &self,
-        m: &Measurements<N>,
-        t: &mut [f32; N],
-        assign: bool,
-    ) {
+    fn subtract_measurements<const N: usize>(&self, m: &Measurements<N>, t: &mut [f32; N], assign: bool) {
         self.for_each_selected(|i, e| {
             let y = m.values.get(e).copied().unwrap_or(0.0);
             if let Some(x) = t.get_mut(i) {
@@ -173,11 +150,7 @@ pub fn solve_pinv<
     cfg: &Sl0Config,
     ws: &mut Workspace<PS, PT, PU, PV, B, N>,
 ) -> Result<Outcome, SolveError> {
-    let Workspace {
-        coeffs,
-        signal,
-        measurements: m,
-    } = ws;
+    let Workspace { coeffs, signal, measurements: m } = ws;
     let eps = start(cfg, m)?;
     let mut complete = true;
     op.for_each_selected(|_, e| complete &= m.measured.get(e).copied().unwrap_or(false));

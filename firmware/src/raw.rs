@@ -24,20 +24,12 @@ pub struct RawFormat {
 
 impl RawFormat {
     /// Samples already normalised: black 0, white 1, anything up to 1 valid.
-    pub const NORMALISED: Self = Self {
-        black: 0.0,
-        white: 1.0,
-        max_valid: 1.0,
-    };
+    pub const NORMALISED: Self = Self { black: 0.0, white: 1.0, max_valid: 1.0 };
 
     /// A `bits`-bit sensor with the given black level; the top code is saturated.
     pub fn bits(bits: u8, black: f32) -> Self {
         let top = ((1u32 << bits.clamp(1, 24)) - 1) as f32;
-        Self {
-            black,
-            white: top,
-            max_valid: top - 1.0,
-        }
+        Self { black, white: top, max_valid: top - 1.0 }
     }
 
     /// Whether the format can normalise anything: finite, `white > black`, `max_valid >= 0`.
@@ -163,20 +155,10 @@ impl<'a, T: Sample> FrameSource<'a, T> {
 impl<T: Sample> TileSource for FrameSource<'_, T> {
     type Error = ReadError;
 
-    fn read(
-        &mut self,
-        snapshot: usize,
-        row: usize,
-        col: usize,
-        out: &mut [f32],
-    ) -> Result<(), ReadError> {
-        let frame = self.frames.get(snapshot).ok_or(ReadError::NoSuchSnapshot {
-            snapshot: snapshot.min(255) as u8,
-        })?;
-        let oob = ReadError::OutOfBounds {
-            row: row.min(u32::MAX as usize) as u32,
-            col: col.min(u32::MAX as usize) as u32,
-        };
+    fn read(&mut self, snapshot: usize, row: usize, col: usize, out: &mut [f32]) -> Result<(), ReadError> {
+        let frame = self.frames.get(snapshot).ok_or(ReadError::NoSuchSnapshot { snapshot: snapshot.min(255) as u8 })?;
+        let oob =
+            ReadError::OutOfBounds { row: row.min(u32::MAX as usize) as u32, col: col.min(u32::MAX as usize) as u32 };
         if row >= frame.rows || col.saturating_add(out.len()) > frame.cols {
             return Err(oob);
         }

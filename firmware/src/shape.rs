@@ -20,14 +20,8 @@ pub struct PatchShape<
     const N: usize,
 >;
 
-impl<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
-> PatchShape<PS, PT, PU, PV, B, N>
+impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
+    PatchShape<PS, PT, PU, PV, B, N>
 {
     /// Sensor pixels of one patch (`PS * PT * PU * PV`).
     pub const PIXELS: usize = PS * PT * PU * PV;
@@ -40,19 +34,10 @@ impl<
 
     /// Compile-time check that the sizes agree; evaluated by every constructor.
     pub const CHECK: () = {
-        assert!(
-            PS > 0 && PT > 0 && PU > 0 && PV > 0 && B > 0,
-            "patch dimensions must be positive"
-        );
-        assert!(
-            N == PS * PT * PU * PV * B,
-            "N must equal PS * PT * PU * PV * B"
-        );
+        assert!(PS > 0 && PT > 0 && PU > 0 && PV > 0 && B > 0, "patch dimensions must be positive");
+        assert!(N == PS * PT * PU * PV * B, "N must equal PS * PT * PU * PV * B");
         assert!(B <= MAX_BANDS, "at most MAX_BANDS bands");
-        assert!(
-            N <= u16::MAX as usize,
-            "a patch must have at most 65535 values"
-        );
+        assert!(N <= u16::MAX as usize, "a patch must have at most 65535 values");
     };
 
     /// Index of entry `(s, t, u, v, b)` in a patch buffer.

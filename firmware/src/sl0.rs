@@ -49,14 +49,8 @@ impl Sl0Config {
     /// The defaults: `sigma_f = 0.7`, `L = 3`, `mu = 2`, `sigma_min = 1e-3`, at most 300
     /// steps, exact projection. The start is `sigma0 = max |S0|` of the minimum-norm
     /// solution `S0`; from a patch of mean brightness 0.5 that is about 20 levels (60 steps).
-    pub const DEFAULT: Self = Self {
-        sigma_f: 0.7,
-        steps: 3,
-        mu: 2.0,
-        sigma_min: 1e-3,
-        max_iterations: 300,
-        noise: 0.0,
-    };
+    pub const DEFAULT: Self =
+        Self { sigma_f: 0.7, steps: 3, mu: 2.0, sigma_min: 1e-3, max_iterations: 300, noise: 0.0 };
 
     /// Checks every field's range.
     ///
@@ -219,10 +213,7 @@ fn project<const N: usize>(x: &mut [f32; N], m: &Measurements<N>, eps: f32) -> f
 
 /// The checks both projection paths start with; returns the noise-ball radius
 /// `eps = noise * sqrt(m)` (0 for exact projection).
-pub(crate) fn start<const N: usize>(
-    cfg: &Sl0Config,
-    m: &Measurements<N>,
-) -> Result<f32, SolveError> {
+pub(crate) fn start<const N: usize>(cfg: &Sl0Config, m: &Measurements<N>) -> Result<f32, SolveError> {
     cfg.validate()?;
     if m.count == 0 {
         return Err(SolveError::NoMeasurements);
@@ -233,18 +224,8 @@ pub(crate) fn start<const N: usize>(
 /// The sigma schedule of Algorithm 1, shared by both projection paths: runs `step` (one
 /// ascent + projection, returning the residual) `L` times per level until `sigma_min`, the
 /// iteration bound, or sigma underflow.
-pub(crate) fn run_schedule(
-    cfg: &Sl0Config,
-    sigma0: f32,
-    mut step: impl FnMut(f32) -> f32,
-) -> Outcome {
-    let mut out = Outcome {
-        iterations: 0,
-        levels: 0,
-        sigma0,
-        residual: 0.0,
-        ended: Ended::SigmaMin,
-    };
+pub(crate) fn run_schedule(cfg: &Sl0Config, sigma0: f32, mut step: impl FnMut(f32) -> f32) -> Outcome {
+    let mut out = Outcome { iterations: 0, levels: 0, sigma0, residual: 0.0, ended: Ended::SigmaMin };
     let mut sigma = sigma0;
     out.ended = 'levels: loop {
         if sigma.is_nan() || sigma <= cfg.sigma_min {
@@ -274,23 +255,12 @@ pub(crate) fn run_schedule(
 /// # Errors
 /// [`SolveError::InvalidConfig`], [`SolveError::NoMeasurements`], or
 /// [`SolveError::NonFiniteResult`] (then `ws.patch()` is not a decode).
-pub fn solve<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
->(
+pub fn solve<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
     dict: &Dictionary<PS, PT, PU, PV, B>,
     cfg: &Sl0Config,
     ws: &mut Workspace<PS, PT, PU, PV, B, N>,
 ) -> Result<Outcome, SolveError> {
-    let Workspace {
-        coeffs,
-        signal,
-        measurements: m,
-    } = ws;
+    let Workspace { coeffs, signal, measurements: m } = ws;
     let eps = start(cfg, m)?;
 
     // Minimum-norm start: S0 = analysis of the measurements, zeros elsewhere.

@@ -38,13 +38,7 @@ pub trait TileSource {
     ///
     /// # Errors
     /// The source's own error; the decoder then abandons the current tile only.
-    fn read(
-        &mut self,
-        snapshot: usize,
-        row: usize,
-        col: usize,
-        out: &mut [f32],
-    ) -> Result<(), Self::Error>;
+    fn read(&mut self, snapshot: usize, row: usize, col: usize, out: &mut [f32]) -> Result<(), Self::Error>;
 }
 
 /// Where decoded patches go.
@@ -56,12 +50,7 @@ pub trait PatchSink<const N: usize> {
     ///
     /// # Errors
     /// The sink's own error; the decoder then abandons the current tile.
-    fn accept(
-        &mut self,
-        origin: PatchOrigin,
-        patch: &[f32; N],
-        report: &PatchReport,
-    ) -> Result<(), Self::Error>;
+    fn accept(&mut self, origin: PatchOrigin, patch: &[f32; N], report: &PatchReport) -> Result<(), Self::Error>;
 
     /// A patch that could not be decoded; the decoder goes on with the next one.
     ///
@@ -85,10 +74,7 @@ pub struct SensorGeometry {
 impl SensorGeometry {
     /// Raw frame rows and columns.
     pub fn frame_size(&self) -> (usize, usize) {
-        (
-            self.lenslets.0 as usize * self.lenslet.rows as usize,
-            self.lenslets.1 as usize * self.lenslet.cols as usize,
-        )
+        (self.lenslets.0 as usize * self.lenslet.rows as usize, self.lenslets.1 as usize * self.lenslet.cols as usize)
     }
 }
 
@@ -220,9 +206,7 @@ impl fmt::Display for ConfigError {
             Self::LensletMismatch => f.write_str("mask and sensor disagree on the lenslet size"),
             Self::PatchViews => f.write_str("patch has more views than a lenslet"),
             Self::BandMismatch => f.write_str("mask and patch disagree on the band count"),
-            Self::BlockMismatch => {
-                f.write_str("kronecker mask block differs from the patch's lenslets")
-            }
+            Self::BlockMismatch => f.write_str("kronecker mask block differs from the patch's lenslets"),
             Self::RawFormat => f.write_str("raw format: need finite levels with white > black"),
             Self::Solver(e) => write!(f, "solver: {e}"),
         }
@@ -313,15 +297,8 @@ fn spans(total: usize, patch: usize, per_tile: usize) -> impl Iterator<Item = (u
     grid.chain(edge)
 }
 
-impl<
-    'a,
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
-> TileDecoder<'a, PS, PT, PU, PV, B, N>
+impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
+    TileDecoder<'a, PS, PT, PU, PV, B, N>
 {
     /// Checks that the parts of `config` agree with each other and with the patch type.
     ///
@@ -329,13 +306,7 @@ impl<
     /// The first [`ConfigError`] found.
     pub fn new(config: DecoderConfig<'a>) -> Result<Self, ConfigError> {
         const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
-        let DecoderConfig {
-            sensor,
-            mask,
-            raw,
-            sl0,
-            ..
-        } = &config;
+        let DecoderConfig { sensor, mask, raw, sl0, .. } = &config;
         if mask.lenslet_size() != sensor.lenslet {
             return Err(ConfigError::LensletMismatch);
         }
@@ -345,9 +316,7 @@ impl<
         if mask.bands() != B {
             return Err(ConfigError::BandMismatch);
         }
-        if mask.family() == MaskFamily::Kronecker
-            && mask.kronecker_phi::<PS, PT, PU, PV>(0, 0).is_err()
-        {
+        if mask.family() == MaskFamily::Kronecker && mask.kronecker_phi::<PS, PT, PU, PV>(0, 0).is_err() {
             return Err(ConfigError::BlockMismatch);
         }
         if !raw.is_valid() {
@@ -374,14 +343,8 @@ impl<
     /// multiple of the patch, one strip of patches aligned to the last lenslet row or
     /// column (overlapping the grid), so every lenslet is covered. Empty if the sensor is
     /// smaller than one patch.
-    pub fn tiles(
-        &self,
-        patches: (u16, u16),
-    ) -> impl Iterator<Item = Tile> + use<'a, PS, PT, PU, PV, B, N> {
-        let (rows, cols) = (
-            self.config.sensor.lenslets.0 as usize,
-            self.config.sensor.lenslets.1 as usize,
-        );
+    pub fn tiles(&self, patches: (u16, u16)) -> impl Iterator<Item = Tile> + use<'a, PS, PT, PU, PV, B, N> {
+        let (rows, cols) = (self.config.sensor.lenslets.0 as usize, self.config.sensor.lenslets.1 as usize);
         let per = (patches.0.max(1) as usize, patches.1.max(1) as usize);
         spans(rows, PS, per.0).flat_map(move |(r0, nr)| {
             spans(cols, PT, per.1).map(move |(c0, nc)| Tile {
@@ -412,10 +375,7 @@ impl<
         ws: &mut Workspace<PS, PT, PU, PV, B, N>,
     ) -> Result<(PatchFlags, u16), S::Error> {
         let c = &self.config;
-        let (lu, lv) = (
-            c.sensor.lenslet.rows as usize,
-            c.sensor.lenslet.cols as usize,
-        );
+        let (lu, lv) = (c.sensor.lenslet.rows as usize, c.sensor.lenslet.cols as usize);
         let k = c.mask.snapshots();
         let m = ws.measurements_mut();
         m.clear();
@@ -438,13 +398,7 @@ impl<
                             continue;
                         }
                         for (band, r) in c.mask.bands_at(row, col).iter().zip(&run) {
-                            let at = PatchShape::<PS, PT, PU, PV, B, N>::index(
-                                s,
-                                t,
-                                u,
-                                v,
-                                *band as usize,
-                            );
+                            let at = PatchShape::<PS, PT, PU, PV, B, N>::index(s, t, u, v, *band as usize);
                             let ok = match c.raw.classify(r[v]) {
                                 Ok(y) => m.set(at, y).map_err(|_| Invalid::NonFinite),
                                 Err(e) => Err(e),
@@ -488,9 +442,7 @@ impl<
                         view_row,
                         view_col,
                     };
-                    let (flags, excluded) = self
-                        .read_patch(origin, source, ws)
-                        .map_err(TileError::Source)?;
+                    let (flags, excluded) = self.read_patch(origin, source, ws).map_err(TileError::Source)?;
                     match model.decode(&self.config.sl0, ws) {
                         Ok(done) => {
                             let r = PatchReport {
@@ -506,8 +458,7 @@ impl<
                                 log!(warn, "patch flagged: {} samples left out", excluded);
                             }
                             report.decoded += 1;
-                            sink.accept(origin, ws.patch(), &r)
-                                .map_err(TileError::Sink)?;
+                            sink.accept(origin, ws.patch(), &r).map_err(TileError::Sink)?;
                         }
                         Err(e) => {
                             report.failed += 1;
@@ -531,12 +482,7 @@ impl<
         sink: &mut K,
         ws: &mut Workspace<PS, PT, PU, PV, B, N>,
     ) -> FrameReport<S::Error, K::Error> {
-        let mut frame = FrameReport {
-            patches: TileReport::default(),
-            tiles: 0,
-            failed_tiles: 0,
-            first_failure: None,
-        };
+        let mut frame = FrameReport { patches: TileReport::default(), tiles: 0, failed_tiles: 0, first_failure: None };
         for tile in self.tiles(tile_patches) {
             frame.tiles += 1;
             match self.decode_tile(model, tile, source, sink, ws) {

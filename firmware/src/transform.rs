@@ -18,10 +18,7 @@ use crate::shape::PatchShape;
 fn mode_rows<const D: usize>(m: &Matrix<D>, src: &[f32], dst: &mut [f32], inner: usize) {
     debug_assert_eq!(src.len(), dst.len());
     debug_assert_eq!(src.len() % (D * inner), 0);
-    for (sb, db) in src
-        .chunks_exact(D * inner)
-        .zip(dst.chunks_exact_mut(D * inner))
-    {
+    for (sb, db) in src.chunks_exact(D * inner).zip(dst.chunks_exact_mut(D * inner)) {
         for (row, out) in m.iter().zip(db.chunks_exact_mut(inner)) {
             let mut rows = sb.chunks_exact(inner).zip(row);
             if let Some((x0, &w0)) = rows.next() {
@@ -61,14 +58,7 @@ fn mode_last<const D: usize>(mt: &Matrix<D>, src: &[f32], dst: &mut [f32]) {
 /// Kept out of line: synthesis and analysis share one copy per patch shape, which keeps
 /// the device image small (inlined at each call site it tripled `solve` to 79 KB).
 #[inline(never)]
-fn chain<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
->(
+fn chain<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
     m: &Factors<PS, PT, PU, PV, B>,
     mt5: &Matrix<B>,
     a: &mut [f32; N],
@@ -99,14 +89,7 @@ pub fn synthesize<
 }
 
 /// Analysis: `coeffs = signal x1 D1^T .. x5 D5^T`. `signal` is the scratch and is clobbered.
-pub fn analyze<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
->(
+pub fn analyze<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
     dict: &Dictionary<PS, PT, PU, PV, B>,
     signal: &mut [f32; N],
     coeffs: &mut [f32; N],

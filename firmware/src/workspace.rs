@@ -20,11 +20,7 @@ pub struct Measurements<const N: usize> {
 impl<const N: usize> Measurements<N> {
     /// Nothing measured.
     pub const fn new() -> Self {
-        Self {
-            values: [0.0; N],
-            measured: [false; N],
-            count: 0,
-        }
+        Self { values: [0.0; N], measured: [false; N], count: 0 }
     }
 
     /// Forgets every measurement.
@@ -76,36 +72,20 @@ impl<const N: usize> Default for Measurements<N> {
 
 /// Every buffer of one patch decode. Mutable state, apart from the immutable config.
 #[derive(Clone, Debug)]
-pub struct Workspace<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
-> {
+pub struct Workspace<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
+{
     pub(crate) coeffs: [f32; N],
     pub(crate) signal: [f32; N],
     pub(crate) measurements: Measurements<N>,
 }
 
-impl<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
-> Workspace<PS, PT, PU, PV, B, N>
+impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
+    Workspace<PS, PT, PU, PV, B, N>
 {
     /// A zeroed workspace.
     pub const fn new() -> Self {
         const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
-        Self {
-            coeffs: [0.0; N],
-            signal: [0.0; N],
-            measurements: Measurements::new(),
-        }
+        Self { coeffs: [0.0; N], signal: [0.0; N], measurements: Measurements::new() }
     }
 
     /// The measurements the next solve uses.
@@ -124,14 +104,8 @@ impl<
     }
 }
 
-impl<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
-> Default for Workspace<PS, PT, PU, PV, B, N>
+impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize> Default
+    for Workspace<PS, PT, PU, PV, B, N>
 {
     fn default() -> Self {
         Self::new()

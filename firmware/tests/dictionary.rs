@@ -13,24 +13,12 @@ const DIMS: [usize; 5] = [5, 5, 4, 4, 13];
 
 fn check_dct<const D: usize>() {
     let m = dct_matrix::<D>();
-    assert!(
-        orthonormality_error(&m) <= 1e-6,
-        "DCT {D} not orthonormal: {}",
-        orthonormality_error(&m)
-    );
+    assert!(orthonormality_error(&m) <= 1e-6, "DCT {D} not orthonormal: {}", orthonormality_error(&m));
     for (k, row) in m.iter().enumerate() {
-        let a = if k == 0 {
-            (1.0 / D as f64).sqrt()
-        } else {
-            (2.0 / D as f64).sqrt()
-        };
+        let a = if k == 0 { (1.0 / D as f64).sqrt() } else { (2.0 / D as f64).sqrt() };
         for (n, &x) in row.iter().enumerate() {
-            let want =
-                a * (std::f64::consts::PI * (2 * n + 1) as f64 * k as f64 / (2 * D) as f64).cos();
-            assert!(
-                (f64::from(x) - want).abs() < 1e-7,
-                "DCT {D}[{k}][{n}] = {x}, want {want}"
-            );
+            let want = a * (std::f64::consts::PI * (2 * n + 1) as f64 * k as f64 / (2 * D) as f64).cos();
+            assert!((f64::from(x) - want).abs() < 1e-7, "DCT {D}[{k}][{n}] = {x}, want {want}");
         }
     }
 }
@@ -62,16 +50,10 @@ fn dct_dictionary_is_valid_and_static() {
 fn new_rejects_non_finite_and_non_orthonormal() {
     let mut f = DCT.synthesis().clone();
     f.m3[1][2] = f32::NAN;
-    assert_eq!(
-        Dict::new(f).unwrap_err(),
-        DictionaryError::NonFinite { member: 0, mode: 3 }
-    );
+    assert_eq!(Dict::new(f).unwrap_err(), DictionaryError::NonFinite { member: 0, mode: 3 });
     let mut f = DCT.synthesis().clone();
     f.m5[0][0] += 1e-3;
-    assert_eq!(
-        Dict::new(f).unwrap_err(),
-        DictionaryError::NotOrthonormal { member: 0, mode: 5 }
-    );
+    assert_eq!(Dict::new(f).unwrap_err(), DictionaryError::NotOrthonormal { member: 0, mode: 5 });
     // Within the tolerance is fine.
     let mut f = DCT.synthesis().clone();
     f.m5[0][0] += ORTHONORMAL_TOLERANCE / 10.0;
@@ -79,11 +61,7 @@ fn new_rejects_non_finite_and_non_orthonormal() {
 }
 
 fn members() -> Vec<Dict> {
-    vec![
-        random_dictionary(1),
-        Dictionary::dct(),
-        random_dictionary(2),
-    ]
+    vec![random_dictionary(1), Dictionary::dct(), random_dictionary(2)]
 }
 
 fn blob_of(members: &[Dict]) -> Vec<u8> {
@@ -136,12 +114,7 @@ fn each_corrupt_blob_gets_its_own_error() {
 
     let mut b = good.clone();
     b[4..6].copy_from_slice(&(BLOB_VERSION + 1).to_le_bytes());
-    assert_eq!(
-        read(&b),
-        DictionaryError::UnsupportedVersion {
-            found: BLOB_VERSION + 1
-        }
-    );
+    assert_eq!(read(&b), DictionaryError::UnsupportedVersion { found: BLOB_VERSION + 1 });
 
     let mut b = good.clone();
     b[6] = 1;
@@ -149,12 +122,7 @@ fn each_corrupt_blob_gets_its_own_error() {
 
     let mut b = good.clone();
     b[16..18].copy_from_slice(&12u16.to_le_bytes());
-    assert_eq!(
-        read(&b),
-        DictionaryError::ShapeMismatch {
-            found: [5, 5, 4, 4, 12]
-        }
-    );
+    assert_eq!(read(&b), DictionaryError::ShapeMismatch { found: [5, 5, 4, 4, 12] });
 
     let mut b = good.clone();
     b[18..20].copy_from_slice(&0u16.to_le_bytes());
@@ -162,13 +130,7 @@ fn each_corrupt_blob_gets_its_own_error() {
 
     // Truncated body, and a header that claims more members than the blob holds.
     let b = &good[..good.len() - 8];
-    assert_eq!(
-        read(b),
-        DictionaryError::LengthMismatch {
-            expected: good.len() as u32,
-            found: b.len() as u32
-        }
-    );
+    assert_eq!(read(b), DictionaryError::LengthMismatch { expected: good.len() as u32, found: b.len() as u32 });
     let mut b = good.clone();
     b[18..20].copy_from_slice(&4u16.to_le_bytes());
     assert!(matches!(read(&b), DictionaryError::LengthMismatch { .. }));
@@ -192,58 +154,29 @@ fn each_corrupt_blob_gets_its_own_error() {
     let x = f32::from_le_bytes(b[at..at + 4].try_into().unwrap());
     put_f32(&mut b, at, x + 1e-2);
     reseal(&mut b);
-    assert_eq!(
-        read(&b),
-        DictionaryError::NotOrthonormal { member: 2, mode: 5 }
-    );
+    assert_eq!(read(&b), DictionaryError::NotOrthonormal { member: 2, mode: 5 });
 
     // A blob for another patch shape.
     let other: Vec<Dictionary<5, 5, 5, 5, 13>> = vec![Dictionary::dct()];
     let mut ob = vec![0u8; blob_len([5, 5, 5, 5, 13], 1)];
     write_blob(&other, &mut ob).unwrap();
-    assert_eq!(
-        read(&ob),
-        DictionaryError::ShapeMismatch {
-            found: [5, 5, 5, 5, 13]
-        }
-    );
+    assert_eq!(read(&ob), DictionaryError::ShapeMismatch { found: [5, 5, 5, 5, 13] });
 
     // Member index and member count errors.
     let e = Ensemble::<5, 5, 4, 4, 13>::new(&good).unwrap();
-    assert_eq!(
-        e.member(3).unwrap_err(),
-        DictionaryError::NoSuchMember {
-            index: 3,
-            members: 3
-        }
-    );
-    assert_eq!(
-        Dict::from_blob(&good).unwrap_err(),
-        DictionaryError::MemberCount { found: 3 }
-    );
+    assert_eq!(e.member(3).unwrap_err(), DictionaryError::NoSuchMember { index: 3, members: 3 });
+    assert_eq!(Dict::from_blob(&good).unwrap_err(), DictionaryError::MemberCount { found: 3 });
 
     // Writer errors.
     let mut small = vec![0u8; 100];
     assert_eq!(
         write_blob(&members(), &mut small).unwrap_err(),
-        DictionaryError::BufferTooSmall {
-            needed: good.len() as u32
-        }
+        DictionaryError::BufferTooSmall { needed: good.len() as u32 }
     );
-    assert_eq!(
-        write_blob::<5, 5, 4, 4, 13>(&[], &mut small).unwrap_err(),
-        DictionaryError::MemberCount { found: 0 }
-    );
+    assert_eq!(write_blob::<5, 5, 4, 4, 13>(&[], &mut small).unwrap_err(), DictionaryError::MemberCount { found: 0 });
 
     // Every error prints a message.
-    assert!(
-        DictionaryError::Checksum {
-            stored: 1,
-            computed: 2
-        }
-        .to_string()
-        .contains("checksum")
-    );
+    assert!(DictionaryError::Checksum { stored: 1, computed: 2 }.to_string().contains("checksum"));
 }
 
 #[test]

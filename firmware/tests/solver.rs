@@ -6,8 +6,8 @@ mod common;
 use common::*;
 use rand::Rng;
 use slf_firmware::{
-    Dictionary, Ended, LensletSize, Mask, MaskFamily, PaperWorkspace, PatchShape, PinvOperator,
-    Sl0Config, SolveError, Workspace, solve, solve_pinv,
+    Dictionary, Ended, LensletSize, Mask, MaskFamily, PaperWorkspace, PatchShape, PinvOperator, Sl0Config, SolveError,
+    Workspace, solve, solve_pinv,
 };
 
 const L5: LensletSize = LensletSize { rows: 5, cols: 5 };
@@ -21,10 +21,7 @@ fn workspace_fits_the_ram_budget() {
     let size = core::mem::size_of::<PaperWorkspace>();
     assert!(size <= 96 * 1024, "workspace is {size} bytes");
     // Three patch buffers and a flag per value: nothing else hides in it.
-    assert!(
-        size <= 3 * 4 * 5200 + 5200 + 16,
-        "workspace is {size} bytes"
-    );
+    assert!(size <= 3 * 4 * 5200 + 5200 + 16, "workspace is {size} bytes");
 }
 
 fn masks(k: u8) -> [Mask<'static>; 3] {
@@ -37,17 +34,8 @@ fn masks(k: u8) -> [Mask<'static>; 3] {
 
 /// The orthonormal fast path and the paper's pseudo-inverse path decode the same patch
 /// on kronecker masks (1e-4 relative), with the DCT and with a random orthonormal member.
-fn fast_equals_pinv<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const N: usize,
->() {
-    for (dseed, dict) in [
-        (0, Dictionary::<PS, PT, PU, PV, 13>::dct()),
-        (5, random_dictionary(5)),
-    ] {
+fn fast_equals_pinv<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const N: usize>() {
+    for (dseed, dict) in [(0, Dictionary::<PS, PT, PU, PV, 13>::dct()), (5, random_dictionary(5))] {
         for k in [1u8, 3, 7] {
             let mask = Mask::kronecker(21 + u64::from(k), k, 13, L5, (PS as u8, PT as u8)).unwrap();
             let truth = smooth_patch::<PS, PT, PU, PV, 13, N>(k.into());
@@ -56,8 +44,7 @@ fn fast_equals_pinv<
             let cfg = Sl0Config::DEFAULT;
             let fast_out = solve(&dict, &cfg, &mut ws).unwrap();
             let fast = ws.patch().to_vec();
-            let op = PinvOperator::new(&dict, &mask.kronecker_phi::<PS, PT, PU, PV>(0, 0).unwrap())
-                .unwrap();
+            let op = PinvOperator::new(&dict, &mask.kronecker_phi::<PS, PT, PU, PV>(0, 0).unwrap()).unwrap();
             let pinv_out = solve_pinv(&op, &cfg, &mut ws).unwrap();
             let e = rel_err32(ws.patch(), &fast);
             assert!(e <= 1e-4, "dict {dseed} k {k}: fast vs pinv rel diff {e}");
@@ -86,36 +73,22 @@ fn pinv_path_needs_the_kronecker_measurements() {
     let mut w = ws();
     // Measured with a pixel mask: not what this Phi selects.
     measure(&Mask::pixel(1, 2, 13, L5).unwrap(), (0, 0), &truth, &mut w);
-    assert_eq!(
-        solve_pinv(&op, &Sl0Config::DEFAULT, &mut w).unwrap_err(),
-        SolveError::IncompleteKronecker
-    );
+    assert_eq!(solve_pinv(&op, &Sl0Config::DEFAULT, &mut w).unwrap_err(), SolveError::IncompleteKronecker);
     // One measurement missing.
     measure(&mask, (0, 0), &truth, &mut w);
     assert!(solve_pinv(&op, &Sl0Config::DEFAULT, &mut w).is_ok());
-    let first = (0..5200)
-        .find(|&i| w.measurements().get(i).is_some())
-        .unwrap();
+    let first = (0..5200).find(|&i| w.measurements().get(i).is_some()).unwrap();
     let mut w2 = ws();
     for i in (0..5200).filter(|&i| i != first) {
         if let Some(y) = w.measurements().get(i) {
             w2.measurements_mut().set(i, y).unwrap();
         }
     }
-    assert_eq!(
-        solve_pinv(&op, &Sl0Config::DEFAULT, &mut w2).unwrap_err(),
-        SolveError::IncompleteKronecker
-    );
+    assert_eq!(solve_pinv(&op, &Sl0Config::DEFAULT, &mut w2).unwrap_err(), SolveError::IncompleteKronecker);
 }
 
 /// k = 13 measures every band of every pixel: the decode is the patch itself.
-fn all_bands_reproduce<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const N: usize,
->() {
+fn all_bands_reproduce<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const N: usize>() {
     let dict = Dictionary::<PS, PT, PU, PV, 13>::dct();
     let truth = smooth_patch::<PS, PT, PU, PV, 13, N>(9);
     let all = [
@@ -148,50 +121,17 @@ fn bad_config_is_a_typed_error() {
     let d = Sl0Config::DEFAULT;
     for (cfg, field) in [
         (Sl0Config { sigma_f: 1.0, ..d }, "sigma_f"),
-        (
-            Sl0Config {
-                sigma_f: f32::NAN,
-                ..d
-            },
-            "sigma_f",
-        ),
+        (Sl0Config { sigma_f: f32::NAN, ..d }, "sigma_f"),
         (Sl0Config { steps: 0, ..d }, "steps"),
         (Sl0Config { mu: -1.0, ..d }, "mu"),
-        (
-            Sl0Config {
-                sigma_min: 0.0,
-                ..d
-            },
-            "sigma_min",
-        ),
-        (
-            Sl0Config {
-                max_iterations: 0,
-                ..d
-            },
-            "max_iterations",
-        ),
-        (
-            Sl0Config {
-                noise: f32::INFINITY,
-                ..d
-            },
-            "noise",
-        ),
+        (Sl0Config { sigma_min: 0.0, ..d }, "sigma_min"),
+        (Sl0Config { max_iterations: 0, ..d }, "max_iterations"),
+        (Sl0Config { noise: f32::INFINITY, ..d }, "noise"),
     ] {
-        assert_eq!(
-            solve(&dict, &cfg, &mut w).unwrap_err(),
-            SolveError::InvalidConfig { field }
-        );
+        assert_eq!(solve(&dict, &cfg, &mut w).unwrap_err(), SolveError::InvalidConfig { field });
     }
-    assert_eq!(
-        w.measurements_mut().set(5200, 1.0),
-        Err(SolveError::IndexOutOfRange)
-    );
-    assert_eq!(
-        w.measurements_mut().set(3, f32::NAN),
-        Err(SolveError::NonFiniteMeasurement)
-    );
+    assert_eq!(w.measurements_mut().set(5200, 1.0), Err(SolveError::IndexOutOfRange));
+    assert_eq!(w.measurements_mut().set(3, f32::NAN), Err(SolveError::NonFiniteMeasurement));
     assert_eq!(w.measurements().count(), 1);
 }
 
@@ -235,10 +175,7 @@ macro_rules! shape_suite {
                     let truth = sparse_patch(seed, 12);
                     let mut w = wsn();
                     measure(&mask, (0, 0), &truth, &mut w);
-                    let cfg = Sl0Config {
-                        sigma_min: 1e-4,
-                        ..Sl0Config::DEFAULT
-                    };
+                    let cfg = Sl0Config { sigma_min: 1e-4, ..Sl0Config::DEFAULT };
                     let out = solve(&dict, &cfg, &mut w).unwrap();
                     let e = rel_err32(w.patch(), &truth);
                     assert!(e <= 1e-3, "seed {seed}: rel err {e} after {out:?}");
@@ -281,14 +218,10 @@ macro_rules! shape_suite {
                             w.measurements_mut().set(i, y + n).unwrap();
                         }
                     }
-                    let noisy: Vec<(usize, f32)> = (0..N)
-                        .filter_map(|i| w.measurements().get(i).map(|y| (i, y)))
-                        .collect();
+                    let noisy: Vec<(usize, f32)> =
+                        (0..N).filter_map(|i| w.measurements().get(i).map(|y| (i, y))).collect();
                     for (mode, e) in err.iter_mut().enumerate() {
-                        let cfg = Sl0Config {
-                            noise: if mode == 1 { noise } else { 0.0 },
-                            ..Sl0Config::DEFAULT
-                        };
+                        let cfg = Sl0Config { noise: if mode == 1 { noise } else { 0.0 }, ..Sl0Config::DEFAULT };
                         solve(&dict, &cfg, &mut w).unwrap();
                         let p = w.patch();
                         let r2: f32 = noisy.iter().map(|&(i, y)| (p[i] - y).powi(2)).sum();
@@ -301,12 +234,7 @@ macro_rules! shape_suite {
                         *e += rel_err32(p, &truth);
                     }
                 }
-                assert!(
-                    err[1] < err[0],
-                    "noise-aware {} not below exact {}",
-                    err[1],
-                    err[0]
-                );
+                assert!(err[1] < err[0], "noise-aware {} not below exact {}", err[1], err[0]);
             }
 
             #[test]
@@ -315,10 +243,7 @@ macro_rules! shape_suite {
                 let truth = smooth_patch::<5, 5, PU, PV, 13, N>(3);
                 let mut w = wsn();
                 measure(&masks(1)[2], (0, 0), &truth, &mut w);
-                let cfg = Sl0Config {
-                    max_iterations: 7,
-                    ..Sl0Config::DEFAULT
-                };
+                let cfg = Sl0Config { max_iterations: 7, ..Sl0Config::DEFAULT };
                 let out = solve(&dict, &cfg, &mut w).unwrap();
                 assert_eq!(out.iterations, 7);
                 assert!(out.hit_bound());
@@ -328,11 +253,7 @@ macro_rules! shape_suite {
                 // Levels: sigma0 * sigma_f^levels <= sigma_min < sigma0 * sigma_f^(levels-1).
                 let c = Sl0Config::DEFAULT;
                 let expect = ((c.sigma_min / out.sigma0).ln() / c.sigma_f.ln()).ceil() as u32;
-                assert!(
-                    out.levels.abs_diff(expect) <= 1,
-                    "levels {} vs {expect}",
-                    out.levels
-                );
+                assert!(out.levels.abs_diff(expect) <= 1, "levels {} vs {expect}", out.levels);
                 assert_eq!(out.iterations, out.levels * u32::from(c.steps));
             }
 
@@ -350,23 +271,14 @@ macro_rules! shape_suite {
                 let p = w.patch();
                 assert!(p.iter().all(|x| x.is_finite()), "non-finite output");
                 assert!(out.iterations <= cfg.max_iterations);
-                let max_y = (0..N)
-                    .filter_map(|i| w.measurements().get(i))
-                    .fold(0.0f32, |m, y| m.max(y.abs()));
+                let max_y = (0..N).filter_map(|i| w.measurements().get(i)).fold(0.0f32, |m, y| m.max(y.abs()));
                 for (i, &x) in p.iter().enumerate() {
                     if let Some(y) = w.measurements().get(i) {
-                        assert!(
-                            (x - y).abs() <= 1e-5 * max_y.max(f32::MIN_POSITIVE),
-                            "entry {i}: {x} vs measured {y}"
-                        );
+                        assert!((x - y).abs() <= 1e-5 * max_y.max(f32::MIN_POSITIVE), "entry {i}: {x} vs measured {y}");
                     }
                 }
                 let max_out = p.iter().fold(0.0f32, |m, x| m.max(x.abs()));
-                assert!(
-                    max_out <= 1.5 * max_y,
-                    "{:?}: output {max_out} vs measurements {max_y}",
-                    mask.family()
-                );
+                assert!(max_out <= 1.5 * max_y, "{:?}: output {max_out} vs measurements {max_y}", mask.family());
                 (rel_err32(p, truth), p.to_vec())
             }
 
@@ -386,11 +298,7 @@ macro_rules! shape_suite {
                 for k in [1, 3] {
                     for mask in masks(k) {
                         let (e, _) = decode_checked(truth, &mask, &Sl0Config::DEFAULT);
-                        assert!(
-                            e <= error_bound(&mask),
-                            "{name} {:?} k {k}: rel err {e}",
-                            mask.family()
-                        );
+                        assert!(e <= error_bound(&mask), "{name} {:?} k {k}: rel err {e}", mask.family());
                     }
                 }
             }
@@ -424,13 +332,8 @@ macro_rules! shape_suite {
 
             #[test]
             fn hard_full_scale_checkerboards_stay_bounded() {
-                let spatial: Vec<f32> = (0..N)
-                    .map(Shape::coordinates)
-                    .map(|[s, t, ..]| ((s + t) % 2) as f32)
-                    .collect();
-                let spectral: Vec<f32> = (0..N)
-                    .map(|i| (Shape::coordinates(i)[4] % 2) as f32)
-                    .collect();
+                let spatial: Vec<f32> = (0..N).map(Shape::coordinates).map(|[s, t, ..]| ((s + t) % 2) as f32).collect();
+                let spectral: Vec<f32> = (0..N).map(|i| (Shape::coordinates(i)[4] % 2) as f32).collect();
                 check_hard_case("spatial checkerboard", &spatial);
                 check_hard_case("spectral checkerboard", &spectral);
                 // A pixel mask resolves a spatial checkerboard even from one snapshot.
@@ -449,11 +352,7 @@ macro_rules! shape_suite {
                     .collect();
                 check_hard_case("1e-6..1", &truth);
                 // Every band measured: reproduced to f32 precision across all six decades.
-                let (e, _) = decode_checked(
-                    &truth,
-                    &Mask::pixel(1, 13, 13, L5).unwrap(),
-                    &Sl0Config::DEFAULT,
-                );
+                let (e, _) = decode_checked(&truth, &Mask::pixel(1, 13, 13, L5).unwrap(), &Sl0Config::DEFAULT);
                 assert!(e <= 1e-6, "k = 13 rel err {e}");
             }
 
@@ -462,11 +361,7 @@ macro_rules! shape_suite {
                 let truth = smooth_patch::<5, 5, PU, PV, 13, N>(8);
                 for sigma_min in [1e-30f32, f32::MIN_POSITIVE, 1e-45] {
                     for max_iterations in [100_000, 50] {
-                        let cfg = Sl0Config {
-                            sigma_min,
-                            max_iterations,
-                            ..Sl0Config::DEFAULT
-                        };
+                        let cfg = Sl0Config { sigma_min, max_iterations, ..Sl0Config::DEFAULT };
                         let (e, _) = decode_checked(&truth, &masks(3)[2], &cfg);
                         assert!(e <= 0.1, "sigma_min {sigma_min}: rel err {e}");
                     }
@@ -474,11 +369,7 @@ macro_rules! shape_suite {
                 let dict = Dict::dct();
                 let mut w = wsn();
                 measure(&masks(3)[2], (0, 0), &truth, &mut w);
-                let cfg = Sl0Config {
-                    sigma_min: 1e-45,
-                    max_iterations: 100_000,
-                    ..Sl0Config::DEFAULT
-                };
+                let cfg = Sl0Config { sigma_min: 1e-45, max_iterations: 100_000, ..Sl0Config::DEFAULT };
                 let out = solve(&dict, &cfg, &mut w).unwrap();
                 assert_eq!(out.ended, Ended::SigmaUnderflow);
                 assert!(out.iterations < 1000);
@@ -488,19 +379,14 @@ macro_rules! shape_suite {
             fn hard_no_measurement_is_a_typed_error() {
                 let dict = Dict::dct();
                 let mut w = wsn();
-                assert_eq!(
-                    solve(&dict, &Sl0Config::DEFAULT, &mut w).unwrap_err(),
-                    SolveError::NoMeasurements
-                );
+                assert_eq!(solve(&dict, &Sl0Config::DEFAULT, &mut w).unwrap_err(), SolveError::NoMeasurements);
             }
 
             #[test]
             fn hard_single_measurement_is_bounded() {
                 let dict = Dict::dct();
                 let mut w = wsn();
-                w.measurements_mut()
-                    .set(Shape::index(4, 4, 3, 3, 12), 0.8)
-                    .unwrap();
+                w.measurements_mut().set(Shape::index(4, 4, 3, 3, 12), 0.8).unwrap();
                 solve(&dict, &Sl0Config::DEFAULT, &mut w).unwrap();
                 let p = w.patch();
                 assert!(p.iter().all(|x| x.is_finite() && x.abs() <= 0.8 + 1e-6));

@@ -9,10 +9,7 @@ use slf_firmware::*;
 
 const L5: LensletSize = LensletSize { rows: 5, cols: 5 };
 /// 10 x 15 lenslets of 5 x 5 views: 2 x 3 blocks of the paper's patch, 50 x 75 pixels.
-const SENSOR: SensorGeometry = SensorGeometry {
-    lenslets: (10, 15),
-    lenslet: L5,
-};
+const SENSOR: SensorGeometry = SensorGeometry { lenslets: (10, 15), lenslet: L5 };
 type Decoder<'a> = TileDecoder<'a, 5, 5, 4, 4, 13, 5200>;
 
 /// A smooth 5D light field over the whole sensor, `[s][t][u][v][b]`.
@@ -78,12 +75,7 @@ struct Collect {
 
 impl PatchSink<5200> for Collect {
     type Error = ();
-    fn accept(
-        &mut self,
-        origin: PatchOrigin,
-        patch: &[f32; 5200],
-        report: &PatchReport,
-    ) -> Result<(), ()> {
+    fn accept(&mut self, origin: PatchOrigin, patch: &[f32; 5200], report: &PatchReport) -> Result<(), ()> {
         self.accepted.push((origin, patch.to_vec(), *report));
         Ok(())
     }
@@ -103,15 +95,8 @@ fn config(mask: Mask<'static>) -> DecoderConfig<'static> {
     }
 }
 
-fn decode_all(
-    dec: &Decoder,
-    frames: &[Vec<f32>],
-    dict: &Dictionary<5, 5, 4, 4, 13>,
-) -> (Collect, TileReport) {
-    let raw: Vec<RawFrame<f32>> = frames
-        .iter()
-        .map(|f| RawFrame::new(f, 50, 75).unwrap())
-        .collect();
+fn decode_all(dec: &Decoder, frames: &[Vec<f32>], dict: &Dictionary<5, 5, 4, 4, 13>) -> (Collect, TileReport) {
+    let raw: Vec<RawFrame<f32>> = frames.iter().map(|f| RawFrame::new(f, 50, 75).unwrap()).collect();
     let mut src = FrameSource::new(&raw);
     let mut sink = Collect::default();
     let mut ws = Box::new(PaperWorkspace::new());
@@ -131,41 +116,17 @@ fn tile_decode_is_the_solver_on_the_cameras_measurements() {
         Mask::kronecker(3, 2, 13, L5, (5, 5)).unwrap(),
     ] {
         let dec = Decoder::new(config(mask)).unwrap();
-        assert_eq!(
-            dec.windows().collect::<Vec<_>>(),
-            [(0, 0), (0, 1), (1, 0), (1, 1)]
-        );
+        assert_eq!(dec.windows().collect::<Vec<_>>(), [(0, 0), (0, 1), (1, 0), (1, 1)]);
         let (sink, report) = decode_all(&dec, &capture(&l, &mask), &dict);
-        assert_eq!(
-            report,
-            TileReport {
-                decoded: 24,
-                flagged: 0,
-                failed: 0
-            }
-        );
+        assert_eq!(report, TileReport { decoded: 24, flagged: 0, failed: 0 });
         assert_eq!(sink.accepted.len(), 24);
         for (origin, patch, rep) in &sink.accepted {
             let truth = truth_patch(&l, *origin);
             let mut ws = Box::new(PaperWorkspace::new());
-            let (l0, v0) = (
-                (origin.lenslet_row, origin.lenslet_col),
-                (origin.view_row, origin.view_col),
-            );
-            measure_window(
-                &mask,
-                (l0.0.into(), l0.1.into()),
-                (v0.0.into(), v0.1.into()),
-                &truth,
-                &mut ws,
-            );
+            let (l0, v0) = ((origin.lenslet_row, origin.lenslet_col), (origin.view_row, origin.view_col));
+            measure_window(&mask, (l0.0.into(), l0.1.into()), (v0.0.into(), v0.1.into()), &truth, &mut ws);
             let out = solve(&dict, &Sl0Config::DEFAULT, &mut ws).unwrap();
-            assert_eq!(
-                &ws.patch()[..],
-                &patch[..],
-                "{:?} {origin:?}",
-                mask.family()
-            );
+            assert_eq!(&ws.patch()[..], &patch[..], "{:?} {origin:?}", mask.family());
             assert_eq!(out, rep.outcome);
             assert_eq!(rep.measured as usize, 400 * mask.snapshots());
             assert!(patch.iter().all(|x| x.is_finite()));
@@ -184,30 +145,13 @@ fn sixteen_bit_frames_with_black_level() {
     let raw = RawFormat::bits(12, 64.0);
     let frames: Vec<Vec<u16>> = capture(&l, &mask)
         .iter()
-        .map(|f| {
-            f.iter()
-                .map(|&x| (64.0 + x * (4095.0 - 64.0)).round() as u16)
-                .collect()
-        })
+        .map(|f| f.iter().map(|&x| (64.0 + x * (4095.0 - 64.0)).round() as u16).collect())
         .collect();
-    let dec = Decoder::new(DecoderConfig {
-        raw,
-        ..config(mask)
-    })
-    .unwrap();
-    let rf: Vec<RawFrame<u16>> = frames
-        .iter()
-        .map(|f| RawFrame::new(f, 50, 75).unwrap())
-        .collect();
+    let dec = Decoder::new(DecoderConfig { raw, ..config(mask) }).unwrap();
+    let rf: Vec<RawFrame<u16>> = frames.iter().map(|f| RawFrame::new(f, 50, 75).unwrap()).collect();
     let mut sink = Collect::default();
     let mut ws = Box::new(PaperWorkspace::new());
-    let r = dec.decode_frame(
-        &Dictionary::dct(),
-        (2, 3),
-        &mut FrameSource::new(&rf),
-        &mut sink,
-        &mut ws,
-    );
+    let r = dec.decode_frame(&Dictionary::dct(), (2, 3), &mut FrameSource::new(&rf), &mut sink, &mut ws);
     assert_eq!((r.tiles, r.patches.decoded, r.patches.flagged), (1, 24, 0));
     for (origin, patch, _) in &sink.accepted {
         let e = rel_err32(patch, &truth_patch(&l, *origin));
@@ -232,40 +176,22 @@ fn bad_samples_are_flagged_left_out_and_lose_nothing_else() {
     bad[2][7 * 75 + 8] = -0.5;
     bad[0][8 * 75 + 8] = 1.5;
     let defects = [Pixel { row: 5, col: 10 }];
-    let dec = Decoder::new(DecoderConfig {
-        defects: DefectList::new(&defects).unwrap(),
-        ..config(mask)
-    })
-    .unwrap();
+    let dec = Decoder::new(DecoderConfig { defects: DefectList::new(&defects).unwrap(), ..config(mask) }).unwrap();
     let (sink, report) = decode_all(&dec, &bad, &dict);
     assert_eq!(report.decoded, 24);
     assert!(report.flagged >= 1);
-    for ((origin, patch, rep), (o2, clean_patch, _)) in
-        sink.accepted.iter().zip(&clean_sink.accepted)
-    {
+    for ((origin, patch, rep), (o2, clean_patch, _)) in sink.accepted.iter().zip(&clean_sink.accepted) {
         assert_eq!(origin, o2);
         assert!(patch.iter().all(|x| x.is_finite()));
         let touched = origin.lenslet_row == 0 && origin.lenslet_col == 0;
         if !touched {
             assert!(rep.flags.is_empty());
-            assert_eq!(
-                patch, clean_patch,
-                "{origin:?} changed by bad samples elsewhere"
-            );
+            assert_eq!(patch, clean_patch, "{origin:?} changed by bad samples elsewhere");
             continue;
         }
         if (origin.view_row, origin.view_col) == (0, 0) {
-            for f in [
-                PatchFlags::NON_FINITE,
-                PatchFlags::NEGATIVE,
-                PatchFlags::OVER_RANGE,
-                PatchFlags::DEFECTIVE,
-            ] {
-                assert!(
-                    rep.flags.contains(f),
-                    "{origin:?} missing {f:?} in {:?}",
-                    rep.flags
-                );
+            for f in [PatchFlags::NON_FINITE, PatchFlags::NEGATIVE, PatchFlags::OVER_RANGE, PatchFlags::DEFECTIVE] {
+                assert!(rep.flags.contains(f), "{origin:?} missing {f:?} in {:?}", rep.flags);
             }
             assert!(rep.outcome.iterations <= Sl0Config::DEFAULT.max_iterations);
             assert_eq!(rep.excluded, 4 + 3); // four bad samples + one defective pixel x 3 snapshots
@@ -291,31 +217,15 @@ fn a_patch_without_measurements_is_rejected_and_the_tile_goes_on() {
         }
     }
     // Every pixel of block (0, 1) is on the defect list.
-    let defects: Vec<Pixel> = (0..25)
-        .flat_map(|r| (25..50).map(move |c| Pixel { row: r, col: c }))
-        .collect();
+    let defects: Vec<Pixel> = (0..25).flat_map(|r| (25..50).map(move |c| Pixel { row: r, col: c })).collect();
     let defects: &'static [Pixel] = Box::leak(defects.into_boxed_slice());
-    let dec = Decoder::new(DecoderConfig {
-        defects: DefectList::new(defects).unwrap(),
-        ..config(mask)
-    })
-    .unwrap();
+    let dec = Decoder::new(DecoderConfig { defects: DefectList::new(defects).unwrap(), ..config(mask) }).unwrap();
     let (sink, report) = decode_all(&dec, &frames, &Dictionary::dct());
-    assert_eq!(
-        report,
-        TileReport {
-            decoded: 16,
-            flagged: 0,
-            failed: 8
-        }
-    );
+    assert_eq!(report, TileReport { decoded: 16, flagged: 0, failed: 8 });
     assert_eq!(sink.rejected.len(), 8);
     for (o, e) in &sink.rejected {
         assert_eq!(*e, SolveError::NoMeasurements);
-        assert!(
-            matches!((o.lenslet_row, o.lenslet_col), (5, 10) | (0, 5)),
-            "{o:?}"
-        );
+        assert!(matches!((o.lenslet_row, o.lenslet_col), (5, 10) | (0, 5)), "{o:?}");
     }
     for (_, patch, _) in &sink.accepted {
         assert!(patch.iter().all(|x| x.is_finite()));
@@ -330,18 +240,9 @@ struct Flaky<'a> {
 
 impl TileSource for Flaky<'_> {
     type Error = ReadError;
-    fn read(
-        &mut self,
-        snapshot: usize,
-        row: usize,
-        col: usize,
-        out: &mut [f32],
-    ) -> Result<(), ReadError> {
+    fn read(&mut self, snapshot: usize, row: usize, col: usize, out: &mut [f32]) -> Result<(), ReadError> {
         if row == self.bad_row && col >= 25 {
-            return Err(ReadError::OutOfBounds {
-                row: row as u32,
-                col: col as u32,
-            });
+            return Err(ReadError::OutOfBounds { row: row as u32, col: col as u32 });
         }
         self.inner.read(snapshot, row, col, out)
     }
@@ -352,15 +253,9 @@ fn a_failing_tile_is_abandoned_and_the_frame_goes_on() {
     let l = light_field();
     let mask = Mask::pixel(1, 1, 13, L5).unwrap();
     let frames = capture(&l, &mask);
-    let raw: Vec<RawFrame<f32>> = frames
-        .iter()
-        .map(|f| RawFrame::new(f, 50, 75).unwrap())
-        .collect();
+    let raw: Vec<RawFrame<f32>> = frames.iter().map(|f| RawFrame::new(f, 50, 75).unwrap()).collect();
     let dec = Decoder::new(config(mask)).unwrap();
-    let mut src = Flaky {
-        inner: FrameSource::new(&raw),
-        bad_row: 31,
-    };
+    let mut src = Flaky { inner: FrameSource::new(&raw), bad_row: 31 };
     let mut sink = Collect::default();
     let mut ws = Box::new(PaperWorkspace::new());
     // Tiles of one patch: the six blocks; row 31, col >= 25 is in blocks (1, 1) and (1, 2).
@@ -370,15 +265,8 @@ fn a_failing_tile_is_abandoned_and_the_frame_goes_on() {
     assert_eq!(r.patches.decoded, 16);
     let (tile, err) = r.first_failure.unwrap();
     assert_eq!((tile.lenslet_row, tile.lenslet_col), (5, 5));
-    assert!(matches!(
-        err,
-        TileError::Source(ReadError::OutOfBounds { row: 31, .. })
-    ));
-    assert!(
-        sink.accepted
-            .iter()
-            .all(|(o, ..)| o.lenslet_row == 0 || o.lenslet_col == 0)
-    );
+    assert!(matches!(err, TileError::Source(ReadError::OutOfBounds { row: 31, .. })));
+    assert!(sink.accepted.iter().all(|(o, ..)| o.lenslet_row == 0 || o.lenslet_col == 0));
 }
 
 #[test]
@@ -386,43 +274,15 @@ fn tile_geometry_is_checked() {
     let mask = Mask::pixel(1, 1, 13, L5).unwrap();
     let dec = Decoder::new(config(mask)).unwrap();
     let frames = [vec![0.5f32; 50 * 75]];
-    let raw: Vec<RawFrame<f32>> = frames
-        .iter()
-        .map(|f| RawFrame::new(f, 50, 75).unwrap())
-        .collect();
+    let raw: Vec<RawFrame<f32>> = frames.iter().map(|f| RawFrame::new(f, 50, 75).unwrap()).collect();
     let mut ws = Box::new(PaperWorkspace::new());
     let dict = Dictionary::dct();
     for tile in [
-        Tile {
-            lenslet_row: 6,
-            lenslet_col: 0,
-            lenslet_rows: 5,
-            lenslet_cols: 5,
-        },
-        Tile {
-            lenslet_row: 0,
-            lenslet_col: 0,
-            lenslet_rows: 4,
-            lenslet_cols: 5,
-        },
-        Tile {
-            lenslet_row: 5,
-            lenslet_col: 0,
-            lenslet_rows: 10,
-            lenslet_cols: 5,
-        },
-        Tile {
-            lenslet_row: 0,
-            lenslet_col: 15,
-            lenslet_rows: 5,
-            lenslet_cols: 5,
-        },
-        Tile {
-            lenslet_row: 0,
-            lenslet_col: 0,
-            lenslet_rows: 0,
-            lenslet_cols: 5,
-        },
+        Tile { lenslet_row: 6, lenslet_col: 0, lenslet_rows: 5, lenslet_cols: 5 },
+        Tile { lenslet_row: 0, lenslet_col: 0, lenslet_rows: 4, lenslet_cols: 5 },
+        Tile { lenslet_row: 5, lenslet_col: 0, lenslet_rows: 10, lenslet_cols: 5 },
+        Tile { lenslet_row: 0, lenslet_col: 15, lenslet_rows: 5, lenslet_cols: 5 },
+        Tile { lenslet_row: 0, lenslet_col: 0, lenslet_rows: 0, lenslet_cols: 5 },
     ] {
         let mut sink = Collect::default();
         let r = dec.decode_tile(&dict, tile, &mut FrameSource::new(&raw), &mut sink, &mut ws);
@@ -431,30 +291,15 @@ fn tile_geometry_is_checked() {
     }
     assert_eq!(
         RawFrame::new(&frames[0][..10], 50, 75).unwrap_err(),
-        SensingError::FrameSize {
-            expected: 3750,
-            found: 10
-        }
+        SensingError::FrameSize { expected: 3750, found: 10 }
     );
     // A frame with fewer snapshots than the mask: the source says so, per tile.
     let mask3 = Mask::pixel(1, 3, 13, L5).unwrap();
     let dec3 = Decoder::new(config(mask3)).unwrap();
     let mut sink = Collect::default();
-    let r = dec3.decode_frame(
-        &dict,
-        (1, 1),
-        &mut FrameSource::new(&raw),
-        &mut sink,
-        &mut ws,
-    );
+    let r = dec3.decode_frame(&dict, (1, 1), &mut FrameSource::new(&raw), &mut sink, &mut ws);
     assert_eq!(r.failed_tiles, 6);
-    assert!(matches!(
-        r.first_failure,
-        Some((
-            _,
-            TileError::Source(ReadError::NoSuchSnapshot { snapshot: 1 })
-        ))
-    ));
+    assert!(matches!(r.first_failure, Some((_, TileError::Source(ReadError::NoSuchSnapshot { snapshot: 1 })))));
 }
 
 #[test]
@@ -462,51 +307,17 @@ fn decoder_config_is_checked() {
     let m = Mask::pixel(1, 1, 13, L5).unwrap();
     let err = |c| Decoder::new(c).unwrap_err();
     let l4 = LensletSize { rows: 4, cols: 5 };
-    assert_eq!(
-        err(config(Mask::pixel(1, 1, 13, l4).unwrap())),
-        ConfigError::LensletMismatch
-    );
-    let small = SensorGeometry {
-        lenslets: (10, 10),
-        lenslet: LensletSize { rows: 3, cols: 3 },
-    };
+    assert_eq!(err(config(Mask::pixel(1, 1, 13, l4).unwrap())), ConfigError::LensletMismatch);
+    let small = SensorGeometry { lenslets: (10, 10), lenslet: LensletSize { rows: 3, cols: 3 } };
     let m3 = Mask::pixel(1, 1, 13, small.lenslet).unwrap();
+    assert_eq!(err(DecoderConfig { sensor: small, ..config(m3) }), ConfigError::PatchViews);
+    assert_eq!(err(config(Mask::pixel(1, 1, 12, L5).unwrap())), ConfigError::BandMismatch);
+    assert_eq!(err(config(Mask::kronecker(1, 1, 13, L5, (4, 4)).unwrap())), ConfigError::BlockMismatch);
+    let bad_raw = RawFormat { black: 1.0, white: 1.0, max_valid: 1.0 };
+    assert_eq!(err(DecoderConfig { raw: bad_raw, ..config(m) }), ConfigError::RawFormat);
+    let bad_sl0 = Sl0Config { steps: 0, ..Sl0Config::DEFAULT };
     assert_eq!(
-        err(DecoderConfig {
-            sensor: small,
-            ..config(m3)
-        }),
-        ConfigError::PatchViews
-    );
-    assert_eq!(
-        err(config(Mask::pixel(1, 1, 12, L5).unwrap())),
-        ConfigError::BandMismatch
-    );
-    assert_eq!(
-        err(config(Mask::kronecker(1, 1, 13, L5, (4, 4)).unwrap())),
-        ConfigError::BlockMismatch
-    );
-    let bad_raw = RawFormat {
-        black: 1.0,
-        white: 1.0,
-        max_valid: 1.0,
-    };
-    assert_eq!(
-        err(DecoderConfig {
-            raw: bad_raw,
-            ..config(m)
-        }),
-        ConfigError::RawFormat
-    );
-    let bad_sl0 = Sl0Config {
-        steps: 0,
-        ..Sl0Config::DEFAULT
-    };
-    assert_eq!(
-        err(DecoderConfig {
-            sl0: bad_sl0,
-            ..config(m)
-        }),
+        err(DecoderConfig { sl0: bad_sl0, ..config(m) }),
         ConfigError::Solver(SolveError::InvalidConfig { field: "steps" })
     );
 }
@@ -516,10 +327,7 @@ fn full_view_patches_need_one_window() {
     let l = light_field();
     let mask = Mask::pixel(2, 3, 13, L5).unwrap();
     let frames = capture(&l, &mask);
-    let raw: Vec<RawFrame<f32>> = frames
-        .iter()
-        .map(|f| RawFrame::new(f, 50, 75).unwrap())
-        .collect();
+    let raw: Vec<RawFrame<f32>> = frames.iter().map(|f| RawFrame::new(f, 50, 75).unwrap()).collect();
     let dec = TileDecoder::<5, 5, 5, 5, 13, 8125>::new(config(mask)).unwrap();
     assert_eq!(dec.windows().count(), 1);
     struct Count(usize, f64);
@@ -533,44 +341,24 @@ fn full_view_patches_need_one_window() {
     }
     let mut sink = Count(0, 0.0);
     let mut ws = Box::new(Workspace::<5, 5, 5, 5, 13, 8125>::new());
-    let r = dec.decode_frame(
-        &Dictionary::dct(),
-        (2, 3),
-        &mut FrameSource::new(&raw),
-        &mut sink,
-        &mut ws,
-    );
+    let r = dec.decode_frame(&Dictionary::dct(), (2, 3), &mut FrameSource::new(&raw), &mut sink, &mut ws);
     assert_eq!((r.patches.decoded, sink.0), (6, 6));
     let mean = sink.1 / (6.0 * 8125.0);
     let truth_mean = l.iter().map(|&x| f64::from(x)).sum::<f64>() / l.len() as f64;
-    assert!(
-        (mean - truth_mean).abs() < 0.01,
-        "mean {mean} vs {truth_mean}"
-    );
+    assert!((mean - truth_mean).abs() < 0.01, "mean {mean} vs {truth_mean}");
 }
 
 #[test]
 fn tiles_cover_every_lenslet_of_any_sensor() {
     for (rows, cols) in [(10u16, 15u16), (12, 13), (5, 9), (4, 20), (7, 7)] {
-        let sensor = SensorGeometry {
-            lenslets: (rows, cols),
-            lenslet: L5,
-        };
+        let sensor = SensorGeometry { lenslets: (rows, cols), lenslet: L5 };
         let mask = Mask::pixel(1, 1, 13, L5).unwrap();
-        let dec = Decoder::new(DecoderConfig {
-            sensor,
-            ..config(mask)
-        })
-        .unwrap();
+        let dec = Decoder::new(DecoderConfig { sensor, ..config(mask) }).unwrap();
         for per in [(1u16, 1u16), (2, 3), (100, 100)] {
             let mut covered = vec![0u32; rows as usize * cols as usize];
             for t in dec.tiles(per) {
                 assert!(t.lenslet_rows % 5 == 0 && t.lenslet_cols % 5 == 0, "{t:?}");
-                assert!(
-                    t.lenslet_row + t.lenslet_rows <= rows
-                        && t.lenslet_col + t.lenslet_cols <= cols,
-                    "{t:?}"
-                );
+                assert!(t.lenslet_row + t.lenslet_rows <= rows && t.lenslet_col + t.lenslet_cols <= cols, "{t:?}");
                 assert!(t.lenslet_rows <= 5 * per.0 && t.lenslet_cols <= 5 * per.1);
                 for r in t.lenslet_row..t.lenslet_row + t.lenslet_rows {
                     for c in t.lenslet_col..t.lenslet_col + t.lenslet_cols {
@@ -579,15 +367,9 @@ fn tiles_cover_every_lenslet_of_any_sensor() {
                 }
             }
             if rows < 5 || cols < 5 {
-                assert!(
-                    covered.iter().all(|&c| c == 0),
-                    "sensor smaller than a patch"
-                );
+                assert!(covered.iter().all(|&c| c == 0), "sensor smaller than a patch");
             } else {
-                assert!(
-                    covered.iter().all(|&c| c >= 1),
-                    "{rows}x{cols} per {per:?}: uncovered lenslet"
-                );
+                assert!(covered.iter().all(|&c| c >= 1), "{rows}x{cols} per {per:?}: uncovered lenslet");
                 // Grid, row strip, column strip and their corner at most.
                 assert!(covered.iter().all(|&c| c <= 4));
             }

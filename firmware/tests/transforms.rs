@@ -17,18 +17,13 @@ fn check_against_dense<
     const B: usize,
     const N: usize,
 >() {
-    for (dseed, dict) in [
-        (0u64, Dictionary::<PS, PT, PU, PV, B>::dct()),
-        (7, random_dictionary(7)),
-    ] {
+    for (dseed, dict) in [(0u64, Dictionary::<PS, PT, PU, PV, B>::dct()), (7, random_dictionary(7))] {
         let (k, n) = dense_kronecker(dict.synthesis());
         assert_eq!(n, N);
         let (kt, _) = dense_kronecker(dict.analysis());
         let mut r = rng(100 + dseed);
         for _ in 0..3 {
-            let s: Vec<f32> = (0..N)
-                .map(|_| rand::Rng::random_range(&mut r, -1.0f32..1.0))
-                .collect();
+            let s: Vec<f32> = (0..N).map(|_| rand::Rng::random_range(&mut r, -1.0f32..1.0)).collect();
             let mut a: Box<[f32; N]> = Box::new(s.clone().try_into().unwrap());
             let mut x = Box::new([0.0f32; N]);
             synthesize(&dict, &mut a, &mut x);
@@ -57,9 +52,7 @@ fn full_view_patch_transforms_match_dense_kronecker() {
 fn synthesis_then_analysis_is_identity() {
     let dict = random_dictionary::<5, 5, 4, 4, 13>(3);
     let mut r = rng(4);
-    let s: Vec<f32> = (0..5200)
-        .map(|_| rand::Rng::random_range(&mut r, -1.0f32..1.0))
-        .collect();
+    let s: Vec<f32> = (0..5200).map(|_| rand::Rng::random_range(&mut r, -1.0f32..1.0)).collect();
     let mut a: Box<[f32; 5200]> = Box::new(s.clone().try_into().unwrap());
     let mut x = Box::new([0.0f32; 5200]);
     synthesize(&dict, &mut a, &mut x);
@@ -68,22 +61,12 @@ fn synthesis_then_analysis_is_identity() {
 }
 
 fn dot(a: &[f32], b: &[f32]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(&x, &y)| f64::from(x) * f64::from(y))
-        .sum()
+    a.iter().zip(b).map(|(&x, &y)| f64::from(x) * f64::from(y)).sum()
 }
 
 /// `<A x, y> = <x, A^T y>` for synthesis A and analysis A^T, with a dictionary and
 /// vectors drawn by proptest from a fixed seed.
-fn adjoint_case<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
->(
+fn adjoint_case<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
     dict_seed: u64,
     x: &[f32],
     y: &[f32],
@@ -98,20 +81,12 @@ fn adjoint_case<
     let lhs = dot(&ax[..], y);
     let rhs = dot(x, &aty[..]);
     let scale = dot(x, x).sqrt() * dot(y, y).sqrt();
-    prop_assert!(
-        (lhs - rhs).abs() <= 1e-5 * scale,
-        "lhs {lhs} rhs {rhs} scale {scale}"
-    );
+    prop_assert!((lhs - rhs).abs() <= 1e-5 * scale, "lhs {lhs} rhs {rhs} scale {scale}");
     Ok(())
 }
 
 fn config() -> Config {
-    Config {
-        cases: 24,
-        rng_seed: RngSeed::Fixed(0x51f_5eed),
-        failure_persistence: None,
-        ..Config::default()
-    }
+    Config { cases: 24, rng_seed: RngSeed::Fixed(0x51f_5eed), failure_persistence: None, ..Config::default() }
 }
 
 proptest! {

@@ -71,16 +71,10 @@ impl Factors<f64> {
         let dct = |n: usize| -> (usize, Vec<f64>) {
             let mut m = vec![0.0; n * n];
             for k in 0..n {
-                let a = if k == 0 {
-                    (1.0 / n as f64).sqrt()
-                } else {
-                    (2.0 / n as f64).sqrt()
-                };
+                let a = if k == 0 { (1.0 / n as f64).sqrt() } else { (2.0 / n as f64).sqrt() };
                 for i in 0..n {
                     // Synthesis: columns are atoms, D[i][k] = C[k][i].
-                    m[i * n + k] = a
-                        * (std::f64::consts::PI * (2 * i + 1) as f64 * k as f64 / (2 * n) as f64)
-                            .cos();
+                    m[i * n + k] = a * (std::f64::consts::PI * (2 * i + 1) as f64 * k as f64 / (2 * n) as f64).cos();
                 }
             }
             (n, m)
@@ -148,12 +142,7 @@ impl<T: Real> Dense1D<T> {
         let a = d.select_rows(measured);
         let gram = &a * a.transpose();
         let a_pinv = a.transpose() * gram.cholesky()?.inverse();
-        Some(Self {
-            d,
-            a,
-            a_pinv,
-            measured: measured.to_vec(),
-        })
+        Some(Self { d, a, a_pinv, measured: measured.to_vec() })
     }
 
     /// Bytes of the dense matrices (D, A, A^+).
@@ -167,11 +156,7 @@ impl<T: Real> Dense1D<T> {
         let mu = T::from(cfg.mu);
         let (iterations, _) = schedule(cfg, max_abs(&s), |inv| {
             ascend(&mut s, mu, inv);
-            let r: Vec<T> = matvec(&self.a, &s)
-                .iter()
-                .zip(y)
-                .map(|(&a, &b)| a - b)
-                .collect();
+            let r: Vec<T> = matvec(&self.a, &s).iter().zip(y).map(|(&a, &b)| a - b).collect();
             for (x, c) in s.iter_mut().zip(matvec(&self.a_pinv, &r)) {
                 *x -= c;
             }
@@ -196,11 +181,7 @@ fn modes<T: Real>(f: &[(usize, Vec<T>)], x: &[T], transpose: bool) -> Vec<T> {
         for o in 0..outer {
             for a in 0..*n {
                 for c in 0..*n {
-                    let w = if transpose {
-                        m[c * n + a]
-                    } else {
-                        m[a * n + c]
-                    };
+                    let w = if transpose { m[c * n + a] } else { m[a * n + c] };
                     for j in 0..inner {
                         next[(o * n + a) * inner + j] += w * cur[(o * n + c) * inner + j];
                     }
@@ -214,11 +195,7 @@ fn modes<T: Real>(f: &[(usize, Vec<T>)], x: &[T], transpose: bool) -> Vec<T> {
 
 /// 5D SL0 (fast path) in `T`: the reference for the firmware's f32 decoder and for the
 /// 1D method. `measured[i]` is `Some(y)` for a measured entry.
-pub fn solve_5d<T: Real>(
-    factors: &Factors<T>,
-    measured: &[Option<T>],
-    cfg: &Sl0Config,
-) -> (Vec<T>, u32) {
+pub fn solve_5d<T: Real>(factors: &Factors<T>, measured: &[Option<T>], cfg: &Sl0Config) -> (Vec<T>, u32) {
     let f = &factors.0;
     let project = |x: &mut [T]| {
         for (x, y) in x.iter_mut().zip(measured) {

@@ -14,8 +14,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal, Poisson};
 
 use crate::capture::{
-    Capture, CaptureDescription, FORMAT, MaskDescription, MaskSource, NoiseDescription, VERSION,
-    frame_names,
+    Capture, CaptureDescription, FORMAT, MaskDescription, MaskSource, NoiseDescription, VERSION, frame_names,
 };
 use crate::lightfield::LightField;
 use crate::spectra::BAND_NM;
@@ -48,11 +47,7 @@ impl CameraConfig {
     /// white at 90 % of the range, 20,000 e- full well, 2 DN read noise, no defects.
     pub fn pixel(seed: u64, k: u8) -> Self {
         Self {
-            mask: MaskDescription::Pixel(MaskSource {
-                snapshots: Some(k),
-                seed: Some(seed),
-                tile: None,
-            }),
+            mask: MaskDescription::Pixel(MaskSource { snapshots: Some(k), seed: Some(seed), tile: None }),
             bits: 12,
             black_level: 64,
             white_fraction: 0.9,
@@ -71,23 +66,16 @@ impl CameraConfig {
 
     /// No noise at all (shot or read): for tests that isolate the decoder.
     pub fn noiseless(self) -> Self {
-        Self {
-            full_well: None,
-            read_noise: 0.0,
-            ..self
-        }
+        Self { full_well: None, read_noise: 0.0, ..self }
     }
 
     /// Snapshots the mask takes.
     pub fn snapshots(&self) -> usize {
         match &self.mask {
             MaskDescription::Kronecker { snapshots, .. } => *snapshots as usize,
-            MaskDescription::Pixel(s) | MaskDescription::Lenslet(s) => s
-                .tile
-                .as_ref()
-                .map(|t| t.len())
-                .or(s.snapshots.map(usize::from))
-                .unwrap_or(0),
+            MaskDescription::Pixel(s) | MaskDescription::Lenslet(s) => {
+                s.tile.as_ref().map(|t| t.len()).or(s.snapshots.map(usize::from)).unwrap_or(0)
+            }
         }
     }
 }
@@ -97,23 +85,11 @@ impl CameraConfig {
 /// # Errors
 /// A bad mask or sensor description.
 pub fn simulate(lf: &LightField, cam: &CameraConfig) -> Result<Capture> {
-    ensure!(
-        lf.bands == BAND_NM.len(),
-        "light field has {} bands, the camera {}",
-        lf.bands,
-        BAND_NM.len()
-    );
-    ensure!(
-        (1..=16).contains(&cam.bits),
-        "bits {} out of 1..=16",
-        cam.bits
-    );
+    ensure!(lf.bands == BAND_NM.len(), "light field has {} bands, the camera {}", lf.bands, BAND_NM.len());
+    ensure!((1..=16).contains(&cam.bits), "bits {} out of 1..=16", cam.bits);
     let top = ((1u32 << cam.bits) - 1) as f32;
     let black = f32::from(cam.black_level);
-    ensure!(
-        black < top,
-        "black level {black} at or above the top code {top}"
-    );
+    ensure!(black < top, "black level {black} at or above the top code {top}");
     let white = black + cam.white_fraction * (top - black);
     let (lu, lv) = lf.views;
     let (rows, cols) = (lf.rows * lu, lf.cols * lv);
@@ -136,18 +112,14 @@ pub fn simulate(lf: &LightField, cam: &CameraConfig) -> Result<Capture> {
         black_level: black,
         white_level: white,
         saturation_level: top,
-        noise: cam.full_well.map(|fw| NoiseDescription {
-            full_well_electrons: fw,
-            read_noise_dn: cam.read_noise,
-        }),
+        noise: cam.full_well.map(|fw| NoiseDescription { full_well_electrons: fw, read_noise_dn: cam.read_noise }),
         defective_pixels: defects.clone(),
     };
     // Build the mask through the capture so the description is checked the same way as a
     // loaded one.
     let blank = Capture::new(description.clone(), vec![vec![0; rows * cols]; k])?;
     let mask = blank.mask()?;
-    let read = Normal::new(0.0f32, cam.read_noise.max(0.0))
-        .map_err(|e| anyhow::anyhow!("read noise: {e}"))?;
+    let read = Normal::new(0.0f32, cam.read_noise.max(0.0)).map_err(|e| anyhow::anyhow!("read noise: {e}"))?;
     let mut frames = vec![vec![0u16; rows * cols]; k];
     for row in 0..rows {
         for col in 0..cols {
@@ -158,20 +130,13 @@ pub fn simulate(lf: &LightField, cam: &CameraConfig) -> Result<Capture> {
                 let signal = match cam.full_well {
                     Some(fw) if l > 0.0 => {
                         let e = f64::from(l * fw);
-                        let noisy = Poisson::new(e)
-                            .map(|p| p.sample(&mut rng) as f32)
-                            .unwrap_or(l * fw);
+                        let noisy = Poisson::new(e).map(|p| p.sample(&mut rng) as f32).unwrap_or(l * fw);
                         noisy / fw
                     }
                     _ => l,
                 };
-                let dn = black
-                    + signal * (white - black)
-                    + if cam.read_noise > 0.0 {
-                        read.sample(&mut rng)
-                    } else {
-                        0.0
-                    };
+                let dn =
+                    black + signal * (white - black) + if cam.read_noise > 0.0 { read.sample(&mut rng) } else { 0.0 };
                 frames[j][row * cols + col] = dn.round().clamp(0.0, top) as u16;
             }
         }

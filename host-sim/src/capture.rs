@@ -28,11 +28,7 @@ pub enum MaskDescription {
     /// Band per lenslet and snapshot.
     Lenslet(MaskSource),
     /// The paper's: band per block of `block` lenslets and snapshot.
-    Kronecker {
-        snapshots: u8,
-        seed: u64,
-        block: [u8; 2],
-    },
+    Kronecker { snapshots: u8, seed: u64, block: [u8; 2] },
 }
 
 /// A seed and snapshot count, or a tile `tile[snapshot][row][col]` of band indices.
@@ -106,45 +102,20 @@ impl Capture {
     /// A message naming the field that is wrong.
     pub fn new(description: CaptureDescription, frames: Vec<Vec<u16>>) -> Result<Self> {
         let d = &description;
+        ensure!(d.format == FORMAT, "format is {:?}, expected {FORMAT:?}", d.format);
+        ensure!(d.version == VERSION, "version {} is not supported (this slf reads {VERSION})", d.version);
         ensure!(
-            d.format == FORMAT,
-            "format is {:?}, expected {FORMAT:?}",
-            d.format
-        );
-        ensure!(
-            d.version == VERSION,
-            "version {} is not supported (this slf reads {VERSION})",
-            d.version
-        );
-        ensure!(
-            d.lenslets
-                .iter()
-                .all(|&x| (1..=u16::MAX as usize).contains(&x)),
+            d.lenslets.iter().all(|&x| (1..=u16::MAX as usize).contains(&x)),
             "lenslets {:?} out of range",
             d.lenslets
         );
+        ensure!(d.views.iter().all(|&x| (1..=255).contains(&x)), "views {:?} out of range 1..=255", d.views);
+        ensure!((1..=32).contains(&d.bands_nm.len()), "bands_nm has {} entries, expected 1..=32", d.bands_nm.len());
         ensure!(
-            d.views.iter().all(|&x| (1..=255).contains(&x)),
-            "views {:?} out of range 1..=255",
-            d.views
-        );
-        ensure!(
-            (1..=32).contains(&d.bands_nm.len()),
-            "bands_nm has {} entries, expected 1..=32",
-            d.bands_nm.len()
-        );
-        ensure!(
-            d.black_level.is_finite()
-                && d.white_level > d.black_level
-                && d.saturation_level > d.black_level,
+            d.black_level.is_finite() && d.white_level > d.black_level && d.saturation_level > d.black_level,
             "levels: need black_level < white_level and black_level < saturation_level"
         );
-        ensure!(
-            frames.len() == d.frames.len(),
-            "{} frames for {} names",
-            frames.len(),
-            d.frames.len()
-        );
+        ensure!(frames.len() == d.frames.len(), "{} frames for {} names", frames.len(), d.frames.len());
         let (rows, cols) = (d.lenslets[0] * d.views[0], d.lenslets[1] * d.views[1]);
         for (i, f) in frames.iter().enumerate() {
             ensure!(
@@ -157,14 +128,10 @@ impl Capture {
         let tile_bands = match &d.mask {
             MaskDescription::Pixel(MaskSource { tile: Some(t), .. })
             | MaskDescription::Lenslet(MaskSource { tile: Some(t), .. }) => {
-                ensure!(
-                    !t.is_empty() && !t[0].is_empty() && !t[0][0].is_empty(),
-                    "mask.tile is empty"
-                );
+                ensure!(!t.is_empty() && !t[0].is_empty() && !t[0][0].is_empty(), "mask.tile is empty");
                 let (r, c) = (t[0].len(), t[0][0].len());
                 ensure!(
-                    t.iter()
-                        .all(|s| s.len() == r && s.iter().all(|row| row.len() == c)),
+                    t.iter().all(|s| s.len() == r && s.iter().all(|row| row.len() == c)),
                     "mask.tile: every snapshot must be {r} rows of {c} columns"
                 );
                 t.iter().flatten().flatten().copied().collect()
@@ -177,19 +144,11 @@ impl Capture {
                 (r as usize) < rows && (c as usize) < cols,
                 "defective pixel [{r}, {c}] outside the {rows} x {cols} frame"
             );
-            defects.push(Pixel {
-                row: r as u16,
-                col: c as u16,
-            });
+            defects.push(Pixel { row: r as u16, col: c as u16 });
         }
         defects.sort();
         defects.dedup();
-        let capture = Self {
-            description,
-            frames,
-            tile_bands,
-            defects,
-        };
+        let capture = Self { description, frames, tile_bands, defects };
         let mask = capture.mask()?;
         ensure!(
             mask.snapshots() == capture.frames.len(),
@@ -205,10 +164,7 @@ impl Capture {
         let d = &self.description;
         SensorGeometry {
             lenslets: (d.lenslets[0] as u16, d.lenslets[1] as u16),
-            lenslet: LensletSize {
-                rows: d.views[0] as u8,
-                cols: d.views[1] as u8,
-            },
+            lenslet: LensletSize { rows: d.views[0] as u8, cols: d.views[1] as u8 },
         }
     }
 
@@ -226,30 +182,19 @@ impl Capture {
         let bands = d.bands_nm.len() as u8;
         let lenslet = self.sensor().lenslet;
         let m = match &d.mask {
-            MaskDescription::Kronecker {
-                snapshots,
-                seed,
-                block,
-            } => Mask::kronecker(*seed, *snapshots, bands, lenslet, (block[0], block[1])),
+            MaskDescription::Kronecker { snapshots, seed, block } => {
+                Mask::kronecker(*seed, *snapshots, bands, lenslet, (block[0], block[1]))
+            }
             MaskDescription::Pixel(src) | MaskDescription::Lenslet(src) => {
                 let pixel = matches!(d.mask, MaskDescription::Pixel(_));
                 match (&src.tile, src.seed, src.snapshots) {
                     (Some(t), None, snapshots) => {
                         let k = t.len() as u8;
                         if let Some(s) = snapshots {
-                            ensure!(
-                                s == k,
-                                "mask.snapshots is {s} but mask.tile has {k} snapshots"
-                            );
+                            ensure!(s == k, "mask.snapshots is {s} but mask.tile has {k} snapshots");
                         }
-                        let tile = BandTile::new(
-                            t[0].len() as u16,
-                            t[0][0].len() as u16,
-                            k,
-                            bands,
-                            &self.tile_bands,
-                        )
-                        .map_err(|e| anyhow::anyhow!("mask.tile: {e}"))?;
+                        let tile = BandTile::new(t[0].len() as u16, t[0][0].len() as u16, k, bands, &self.tile_bands)
+                            .map_err(|e| anyhow::anyhow!("mask.tile: {e}"))?;
                         if pixel {
                             Mask::pixel_tile(tile, bands, lenslet)
                         } else {
@@ -273,11 +218,7 @@ impl Capture {
     /// How raw values map to measurements.
     pub fn raw_format(&self) -> RawFormat {
         let d = &self.description;
-        RawFormat {
-            black: d.black_level,
-            white: d.white_level,
-            max_valid: d.saturation_level - 0.5,
-        }
+        RawFormat { black: d.black_level, white: d.white_level, max_valid: d.saturation_level - 0.5 }
     }
 
     /// The defect list for the decoder.
@@ -292,14 +233,11 @@ impl Capture {
     /// A message with the file and what is wrong in it.
     pub fn load(dir: &Path) -> Result<Self> {
         let desc_path = dir.join(DESCRIPTION);
-        let text = fs::read_to_string(&desc_path)
-            .with_context(|| format!("cannot read {}", desc_path.display()))?;
+        let text = fs::read_to_string(&desc_path).with_context(|| format!("cannot read {}", desc_path.display()))?;
         let description: CaptureDescription = serde_json::from_str(&text)
             .with_context(|| format!("{}: invalid capture description", desc_path.display()))?;
-        let (rows, cols) = (
-            description.lenslets[0] * description.views[0],
-            description.lenslets[1] * description.views[1],
-        );
+        let (rows, cols) =
+            (description.lenslets[0] * description.views[0], description.lenslets[1] * description.views[1]);
         let mut frames = Vec::with_capacity(description.frames.len());
         for name in &description.frames {
             let path = dir.join(name);
@@ -311,8 +249,7 @@ impl Capture {
             );
             frames.push(data);
         }
-        Self::new(description, frames)
-            .with_context(|| format!("{}: inconsistent capture", desc_path.display()))
+        Self::new(description, frames).with_context(|| format!("{}: inconsistent capture", desc_path.display()))
     }
 
     /// Writes the capture folder: `capture.json` and the frames under their names
@@ -340,8 +277,7 @@ pub fn read_frame(path: &Path) -> Result<(Vec<u16>, usize, usize)> {
     match extension(path).as_str() {
         "npy" => read_npy_u16_2d(path),
         "pgm" | "png" => {
-            let img = image::open(path)
-                .with_context(|| format!("{}: cannot decode image", path.display()))?;
+            let img = image::open(path).with_context(|| format!("{}: cannot decode image", path.display()))?;
             let color = img.color();
             ensure!(
                 matches!(color, image::ColorType::L16 | image::ColorType::L8),
@@ -357,10 +293,7 @@ pub fn read_frame(path: &Path) -> Result<(Vec<u16>, usize, usize)> {
             };
             Ok((data, h as usize, w as usize))
         }
-        other => bail!(
-            "{}: unknown frame format {other:?} (use .pgm, .png or .npy)",
-            path.display()
-        ),
+        other => bail!("{}: unknown frame format {other:?} (use .pgm, .png or .npy)", path.display()),
     }
 }
 
@@ -370,30 +303,19 @@ pub fn read_frame(path: &Path) -> Result<(Vec<u16>, usize, usize)> {
 /// I/O and encoding errors, with the file.
 pub fn write_frame(path: &Path, data: &[u16], rows: usize, cols: usize) -> Result<()> {
     match extension(path).as_str() {
-        "npy" => write_npy_u16_2d(path, data, rows, cols)
-            .with_context(|| format!("cannot write {}", path.display())),
+        "npy" => write_npy_u16_2d(path, data, rows, cols).with_context(|| format!("cannot write {}", path.display())),
         "pgm" | "png" => {
-            let img = image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_raw(
-                cols as u32,
-                rows as u32,
-                data.to_vec(),
-            )
-            .context("frame size does not match its data")?;
-            img.save(path)
-                .with_context(|| format!("cannot write {}", path.display()))
+            let img =
+                image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_raw(cols as u32, rows as u32, data.to_vec())
+                    .context("frame size does not match its data")?;
+            img.save(path).with_context(|| format!("cannot write {}", path.display()))
         }
-        other => bail!(
-            "{}: unknown frame format {other:?} (use .pgm, .png or .npy)",
-            path.display()
-        ),
+        other => bail!("{}: unknown frame format {other:?} (use .pgm, .png or .npy)", path.display()),
     }
 }
 
 fn extension(path: &Path) -> String {
-    path.extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase()
+    path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
 }
 
 /// Frame file names for `k` snapshots with extension `ext`.

@@ -12,8 +12,8 @@ use anyhow::{Result, anyhow, ensure};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use slf_firmware::{
-    DecoderConfig, Dictionary, FrameSource, PaperShape, PaperWorkspace, PatchModel, PatchOrigin,
-    PatchReport, PatchSink, RawFrame, Sl0Config, SolveError, Tile, TileDecoder, TileReport,
+    DecoderConfig, Dictionary, FrameSource, PaperShape, PaperWorkspace, PatchModel, PatchOrigin, PatchReport,
+    PatchSink, RawFrame, Sl0Config, SolveError, Tile, TileDecoder, TileReport,
 };
 
 use crate::capture::Capture;
@@ -47,14 +47,8 @@ impl Basis {
     pub fn name(&self) -> &'static str {
         match self {
             Self::Dct => "DCT",
-            Self::Ensemble {
-                choice: slf_firmware::MemberChoice::Screened(_),
-                ..
-            } => "ensemble screened",
-            Self::Ensemble {
-                choice: slf_firmware::MemberChoice::Exhaustive(_),
-                ..
-            } => "ensemble exhaustive",
+            Self::Ensemble { choice: slf_firmware::MemberChoice::Screened(_), .. } => "ensemble screened",
+            Self::Ensemble { choice: slf_firmware::MemberChoice::Exhaustive(_), .. } => "ensemble exhaustive",
         }
     }
 }
@@ -63,21 +57,13 @@ impl Basis {
 ///
 /// # Errors
 /// An invalid blob, or what [`decode`] reports.
-pub fn decode_with(
-    capture: &Capture,
-    basis: &Basis,
-    opts: &DecodeOptions,
-) -> Result<(LightField, DecodeReport)> {
+pub fn decode_with(capture: &Capture, basis: &Basis, opts: &DecodeOptions) -> Result<(LightField, DecodeReport)> {
     match basis {
         Basis::Dct => decode(capture, &Dictionary::dct(), opts),
         Basis::Ensemble { blob, choice } => {
-            let ensemble = slf_firmware::Ensemble::<5, 5, 4, 4, 13>::new(blob)
-                .map_err(|e| anyhow!("dictionary blob: {e}"))?;
-            decode(
-                capture,
-                &slf_firmware::EnsembleModel::new(ensemble, *choice),
-                opts,
-            )
+            let ensemble =
+                slf_firmware::Ensemble::<5, 5, 4, 4, 13>::new(blob).map_err(|e| anyhow!("dictionary blob: {e}"))?;
+            decode(capture, &slf_firmware::EnsembleModel::new(ensemble, *choice), opts)
         }
     }
 }
@@ -94,11 +80,7 @@ pub struct DecodeOptions {
 
 impl Default for DecodeOptions {
     fn default() -> Self {
-        Self {
-            sl0: Sl0Config::DEFAULT,
-            tile_patches: (2, 2),
-            progress: false,
-        }
+        Self { sl0: Sl0Config::DEFAULT, tile_patches: (2, 2), progress: false }
     }
 }
 
@@ -135,15 +117,7 @@ struct TileSums {
 impl TileSums {
     fn new(tile: Tile, views: (usize, usize)) -> Self {
         let n = tile.lenslet_rows as usize * tile.lenslet_cols as usize * views.0 * views.1 * 13;
-        Self {
-            tile,
-            views,
-            sum: vec![0.0; n],
-            count: vec![0; n],
-            steps: 0,
-            solves: 0,
-            members: Vec::new(),
-        }
+        Self { tile, views, sum: vec![0.0; n], count: vec![0; n], steps: 0, solves: 0, members: Vec::new() }
     }
 
     /// Index in the tile's `(s, t, u, v, b)` buffer.
@@ -155,30 +129,17 @@ impl TileSums {
 impl PatchSink<5200> for TileSums {
     type Error = core::convert::Infallible;
 
-    fn accept(
-        &mut self,
-        o: PatchOrigin,
-        patch: &[f32; 5200],
-        report: &PatchReport,
-    ) -> Result<(), Self::Error> {
+    fn accept(&mut self, o: PatchOrigin, patch: &[f32; 5200], report: &PatchReport) -> Result<(), Self::Error> {
         self.steps += u64::from(report.outcome.iterations);
         self.solves += u64::from(report.solves);
         if let Some(m) = report.member {
             self.members.push((o, m));
         }
-        let (s0, t0) = (
-            (o.lenslet_row - self.tile.lenslet_row) as usize,
-            (o.lenslet_col - self.tile.lenslet_col) as usize,
-        );
+        let (s0, t0) =
+            ((o.lenslet_row - self.tile.lenslet_row) as usize, (o.lenslet_col - self.tile.lenslet_col) as usize);
         for (i, &x) in patch.iter().enumerate() {
             let [s, t, u, v, b] = PaperShape::coordinates(i);
-            let j = self.at(
-                s0 + s,
-                t0 + t,
-                o.view_row as usize + u,
-                o.view_col as usize + v,
-                b,
-            );
+            let j = self.at(s0 + s, t0 + t, o.view_row as usize + u, o.view_col as usize + v, b);
             self.sum[j] += x;
             self.count[j] += 1;
         }
@@ -202,11 +163,7 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
 ) -> Result<(LightField, DecodeReport)> {
     let start = Instant::now();
     let d = &capture.description;
-    ensure!(
-        d.bands_nm.len() == 13,
-        "the decoder's patch has 13 bands, the capture {}",
-        d.bands_nm.len()
-    );
+    ensure!(d.bands_nm.len() == 13, "the decoder's patch has 13 bands, the capture {}", d.bands_nm.len());
     let config = DecoderConfig {
         sensor: capture.sensor(),
         mask: capture.mask()?,
@@ -214,8 +171,7 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
         defects: capture.defects(),
         sl0: opts.sl0,
     };
-    let decoder =
-        TileDecoder::<5, 5, 4, 4, 13, 5200>::new(config).map_err(|e| anyhow!("decoder: {e}"))?;
+    let decoder = TileDecoder::<5, 5, 4, 4, 13, 5200>::new(config).map_err(|e| anyhow!("decoder: {e}"))?;
     let (rows, cols) = capture.frame_size();
     let raw: Vec<RawFrame<u16>> = capture
         .frames
@@ -234,10 +190,8 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
 
     let bar = ProgressBar::with_draw_target(Some(tiles.len() as u64), ProgressDrawTarget::hidden());
     bar.set_style(
-        ProgressStyle::with_template(
-            "decoding {bar:40} {pos}/{len} tiles, {elapsed} elapsed, {eta} left",
-        )
-        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        ProgressStyle::with_template("decoding {bar:40} {pos}/{len} tiles, {elapsed} elapsed, {eta} left")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let shown = AtomicBool::new(false);
     let results: Vec<(TileSums, Result<TileReport, String>)> = tiles
@@ -247,14 +201,9 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
             |ws, &tile| {
                 let mut sums = TileSums::new(tile, views);
                 let mut source = FrameSource::new(&raw);
-                let r = decoder
-                    .decode_tile(model, tile, &mut source, &mut sums, ws)
-                    .map_err(|e| e.to_string());
+                let r = decoder.decode_tile(model, tile, &mut source, &mut sums, ws).map_err(|e| e.to_string());
                 bar.inc(1);
-                if opts.progress
-                    && start.elapsed().as_secs_f64() > 1.0
-                    && !shown.swap(true, Ordering::Relaxed)
-                {
+                if opts.progress && start.elapsed().as_secs_f64() > 1.0 && !shown.swap(true, Ordering::Relaxed) {
                     bar.set_draw_target(ProgressDrawTarget::stderr());
                 }
                 (sums, r)
@@ -266,10 +215,7 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
     let mut lf = LightField::zeros(views, d.lenslets[0], d.lenslets[1], 13);
     let mut sum = vec![0.0f32; lf.data.len()];
     let mut count = vec![0u16; lf.data.len()];
-    let mut report = DecodeReport {
-        tiles: tiles.len(),
-        ..DecodeReport::default()
-    };
+    let mut report = DecodeReport { tiles: tiles.len(), ..DecodeReport::default() };
     for (sums, r) in &results {
         match r {
             Ok(t) => {
@@ -288,13 +234,7 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
                 for u in 0..views.0 {
                     for v in 0..views.1 {
                         let src = sums.at(s, t, u, v, 0);
-                        let dst = lf.index(
-                            u,
-                            v,
-                            tile.lenslet_row as usize + s,
-                            tile.lenslet_col as usize + t,
-                            0,
-                        );
+                        let dst = lf.index(u, v, tile.lenslet_row as usize + s, tile.lenslet_col as usize + t, 0);
                         for b in 0..13 {
                             sum[dst + b] += sums.sum[src + b];
                             count[dst + b] += sums.count[src + b];

@@ -31,13 +31,7 @@ impl LightField {
     /// A light field of zeros.
     pub fn zeros(views: (usize, usize), rows: usize, cols: usize, bands: usize) -> Self {
         let n = views.0 * views.1 * rows * cols * bands;
-        Self {
-            views,
-            rows,
-            cols,
-            bands,
-            data: vec![0.0; n],
-        }
+        Self { views, rows, cols, bands, data: vec![0.0; n] }
     }
 
     /// The shape as `[U, V, H, W, B]`.
@@ -82,35 +76,21 @@ pub enum Dtype {
 #[derive(Debug, thiserror::Error)]
 pub enum NpyError {
     #[error("{path}: {source}")]
-    Io {
-        path: String,
-        source: std::io::Error,
-    },
+    Io { path: String, source: std::io::Error },
     #[error("{path}: dtype {found}, expected float32 ('<f4') or uint16 ('<u2')")]
     Dtype { path: String, found: String },
     #[error("{path}: {rank} axes {shape:?}, expected 5 (U, V, H, W, B)")]
-    Rank {
-        path: String,
-        rank: usize,
-        shape: Vec<u64>,
-    },
+    Rank { path: String, rank: usize, shape: Vec<u64> },
     #[error("{path}: shape {shape:?} has an empty axis")]
     Empty { path: String, shape: Vec<u64> },
     #[error("{path}: Fortran-order arrays are not supported; save with C order")]
     Order { path: String },
     #[error("{path}: truncated body: header promises {expected} values, file holds {found}")]
-    Truncated {
-        path: String,
-        expected: u64,
-        found: u64,
-    },
+    Truncated { path: String, expected: u64, found: u64 },
 }
 
 fn io_err(path: &Path) -> impl Fn(std::io::Error) -> NpyError + '_ {
-    move |source| NpyError::Io {
-        path: path.display().to_string(),
-        source,
-    }
+    move |source| NpyError::Io { path: path.display().to_string(), source }
 }
 
 /// Reads a 5-axis `(U, V, H, W, B)` float32 or uint16 `.npy` file.
@@ -123,11 +103,7 @@ pub fn read_npy(path: &Path) -> Result<LightField, NpyError> {
     let npy = npyz::NpyFile::new(BufReader::new(file)).map_err(io_err(path))?;
     let shape = npy.shape().to_vec();
     if shape.len() != 5 {
-        return Err(NpyError::Rank {
-            path: p,
-            rank: shape.len(),
-            shape,
-        });
+        return Err(NpyError::Rank { path: p, rank: shape.len(), shape });
     }
     if shape.contains(&0) {
         return Err(NpyError::Empty { path: p, shape });
@@ -138,46 +114,27 @@ pub fn read_npy(path: &Path) -> Result<LightField, NpyError> {
     let descr = npy.dtype().descr();
     let expected: u64 = shape.iter().product();
     let s: Vec<usize> = shape.iter().map(|&x| x as usize).collect();
-    let mut lf = LightField {
-        views: (s[0], s[1]),
-        rows: s[2],
-        cols: s[3],
-        bands: s[4],
-        data: Vec::new(),
-    };
+    let mut lf = LightField { views: (s[0], s[1]), rows: s[2], cols: s[3], bands: s[4], data: Vec::new() };
     let (item, f32_data) = match descr.as_str() {
         "'<f4'" => (4, true),
         "'<u2'" => (2, false),
         _ => {
-            return Err(NpyError::Dtype {
-                path: p,
-                found: descr,
-            });
+            return Err(NpyError::Dtype { path: p, found: descr });
         }
     };
     // Read the whole body and check its length before converting: a short body is reported
     // as truncation, with counts, not as an I/O error in the middle of a value.
     let mut body = Vec::new();
-    npy.into_inner()
-        .read_to_end(&mut body)
-        .map_err(io_err(path))?;
+    npy.into_inner().read_to_end(&mut body).map_err(io_err(path))?;
     let found = body.len() as u64 / item;
     if found < expected {
-        return Err(NpyError::Truncated {
-            path: p,
-            expected,
-            found,
-        });
+        return Err(NpyError::Truncated { path: p, expected, found });
     }
     let body = &body[..(expected * item) as usize];
     lf.data = if f32_data {
-        body.chunks_exact(4)
-            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-            .collect()
+        body.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect()
     } else {
-        body.chunks_exact(2)
-            .map(|c| f32::from(u16::from_le_bytes([c[0], c[1]])) / 65535.0)
-            .collect()
+        body.chunks_exact(2).map(|c| f32::from(u16::from_le_bytes([c[0], c[1]])) / 65535.0).collect()
     };
     Ok(lf)
 }
@@ -207,12 +164,7 @@ pub fn write_npy(path: &Path, lf: &LightField, dtype: Dtype) -> Result<(), NpyEr
                 .writer(file)
                 .begin_nd()
                 .map_err(io_err(path))?;
-            w.extend(
-                lf.data
-                    .iter()
-                    .map(|&x| (x.clamp(0.0, 1.0) * 65535.0).round() as u16),
-            )
-            .map_err(io_err(path))?;
+            w.extend(lf.data.iter().map(|&x| (x.clamp(0.0, 1.0) * 65535.0).round() as u16)).map_err(io_err(path))?;
             w.finish().map_err(io_err(path))
         }
     }
@@ -222,18 +174,9 @@ pub fn write_npy(path: &Path, lf: &LightField, dtype: Dtype) -> Result<(), NpyEr
 ///
 /// # Errors
 /// I/O errors.
-pub fn write_npy_u16_2d(
-    path: &Path,
-    data: &[u16],
-    rows: usize,
-    cols: usize,
-) -> std::io::Result<()> {
+pub fn write_npy_u16_2d(path: &Path, data: &[u16], rows: usize, cols: usize) -> std::io::Result<()> {
     let file = BufWriter::new(File::create(path)?);
-    let mut w = npyz::WriteOptions::new()
-        .default_dtype()
-        .shape(&[rows as u64, cols as u64])
-        .writer(file)
-        .begin_nd()?;
+    let mut w = npyz::WriteOptions::new().default_dtype().shape(&[rows as u64, cols as u64]).writer(file).begin_nd()?;
     w.extend(data.iter().copied())?;
     w.finish()
 }
@@ -244,27 +187,13 @@ pub fn write_npy_u16_2d(
 /// A message saying what is wrong.
 pub fn read_npy_u16_2d(path: &Path) -> anyhow::Result<(Vec<u16>, usize, usize)> {
     let file = File::open(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    let npy = npyz::NpyFile::new(BufReader::new(file))
-        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let npy = npyz::NpyFile::new(BufReader::new(file)).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let shape = npy.shape().to_vec();
-    anyhow::ensure!(
-        shape.len() == 2,
-        "{}: raw frame must have 2 axes, found {shape:?}",
-        path.display()
-    );
+    anyhow::ensure!(shape.len() == 2, "{}: raw frame must have 2 axes, found {shape:?}", path.display());
     let descr = npy.dtype().descr();
-    anyhow::ensure!(
-        descr == "'<u2'",
-        "{}: raw frame dtype {descr}, expected uint16 ('<u2')",
-        path.display()
-    );
-    anyhow::ensure!(
-        npy.order() == npyz::Order::C,
-        "{}: Fortran order not supported",
-        path.display()
-    );
-    let data: Vec<u16> = npy
-        .into_vec()
-        .map_err(|e| anyhow::anyhow!("{}: truncated or unreadable body: {e}", path.display()))?;
+    anyhow::ensure!(descr == "'<u2'", "{}: raw frame dtype {descr}, expected uint16 ('<u2')", path.display());
+    anyhow::ensure!(npy.order() == npyz::Order::C, "{}: Fortran order not supported", path.display());
+    let data: Vec<u16> =
+        npy.into_vec().map_err(|e| anyhow::anyhow!("{}: truncated or unreadable body: {e}", path.display()))?;
     Ok((data, shape[0] as usize, shape[1] as usize))
 }

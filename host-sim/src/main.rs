@@ -12,8 +12,8 @@ use slf_host::camera::{CameraConfig, simulate};
 use slf_host::capture::{Capture, MaskDescription, MaskSource};
 use slf_host::decode::{Basis, DecodeOptions, DecodeReport, PaperDictionary, decode_with};
 use slf_host::firmware::{
-    ChoiceRule, DEFAULT_ENSEMBLE, Dictionary, LensletSize, Mask, MemberChoice, PaperShape,
-    PaperWorkspace, Sl0Config, blob, solve, write_blob,
+    ChoiceRule, DEFAULT_ENSEMBLE, Dictionary, LensletSize, Mask, MemberChoice, PaperShape, PaperWorkspace, Sl0Config,
+    blob, solve, write_blob,
 };
 use slf_host::lightfield::{Dtype, LightField, read_npy, write_npy};
 use slf_host::metrics::{Metrics, evaluate};
@@ -22,11 +22,7 @@ use slf_host::scene::{self, SceneSize};
 use slf_host::train;
 
 #[derive(Parser)]
-#[command(
-    name = "slf",
-    version,
-    about = "Compressive spectral light-field camera: simulate, decode, measure"
-)]
+#[command(name = "slf", version, about = "Compressive spectral light-field camera: simulate, decode, measure")]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -41,19 +37,11 @@ enum Family {
 
 impl Family {
     fn mask(self, seed: u64, k: u8) -> MaskDescription {
-        let src = MaskSource {
-            snapshots: Some(k),
-            seed: Some(seed),
-            tile: None,
-        };
+        let src = MaskSource { snapshots: Some(k), seed: Some(seed), tile: None };
         match self {
             Family::Pixel => MaskDescription::Pixel(src),
             Family::Lenslet => MaskDescription::Lenslet(src),
-            Family::Kronecker => MaskDescription::Kronecker {
-                snapshots: k,
-                seed,
-                block: [5, 5],
-            },
+            Family::Kronecker => MaskDescription::Kronecker { snapshots: k, seed, block: [5, 5] },
         }
     }
 }
@@ -72,6 +60,23 @@ enum Choice {
     Screened,
     /// Solve with every member, keep the sparsest (K + 1 solves).
     Exhaustive,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum Rule {
+    /// Energy outside the --rule-tau largest coefficients.
+    Residual,
+    /// The l1 norm of the coefficients.
+    L1,
+}
+
+impl Rule {
+    fn rule(self, tau: u16) -> ChoiceRule {
+        match self {
+            Rule::Residual => ChoiceRule::Residual { tau },
+            Rule::L1 => ChoiceRule::L1,
+        }
+    }
 }
 
 #[derive(clap::Args, Clone, Debug)]
@@ -93,9 +98,7 @@ impl BasisArgs {
             DictionaryKind::Dct => Basis::Dct,
             DictionaryKind::Ensemble => {
                 let blob = match &self.blob {
-                    Some(p) => {
-                        std::fs::read(p).with_context(|| format!("cannot read {}", p.display()))?
-                    }
+                    Some(p) => std::fs::read(p).with_context(|| format!("cannot read {}", p.display()))?,
                     None => DEFAULT_ENSEMBLE.to_vec(),
                 };
                 let rule = ChoiceRule::DEFAULT;
@@ -276,6 +279,9 @@ enum Command {
         group: usize,
         #[arg(long, default_value_t = 1)]
         seed: u64,
+        /// Learn every member (by default member 0 is the fixed 5D DCT).
+        #[arg(long)]
+        no_dct_member: bool,
     },
     /// PSNR / SSIM / SA of every test scene x mask family x k, with the DCT; a markdown table.
     Sweep {
@@ -305,6 +311,15 @@ enum Command {
         /// Ensemble blob (default: the shipped one).
         #[arg(long)]
         blob: Option<PathBuf>,
+        /// Only these mask families (default: all three).
+        #[arg(long, value_enum, value_delimiter = ',')]
+        masks: Vec<Family>,
+        /// Member-choice rule.
+        #[arg(long, value_enum, default_value_t = Rule::Residual)]
+        rule: Rule,
+        /// Coefficients kept by the residual rule.
+        #[arg(long, default_value_t = 260)]
+        rule_tau: u16,
     },
 }
 
@@ -341,35 +356,15 @@ fn main() -> ExitCode {
 
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
-        Command::Demo {
-            out,
-            scene,
-            size,
-            basis,
-        } => demo(&out, &scene, size, &basis.basis()?),
-        Command::Scene {
-            name,
-            output,
-            seed,
-            size,
-            views,
-            dtype,
-        } => {
+        Command::Demo { out, scene, size, basis } => demo(&out, &scene, size, &basis.basis()?),
+        Command::Scene { name, output, seed, size, views, dtype } => {
             let s = if name == "random" {
                 scene::random(seed)
             } else {
-                scene::named(&name).with_context(|| {
-                    format!(
-                        "unknown scene {name:?}: one of {:?} or random",
-                        scene::NAMES
-                    )
-                })?
+                scene::named(&name)
+                    .with_context(|| format!("unknown scene {name:?}: one of {:?} or random", scene::NAMES))?
             };
-            let lf = s.render(SceneSize {
-                views: (views, views),
-                rows: size,
-                cols: size,
-            });
+            let lf = s.render(SceneSize { views: (views, views), rows: size, cols: size });
             write_npy(&output, &lf, dtype)?;
             println!("wrote {} ({:?})", output.display(), lf.shape());
             Ok(())
@@ -387,8 +382,7 @@ fn run(cli: Cli) -> Result<()> {
             format,
         } => {
             let lf = read_npy(&input)?;
-            let mut cam =
-                CameraConfig::pixel(seed, snapshots).with_mask(mask.mask(seed, snapshots));
+            let mut cam = CameraConfig::pixel(seed, snapshots).with_mask(mask.mask(seed, snapshots));
             cam.read_noise = read_noise;
             cam.full_well = Some(full_well);
             cam.defect_fraction = defects;
@@ -398,28 +392,12 @@ fn run(cli: Cli) -> Result<()> {
             }
             let capture = simulate(&lf, &cam)?;
             capture.save(&output)?;
-            println!(
-                "wrote {} ({} snapshots)",
-                output.display(),
-                capture.frames.len()
-            );
+            println!("wrote {} ({} snapshots)", output.display(), capture.frames.len());
             Ok(())
         }
-        Command::Decode {
-            capture,
-            output,
-            solver,
-            basis,
-            member_map,
-            dtype,
-            quiet,
-        } => {
+        Command::Decode { capture, output, solver, basis, member_map, dtype, quiet } => {
             let cap = Capture::load(&capture)?;
-            let opts = DecodeOptions {
-                sl0: solver.config()?,
-                progress: !quiet,
-                ..DecodeOptions::default()
-            };
+            let opts = DecodeOptions { sl0: solver.config()?, progress: !quiet, ..DecodeOptions::default() };
             let (lf, r) = decode_with(&cap, &basis.basis()?, &opts)?;
             if let Some(path) = member_map {
                 let mut csv = String::from(
@@ -433,8 +411,7 @@ fn run(cli: Cli) -> Result<()> {
                         o.lenslet_row, o.lenslet_col, o.view_row, o.view_col
                     );
                 }
-                std::fs::write(&path, csv)
-                    .with_context(|| format!("cannot write {}", path.display()))?;
+                std::fs::write(&path, csv).with_context(|| format!("cannot write {}", path.display()))?;
             }
             write_npy(&output, &lf, dtype)?;
             println!(
@@ -450,31 +427,16 @@ fn run(cli: Cli) -> Result<()> {
         }
         Command::Eval { truth, recon } => {
             let m = evaluate(&read_npy(&truth)?, &read_npy(&recon)?)?;
-            println!(
-                "PSNR {:.3} dB (data range {:.6} = max of ground truth)",
-                m.psnr, m.data_range
-            );
+            println!("PSNR {:.3} dB (data range {:.6} = max of ground truth)", m.psnr, m.data_range);
             println!("SSIM {:.4}", m.ssim);
             println!("SA   {:.3} deg", m.sa);
             Ok(())
         }
-        Command::Baseline {
-            patches,
-            mask,
-            snapshots,
-        } => baseline(patches, mask, snapshots),
-        Command::Sweep {
-            size,
-            k,
-            output,
-            basis,
-        } => sweep(size, &k, output.as_deref(), &basis.basis()?),
-        Command::Compare {
-            size,
-            k,
-            output,
-            blob,
-        } => compare(size, &k, output.as_deref(), blob.as_deref()),
+        Command::Baseline { patches, mask, snapshots } => baseline(patches, mask, snapshots),
+        Command::Sweep { size, k, output, basis } => sweep(size, &k, output.as_deref(), &basis.basis()?),
+        Command::Compare { size, k, output, blob, masks, rule, rule_tau } => {
+            compare(size, &k, output.as_deref(), blob.as_deref(), &masks, rule.rule(rule_tau))
+        }
         Command::Train {
             output,
             input,
@@ -486,15 +448,13 @@ fn run(cli: Cli) -> Result<()> {
             iterations,
             group,
             seed,
+            no_dct_member,
         } => {
             let start = Instant::now();
             let fields = if input.is_empty() {
                 train::training_fields(scenes, size, 1000 + seed)
             } else {
-                input
-                    .iter()
-                    .map(|p| read_npy(p))
-                    .collect::<Result<Vec<_>, _>>()?
+                input.iter().map(|p| read_npy(p)).collect::<Result<Vec<_>, _>>()?
             };
             for (i, f) in fields.iter().enumerate() {
                 anyhow::ensure!(
@@ -504,26 +464,11 @@ fn run(cli: Cli) -> Result<()> {
                 );
             }
             let data = train::sample_patches(&fields, patches, seed);
-            let cfg = train::TrainConfig {
-                members,
-                tau,
-                iterations,
-                group,
-                seed,
-                progress: true,
-            };
+            let cfg = train::TrainConfig { members, tau, iterations, group, seed, progress: true };
             let (dicts, reports) = train::train(&data, &cfg);
-            println!(
-                "| iteration | members | ensemble coding error | DCT coding error |\n| --- | --- | --- | --- |"
-            );
+            println!("| iteration | members | ensemble coding error | DCT coding error |\n| --- | --- | --- | --- |");
             for (i, r) in reports.iter().enumerate() {
-                println!(
-                    "| {} | {} | {:.5} | {:.5} |",
-                    i + 1,
-                    r.members,
-                    r.ensemble_error,
-                    r.dct_error
-                );
+                println!("| {} | {} | {:.5} | {:.5} |", i + 1, r.members, r.ensemble_error, r.dct_error);
             }
             let final_err = train::ensemble_error(&data, &dicts, tau);
             println!(
@@ -533,27 +478,19 @@ fn run(cli: Cli) -> Result<()> {
             );
             let mut blob = vec![0u8; blob::blob_len(PaperShape::DIMS, dicts.len())];
             write_blob(&dicts, &mut blob).map_err(|e| anyhow::anyhow!("{e}"))?;
-            std::fs::write(&output, &blob)
-                .with_context(|| format!("cannot write {}", output.display()))?;
-            println!(
-                "wrote {} ({} bytes) in {:.1} s",
-                output.display(),
-                blob.len(),
-                start.elapsed().as_secs_f64()
-            );
+            std::fs::write(&output, &blob).with_context(|| format!("cannot write {}", output.display()))?;
+            println!("wrote {} ({} bytes) in {:.1} s", output.display(), blob.len(), start.elapsed().as_secs_f64());
             Ok(())
         }
     }
 }
 
 fn row(scene: &str, family: &str, k: u8, m: &Metrics, seconds: f64) -> String {
-    format!(
-        "| {scene} | {family} | {k} | {:.2} | {:.4} | {:.2} | {:.2} |",
-        m.psnr, m.ssim, m.sa, seconds
-    )
+    format!("| {scene} | {family} | {k} | {:.2} | {:.4} | {:.2} | {:.2} |", m.psnr, m.ssim, m.sa, seconds)
 }
 
-const HEADER: &str = "| scene | mask | k | PSNR dB | SSIM | SA deg | decode s |\n| --- | --- | --- | --- | --- | --- | --- |";
+const HEADER: &str =
+    "| scene | mask | k | PSNR dB | SSIM | SA deg | decode s |\n| --- | --- | --- | --- | --- | --- | --- |";
 
 fn run_one(
     truth: &LightField,
@@ -562,17 +499,10 @@ fn run_one(
     progress: bool,
 ) -> Result<(LightField, Metrics, DecodeReport)> {
     let capture = simulate(truth, cam)?;
-    let opts = DecodeOptions {
-        progress,
-        ..DecodeOptions::default()
-    };
+    let opts = DecodeOptions { progress, ..DecodeOptions::default() };
     let (recon, report) = decode_with(&capture, basis, &opts)?;
     if report.failed_tiles > 0 || report.uncovered > 0 {
-        bail!(
-            "decode lost {} tiles, {} values uncovered",
-            report.failed_tiles,
-            report.uncovered
-        );
+        bail!("decode lost {} tiles, {} values uncovered", report.failed_tiles, report.uncovered);
     }
     let metrics = evaluate(truth, &recon)?;
     Ok((recon, metrics, report))
@@ -581,13 +511,8 @@ fn run_one(
 fn demo(out: &Path, name: &str, size: usize, basis: &Basis) -> Result<()> {
     let start = Instant::now();
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
-    let s = scene::named(name)
-        .with_context(|| format!("unknown scene {name:?}: one of {:?}", scene::NAMES))?;
-    let truth = s.render(SceneSize {
-        views: (5, 5),
-        rows: size,
-        cols: size,
-    });
+    let s = scene::named(name).with_context(|| format!("unknown scene {name:?}: one of {:?}", scene::NAMES))?;
+    let truth = s.render(SceneSize { views: (5, 5), rows: size, cols: size });
     write_npy(&out.join("truth.npy"), &truth, Dtype::F32)?;
     println!(
         "scene {name}: {size} x {size} lenslets, 5 x 5 views, 13 bands; pixel mask; {}; {} threads",
@@ -602,10 +527,7 @@ fn demo(out: &Path, name: &str, size: usize, basis: &Basis) -> Result<()> {
         write_npy(&out.join(format!("recon_k{k}.npy")), &recon, Dtype::F32)?;
         write_comparison(&out.join(format!("preview_k{k}.png")), &truth, &recon)?;
     }
-    println!(
-        "PSNR data range = max of ground truth ({:.4}).",
-        truth.max()
-    );
+    println!("PSNR data range = max of ground truth ({:.4}).", truth.max());
     println!(
         "previews (truth | reconstruction | error) in {}; total {:.1} s",
         out.display(),
@@ -618,13 +540,8 @@ fn sweep(size: usize, ks: &[u8], output: Option<&Path>, basis: &Basis) -> Result
     let mut lines = vec![HEADER.to_string()];
     println!("{HEADER}");
     for name in scene::NAMES {
-        let truth = scene::named(name)
-            .context("named scene")?
-            .render(SceneSize {
-                views: (5, 5),
-                rows: size,
-                cols: size,
-            });
+        let truth =
+            scene::named(name).context("named scene")?.render(SceneSize { views: (5, 5), rows: size, cols: size });
         for family in [Family::Pixel, Family::Lenslet, Family::Kronecker] {
             for &k in ks {
                 let cam = CameraConfig::pixel(7, k).with_mask(family.mask(7, k));
@@ -637,56 +554,46 @@ fn sweep(size: usize, ks: &[u8], output: Option<&Path>, basis: &Basis) -> Result
         }
     }
     if let Some(p) = output {
-        std::fs::write(p, lines.join("\n") + "\n")
-            .with_context(|| format!("cannot write {}", p.display()))?;
+        std::fs::write(p, lines.join("\n") + "\n").with_context(|| format!("cannot write {}", p.display()))?;
     }
     Ok(())
 }
 
-fn compare(size: usize, ks: &[u8], output: Option<&Path>, blob: Option<&Path>) -> Result<()> {
+fn compare(
+    size: usize,
+    ks: &[u8],
+    output: Option<&Path>,
+    blob: Option<&Path>,
+    masks: &[Family],
+    rule: ChoiceRule,
+) -> Result<()> {
     let blob = match blob {
         Some(p) => std::fs::read(p).with_context(|| format!("cannot read {}", p.display()))?,
         None => DEFAULT_ENSEMBLE.to_vec(),
     };
-    let rule = ChoiceRule::DEFAULT;
     let bases = [
         Basis::Dct,
-        Basis::Ensemble {
-            blob: blob.clone(),
-            choice: MemberChoice::Exhaustive(rule),
-        },
-        Basis::Ensemble {
-            blob,
-            choice: MemberChoice::Screened(rule),
-        },
+        Basis::Ensemble { blob: blob.clone(), choice: MemberChoice::Exhaustive(rule) },
+        Basis::Ensemble { blob, choice: MemberChoice::Screened(rule) },
     ];
     let truths: Vec<LightField> = scene::NAMES
         .iter()
-        .map(|n| {
-            scene::named(n).map(|s| {
-                s.render(SceneSize {
-                    views: (5, 5),
-                    rows: size,
-                    cols: size,
-                })
-            })
-        })
+        .map(|n| scene::named(n).map(|s| s.render(SceneSize { views: (5, 5), rows: size, cols: size })))
         .collect::<Option<_>>()
         .context("named scene")?;
     let mut lines = vec![
-        format!(
-            "| basis | mask | k | PSNR dB | SSIM | SA deg | solves / patch | ms / patch (1 core) |"
-        ),
+        format!("| basis | mask | k | PSNR dB | SSIM | SA deg | solves / patch | ms / patch (1 core) |"),
         "| --- | --- | --- | --- | --- | --- | --- | --- |".to_string(),
     ];
     lines.iter().for_each(|l| println!("{l}"));
     let threads = rayon::current_num_threads() as f64;
-    for family in [Family::Pixel, Family::Lenslet, Family::Kronecker] {
+    let families =
+        if masks.is_empty() { vec![Family::Pixel, Family::Lenslet, Family::Kronecker] } else { masks.to_vec() };
+    for family in families {
         for &k in ks {
             for basis in &bases {
                 let cam = CameraConfig::pixel(7, k).with_mask(family.mask(7, k));
-                let (mut p, mut s, mut a, mut secs, mut solves, mut patches) =
-                    (0.0, 0.0, 0.0, 0.0, 0u64, 0u64);
+                let (mut p, mut s, mut a, mut secs, mut solves, mut patches) = (0.0, 0.0, 0.0, 0.0, 0u64, 0u64);
                 for truth in &truths {
                     let (_, m, r) = run_one(truth, &cam, basis, false)?;
                     p += m.psnr;
@@ -713,8 +620,7 @@ fn compare(size: usize, ks: &[u8], output: Option<&Path>, blob: Option<&Path>) -
         }
     }
     if let Some(path) = output {
-        std::fs::write(path, lines.join("\n") + "\n")
-            .with_context(|| format!("cannot write {}", path.display()))?;
+        std::fs::write(path, lines.join("\n") + "\n").with_context(|| format!("cannot write {}", path.display()))?;
     }
     Ok(())
 }
@@ -722,11 +628,8 @@ fn compare(size: usize, ks: &[u8], output: Option<&Path>, blob: Option<&Path>) -
 fn baseline(patches: usize, family: Family, k: u8) -> Result<()> {
     let dict: PaperDictionary = Dictionary::dct();
     let cfg = Sl0Config::DEFAULT;
-    let truth = scene::named("texture").context("scene")?.render(SceneSize {
-        views: (4, 4),
-        rows: 5 * patches,
-        cols: 5,
-    });
+    let truth =
+        scene::named("texture").context("scene")?.render(SceneSize { views: (4, 4), rows: 5 * patches, cols: 5 });
     let lenslet = LensletSize { rows: 4, cols: 4 };
     let mask = match family {
         Family::Pixel => Mask::pixel(3, k, 13, lenslet),
@@ -741,14 +644,9 @@ fn baseline(patches: usize, family: Family, k: u8) -> Result<()> {
         let mut measured = Vec::new();
         for i in 0..5200 {
             let [s, t, u, v, b] = PaperShape::coordinates(i);
-            if mask
-                .bands_at((5 * p + s) * 4 + u, t * 4 + v)
-                .contains(&(b as u8))
-            {
+            if mask.bands_at((5 * p + s) * 4 + u, t * 4 + v).contains(&(b as u8)) {
                 let y = truth.get(u, v, 5 * p + s, t, b);
-                ws.measurements_mut()
-                    .set(i, y)
-                    .map_err(|e| anyhow::anyhow!("{e}"))?;
+                ws.measurements_mut().set(i, y).map_err(|e| anyhow::anyhow!("{e}"))?;
                 measured.push((i, y));
             }
         }
@@ -758,19 +656,13 @@ fn baseline(patches: usize, family: Family, k: u8) -> Result<()> {
         let idx: Vec<usize> = measured.iter().map(|m| m.0).collect();
         let y: Vec<f32> = measured.iter().map(|m| m.1).collect();
         let start = Instant::now();
-        let one = Dense1D::<f32>::new(&Factors::from_dictionary(&dict), &idx)
-            .context("A A^T is singular")?;
+        let one = Dense1D::<f32>::new(&Factors::from_dictionary(&dict), &idx).context("A A^T is singular")?;
         let setup = start.elapsed().as_secs_f64();
         let start = Instant::now();
         let (x1, _) = one.solve(&y, &cfg);
         t1 += start.elapsed().as_secs_f64();
         mem1 = mem1.max(one.memory_bytes());
-        worst = worst.max(
-            x1.iter()
-                .zip(ws.patch())
-                .map(|(a, b)| (a - b).abs())
-                .fold(0.0, f32::max),
-        );
+        worst = worst.max(x1.iter().zip(ws.patch()).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max));
         if p == 0 {
             println!("1D set-up (D, A, A^+ for one mask): {setup:.2} s");
         }
@@ -778,18 +670,10 @@ fn baseline(patches: usize, family: Family, k: u8) -> Result<()> {
     // 5D: the five matrices (as stored in a blob) and the workspace; 1D: D, A and A^+.
     let dict5 = blob::member_len(PaperShape::DIMS);
     let ws5 = std::mem::size_of::<PaperWorkspace>();
-    println!(
-        "{patches} patches, {family:?} mask, k = {k}, default SL0; 1D vs 5D max abs difference {worst:.2e}"
-    );
+    println!("{patches} patches, {family:?} mask, k = {k}, default SL0; 1D vs 5D max abs difference {worst:.2e}");
     println!("| method | time per patch | memory |\n| --- | --- | --- |");
-    println!(
-        "| 5D (firmware, f32) | {:.2} ms | {dict5} B dictionary + {ws5} B workspace |",
-        1e3 * t5 / patches as f64
-    );
-    println!(
-        "| 1D (dense f32, f64 sums) | {:.2} ms | {mem1} B (D, A, A^+) |",
-        1e3 * t1 / patches as f64
-    );
+    println!("| 5D (firmware, f32) | {:.2} ms | {dict5} B dictionary + {ws5} B workspace |", 1e3 * t5 / patches as f64);
+    println!("| 1D (dense f32, f64 sums) | {:.2} ms | {mem1} B (D, A, A^+) |", 1e3 * t1 / patches as f64);
     println!("time ratio 1D/5D {:.1}x (paper: 106x)", t1 / t5);
     println!(
         "memory ratio 1D/5D: dictionaries {:.0} (paper: 107,729), everything {:.0}",

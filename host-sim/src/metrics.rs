@@ -41,14 +41,8 @@ pub fn evaluate(truth: &LightField, recon: &LightField) -> Result<Metrics> {
         recon.shape()
     );
     let data_range = f64::from(truth.max());
-    ensure!(
-        data_range > 0.0,
-        "the ground truth has no positive value (data range 0)"
-    );
-    ensure!(
-        truth.rows >= WIN && truth.cols >= WIN,
-        "SSIM needs slices of at least {WIN} x {WIN} pixels"
-    );
+    ensure!(data_range > 0.0, "the ground truth has no positive value (data range 0)");
+    ensure!(truth.rows >= WIN && truth.cols >= WIN, "SSIM needs slices of at least {WIN} x {WIN} pixels");
     Ok(Metrics {
         psnr: psnr(&truth.data, &recon.data, data_range),
         data_range,
@@ -59,12 +53,8 @@ pub fn evaluate(truth: &LightField, recon: &LightField) -> Result<Metrics> {
 
 /// PSNR in dB for the given data range (infinite for identical inputs).
 pub fn psnr(truth: &[f32], recon: &[f32], data_range: f64) -> f64 {
-    let mse = truth
-        .iter()
-        .zip(recon)
-        .map(|(&a, &b)| (f64::from(a) - f64::from(b)).powi(2))
-        .sum::<f64>()
-        / truth.len() as f64;
+    let mse =
+        truth.iter().zip(recon).map(|(&a, &b)| (f64::from(a) - f64::from(b)).powi(2)).sum::<f64>() / truth.len() as f64;
     10.0 * (data_range * data_range / mse).log10()
 }
 
@@ -129,22 +119,14 @@ pub fn ssim_2d(a: &[f64], b: &[f64], h: usize, w: usize, data_range: f64) -> f64
 pub fn ssim(truth: &LightField, recon: &LightField, data_range: f64) -> f64 {
     let (h, w) = (truth.rows, truth.cols);
     let slice = |lf: &LightField, u, v, b| -> Vec<f64> {
-        (0..h * w)
-            .map(|p| f64::from(lf.get(u, v, p / w, p % w, b)))
-            .collect()
+        (0..h * w).map(|p| f64::from(lf.get(u, v, p / w, p % w, b))).collect()
     };
     let mut total = 0.0;
     let mut n = 0;
     for u in 0..truth.views.0 {
         for v in 0..truth.views.1 {
             for b in 0..truth.bands {
-                total += ssim_2d(
-                    &slice(truth, u, v, b),
-                    &slice(recon, u, v, b),
-                    h,
-                    w,
-                    data_range,
-                );
+                total += ssim_2d(&slice(truth, u, v, b), &slice(recon, u, v, b), h, w, data_range);
                 n += 1;
             }
         }
@@ -157,11 +139,7 @@ pub fn spectral_angle(truth: &LightField, recon: &LightField) -> f64 {
     let bands = truth.bands;
     let mut total = 0.0;
     let mut n = 0usize;
-    for (t, r) in truth
-        .data
-        .chunks_exact(bands)
-        .zip(recon.data.chunks_exact(bands))
-    {
+    for (t, r) in truth.data.chunks_exact(bands).zip(recon.data.chunks_exact(bands)) {
         let tt: f64 = t.iter().map(|&x| f64::from(x).powi(2)).sum();
         if tt == 0.0 {
             continue;
@@ -170,15 +148,8 @@ pub fn spectral_angle(truth: &LightField, recon: &LightField) -> f64 {
         let angle = if rr == 0.0 {
             90.0
         } else {
-            let tr: f64 = t
-                .iter()
-                .zip(r)
-                .map(|(&a, &b)| f64::from(a) * f64::from(b))
-                .sum();
-            (tr / (tt.sqrt() * rr.sqrt()))
-                .clamp(-1.0, 1.0)
-                .acos()
-                .to_degrees()
+            let tr: f64 = t.iter().zip(r).map(|(&a, &b)| f64::from(a) * f64::from(b)).sum();
+            (tr / (tt.sqrt() * rr.sqrt())).clamp(-1.0, 1.0).acos().to_degrees()
         };
         total += angle;
         n += 1;

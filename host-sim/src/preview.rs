@@ -17,11 +17,7 @@ use crate::spectra::{CMF_1931, D65};
 /// XYZ of a radiance spectrum (white reflector: Y = 1).
 pub fn xyz(spectrum: &[f32]) -> [f64; 3] {
     let peak = D65.iter().fold(0.0f32, |m, &x| m.max(x)) as f64;
-    let white_y: f64 = D65
-        .iter()
-        .zip(&CMF_1931)
-        .map(|(&e, c)| f64::from(e) / peak * f64::from(c[1]))
-        .sum();
+    let white_y: f64 = D65.iter().zip(&CMF_1931).map(|(&e, c)| f64::from(e) / peak * f64::from(c[1])).sum();
     let mut out = [0.0; 3];
     for (&l, c) in spectrum.iter().zip(&CMF_1931) {
         for (o, &cm) in out.iter_mut().zip(c) {
@@ -33,22 +29,14 @@ pub fn xyz(spectrum: &[f32]) -> [f64; 3] {
 
 /// Linear sRGB of XYZ.
 pub fn linear_srgb(xyz: [f64; 3]) -> [f64; 3] {
-    const M: [[f64; 3]; 3] = [
-        [3.2406, -1.5372, -0.4986],
-        [-0.9689, 1.8758, 0.0415],
-        [0.0557, -0.2040, 1.0570],
-    ];
+    const M: [[f64; 3]; 3] = [[3.2406, -1.5372, -0.4986], [-0.9689, 1.8758, 0.0415], [0.0557, -0.2040, 1.0570]];
     M.map(|r| r[0] * xyz[0] + r[1] * xyz[1] + r[2] * xyz[2])
 }
 
 /// The sRGB transfer function, `[0, 1]` linear to 8 bits.
 pub fn encode(c: f64) -> u8 {
     let c = c.clamp(0.0, 1.0);
-    let e = if c <= 0.003_130_8 {
-        12.92 * c
-    } else {
-        1.055 * c.powf(1.0 / 2.4) - 0.055
-    };
+    let e = if c <= 0.003_130_8 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 };
     (e * 255.0).round() as u8
 }
 
@@ -59,9 +47,8 @@ fn central(lf: &LightField) -> (usize, usize) {
 /// The exposure that maps the 99th-percentile luminance of `lf`'s central view to 1.
 pub fn exposure(lf: &LightField) -> f64 {
     let (u, v) = central(lf);
-    let mut ys: Vec<f64> = (0..lf.rows * lf.cols)
-        .map(|p| xyz(lf.spectrum(u, v, p / lf.cols, p % lf.cols))[1])
-        .collect();
+    let mut ys: Vec<f64> =
+        (0..lf.rows * lf.cols).map(|p| xyz(lf.spectrum(u, v, p / lf.cols, p % lf.cols))[1]).collect();
     ys.sort_by(f64::total_cmp);
     let p99 = ys.get(ys.len() * 99 / 100).copied().unwrap_or(1.0);
     if p99 > 0.0 { 1.0 / p99 } else { 1.0 }
@@ -101,19 +88,10 @@ pub fn write_comparison(path: &Path, truth: &LightField, recon: &LightField) -> 
         for x in 0..w {
             out.put_pixel(x, y, *a.get_pixel(x, y));
             out.put_pixel(w + gap + x, y, *b.get_pixel(x, y));
-            let (ts, rs) = (
-                truth.spectrum(u, v, y as usize, x as usize),
-                recon.spectrum(u, v, y as usize, x as usize),
-            );
-            let err = ts
-                .iter()
-                .zip(rs)
-                .map(|(&p, &q)| f64::from((p - q).abs()))
-                .sum::<f64>()
-                / ts.len() as f64;
+            let (ts, rs) = (truth.spectrum(u, v, y as usize, x as usize), recon.spectrum(u, v, y as usize, x as usize));
+            let err = ts.iter().zip(rs).map(|(&p, &q)| f64::from((p - q).abs())).sum::<f64>() / ts.len() as f64;
             out.put_pixel(2 * (w + gap) + x, y, heat(err / full));
         }
     }
-    out.save(path)
-        .with_context(|| format!("cannot write {}", path.display()))
+    out.save(path).with_context(|| format!("cannot write {}", path.display()))
 }

@@ -11,9 +11,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use crate::lightfield::LightField;
-use crate::spectra::{
-    BANDS, COLORCHECKER, Spectrum, colorchecker, narrow_band, smooth_random, under_d65,
-};
+use crate::spectra::{BANDS, COLORCHECKER, Spectrum, colorchecker, narrow_band, smooth_random, under_d65};
 
 /// The region a layer covers, in reference-view coordinates normalised to `[0, 1]`.
 #[derive(Clone, Debug, PartialEq)]
@@ -56,9 +54,8 @@ pub enum Texture {
 }
 
 fn hash01(seed: u64, ix: i64, iy: i64) -> f32 {
-    let mut z = seed
-        ^ (ix as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
-        ^ (iy as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F);
+    let mut z =
+        seed ^ (ix as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (iy as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F);
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
     ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
@@ -80,12 +77,9 @@ impl Texture {
             Texture::Flat => 0.0,
             Texture::Noise { cell, seed } => value_noise(seed, y / cell, x / cell),
             Texture::Stripes { period, angle } => {
-                0.5 + 0.5
-                    * (std::f32::consts::TAU * (x * angle.cos() + y * angle.sin()) / period).sin()
+                0.5 + 0.5 * (std::f32::consts::TAU * (x * angle.cos() + y * angle.sin()) / period).sin()
             }
-            Texture::Checks { period } => {
-                ((y / period).floor() + (x / period).floor()).rem_euclid(2.0)
-            }
+            Texture::Checks { period } => ((y / period).floor() + (x / period).floor()).rem_euclid(2.0),
             Texture::Fine { seed } => value_noise(seed, y, x),
         }
     }
@@ -122,11 +116,7 @@ pub struct SceneSize {
 impl Default for SceneSize {
     /// 5 x 5 views of 100 x 100 pixels.
     fn default() -> Self {
-        Self {
-            views: (5, 5),
-            rows: 100,
-            cols: 100,
-        }
+        Self { views: (5, 5), rows: 100, cols: 100 }
     }
 }
 
@@ -136,14 +126,9 @@ impl Scene {
         let mut lf = LightField::zeros(size.views, size.rows, size.cols, BANDS);
         let mut layers: Vec<&Layer> = self.layers.iter().collect();
         layers.sort_by(|a, b| b.disparity.total_cmp(&a.disparity)); // nearest first
-        let radiance: Vec<[Spectrum; 2]> = layers
-            .iter()
-            .map(|l| l.reflectance.map(|r| under_d65(&r).map(|x| x * self.gain)))
-            .collect();
-        let (cu, cv) = (
-            (size.views.0 as f32 - 1.0) / 2.0,
-            (size.views.1 as f32 - 1.0) / 2.0,
-        );
+        let radiance: Vec<[Spectrum; 2]> =
+            layers.iter().map(|l| l.reflectance.map(|r| under_d65(&r).map(|x| x * self.gain))).collect();
+        let (cu, cv) = ((size.views.0 as f32 - 1.0) / 2.0, (size.views.1 as f32 - 1.0) / 2.0);
         let (h, w) = (size.rows as f32, size.cols as f32);
         for u in 0..size.views.0 {
             for v in 0..size.views.1 {
@@ -154,13 +139,10 @@ impl Scene {
                         for (sy, sx) in [(0.25, 0.25), (0.25, 0.75), (0.75, 0.25), (0.75, 0.75)] {
                             let (py, px) = (y as f32 + sy, x as f32 + sx);
                             for (layer, rad) in layers.iter().zip(&radiance) {
-                                let (ly, lx) =
-                                    (py + layer.disparity * du, px + layer.disparity * dv);
+                                let (ly, lx) = (py + layer.disparity * du, px + layer.disparity * dv);
                                 if layer.shape.contains(ly / h, lx / w) {
                                     let t = layer.texture.weight(ly, lx);
-                                    for (a, (r0, r1)) in
-                                        acc.iter_mut().zip(rad[0].iter().zip(&rad[1]))
-                                    {
+                                    for (a, (r0, r1)) in acc.iter_mut().zip(rad[0].iter().zip(&rad[1])) {
                                         *a += 0.25 * (r0 + t * (r1 - r0));
                                     }
                                     break;
@@ -190,36 +172,15 @@ pub const NAMES: [&str; 5] = ["smooth", "texture", "depth", "saturated", "dark"]
 
 /// A named test scene (see [`NAMES`]); `None` for an unknown name.
 pub fn named(name: &str) -> Option<Scene> {
-    let layer = |disparity, shape, texture, r0, r1| Layer {
-        disparity,
-        shape,
-        texture,
-        reflectance: [r0, r1],
-    };
+    let layer = |disparity, shape, texture, r0, r1| Layer { disparity, shape, texture, reflectance: [r0, r1] };
     let layers = match name {
         // Broad gradients and soft noise: what compressed sensing finds easiest.
         "smooth" => vec![
-            layer(
-                -0.5,
-                Shape::Everywhere,
-                Texture::Noise {
-                    cell: 40.0,
-                    seed: 1,
-                },
-                cc("blue sky"),
-                cc("foliage"),
-            ),
+            layer(-0.5, Shape::Everywhere, Texture::Noise { cell: 40.0, seed: 1 }, cc("blue sky"), cc("foliage")),
             layer(
                 0.5,
-                Shape::Disc {
-                    cy: 0.5,
-                    cx: 0.5,
-                    r: 0.3,
-                },
-                Texture::Noise {
-                    cell: 25.0,
-                    seed: 2,
-                },
+                Shape::Disc { cy: 0.5, cx: 0.5, r: 0.3 },
+                Texture::Noise { cell: 25.0, seed: 2 },
                 cc("light skin"),
                 cc("orange yellow"),
             ),
@@ -229,10 +190,7 @@ pub fn named(name: &str) -> Option<Scene> {
             layer(
                 -1.0,
                 Shape::Everywhere,
-                Texture::Stripes {
-                    period: 3.0,
-                    angle: 0.4,
-                },
+                Texture::Stripes { period: 3.0, angle: 0.4 },
                 cc("neutral 8 (.23 D)"),
                 cc("moderate red"),
             ),
@@ -245,11 +203,7 @@ pub fn named(name: &str) -> Option<Scene> {
             ),
             layer(
                 1.0,
-                Shape::Disc {
-                    cy: 0.65,
-                    cx: 0.65,
-                    r: 0.25,
-                },
+                Shape::Disc { cy: 0.65, cx: 0.65, r: 0.25 },
                 Texture::Fine { seed: 3 },
                 cc("yellow green"),
                 cc("purple"),
@@ -260,75 +214,28 @@ pub fn named(name: &str) -> Option<Scene> {
             layer(
                 -1.5,
                 Shape::Everywhere,
-                Texture::Noise {
-                    cell: 30.0,
-                    seed: 4,
-                },
+                Texture::Noise { cell: 30.0, seed: 4 },
                 cc("neutral 5 (.70 D)"),
                 cc("neutral 6.5 (.44 D)"),
             ),
-            layer(
-                -0.5,
-                rect(0.1, 0.1, 0.7, 0.45),
-                Texture::Flat,
-                cc("red"),
-                cc("red"),
-            ),
-            layer(
-                0.5,
-                rect(0.3, 0.3, 0.9, 0.7),
-                Texture::Flat,
-                cc("blue"),
-                cc("blue"),
-            ),
-            layer(
-                1.5,
-                Shape::Disc {
-                    cy: 0.35,
-                    cx: 0.7,
-                    r: 0.18,
-                },
-                Texture::Flat,
-                cc("yellow"),
-                cc("yellow"),
-            ),
+            layer(-0.5, rect(0.1, 0.1, 0.7, 0.45), Texture::Flat, cc("red"), cc("red")),
+            layer(0.5, rect(0.3, 0.3, 0.9, 0.7), Texture::Flat, cc("blue"), cc("blue")),
+            layer(1.5, Shape::Disc { cy: 0.35, cx: 0.7, r: 0.18 }, Texture::Flat, cc("yellow"), cc("yellow")),
         ],
         // Saturated chart colours and narrow-band lines.
         "saturated" => {
-            let mut l = vec![layer(
-                0.0,
-                Shape::Everywhere,
-                Texture::Flat,
-                cc("black 2 (1.5 D)"),
-                cc("black 2 (1.5 D)"),
-            )];
-            let colours = [
-                cc("red"),
-                cc("green"),
-                cc("blue"),
-                cc("yellow"),
-                cc("magenta"),
-                cc("cyan"),
-            ];
+            let mut l =
+                vec![layer(0.0, Shape::Everywhere, Texture::Flat, cc("black 2 (1.5 D)"), cc("black 2 (1.5 D)"))];
+            let colours = [cc("red"), cc("green"), cc("blue"), cc("yellow"), cc("magenta"), cc("cyan")];
             for (i, c) in colours.iter().enumerate() {
                 let (y, x) = ((i / 3) as f32 * 0.5, (i % 3) as f32 / 3.0);
-                l.push(layer(
-                    0.4,
-                    rect(y + 0.05, x + 0.03, y + 0.45, x + 0.3),
-                    Texture::Flat,
-                    *c,
-                    *c,
-                ));
+                l.push(layer(0.4, rect(y + 0.05, x + 0.03, y + 0.45, x + 0.3), Texture::Flat, *c, *c));
             }
             for (i, nm) in [450.0, 530.0, 610.0, 660.0].iter().enumerate() {
                 let c = narrow_band(*nm, 12.0);
                 l.push(layer(
                     1.0,
-                    Shape::Disc {
-                        cy: 0.25 + 0.5 * (i / 2) as f32,
-                        cx: 0.2 + 0.6 * (i % 2) as f32,
-                        r: 0.08,
-                    },
+                    Shape::Disc { cy: 0.25 + 0.5 * (i / 2) as f32, cx: 0.2 + 0.6 * (i % 2) as f32, r: 0.08 },
                     Texture::Flat,
                     c,
                     c,
@@ -338,19 +245,11 @@ pub fn named(name: &str) -> Option<Scene> {
         }
         // The depth scene at 4 % exposure: low light.
         "dark" => {
-            return named("depth").map(|s| Scene {
-                name: "dark".into(),
-                gain: 0.04,
-                ..s
-            });
+            return named("depth").map(|s| Scene { name: "dark".into(), gain: 0.04, ..s });
         }
         _ => return None,
     };
-    Some(Scene {
-        name: name.into(),
-        layers,
-        gain: 1.0,
-    })
+    Some(Scene { name: name.into(), layers, gain: 1.0 })
 }
 
 /// A random training scene: a textured background and 2 to 5 shapes at distinct
@@ -364,17 +263,11 @@ pub fn random(seed: u64) -> Scene {
     };
     let texture = |rng: &mut ChaCha8Rng| match rng.random_range(0..5) {
         0 => Texture::Flat,
-        1 => Texture::Noise {
-            cell: rng.random_range(4.0..40.0),
-            seed: rng.random(),
-        },
-        2 => Texture::Stripes {
-            period: rng.random_range(2.0..12.0),
-            angle: rng.random_range(0.0..std::f32::consts::PI),
-        },
-        3 => Texture::Checks {
-            period: rng.random_range(1.0..8.0),
-        },
+        1 => Texture::Noise { cell: rng.random_range(4.0..40.0), seed: rng.random() },
+        2 => {
+            Texture::Stripes { period: rng.random_range(2.0..12.0), angle: rng.random_range(0.0..std::f32::consts::PI) }
+        }
+        3 => Texture::Checks { period: rng.random_range(1.0..8.0) },
         _ => Texture::Fine { seed: rng.random() },
     };
     let count = rng.random_range(3..=6);
@@ -386,12 +279,7 @@ pub fn random(seed: u64) -> Scene {
             Shape::Everywhere
         } else if rng.random_bool(0.5) {
             let (y0, x0) = (rng.random_range(-0.1..0.7), rng.random_range(-0.1..0.7));
-            rect(
-                y0,
-                x0,
-                y0 + rng.random_range(0.15..0.6),
-                x0 + rng.random_range(0.15..0.6),
-            )
+            rect(y0, x0, y0 + rng.random_range(0.15..0.6), x0 + rng.random_range(0.15..0.6))
         } else {
             Shape::Disc {
                 cy: rng.random_range(0.0..1.0),
@@ -401,16 +289,7 @@ pub fn random(seed: u64) -> Scene {
         };
         let tex = texture(&mut rng);
         let r = [spectrum(&mut rng), spectrum(&mut rng)];
-        layers.push(Layer {
-            disparity: d,
-            shape,
-            texture: tex,
-            reflectance: r,
-        });
+        layers.push(Layer { disparity: d, shape, texture: tex, reflectance: r });
     }
-    Scene {
-        name: format!("random-{seed}"),
-        layers,
-        gain: rng.random_range(0.5..1.0),
-    }
+    Scene { name: format!("random-{seed}"), layers, gain: rng.random_range(0.5..1.0) }
 }

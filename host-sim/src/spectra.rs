@@ -15,10 +15,7 @@ pub type Spectrum = [f32; BANDS];
 
 /// A ColorChecker patch's reflectance by its chart name ("dark skin", "blue sky", ..).
 pub fn colorchecker(name: &str) -> Option<Spectrum> {
-    COLORCHECKER
-        .iter()
-        .find(|(n, _)| *n == name)
-        .map(|(_, s)| *s)
+    COLORCHECKER.iter().find(|(n, _)| *n == name).map(|(_, s)| *s)
 }
 
 /// A smooth random reflectance: a floor plus two or three broad Gaussian bumps, in
@@ -26,20 +23,10 @@ pub fn colorchecker(name: &str) -> Option<Spectrum> {
 pub fn smooth_random(rng: &mut impl Rng) -> Spectrum {
     let floor = rng.random_range(0.03..0.3f32);
     let bumps: Vec<(f32, f32, f32)> = (0..rng.random_range(2..=3))
-        .map(|_| {
-            (
-                rng.random_range(380.0..720.0f32),
-                rng.random_range(40.0..120.0f32),
-                rng.random_range(0.1..0.7f32),
-            )
-        })
+        .map(|_| (rng.random_range(380.0..720.0f32), rng.random_range(40.0..120.0f32), rng.random_range(0.1..0.7f32)))
         .collect();
     BAND_NM.map(|nm| {
-        let v = floor
-            + bumps
-                .iter()
-                .map(|&(c, w, a)| a * (-0.5 * ((nm - c) / w).powi(2)).exp())
-                .sum::<f32>();
+        let v = floor + bumps.iter().map(|&(c, w, a)| a * (-0.5 * ((nm - c) / w).powi(2)).exp()).sum::<f32>();
         v.clamp(0.03, 0.95)
     })
 }

@@ -15,6 +15,10 @@
 //!    `M = A Sigma B^T` (a small SVD, nalgebra). Then re-code. Neither step can increase
 //!    the coding error at fixed assignments; a test holds it to that.
 //!
+//! With `dct_member` (the default) member 0 is the 5D DCT, never updated or dropped: the
+//! learned members come from textured training scenes, and a smooth patch is coded best by
+//! the DCT, so the ensemble keeps it as one of its choices.
+//!
 //! Parallel over patches (rayon) in fixed chunks summed in order, so the result does not
 //! depend on the thread count: the same seed and patches give the same blob bytes.
 
@@ -47,20 +51,15 @@ pub struct TrainConfig {
     /// Patches per member for the HOSVD initialisation.
     pub group: usize,
     pub seed: u64,
+    /// Member 0 is the 5D DCT, kept fixed: patches the DCT codes best (smooth ones) keep it.
+    pub dct_member: bool,
     /// Show a progress bar.
     pub progress: bool,
 }
 
 impl Default for TrainConfig {
     fn default() -> Self {
-        Self {
-            members: 8,
-            tau: 260,
-            iterations: 10,
-            group: 32,
-            seed: 1,
-            progress: false,
-        }
+        Self { members: 8, tau: 260, iterations: 10, group: 32, seed: 1, dct_member: true, progress: false }
     }
 }
 
@@ -80,14 +79,8 @@ pub fn sample_patches(fields: &[LightField], count: usize, seed: u64) -> Vec<f32
     let mut out = Vec::with_capacity(count * N);
     for _ in 0..count {
         let lf = &fields[rng.random_range(0..fields.len())];
-        let (r, c) = (
-            rng.random_range(0..=lf.rows - 5),
-            rng.random_range(0..=lf.cols - 5),
-        );
-        let (u0, v0) = (
-            rng.random_range(0..=lf.views.0 - 4),
-            rng.random_range(0..=lf.views.1 - 4),
-        );
+        let (r, c) = (rng.random_range(0..=lf.rows - 5), rng.random_range(0..=lf.cols - 5));
+        let (u0, v0) = (rng.random_range(0..=lf.views.0 - 4), rng.random_range(0..=lf.views.1 - 4));
         for i in 0..N {
             let [s, t, u, v, b] = PaperShape::coordinates(i);
             out.push(lf.get(u0 + u, v0 + v, r + s, c + t, b));
@@ -155,8 +148,7 @@ fn hosvd(patches: &[f32], group: &[usize]) -> Member {
                     let base = o * d * st + i;
                     for a in 0..d {
                         for c in 0..d {
-                            gram[(a, c)] +=
-                                f64::from(x[base + a * st]) * f64::from(x[base + c * st]);
+                            gram[(a, c)] += f64::from(x[base + a * st]) * f64::from(x[base + c * st]);
                         }
                     }
                 }
@@ -169,9 +161,7 @@ fn hosvd(patches: &[f32], group: &[usize]) -> Member {
         for (k, &j) in order.iter().enumerate() {
             let col = eig.eigenvectors.column(j);
             // Deterministic sign: the largest entry positive.
-            let big = col
-                .iter()
-                .fold(0.0f64, |m, &x| if x.abs() > m.abs() { x } else { m });
+            let big = col.iter().fold(0.0f64, |m, &x| if x.abs() > m.abs() { x } else { m });
             let sign = if big < 0.0 { -1.0 } else { 1.0 };
             for i in 0..d {
                 u[i * d + k] = sign * col[i];
@@ -186,21 +176,12 @@ pub fn top_tau(s: &[f32], tau: usize) -> (f64, Vec<u16>) {
     let mut idx: Vec<u16> = (0..s.len() as u16).collect();
     let total: f64 = s.iter().map(|&x| f64::from(x) * f64::from(x)).sum();
     if tau < s.len() {
-        idx.select_nth_unstable_by(tau, |&a, &b| {
-            s[b as usize]
-                .abs()
-                .total_cmp(&s[a as usize].abs())
-                .then(a.cmp(&b))
-        });
+        idx.select_nth_unstable_by(tau, |&a, &b| s[b as usize].abs().total_cmp(&s[a as usize].abs()).then(a.cmp(&b)));
         idx.truncate(tau);
     }
     idx.sort_unstable();
     let kept: f64 = idx.iter().map(|&i| f64::from(s[i as usize]).powi(2)).sum();
-    let err = if total > 0.0 {
-        ((total - kept) / total).max(0.0)
-    } else {
-        0.0
-    };
+    let err = if total > 0.0 { ((total - kept) / total).max(0.0) } else { 0.0 };
     (err, idx)
 }
 
@@ -216,10 +197,7 @@ fn coefficients(patches: &[f32], p: usize, dict: &PaperDictionary) -> Box<[f32; 
 /// Mean relative coding error of every patch in `dict` at `tau`.
 pub fn coding_error(patches: &[f32], dict: &PaperDictionary, tau: usize) -> f64 {
     let count = patches.len() / N;
-    let sum: f64 = (0..count)
-        .into_par_iter()
-        .map(|p| top_tau(&coefficients(patches, p, dict)[..], tau).0)
-        .sum();
+    let sum: f64 = (0..count).into_par_iter().map(|p| top_tau(&coefficients(patches, p, dict)[..], tau).0).sum();
     sum / count as f64
 }
 
@@ -228,12 +206,7 @@ pub fn ensemble_error(patches: &[f32], members: &[PaperDictionary], tau: usize) 
     let count = patches.len() / N;
     let sum: f64 = (0..count)
         .into_par_iter()
-        .map(|p| {
-            members
-                .iter()
-                .map(|d| top_tau(&coefficients(patches, p, d)[..], tau).0)
-                .fold(f64::INFINITY, f64::min)
-        })
+        .map(|p| members.iter().map(|d| top_tau(&coefficients(patches, p, d)[..], tau).0).fold(f64::INFINITY, f64::min))
         .sum();
     sum / count as f64
 }
@@ -247,10 +220,7 @@ pub fn assign(patches: &[f32], members: &[PaperDictionary], tau: usize) -> Vec<(
                 .iter()
                 .enumerate()
                 .map(|(k, d)| (k, top_tau(&coefficients(patches, p, d)[..], tau).0))
-                .fold(
-                    (0, f64::INFINITY),
-                    |best, c| if c.1 < best.1 { c } else { best },
-                )
+                .fold((0, f64::INFINITY), |best, c| if c.1 < best.1 { c } else { best })
         })
         .collect()
 }
@@ -258,11 +228,7 @@ pub fn assign(patches: &[f32], members: &[PaperDictionary], tau: usize) -> Vec<(
 /// Mean coding error of the patches assigned to `k` (`assignment[p] == k`) in `member`.
 pub fn member_error(patches: &[f32], member: &Member, which: &[usize], tau: usize) -> f64 {
     let d = member.dictionary();
-    which
-        .iter()
-        .map(|&p| top_tau(&coefficients(patches, p, &d)[..], tau).0)
-        .sum::<f64>()
-        / which.len().max(1) as f64
+    which.iter().map(|&p| top_tau(&coefficients(patches, p, &d)[..], tau).0).sum::<f64>() / which.len().max(1) as f64
 }
 
 /// One Procrustes update of every mode of `member` on its patches `which`, codes fixed
@@ -318,9 +284,7 @@ pub fn update_member(patches: &[f32], member: &Member, which: &[usize], tau: usi
         // Keep S_full current: S <- S x_n (U_new^T U_cur).
         let r = u_new.transpose() * &u_cur;
         let r_rows: Vec<f64> = (0..d * d).map(|k| r[(k / d, k % d)]).collect();
-        state
-            .par_iter_mut()
-            .for_each(|(full, _)| mode_product(&mut full[..], n, &r_rows));
+        state.par_iter_mut().for_each(|(full, _)| mode_product(&mut full[..], n, &r_rows));
         next.0[n] = (0..d * d).map(|k| u_new[(k / d, k % d)]).collect();
     }
     next
@@ -331,17 +295,10 @@ pub fn update_member(patches: &[f32], member: &Member, which: &[usize], tau: usi
 pub fn train(patches: &[f32], cfg: &TrainConfig) -> (Vec<PaperDictionary>, Vec<IterationReport>) {
     let count = patches.len() / N;
     let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed);
-    let mut members: Vec<Member> = (0..cfg.members)
-        .map(|_| {
-            hosvd(
-                patches,
-                &sample(&mut rng, count, cfg.group.min(count)).into_vec(),
-            )
-        })
-        .collect();
+    let mut members: Vec<Member> =
+        (0..cfg.members).map(|_| hosvd(patches, &sample(&mut rng, count, cfg.group.min(count)).into_vec())).collect();
     let dct_error = coding_error(patches, &Dictionary::dct(), cfg.tau);
-    let bar =
-        ProgressBar::with_draw_target(Some(cfg.iterations as u64), ProgressDrawTarget::hidden());
+    let bar = ProgressBar::with_draw_target(Some(cfg.iterations as u64), ProgressDrawTarget::hidden());
     if cfg.progress {
         bar.set_draw_target(ProgressDrawTarget::stderr());
         bar.set_style(
@@ -354,27 +311,13 @@ pub fn train(patches: &[f32], cfg: &TrainConfig) -> (Vec<PaperDictionary>, Vec<I
         let dicts: Vec<PaperDictionary> = members.iter().map(Member::dictionary).collect();
         let assignment = assign(patches, &dicts, cfg.tau);
         let ensemble_error = assignment.iter().map(|a| a.1).sum::<f64>() / count as f64;
-        let groups: Vec<Vec<usize>> = (0..members.len())
-            .map(|k| (0..count).filter(|&p| assignment[p].0 == k).collect())
-            .collect();
+        let groups: Vec<Vec<usize>> =
+            (0..members.len()).map(|k| (0..count).filter(|&p| assignment[p].0 == k).collect()).collect();
         // Drop members that code no patch.
-        let kept: Vec<(Member, Vec<usize>)> = members
-            .into_iter()
-            .zip(groups)
-            .filter(|(_, g)| !g.is_empty())
-            .collect();
-        reports.push(IterationReport {
-            ensemble_error,
-            dct_error,
-            members: kept.len(),
-        });
-        bar.set_message(format!(
-            "ensemble {ensemble_error:.4} vs DCT {dct_error:.4}"
-        ));
-        members = kept
-            .iter()
-            .map(|(m, g)| update_member(patches, m, g, cfg.tau))
-            .collect();
+        let kept: Vec<(Member, Vec<usize>)> = members.into_iter().zip(groups).filter(|(_, g)| !g.is_empty()).collect();
+        reports.push(IterationReport { ensemble_error, dct_error, members: kept.len() });
+        bar.set_message(format!("ensemble {ensemble_error:.4} vs DCT {dct_error:.4}"));
+        members = kept.iter().map(|(m, g)| update_member(patches, m, g, cfg.tau)).collect();
         bar.inc(1);
     }
     bar.finish_and_clear();
@@ -387,11 +330,7 @@ pub fn training_fields(count: usize, size: usize, seed: u64) -> Vec<LightField> 
     (0..count as u64)
         .into_par_iter()
         .map(|i| {
-            crate::scene::random(seed + i).render(crate::scene::SceneSize {
-                views: (5, 5),
-                rows: size,
-                cols: size,
-            })
+            crate::scene::random(seed + i).render(crate::scene::SceneSize { views: (5, 5), rows: size, cols: size })
         })
         .collect()
 }

@@ -12,26 +12,17 @@
 //! orthonormal only to about 1e-7), and the 1D method accumulates its dense products in f64.
 
 use slf_host::baseline::{Dense1D, Factors, solve_5d};
-use slf_host::firmware::{
-    Dictionary, LensletSize, Mask, PaperShape, PaperWorkspace, Sl0Config, solve,
-};
+use slf_host::firmware::{Dictionary, LensletSize, Mask, PaperShape, PaperWorkspace, Sl0Config, solve};
 use slf_host::scene::{self, SceneSize};
 
 fn max_diff<T: Copy + Into<f64>>(a: &[T], b: &[T]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(&x, &y)| (x.into() - y.into()).abs())
-        .fold(0.0, f64::max)
+    a.iter().zip(b).map(|(&x, &y)| (x.into() - y.into()).abs()).fold(0.0, f64::max)
 }
 
 #[test]
 fn five_d_equals_one_d_for_every_mask_family() {
     let dict = Dictionary::<5, 5, 4, 4, 13>::dct();
-    let lf = scene::named("depth").unwrap().render(SceneSize {
-        views: (4, 4),
-        rows: 20,
-        cols: 20,
-    });
+    let lf = scene::named("depth").unwrap().render(SceneSize { views: (4, 4), rows: 20, cols: 20 });
     let l4 = LensletSize { rows: 4, cols: 4 };
     for k in [1u8, 3] {
         let masks = [
@@ -62,27 +53,18 @@ fn five_d_equals_one_d_for_every_mask_family() {
             let family = mask.family();
 
             for (sigma_min, f32_bound) in [(1e-2f32, 1e-5), (Sl0Config::DEFAULT.sigma_min, 1e-4)] {
-                let cfg = Sl0Config {
-                    sigma_min,
-                    ..Sl0Config::DEFAULT
-                };
+                let cfg = Sl0Config { sigma_min, ..Sl0Config::DEFAULT };
                 let out5 = solve(&dict, &cfg, &mut ws).unwrap();
                 let (x1, it1) = one32.solve(&y32, &cfg);
                 assert_eq!(it1, out5.iterations, "{family:?} k {k}");
                 let d32 = max_diff(&x1, &ws.patch()[..]);
-                assert!(
-                    d32 <= f32_bound,
-                    "{family:?} k {k} sigma_min {sigma_min}: f32 5D vs 1D max abs diff {d32:e}"
-                );
+                assert!(d32 <= f32_bound, "{family:?} k {k} sigma_min {sigma_min}: f32 5D vs 1D max abs diff {d32:e}");
 
                 let (x5, it5) = solve_5d::<f64>(&f64_dct, &meas64, &cfg);
                 let (x1, it1) = one64.solve(&y64, &cfg);
                 assert_eq!(it1, it5);
                 let d64 = max_diff(&x1, &x5);
-                assert!(
-                    d64 <= 1e-9,
-                    "{family:?} k {k} sigma_min {sigma_min}: f64 5D vs 1D max abs diff {d64:e}"
-                );
+                assert!(d64 <= 1e-9, "{family:?} k {k} sigma_min {sigma_min}: f64 5D vs 1D max abs diff {d64:e}");
                 eprintln!(
                     "{family:?} k {k} sigma_min {sigma_min}: f32 diff {d32:.2e}, f64 diff {d64:.2e}, {it5} steps"
                 );

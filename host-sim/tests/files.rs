@@ -9,11 +9,7 @@ use slf_host::lightfield::{Dtype, LightField, read_npy, write_npy};
 use slf_host::scene::{self, SceneSize};
 
 fn small() -> LightField {
-    scene::named("texture").unwrap().render(SceneSize {
-        views: (5, 5),
-        rows: 10,
-        cols: 15,
-    })
+    scene::named("texture").unwrap().render(SceneSize { views: (5, 5), rows: 10, cols: 15 })
 }
 
 #[test]
@@ -26,16 +22,8 @@ fn npy_round_trips_f32_and_u16() {
     write_npy(&p, &lf, Dtype::U16).unwrap();
     let back = read_npy(&p).unwrap();
     assert_eq!(back.shape(), lf.shape());
-    let worst = back
-        .data
-        .iter()
-        .zip(&lf.data)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0, f32::max);
-    assert!(
-        worst <= 0.5 / 65535.0 + 1e-7,
-        "u16 quantisation error {worst}"
-    );
+    let worst = back.data.iter().zip(&lf.data).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max);
+    assert!(worst <= 0.5 / 65535.0 + 1e-7, "u16 quantisation error {worst}");
 }
 
 /// Writes an .npy by hand: header dict and body bytes.
@@ -63,11 +51,7 @@ fn bad_npy_files_say_what_is_wrong() {
     raw_npy(&p, "<f4", "(2, 2, 3)", &[0; 48]);
     assert!(err(&p).contains("3 axes"), "{}", err(&p));
     raw_npy(&p, "<f4", "(1, 1, 2, 2, 3)", &[0; 20]);
-    assert!(
-        err(&p).contains("truncated body: header promises 12 values, file holds 5"),
-        "{}",
-        err(&p)
-    );
+    assert!(err(&p).contains("truncated body: header promises 12 values, file holds 5"), "{}", err(&p));
     raw_npy(&p, "<u2", "(1, 1, 0, 2, 3)", &[]);
     assert!(err(&p).contains("empty axis"), "{}", err(&p));
     std::fs::write(&p, b"not an npy file at all").unwrap();
@@ -97,10 +81,7 @@ fn captures_round_trip_in_every_frame_format() {
 
 fn saved_capture() -> (tempfile::TempDir, serde_json::Value) {
     let dir = tempfile::tempdir().unwrap();
-    simulate(&small(), &CameraConfig::pixel(3, 2))
-        .unwrap()
-        .save(dir.path())
-        .unwrap();
+    simulate(&small(), &CameraConfig::pixel(3, 2)).unwrap().save(dir.path()).unwrap();
     let json = std::fs::read_to_string(dir.path().join("capture.json")).unwrap();
     (dir, serde_json::from_str(&json).unwrap())
 }
@@ -109,46 +90,18 @@ fn saved_capture() -> (tempfile::TempDir, serde_json::Value) {
 fn bad_captures_say_what_and_where() {
     type Edit = Box<dyn Fn(&mut serde_json::Value)>;
     let cases: Vec<(&str, Edit, &str)> = vec![
-        (
-            "format",
-            Box::new(|j| j["format"] = "other".into()),
-            "format is \"other\"",
-        ),
-        (
-            "version",
-            Box::new(|j| j["version"] = 9.into()),
-            "version 9",
-        ),
-        (
-            "unknown field",
-            Box::new(|j| j["colour"] = 1.into()),
-            "unknown field `colour`",
-        ),
-        (
-            "mask family",
-            Box::new(|j| j["mask"]["family"] = "stripes".into()),
-            "unknown variant `stripes`",
-        ),
-        (
-            "snapshots",
-            Box::new(|j| j["mask"]["snapshots"] = 3.into()),
-            "mask has 3 snapshots, capture has 2 frames",
-        ),
-        (
-            "band count",
-            Box::new(|j| j["mask"]["snapshots"] = 14.into()),
-            "14 snapshots with 13 bands",
-        ),
+        ("format", Box::new(|j| j["format"] = "other".into()), "format is \"other\""),
+        ("version", Box::new(|j| j["version"] = 9.into()), "version 9"),
+        ("unknown field", Box::new(|j| j["colour"] = 1.into()), "unknown field `colour`"),
+        ("mask family", Box::new(|j| j["mask"]["family"] = "stripes".into()), "unknown variant `stripes`"),
+        ("snapshots", Box::new(|j| j["mask"]["snapshots"] = 3.into()), "mask has 3 snapshots, capture has 2 frames"),
+        ("band count", Box::new(|j| j["mask"]["snapshots"] = 14.into()), "14 snapshots with 13 bands"),
         (
             "defect",
             Box::new(|j| j["defective_pixels"] = serde_json::json!([[500, 1]])),
             "defective pixel [500, 1] outside",
         ),
-        (
-            "levels",
-            Box::new(|j| j["white_level"] = 10.into()),
-            "black_level < white_level",
-        ),
+        ("levels", Box::new(|j| j["white_level"] = 10.into()), "black_level < white_level"),
         (
             "lenslets",
             Box::new(|j| j["lenslets"] = serde_json::json!([11, 15])),
@@ -156,16 +109,10 @@ fn bad_captures_say_what_and_where() {
         ),
         (
             "tile",
-            Box::new(|j| {
-                j["mask"] = serde_json::json!({"family": "pixel", "tile": [[[0, 1]], [[0, 2]]]})
-            }),
+            Box::new(|j| j["mask"] = serde_json::json!({"family": "pixel", "tile": [[[0, 1]], [[0, 2]]]})),
             "repeated",
         ),
-        (
-            "missing frame",
-            Box::new(|j| j["frames"][1] = "nope.pgm".into()),
-            "nope.pgm",
-        ),
+        ("missing frame", Box::new(|j| j["frames"][1] = "nope.pgm".into()), "nope.pgm"),
     ];
     for (what, edit, want) in cases {
         let (dir, mut json) = saved_capture();
@@ -173,10 +120,7 @@ fn bad_captures_say_what_and_where() {
         std::fs::write(dir.path().join("capture.json"), json.to_string()).unwrap();
         let e = format!("{:#}", Capture::load(dir.path()).unwrap_err());
         assert!(e.contains(want), "{what}: {e}");
-        assert!(
-            e.contains("capture.json") || e.contains(".pgm"),
-            "{what}: names no file: {e}"
-        );
+        assert!(e.contains("capture.json") || e.contains(".pgm"), "{what}: names no file: {e}");
     }
     // A truncated frame file.
     let (dir, _) = saved_capture();
@@ -213,8 +157,5 @@ fn a_capture_written_by_another_tool_loads() {
     let mask = cap.mask().unwrap();
     assert_eq!(mask.bands_at(1, 1).as_slice(), &[12, 2]);
     assert_eq!(mask.bands_at(3, 2).as_slice(), &[8, 9]);
-    assert!(matches!(
-        cap.description.mask,
-        MaskDescription::Pixel(MaskSource { tile: Some(_), .. })
-    ));
+    assert!(matches!(cap.description.mask, MaskDescription::Pixel(MaskSource { tile: Some(_), .. })));
 }

@@ -7,10 +7,9 @@ use slf_host::lightfield::read_npy;
 use slf_host::metrics::evaluate;
 
 fn expected() -> serde_json::Value {
-    let text = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/metrics/expected.json"),
-    )
-    .unwrap();
+    let text =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/metrics/expected.json"))
+            .unwrap();
     serde_json::from_str(&text).unwrap()
 }
 
@@ -25,10 +24,7 @@ fn metrics_match_scikit_image() {
         let e = &exp[case];
         let close = |got: f64, key: &str| {
             let want = e[key].as_f64().unwrap();
-            assert!(
-                (got - want).abs() <= 1e-4,
-                "{case} {key}: {got} vs scikit-image {want}"
-            );
+            assert!((got - want).abs() <= 1e-4, "{case} {key}: {got} vs scikit-image {want}");
         };
         close(m.data_range, "data_range");
         close(m.psnr, "psnr");
@@ -47,10 +43,5 @@ fn identical_light_fields_are_perfect() {
     assert!(m.sa.abs() < 1e-3, "{}", m.sa);
     let mut other = t.clone();
     other.rows -= 1;
-    assert!(
-        evaluate(&t, &other)
-            .unwrap_err()
-            .to_string()
-            .contains("shapes differ")
-    );
+    assert!(evaluate(&t, &other).unwrap_err().to_string().contains("shapes differ"));
 }

@@ -39,13 +39,7 @@ pub fn random_orthonormal<const D: usize>(rng: &mut ChaCha8Rng) -> Matrix<D> {
     m
 }
 
-pub fn random_dictionary<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
->(
+pub fn random_dictionary<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
     seed: u64,
 ) -> Dictionary<PS, PT, PU, PV, B> {
     let mut r = rng(seed);
@@ -65,13 +59,7 @@ fn flat<const D: usize>(m: &Matrix<D>) -> Vec<f64> {
 
 /// The dense N x N matrix of a separable operator, in f64: row-major vec of the patch layout
 /// (band fastest), so `K = M1 (x) M2 (x) M3 (x) M4 (x) M5` by the Kronecker product.
-pub fn dense_kronecker<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
->(
+pub fn dense_kronecker<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
     f: &Factors<PS, PT, PU, PV, B>,
 ) -> (Vec<f64>, usize) {
     fn kron(a: &[f64], ad: usize, b: &[f64], bd: usize) -> Vec<f64> {
@@ -98,23 +86,11 @@ pub fn dense_kronecker<
 
 /// `y = K x` in f64.
 pub fn dense_apply(k: &[f64], n: usize, x: &[f32]) -> Vec<f64> {
-    (0..n)
-        .map(|i| {
-            k[i * n..(i + 1) * n]
-                .iter()
-                .zip(x)
-                .map(|(a, &b)| a * f64::from(b))
-                .sum()
-        })
-        .collect()
+    (0..n).map(|i| k[i * n..(i + 1) * n].iter().zip(x).map(|(a, &b)| a * f64::from(b)).sum()).collect()
 }
 
 pub fn rel_err(a: &[f32], reference: &[f64]) -> f64 {
-    let num: f64 = a
-        .iter()
-        .zip(reference)
-        .map(|(&x, y)| (f64::from(x) - y).powi(2))
-        .sum();
+    let num: f64 = a.iter().zip(reference).map(|(&x, y)| (f64::from(x) - y).powi(2)).sum();
     let den: f64 = reference.iter().map(|y| y * y).sum();
     (num / den.max(1e-300)).sqrt()
 }
@@ -125,10 +101,7 @@ pub fn rel_err32(a: &[f32], reference: &[f32]) -> f64 {
 }
 
 pub fn max_abs_diff(a: &[f32], b: &[f32]) -> f32 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f32::max)
+    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f32::max)
 }
 
 /// A smooth, positive, natural-ish patch: low-order trends in every dimension plus a
@@ -170,14 +143,7 @@ pub fn smooth_patch<
 
 /// Fills `ws`'s measurements as the camera would: patch pixel `(s, t, u, v)` of the patch
 /// whose first lenslet is `lenslet_origin` sees `mask`'s bands at its sensor pixel.
-pub fn measure<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
->(
+pub fn measure<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
     mask: &Mask,
     lenslet_origin: (usize, usize),
     truth: &[f32],
@@ -212,8 +178,7 @@ pub fn measure_window<
                     let row = (lenslet_origin.0 + s) * lu + view_origin.0 + u;
                     let col = (lenslet_origin.1 + t) * lv + view_origin.1 + v;
                     for &band in mask.bands_at(row, col).iter() {
-                        let i =
-                            PatchShape::<PS, PT, PU, PV, B, N>::index(s, t, u, v, band as usize);
+                        let i = PatchShape::<PS, PT, PU, PV, B, N>::index(s, t, u, v, band as usize);
                         m.set(i, truth[i]).expect("finite truth");
                     }
                 }
