@@ -270,7 +270,7 @@ enum Command {
         #[arg(long, default_value_t = 8)]
         members: usize,
         /// Coefficients kept per patch when coding.
-        #[arg(long, default_value_t = 260)]
+        #[arg(long, default_value_t = 100)]
         tau: usize,
         #[arg(long, default_value_t = 10)]
         iterations: usize,
@@ -318,7 +318,7 @@ enum Command {
         #[arg(long, value_enum, default_value_t = Rule::Residual)]
         rule: Rule,
         /// Coefficients kept by the residual rule.
-        #[arg(long, default_value_t = 260)]
+        #[arg(long, default_value_t = 100)]
         rule_tau: u16,
     },
 }
@@ -464,7 +464,15 @@ fn run(cli: Cli) -> Result<()> {
                 );
             }
             let data = train::sample_patches(&fields, patches, seed);
-            let cfg = train::TrainConfig { members, tau, iterations, group, seed, progress: true };
+            let cfg = train::TrainConfig {
+                members,
+                tau,
+                iterations,
+                group,
+                seed,
+                dct_member: !no_dct_member,
+                progress: true,
+            };
             let (dicts, reports) = train::train(&data, &cfg);
             println!("| iteration | members | ensemble coding error | DCT coding error |\n| --- | --- | --- | --- |");
             for (i, r) in reports.iter().enumerate() {

@@ -59,7 +59,7 @@ pub struct TrainConfig {
 
 impl Default for TrainConfig {
     fn default() -> Self {
-        Self { members: 8, tau: 260, iterations: 10, group: 32, seed: 1, dct_member: true, progress: false }
+        Self { members: 8, tau: 100, iterations: 10, group: 32, seed: 1, dct_member: true, progress: false }
     }
 }
 
@@ -231,12 +231,15 @@ pub fn member_error(patches: &[f32], member: &Member, which: &[usize], tau: usiz
     which.iter().map(|&p| top_tau(&coefficients(patches, p, &d)[..], tau).0).sum::<f64>() / which.len().max(1) as f64
 }
 
+/// A patch's full coefficients in a member and its fixed sparse code `(index, value)`.
+type PatchCode = (Box<[f32; N]>, Vec<(u16, f32)>);
+
 /// One Procrustes update of every mode of `member` on its patches `which`, codes fixed
 /// at the start (the `tau` largest coefficients in the current member).
 pub fn update_member(patches: &[f32], member: &Member, which: &[usize], tau: usize) -> Member {
     let dict = member.dictionary();
     // Per patch: the full coefficients (kept current as modes change) and the fixed code.
-    let mut state: Vec<(Box<[f32; N]>, Vec<(u16, f32)>)> = which
+    let mut state: Vec<PatchCode> = which
         .par_iter()
         .map(|&p| {
             let s = coefficients(patches, p, &dict);
@@ -246,8 +249,8 @@ pub fn update_member(patches: &[f32], member: &Member, which: &[usize], tau: usi
         })
         .collect();
     let mut next = member.clone();
-    for n in 0..5 {
-        let (d, st) = (DIMS[n], stride(n));
+    for (n, &d) in DIMS.iter().enumerate() {
+        let st = stride(n);
         // G = sum_p S_full(n) S_sparse(n)^T, in fixed chunks summed in order.
         let parts: Vec<Vec<f64>> = state
             .par_chunks(CHUNK)
@@ -290,13 +293,29 @@ pub fn update_member(patches: &[f32], member: &Member, which: &[usize], tau: usi
     next
 }
 
+/// The starting members: the fixed DCT (with `dct_member`), then the HOSVD of a random
+/// group of `group` patches each.
+pub fn init_members(patches: &[f32], cfg: &TrainConfig) -> Vec<Member> {
+    let count = patches.len() / N;
+    let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed);
+    let fixed = usize::from(cfg.dct_member && cfg.members > 0);
+    let mut members: Vec<Member> = Vec::with_capacity(cfg.members);
+    if fixed == 1 {
+        let dct: Vec<Vec<f64>> = crate::baseline::Factors::dct_f64().0.into_iter().map(|(_, m)| m).collect();
+        members.push(Member(dct.try_into().unwrap_or_else(|_| unreachable!("five modes"))));
+    }
+    while members.len() < cfg.members {
+        members.push(hosvd(patches, &sample(&mut rng, count, cfg.group.min(count)).into_vec()));
+    }
+    members
+}
+
 /// Trains an ensemble on `patches`; returns its members (empty ones dropped) and the
 /// coding error per iteration against the DCT's.
 pub fn train(patches: &[f32], cfg: &TrainConfig) -> (Vec<PaperDictionary>, Vec<IterationReport>) {
     let count = patches.len() / N;
-    let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed);
-    let mut members: Vec<Member> =
-        (0..cfg.members).map(|_| hosvd(patches, &sample(&mut rng, count, cfg.group.min(count)).into_vec())).collect();
+    let fixed = usize::from(cfg.dct_member && cfg.members > 0);
+    let mut members = init_members(patches, cfg);
     let dct_error = coding_error(patches, &Dictionary::dct(), cfg.tau);
     let bar = ProgressBar::with_draw_target(Some(cfg.iterations as u64), ProgressDrawTarget::hidden());
     if cfg.progress {
@@ -313,11 +332,23 @@ pub fn train(patches: &[f32], cfg: &TrainConfig) -> (Vec<PaperDictionary>, Vec<I
         let ensemble_error = assignment.iter().map(|a| a.1).sum::<f64>() / count as f64;
         let groups: Vec<Vec<usize>> =
             (0..members.len()).map(|k| (0..count).filter(|&p| assignment[p].0 == k).collect()).collect();
-        // Drop members that code no patch.
-        let kept: Vec<(Member, Vec<usize>)> = members.into_iter().zip(groups).filter(|(_, g)| !g.is_empty()).collect();
+        // Drop members that code no patch (the fixed DCT stays).
+        let kept: Vec<(Member, Vec<usize>)> = members
+            .into_iter()
+            .zip(groups)
+            .enumerate()
+            .filter(|(k, (_, g))| *k < fixed || !g.is_empty())
+            .map(|(_, mg)| mg)
+            .collect();
         reports.push(IterationReport { ensemble_error, dct_error, members: kept.len() });
         bar.set_message(format!("ensemble {ensemble_error:.4} vs DCT {dct_error:.4}"));
-        members = kept.iter().map(|(m, g)| update_member(patches, m, g, cfg.tau)).collect();
+        members = kept
+            .iter()
+            .enumerate()
+            .map(
+                |(k, (m, g))| if k < fixed || g.is_empty() { m.clone() } else { update_member(patches, m, g, cfg.tau) },
+            )
+            .collect();
         bar.inc(1);
     }
     bar.finish_and_clear();
