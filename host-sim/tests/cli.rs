@@ -40,10 +40,38 @@ fn scene_simulate_decode_eval_round_trip() {
     let psnr: f64 = out.split_whitespace().nth(1).unwrap().parse().unwrap();
     assert!(psnr > 30.0, "{out}");
     assert!(out.contains("data range") && out.contains("SSIM") && out.contains("SA"), "{out}");
+    // The DCT on request, and the member map of the (default) ensemble decode.
+    let out = stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("dct.npy")).args(["--dictionary", "dct", "-q"]));
+    assert!(out.contains("decoded 64 patches"), "{out}");
+    stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("e.npy")).arg("--member-map").arg(p("map.csv")).arg("-q"));
+    let map = std::fs::read_to_string(p("map.csv")).unwrap();
+    assert_eq!(map.lines().next(), Some("lenslet_row,lenslet_col,view_row,view_col,member"));
+    assert_eq!(map.lines().count(), 1 + 64);
+    assert!(map.lines().skip(1).all(|l| l.rsplit(',').next().unwrap().parse::<u16>().unwrap() < 8));
+    // A tiny training run writes a blob the decoder takes.
+    let out = stdout(slf().arg("train").arg("-o").arg(p("e.slfd")).args([
+        "--scenes",
+        "2",
+        "--size",
+        "12",
+        "--patches",
+        "40",
+        "--members",
+        "3",
+        "--iterations",
+        "1",
+        "--group",
+        "8",
+    ]));
+    assert!(out.contains("coding error") && out.contains("vs DCT"), "{out}");
+    stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("e2.npy")).arg("--blob").arg(p("e.slfd")).arg("-q"));
+    std::fs::write(p("bad.slfd"), b"SLFDxx").unwrap();
+    let e = failure(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("e3.npy")).arg("--blob").arg(p("bad.slfd")));
+    assert!(e.contains("dictionary blob"), "{e}");
     // A random training scene in uint16.
     stdout(slf().args(["scene", "random", "--seed", "4", "--size", "12", "--dtype", "u16", "-o"]).arg(p("r.npy")));
     // Every command has help.
-    for c in ["demo", "scene", "simulate", "decode", "eval", "baseline", "sweep"] {
+    for c in ["demo", "scene", "simulate", "decode", "eval", "baseline", "sweep", "train", "compare"] {
         assert!(stdout(slf().args([c, "--help"])).contains("Usage"), "{c}");
     }
 }
