@@ -93,7 +93,7 @@ pub use defects::{DefectList, Pixel};
 pub use dictionary::{Dictionary, DictionaryError, Factors, Matrix};
 pub use mask::{BandTile, KroneckerPhi, LensletSize, Mask, MaskFamily, SensingError};
 pub use pinv::{PinvOperator, solve_pinv};
-pub use raw::{FrameSource, RawFormat, RawFrame};
+pub use raw::{Frame, FrameSource, LeU16Frame, RawFormat, RawFrame};
 pub use shape::{FullViewShape, PaperShape, PatchShape};
 pub use sl0::{Ended, Outcome, Sl0Config, SolveError, solve};
 pub use tile::{

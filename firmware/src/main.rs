@@ -1,31 +1,103 @@
 //! `slf-device`: the decoder on a Cortex-M core.
 //!
-//! Today it decodes one synthetic patch (measured through a seeded `pixel` mask) with the
-//! 5D DCT and reports over semihosting the steps taken and a checksum of the decoded
-//! patch, then exits through semihosting (qemu's exit code: 0 on success). Run it with
-//! `cargo run --release -p slf-firmware --target thumbv7em-none-eabihf` (see the README);
-//! the device issue grows it into a tile decoder of a capture held in flash.
-//! On the host this file builds to a stub that says so.
+//! Decodes every tile of the capture in `firmware/device/capture` (written by
+//! `slf device-capture`, included in flash at build time) with the shipped 8-member
+//! ensemble and screened member choice, and prints over semihosting every decoded patch
+//! (f32 bit patterns) for `slf device-check` to compare with the host's decode. Then it
+//! decodes the same tiles with the 5D DCT. `bench_begin` / `bench_end` bracket one
+//! synthesis, then each ensemble tile, then each DCT tile, so the qemu plugin
+//! `../shared/tools/qemu-insn-count` counts instructions per transform and per patch. The
+//! stack is painted at start and scanned at the end for its peak depth.
+//!
+//! Run: `cargo run --release -p slf-firmware --target thumbv7em-none-eabihf` (qemu is the
+//! runner, see `.cargo/config.toml`). On the host this file builds to a stub that says so.
 #![cfg_attr(target_os = "none", no_std, no_main)]
+
+/// Instruction-count window markers: never inlined, distinct bodies, addresses found by
+/// symbol name. `black_box` keeps the calls and bodies from being folded away.
+#[unsafe(no_mangle)]
+#[inline(never)]
+pub extern "C" fn bench_begin(x: u32) -> u32 {
+    core::hint::black_box(x).wrapping_add(0x5f0d)
+}
+
+#[unsafe(no_mangle)]
+#[inline(never)]
+pub extern "C" fn bench_end(x: u32) -> u32 {
+    core::hint::black_box(x).wrapping_mul(0x2545_f491)
+}
 
 #[cfg(target_os = "none")]
 mod device {
+    include!("../device/capture.rs");
+
     use cortex_m_rt::entry;
-    use cortex_m_semihosting::{debug, hprintln};
+    use cortex_m_semihosting::{debug, hprint, hprintln};
     use panic_semihosting as _;
-    use slf_firmware::{Dictionary, LensletSize, Mask, PaperShape, PaperWorkspace, Sl0Config, solve};
+    use slf_firmware::{
+        ChoiceRule, DEFAULT_ENSEMBLE, DecoderConfig, DefectList, Dictionary, Ensemble, EnsembleModel, FrameSource,
+        LeU16Frame, LensletSize, Mask, MemberChoice, PaperShape, PaperWorkspace, PatchModel, PatchOrigin, PatchReport,
+        PatchSink, RawFormat, SensorGeometry, Sl0Config, TileDecoder,
+    };
 
-    /// The 5D DCT: a compile-time table in flash.
-    static DCT: Dictionary<5, 5, 4, 4, 13> = Dictionary::dct();
+    use super::{bench_begin, bench_end};
 
-    /// A smooth test patch value at `(s, t, u, v, b)`, no trigonometry.
-    fn truth(i: usize) -> f32 {
-        let [s, t, u, v, b] = PaperShape::coordinates(i);
-        0.3 + 0.04 * s as f32 + 0.03 * t as f32 + 0.01 * (u + v) as f32 + 0.02 * b as f32
+    static FRAMES: [&[u8]; 3] = [
+        include_bytes!("../device/capture/snapshot_0.npy"),
+        include_bytes!("../device/capture/snapshot_1.npy"),
+        include_bytes!("../device/capture/snapshot_2.npy"),
+    ];
+
+    /// The body of an `.npy` v1 file: past the 10-byte preamble and the header whose length
+    /// is at bytes 8..10.
+    fn npy_body(file: &'static [u8]) -> &'static [u8] {
+        let header = match file.get(8..10) {
+            Some(&[lo, hi]) => u16::from_le_bytes([lo, hi]) as usize,
+            _ => 0,
+        };
+        file.get(10 + header..).unwrap_or(&[])
+    }
+
+    /// Prints each accepted patch, folds it into a checksum.
+    struct Print {
+        checksum: u32,
+        patches: u32,
+        print: bool,
+    }
+
+    impl PatchSink<5200> for Print {
+        type Error = core::convert::Infallible;
+        fn accept(&mut self, o: PatchOrigin, p: &[f32; 5200], r: &PatchReport) -> Result<(), Self::Error> {
+            self.patches += 1;
+            for x in p {
+                self.checksum = self.checksum.rotate_left(5) ^ x.to_bits();
+            }
+            if self.print {
+                hprintln!(
+                    "patch {} {} {} {} member {} solves {} steps {}",
+                    o.lenslet_row,
+                    o.lenslet_col,
+                    o.view_row,
+                    o.view_col,
+                    r.member.unwrap_or(u16::MAX),
+                    r.solves,
+                    r.outcome.iterations
+                );
+                for row in p.chunks(13) {
+                    hprint!("data");
+                    for x in row {
+                        hprint!(" {:08x}", x.to_bits());
+                    }
+                    hprintln!();
+                }
+            }
+            Ok(())
+        }
     }
 
     #[entry]
     fn main() -> ! {
+        crate::stack::paint();
         let code = run();
         debug::exit(code);
         #[allow(clippy::empty_loop)]
@@ -36,31 +108,133 @@ mod device {
         let Some(ws) = cortex_m::singleton!(: PaperWorkspace = PaperWorkspace::new()) else {
             return debug::EXIT_FAILURE;
         };
-        let Ok(mask) = Mask::pixel(1, 1, 13, LensletSize { rows: 5, cols: 5 }) else {
+        let (rows, cols) = (LENSLETS.0 as usize * VIEWS.0 as usize, LENSLETS.1 as usize * VIEWS.1 as usize);
+        let mut frames = [LeU16Frame::new(&[], 0, 0).ok(), None, None];
+        for (f, file) in frames.iter_mut().zip(FRAMES) {
+            *f = LeU16Frame::new(npy_body(file), rows, cols).ok();
+        }
+        let [Some(f0), Some(f1), Some(f2)] = frames else {
+            hprintln!("error: an embedded frame does not match the capture's size");
             return debug::EXIT_FAILURE;
         };
-        for p in 0..PaperShape::PIXELS {
-            let [s, t, u, v, _] = PaperShape::coordinates(p * 13);
-            for &band in mask.bands_at(s * 5 + u, t * 5 + v).iter() {
-                let i = p * 13 + band as usize;
-                if ws.measurements_mut().set(i, truth(i)).is_err() {
-                    return debug::EXIT_FAILURE;
+        let frames = [f0, f1, f2];
+        let lenslet = LensletSize { rows: VIEWS.0, cols: VIEWS.1 };
+        let Ok(mask) = Mask::pixel(MASK_SEED, SNAPSHOTS, 13, lenslet) else {
+            return debug::EXIT_FAILURE;
+        };
+        let config = DecoderConfig {
+            sensor: SensorGeometry { lenslets: LENSLETS, lenslet },
+            mask,
+            raw: RawFormat { black: BLACK, white: WHITE, max_valid: MAX_VALID },
+            defects: DefectList::EMPTY,
+            sl0: Sl0Config::DEFAULT,
+        };
+        let Ok(decoder) = TileDecoder::<5, 5, 4, 4, 13, 5200>::new(config) else {
+            hprintln!("error: decoder config rejected");
+            return debug::EXIT_FAILURE;
+        };
+        let Ok(ensemble) = Ensemble::<5, 5, 4, 4, 13>::new(DEFAULT_ENSEMBLE) else {
+            hprintln!("error: the shipped ensemble does not validate");
+            return debug::EXIT_FAILURE;
+        };
+        let dct: Dictionary<5, 5, 4, 4, 13> = Dictionary::dct();
+        let model = EnsembleModel::new(ensemble, MemberChoice::Screened(ChoiceRule::DEFAULT));
+
+        // Window 0: one synthesis (PaperShape::TRANSFORM_MACS multiply-adds).
+        ws.coefficients_mut().fill(0.5);
+        bench_begin(0);
+        ws.synthesize(&dct);
+        bench_end(0);
+        hprintln!("transform macs {}", PaperShape::TRANSFORM_MACS);
+
+        let mut out = Print { checksum: 0, patches: 0, print: true };
+        let mut failed = 0u32;
+        hprintln!("model ensemble-screened members {}", model.ensemble().len());
+        // Windows 1..=T: ensemble tiles.
+        for tile in decoder.tiles((1, 1)) {
+            bench_begin(1);
+            let r = decoder.decode_tile(&model, tile, &mut FrameSource::new(&frames), &mut out, ws);
+            bench_end(1);
+            match r {
+                Ok(t) => {
+                    failed += t.failed;
+                    hprintln!("tile {} {} patches {}", tile.lenslet_row, tile.lenslet_col, t.decoded);
                 }
+                Err(_) => failed += 1,
             }
         }
-        match solve(&DCT, &Sl0Config::DEFAULT, ws) {
-            Ok(outcome) => {
-                let sum = ws.patch().iter().fold(0u32, |h, x| h.rotate_left(5) ^ x.to_bits());
-                let worst = (0..5200).map(|i| (ws.patch()[i] - truth(i)).abs()).fold(0.0f32, f32::max);
-                hprintln!("steps {} checksum {:#010x} max-error-e6 {}", outcome.iterations, sum, (worst * 1e6) as u32);
-                debug::EXIT_SUCCESS
+        // Windows T+1..=2T: DCT tiles.
+        let mut quiet = Print { checksum: 0, patches: 0, print: false };
+        hprintln!("model dct");
+        for tile in decoder.tiles((1, 1)) {
+            bench_begin(2);
+            let r = decoder.decode_tile(&dct, tile, &mut FrameSource::new(&frames), &mut quiet, ws);
+            bench_end(2);
+            if r.is_err() {
+                failed += 1;
             }
-            Err(_) => debug::EXIT_FAILURE,
         }
+        let _ = dct.decode(&Sl0Config::DEFAULT, ws);
+        let stack = crate::stack::peak();
+        hprintln!("workspace bytes {}", core::mem::size_of::<PaperWorkspace>());
+        hprintln!("stack peak bytes {}", stack);
+        hprintln!(
+            "done patches={} failed={} checksum={:#010x} dct-checksum={:#010x}",
+            out.patches,
+            failed,
+            out.checksum,
+            quiet.checksum
+        );
+        if failed == 0 { debug::EXIT_SUCCESS } else { debug::EXIT_FAILURE }
+    }
+}
+
+/// Peak stack by painting: the only `unsafe` in the crate, in the binary and not the
+/// decoder library, because measuring the stack means writing and reading memory no Rust
+/// object owns. It runs once at start and once at the end; nothing else touches it.
+#[cfg(target_os = "none")]
+mod stack {
+    const PAINT: u32 = 0xDEAD_BEEF;
+    unsafe extern "C" {
+        /// cortex-m-rt: the top of the stack (initial SP).
+        static _stack_start: u32;
+        /// cortex-m-rt: the end of `.uninit`, where free RAM (and the stack's floor) starts.
+        static __sheap: u32;
+    }
+
+    fn bounds() -> (usize, usize) {
+        // Only the addresses of the linker symbols are taken, never their values.
+        (core::ptr::addr_of!(__sheap) as usize, core::ptr::addr_of!(_stack_start) as usize)
+    }
+
+    /// Paints from the stack's floor up to 256 bytes below the current stack pointer.
+    pub fn paint() {
+        let (floor, _) = bounds();
+        let sp = cortex_m::register::msp::read() as usize;
+        let mut p = floor;
+        while p + 4 <= sp.saturating_sub(256) {
+            // SAFETY: [floor, sp - 256) is RAM below the live stack and above every static;
+            // nothing owns it yet. Word-aligned: cortex-m-rt aligns __sheap to 4.
+            unsafe { core::ptr::write_volatile(p as *mut u32, PAINT) };
+            p += 4;
+        }
+    }
+
+    /// Bytes of stack ever used: from the top down to the lowest word not still painted.
+    pub fn peak() -> usize {
+        let (floor, top) = bounds();
+        let mut p = floor;
+        // SAFETY: reads of the painted region, which nothing but the stack has written.
+        while p < top && unsafe { core::ptr::read_volatile(p as *const u32) } == PAINT {
+            p += 4;
+        }
+        top - p
     }
 }
 
 #[cfg(not(target_os = "none"))]
 fn main() {
     println!("slf-device runs on a Cortex-M core: build with --target thumbv7em-none-eabihf");
+    // Keep the markers referenced on the host too.
+    let _ = (bench_begin(0), bench_end(0));
 }

@@ -140,32 +140,87 @@ impl core::fmt::Display for ReadError {
 
 impl core::error::Error for ReadError {}
 
-/// A [`TileSource`] over raw frames in RAM (or flash), one per snapshot.
-#[derive(Clone, Copy, Debug)]
-pub struct FrameSource<'a, T: Sample> {
-    frames: &'a [RawFrame<'a, T>],
+/// One snapshot's raw frame as little-endian u16 bytes: how a frame sits in flash (an
+/// `.npy` body, a DMA buffer) without copying or aligning it. Checked at construction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LeU16Frame<'a> {
+    bytes: &'a [u8],
+    rows: usize,
+    cols: usize,
 }
 
-impl<'a, T: Sample> FrameSource<'a, T> {
-    pub fn new(frames: &'a [RawFrame<'a, T>]) -> Self {
+impl<'a> LeU16Frame<'a> {
+    /// # Errors
+    /// [`SensingError::FrameSize`] if `bytes.len() != 2 * rows * cols` (in samples).
+    pub fn new(bytes: &'a [u8], rows: usize, cols: usize) -> Result<Self, SensingError> {
+        let expected = rows.saturating_mul(cols);
+        if bytes.len() != expected.saturating_mul(2) {
+            return Err(SensingError::FrameSize {
+                expected: expected.min(u32::MAX as usize) as u32,
+                found: (bytes.len() / 2).min(u32::MAX as usize) as u32,
+            });
+        }
+        Ok(Self { bytes, rows, cols })
+    }
+}
+
+/// A raw frame a [`FrameSource`] reads: its size and its samples by row-major index.
+pub trait Frame {
+    /// Rows and columns.
+    fn size(&self) -> (usize, usize);
+    /// Sample `i` (row-major); `None` past the end.
+    fn sample(&self, i: usize) -> Option<f32>;
+}
+
+impl<T: Sample> Frame for RawFrame<'_, T> {
+    fn size(&self) -> (usize, usize) {
+        (self.rows, self.cols)
+    }
+    #[inline]
+    fn sample(&self, i: usize) -> Option<f32> {
+        self.data.get(i).map(|s| s.to_f32())
+    }
+}
+
+impl Frame for LeU16Frame<'_> {
+    fn size(&self) -> (usize, usize) {
+        (self.rows, self.cols)
+    }
+    #[inline]
+    fn sample(&self, i: usize) -> Option<f32> {
+        match self.bytes.get(2 * i..2 * i + 2) {
+            Some(&[lo, hi]) => Some(f32::from(u16::from_le_bytes([lo, hi]))),
+            _ => None,
+        }
+    }
+}
+
+/// A [`TileSource`] over raw frames in RAM or flash, one per snapshot.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameSource<'a, F: Frame> {
+    frames: &'a [F],
+}
+
+impl<'a, F: Frame> FrameSource<'a, F> {
+    pub fn new(frames: &'a [F]) -> Self {
         Self { frames }
     }
 }
 
-impl<T: Sample> TileSource for FrameSource<'_, T> {
+impl<F: Frame> TileSource for FrameSource<'_, F> {
     type Error = ReadError;
 
     fn read(&mut self, snapshot: usize, row: usize, col: usize, out: &mut [f32]) -> Result<(), ReadError> {
         let frame = self.frames.get(snapshot).ok_or(ReadError::NoSuchSnapshot { snapshot: snapshot.min(255) as u8 })?;
         let oob =
             ReadError::OutOfBounds { row: row.min(u32::MAX as usize) as u32, col: col.min(u32::MAX as usize) as u32 };
-        if row >= frame.rows || col.saturating_add(out.len()) > frame.cols {
+        let (rows, cols) = frame.size();
+        if row >= rows || col.saturating_add(out.len()) > cols {
             return Err(oob);
         }
-        let start = row * frame.cols + col;
-        let src = frame.data.get(start..start + out.len()).ok_or(oob)?;
-        for (o, s) in out.iter_mut().zip(src) {
-            *o = s.to_f32();
+        let start = row * cols + col;
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = frame.sample(start + i).ok_or(oob)?;
         }
         Ok(())
     }

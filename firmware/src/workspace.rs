@@ -98,6 +98,17 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
         &mut self.measurements
     }
 
+    /// The coefficient buffer, e.g. to synthesise a patch from chosen coefficients.
+    pub fn coefficients_mut(&mut self) -> &mut [f32; N] {
+        &mut self.coeffs
+    }
+
+    /// `patch = coefficients x_i D_i`, in place in the workspace (the coefficients are the
+    /// scratch and are clobbered): one transform with no buffer outside the workspace.
+    pub fn synthesize(&mut self, dict: &crate::Dictionary<PS, PT, PU, PV, B>) {
+        crate::transform::synthesize(dict, &mut self.coeffs, &mut self.signal);
+    }
+
     /// The decoded patch after a successful solve (layout of [`PatchShape::index`]).
     pub fn patch(&self) -> &[f32; N] {
         &self.signal

@@ -234,7 +234,7 @@ fn a_patch_without_measurements_is_rejected_and_the_tile_goes_on() {
 
 /// A source that fails on one row, as a bus error would.
 struct Flaky<'a> {
-    inner: FrameSource<'a, f32>,
+    inner: FrameSource<'a, RawFrame<'a, f32>>,
     bad_row: usize,
 }
 

@@ -19,6 +19,7 @@ pub mod baseline;
 pub mod camera;
 pub mod capture;
 pub mod decode;
+pub mod device;
 pub mod lightfield;
 pub mod metrics;
 pub mod preview;

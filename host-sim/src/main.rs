@@ -297,6 +297,21 @@ enum Command {
         #[command(flatten)]
         basis: BasisArgs,
     },
+    /// Write the capture the device binary decodes (frames as .npy and `capture.rs` constants).
+    DeviceCapture {
+        /// Folder (firmware/device).
+        #[arg(short, long, default_value = "firmware/device")]
+        output: PathBuf,
+    },
+    /// Compare the device binary's output (its semihosting log) with the host's decode of
+    /// the same tiles; fails above 1e-5 relative difference.
+    DeviceCheck {
+        /// The device's output.
+        log: PathBuf,
+        /// The capture it decoded.
+        #[arg(long, default_value = "firmware/device/capture")]
+        capture: PathBuf,
+    },
     /// Mean PSNR / SSIM / SA over the test scenes for {DCT, ensemble exhaustive, ensemble
     /// screened} x {pixel, lenslet, kronecker} x k, and time per patch; a markdown table.
     Compare {
@@ -433,6 +448,8 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Baseline { patches, mask, snapshots } => baseline(patches, mask, snapshots),
+        Command::DeviceCapture { output } => slf_host::device::write_capture(&output),
+        Command::DeviceCheck { log, capture } => slf_host::device::check(&log, &capture),
         Command::Sweep { size, k, output, basis } => sweep(size, &k, output.as_deref(), &basis.basis()?),
         Command::Compare { size, k, output, blob, masks, rule, rule_tau } => {
             compare(size, &k, output.as_deref(), blob.as_deref(), &masks, rule.rule(rule_tau))
