@@ -12,8 +12,8 @@
 //!
 //! From the sensor to decoded patches, one module each:
 //!
-//! - **raw frame** ([`raw`], [`defects`]): samples, which of them are measurements, frames
-//!   in memory.
+//! - **raw frame** ([`raw`], [`defects`], [`spi`]): samples, which of them are
+//!   measurements, frames in memory or flash, and a frame buffer read over `embedded-hal` SPI.
 //! - **sensing** ([`mask`]): which band each pixel sees in each snapshot; the three mask
 //!   families `kronecker`, `lenslet`, `pixel`.
 //! - **operators** ([`shape`], [`dct`], [`dictionary`], [`blob`], [`transform`]): the patch
@@ -83,6 +83,7 @@ pub mod pinv;
 pub mod raw;
 pub mod shape;
 pub mod sl0;
+pub mod spi;
 pub mod tile;
 pub mod transform;
 pub mod workspace;
@@ -96,6 +97,7 @@ pub use pinv::{PinvOperator, solve_pinv};
 pub use raw::{Frame, FrameSource, LeU16Frame, RawFormat, RawFrame};
 pub use shape::{FullViewShape, PaperShape, PatchShape};
 pub use sl0::{Ended, Outcome, Sl0Config, SolveError, solve};
+pub use spi::{SpiFrameBuffer, SpiSourceError};
 pub use tile::{
     ConfigError, DecoderConfig, PatchFlags, PatchOrigin, PatchReport, PatchSink, SensorGeometry, Tile, TileDecoder,
     TileError, TileReport, TileSource,
