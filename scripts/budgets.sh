@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# Measures the device budgets on qemu's emulated Cortex-M4F and prints a markdown table:
+# flash (.text + .rodata), static RAM (.data + .bss), peak stack (painted), the Workspace,
+# instructions per transform multiply-add and per patch (5D DCT, shipped ensemble with
+# screened choice), counted by ../shared/tools/qemu-insn-count between bench_begin/bench_end.
+# Needs: thumbv7em-none-eabihf target, qemu-system-arm, gcc, llvm-nm/llvm-size.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+plugin_src="${SLF_SHARED:-../shared}/tools/qemu-insn-count/wincount.c"
+mkdir -p target
+gcc -O2 -shared -fPIC -fvisibility=hidden -o target/libwincount.so "$plugin_src"
+cargo build --release -q -p slf-firmware --target thumbv7em-none-eabihf
+elf=target/thumbv7em-none-eabihf/release/slf-device
+# Thumb symbols carry bit 0; instruction addresses do not.
+addr() { local v; v=$(llvm-nm "$elf" | awk -v s="$1" '$3 == s { print $1 }'); printf '0x%x' $(( 0x$v & ~1 )); }
+begin=$(addr bench_begin); end=$(addr bench_end)
+timeout 600 qemu-system-arm -M netduinoplus2 -nographic -semihosting-config enable=on,target=native \
+  -kernel "$elf" -plugin "target/libwincount.so,start=$begin,end=$end" -d plugin -D target/wincount.log \
+  > target/budget-device.log
+sizes=$(llvm-size -A "$elf")
+sec() { echo "$sizes" | awk -v s="$1" '$1 == s { print $2 }'; }
+text=$(sec .text); rodata=$(sec .rodata); data=$(sec .data); bss=$(sec .bss)
+python3 - "$text" "$rodata" "$data" "$bss" <<'PY'
+import re, sys
+text, rodata, data, bss = (int(x or 0) for x in sys.argv[1:5])
+log = open("target/budget-device.log").read()
+wins = [int(x) for x in re.findall(r"wincount: end window \d+ insns=(\d+)", open("target/wincount.log").read())]
+tiles = [int(x) for x in re.findall(r"^tile \d+ \d+ patches (\d+)", log, re.M)]
+macs = int(re.search(r"transform macs (\d+)", log).group(1))
+stack = int(re.search(r"stack peak bytes (\d+)", log).group(1))
+ws = int(re.search(r"workspace bytes (\d+)", log).group(1))
+t = len(tiles)
+assert len(wins) == 1 + 2 * t, (len(wins), t)
+patches = sum(tiles)
+ens = sum(wins[1:1 + t]) / patches
+dct = sum(wins[1 + t:]) / patches
+flash, ram = text + rodata + data, data + bss + stack
+print("| budget | measured | limit |\n| --- | --- | --- |")
+print(f"| flash (.text + .rodata + .data) | {flash:,} B ({flash / 1024:.1f} KiB) | 128 KiB |")
+print(f"| static RAM (.data + .bss) | {data + bss:,} B | |")
+print(f"| of which the Workspace | {ws:,} B | |")
+print(f"| peak stack (painted) | {stack:,} B | |")
+print(f"| peak RAM for decoding (static + stack) | {ram:,} B ({ram / 1024:.1f} KiB) | 96 KiB |")
+print(f"| instructions per transform ({macs:,} multiply-adds) | {wins[0]:,} ({wins[0] / macs:.2f} per multiply-add) | |")
+print(f"| instructions per patch, 5D DCT | {dct:,.0f} | |")
+print(f"| instructions per patch, ensemble (8 members), screened | {ens:,.0f} | |")
+ok = flash <= 128 * 1024 and ram <= 96 * 1024
+print("within budget" if ok else "OVER BUDGET")
+sys.exit(0 if ok else 1)
+PY
