@@ -5,6 +5,9 @@ fn main() {
     let target = std::env::var("TARGET").unwrap_or_default();
     if target.starts_with("thumb") {
         println!("cargo:rustc-link-arg-bins=-Tlink.x");
+        if std::env::var_os("CARGO_FEATURE_DEFMT").is_some() {
+            println!("cargo:rustc-link-arg-bins=-Tdefmt.x");
+        }
     }
     println!("cargo:rerun-if-changed=../memory.x");
     println!("cargo:rerun-if-changed=build.rs");

@@ -33,6 +33,8 @@ mod device {
 
     use cortex_m_rt::entry;
     use cortex_m_semihosting::{debug, hprint, hprintln};
+    #[cfg(feature = "defmt")]
+    use defmt_semihosting as _;
     use panic_semihosting as _;
     use slf_firmware::{
         ChoiceRule, DEFAULT_ENSEMBLE, DecoderConfig, DefectList, Dictionary, Ensemble, EnsembleModel, FrameSource,
@@ -178,6 +180,15 @@ mod device {
         let stack = crate::stack::peak();
         hprintln!("workspace bytes {}", core::mem::size_of::<PaperWorkspace>());
         hprintln!("stack peak bytes {}", stack);
+        #[cfg(feature = "defmt")]
+        defmt::println!(
+            "done patches={=u32} failed={=u32} checksum={=u32:#010x} dct-checksum={=u32:#010x} stack={=usize}",
+            out.patches,
+            failed,
+            out.checksum,
+            quiet.checksum,
+            stack
+        );
         hprintln!(
             "done patches={} failed={} checksum={:#010x} dct-checksum={:#010x}",
             out.patches,
