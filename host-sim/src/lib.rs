@@ -16,6 +16,7 @@
 pub use slf_firmware as firmware;
 
 pub mod baseline;
+pub mod bench;
 pub mod camera;
 pub mod capture;
 pub mod decode;

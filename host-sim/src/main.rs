@@ -297,6 +297,15 @@ enum Command {
         #[command(flatten)]
         basis: BasisArgs,
     },
+    /// Speed against error: sweep solver settings, bases, masks and k; CSV, markdown, PNG.
+    Bench {
+        /// Output folder (bench.csv, bench.md, bench.png).
+        #[arg(short, long, default_value = "slf-bench")]
+        out: PathBuf,
+        /// A CI-sized run: two small scenes, k = 3, no exhaustive choice.
+        #[arg(long)]
+        quick: bool,
+    },
     /// Write the capture the device binary decodes (frames as .npy and `capture.rs` constants).
     DeviceCapture {
         /// Folder (firmware/device).
@@ -448,6 +457,12 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Baseline { patches, mask, snapshots } => baseline(patches, mask, snapshots),
+        Command::Bench { out, quick } => {
+            let points = slf_host::bench::run(&slf_host::bench::BenchOptions { quick, progress: true })?;
+            slf_host::bench::write(&points, &out)?;
+            println!("{} points; wrote {}/bench.csv, bench.md, bench.png", points.len(), out.display());
+            Ok(())
+        }
         Command::DeviceCapture { output } => slf_host::device::write_capture(&output),
         Command::DeviceCheck { log, capture } => slf_host::device::check(&log, &capture),
         Command::Sweep { size, k, output, basis } => sweep(size, &k, output.as_deref(), &basis.basis()?),

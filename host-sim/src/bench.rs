@@ -1,0 +1,328 @@
+//! Speed against error: `slf bench`.
+//!
+//! For each mask family and k, a one-factor-at-a-time sweep around the default solver:
+//! `sigma_f`, `L`, `sigma_min`, the noise-aware stop, the basis (DCT, ensemble exhaustive,
+//! ensemble screened) and the precision (the f32 decoder against an f64 reference that
+//! runs through the same tile pipeline). Every point records PSNR / SSIM / SA (mean over the
+//! scenes) and time per patch on one thread and on all threads. Output: a CSV, a markdown
+//! table with the Pareto front (per mask family: no other point is both faster and better)
+//! marked, and a PNG plot of PSNR against time per patch, one curve per mask family.
+
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use plotters::prelude::*;
+use slf_firmware::{
+    ChoiceRule, DEFAULT_ENSEMBLE, Dictionary, Ended, MemberChoice, ModelOutcome, Outcome, PatchModel, Sl0Config,
+    SolveError, Workspace,
+};
+
+use crate::baseline::{Factors, solve_5d};
+use crate::camera::{CameraConfig, simulate};
+use crate::capture::{MaskDescription, MaskSource};
+use crate::decode::{Basis, DecodeOptions, decode, decode_with};
+use crate::lightfield::LightField;
+use crate::metrics::evaluate;
+use crate::scene::{self, SceneSize};
+
+/// The f64 reference: SL0 with the DCT in f64 (the host's 5D reference), written back
+/// through the workspace so it runs in the same tile pipeline as the f32 decoder.
+pub struct F64Dct {
+    factors: Factors<f64>,
+    dict: Dictionary<5, 5, 4, 4, 13>,
+}
+
+impl Default for F64Dct {
+    fn default() -> Self {
+        Self { factors: Factors::dct_f64(), dict: Dictionary::dct() }
+    }
+}
+
+impl PatchModel<5, 5, 4, 4, 13, 5200> for F64Dct {
+    fn decode(&self, cfg: &Sl0Config, ws: &mut Workspace<5, 5, 4, 4, 13, 5200>) -> Result<ModelOutcome, SolveError> {
+        cfg.validate()?;
+        let m = ws.measurements();
+        if m.count() == 0 {
+            return Err(SolveError::NoMeasurements);
+        }
+        let meas: Vec<Option<f64>> = (0..5200).map(|i| m.get(i).map(f64::from)).collect();
+        let (x, iterations) = solve_5d::<f64>(&self.factors, &meas, cfg);
+        // Write the f64 patch back: its DCT coefficients (f64 analysis), then one f32
+        // synthesis (rounding ~1e-7, far below the f32-vs-f64 differences measured).
+        let c = self.dict.analysis();
+        let mut s = x;
+        for (n, (d, m)) in [
+            (5usize, c.m1.as_flattened()),
+            (5, c.m2.as_flattened()),
+            (4, c.m3.as_flattened()),
+            (4, c.m4.as_flattened()),
+            (13, c.m5.as_flattened()),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let dims = [5usize, 5, 4, 4, 13];
+            let inner: usize = dims[n + 1..].iter().product();
+            let outer = 5200 / (d * inner);
+            let mut next = vec![0.0f64; 5200];
+            for o in 0..outer {
+                for a in 0..d {
+                    for cc in 0..d {
+                        let w = f64::from(m[a * d + cc]);
+                        for j in 0..inner {
+                            next[(o * d + a) * inner + j] += w * s[(o * d + cc) * inner + j];
+                        }
+                    }
+                }
+            }
+            s = next;
+        }
+        for (dst, v) in ws.coefficients_mut().iter_mut().zip(&s) {
+            *dst = *v as f32;
+        }
+        ws.synthesize(&self.dict);
+        let outcome = Outcome { iterations, levels: 0, sigma0: 0.0, residual: 0.0, ended: Ended::SigmaMin };
+        Ok(ModelOutcome { outcome, member: None, solves: 1 })
+    }
+}
+
+/// What is being decoded with.
+#[derive(Clone, Debug)]
+enum Decoder {
+    Basis(Basis),
+    F64,
+}
+
+/// One point of the sweep.
+#[derive(Clone, Debug)]
+pub struct Point {
+    pub mask: String,
+    pub k: u8,
+    pub setting: String,
+    pub psnr: f64,
+    pub ssim: f64,
+    pub sa: f64,
+    /// Milliseconds per patch on one thread.
+    pub ms_one: f64,
+    /// Milliseconds of wall time per patch on all threads.
+    pub ms_all: f64,
+    pub solves: f64,
+    pub pareto: bool,
+}
+
+/// Sweep size.
+#[derive(Clone, Copy, Debug)]
+pub struct BenchOptions {
+    /// Small scenes, two of them, k = 3 only, no exhaustive choice: CI-sized.
+    pub quick: bool,
+    pub progress: bool,
+}
+
+fn settings(quick: bool) -> Vec<(String, Decoder, Sl0Config)> {
+    let d = Sl0Config::DEFAULT;
+    let dct = || Decoder::Basis(Basis::Dct);
+    let ens = |choice| Decoder::Basis(Basis::Ensemble { blob: DEFAULT_ENSEMBLE.to_vec(), choice });
+    let mut s = vec![
+        ("DCT default".to_string(), dct(), d),
+        ("DCT f64 reference".to_string(), Decoder::F64, d),
+        ("DCT sigma_f 0.5".to_string(), dct(), Sl0Config { sigma_f: 0.5, ..d }),
+        ("DCT sigma_f 0.85".to_string(), dct(), Sl0Config { sigma_f: 0.85, ..d }),
+        ("DCT L 2".to_string(), dct(), Sl0Config { steps: 2, ..d }),
+        ("DCT sigma_min 1e-2".to_string(), dct(), Sl0Config { sigma_min: 1e-2, ..d }),
+        ("DCT sigma_min 3e-4".to_string(), dct(), Sl0Config { sigma_min: 3e-4, ..d }),
+        ("DCT noise-aware".to_string(), dct(), Sl0Config { noise: 2.0 / 3628.0, ..d }),
+        ("ensemble screened".to_string(), ens(MemberChoice::Screened(ChoiceRule::DEFAULT)), d),
+    ];
+    if !quick {
+        s.push(("ensemble exhaustive".to_string(), ens(MemberChoice::Exhaustive(ChoiceRule::DEFAULT)), d));
+    }
+    s
+}
+
+fn mask(family: &str, k: u8) -> MaskDescription {
+    let src = MaskSource { snapshots: Some(k), seed: Some(7), tile: None };
+    match family {
+        "pixel" => MaskDescription::Pixel(src),
+        "lenslet" => MaskDescription::Lenslet(src),
+        _ => MaskDescription::Kronecker { snapshots: k, seed: 7, block: [5, 5] },
+    }
+}
+
+fn run_decoder(
+    capture: &crate::capture::Capture,
+    dec: &Decoder,
+    sl0: Sl0Config,
+) -> Result<(LightField, crate::decode::DecodeReport)> {
+    let opts = DecodeOptions { sl0, ..DecodeOptions::default() };
+    match dec {
+        Decoder::Basis(b) => decode_with(capture, b, &opts),
+        Decoder::F64 => decode(capture, &F64Dct::default(), &opts),
+    }
+}
+
+/// Runs the sweep.
+///
+/// # Errors
+/// A decode or thread-pool failure.
+pub fn run(opts: &BenchOptions) -> Result<Vec<Point>> {
+    let (size, names, ks): (usize, &[&str], &[u8]) =
+        if opts.quick { (20, &["texture", "depth"], &[3]) } else { (40, &scene::NAMES, &[1, 3]) };
+    let truths: Vec<LightField> = names
+        .iter()
+        .map(|n| scene::named(n).map(|s| s.render(SceneSize { views: (5, 5), rows: size, cols: size })))
+        .collect::<Option<_>>()
+        .context("named scene")?;
+    let settings = settings(opts.quick);
+    let families = ["pixel", "lenslet", "kronecker"];
+    let total = (families.len() * ks.len() * settings.len() * truths.len()) as u64;
+    let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::hidden());
+    if opts.progress {
+        bar.set_draw_target(ProgressDrawTarget::stderr());
+        bar.set_style(
+            ProgressStyle::with_template("bench {bar:40} {pos}/{len} {msg}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+    }
+    let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().context("one-thread pool")?;
+    let mut points = Vec::new();
+    for family in families {
+        for &k in ks {
+            let captures: Vec<_> = truths
+                .iter()
+                .map(|t| simulate(t, &CameraConfig::pixel(7, k).with_mask(mask(family, k))))
+                .collect::<Result<_>>()?;
+            for (name, dec, sl0) in &settings {
+                bar.set_message(format!("{family} k={k} {name}"));
+                let (mut p, mut s, mut a, mut t1, mut ta, mut solves, mut patches) =
+                    (0.0, 0.0, 0.0, 0.0, 0.0, 0u64, 0u64);
+                for (truth, capture) in truths.iter().zip(&captures) {
+                    let start = Instant::now();
+                    let (recon, report) = one.install(|| run_decoder(capture, dec, *sl0))?;
+                    t1 += start.elapsed().as_secs_f64();
+                    let start = Instant::now();
+                    run_decoder(capture, dec, *sl0)?;
+                    ta += start.elapsed().as_secs_f64();
+                    let m = evaluate(truth, &recon)?;
+                    (p, s, a) = (p + m.psnr, s + m.ssim, a + m.sa);
+                    solves += report.solves;
+                    patches += u64::from(report.patches.decoded);
+                    bar.inc(1);
+                }
+                let n = truths.len() as f64;
+                let np = patches.max(1) as f64;
+                points.push(Point {
+                    mask: family.into(),
+                    k,
+                    setting: name.clone(),
+                    psnr: p / n,
+                    ssim: s / n,
+                    sa: a / n,
+                    ms_one: 1e3 * t1 / np,
+                    ms_all: 1e3 * ta / np,
+                    solves: solves as f64 / np,
+                    pareto: false,
+                });
+            }
+        }
+    }
+    bar.finish_and_clear();
+    mark_pareto(&mut points);
+    Ok(points)
+}
+
+/// Marks, per mask family and k, the points no other point beats in both time (one
+/// thread) and PSNR.
+pub fn mark_pareto(points: &mut [Point]) {
+    let snapshot = points.to_vec();
+    for p in points.iter_mut() {
+        p.pareto = !snapshot.iter().any(|q| {
+            q.mask == p.mask
+                && q.k == p.k
+                && q.ms_one <= p.ms_one
+                && q.psnr >= p.psnr
+                && (q.ms_one < p.ms_one || q.psnr > p.psnr)
+        });
+    }
+}
+
+/// Writes `bench.csv`, `bench.md` and `bench.png` into `dir`.
+///
+/// # Errors
+/// I/O and drawing errors.
+pub fn write(points: &[Point], dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let mut csv = String::from(
+        "mask,k,setting,psnr_db,ssim,sa_deg,ms_per_patch_1_thread,ms_per_patch_all_threads,solves_per_patch,pareto\n",
+    );
+    let mut md = String::from(
+        "| mask | k | setting | PSNR dB | SSIM | SA deg | ms / patch (1 thread) | ms / patch (all) | solves | Pareto |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n",
+    );
+    for p in points {
+        csv += &format!(
+            "{},{},{},{:.4},{:.5},{:.4},{:.4},{:.4},{:.2},{}\n",
+            p.mask, p.k, p.setting, p.psnr, p.ssim, p.sa, p.ms_one, p.ms_all, p.solves, p.pareto
+        );
+        md += &format!(
+            "| {} | {} | {} | {:.2} | {:.4} | {:.2} | {:.2} | {:.2} | {:.1} | {} |\n",
+            p.mask,
+            p.k,
+            p.setting,
+            p.psnr,
+            p.ssim,
+            p.sa,
+            p.ms_one,
+            p.ms_all,
+            p.solves,
+            if p.pareto { "yes" } else { "" }
+        );
+    }
+    std::fs::write(dir.join("bench.csv"), csv)?;
+    std::fs::write(dir.join("bench.md"), md)?;
+    plot(points, &dir.join("bench.png"))
+}
+
+fn plot(points: &[Point], path: &Path) -> Result<()> {
+    let root = BitMapBackend::new(path, (1000, 700)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let (tmin, tmax) = points.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.ms_one), b.max(p.ms_one)));
+    let (pmin, pmax) =
+        points.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p.psnr), b.max(p.psnr)));
+    let mut chart = ChartBuilder::on(&root)
+        .caption("PSNR against time per patch (one thread); Pareto fronts joined", ("sans-serif", 22))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(55)
+        .build_cartesian_2d((tmin * 0.8..tmax * 1.2).log_scale(), (pmin - 1.0)..(pmax + 1.0))
+        .map_err(|e| anyhow::anyhow!("{e}"))?;
+    chart
+        .configure_mesh()
+        .x_desc("ms per patch (one thread, log scale)")
+        .y_desc("PSNR dB (mean over scenes)")
+        .draw()
+        .map_err(|e| anyhow::anyhow!("{e}"))?;
+    let colours = [RED, BLUE, GREEN, MAGENTA, CYAN, BLACK];
+    let mut series: Vec<(String, u8)> = points.iter().map(|p| (p.mask.clone(), p.k)).collect();
+    series.dedup();
+    for (i, (mask, k)) in series.iter().enumerate() {
+        let c = colours[i % colours.len()];
+        let pts: Vec<&Point> = points.iter().filter(|p| &p.mask == mask && p.k == *k).collect();
+        chart
+            .draw_series(pts.iter().map(|p| Circle::new((p.ms_one, p.psnr), 4, c.filled())))
+            .map_err(|e| anyhow::anyhow!("{e}"))?
+            .label(format!("{mask} k={k}"))
+            .legend(move |(x, y)| Circle::new((x, y), 4, c.filled()));
+        let mut front: Vec<(f64, f64)> = pts.iter().filter(|p| p.pareto).map(|p| (p.ms_one, p.psnr)).collect();
+        front.sort_by(|a, b| a.0.total_cmp(&b.0));
+        chart.draw_series(LineSeries::new(front, c.stroke_width(2))).map_err(|e| anyhow::anyhow!("{e}"))?;
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| anyhow::anyhow!("{e}"))?;
+    root.present().map_err(|e| anyhow::anyhow!("{e}"))?;
+    Ok(())
+}
