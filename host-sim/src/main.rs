@@ -305,6 +305,9 @@ enum Command {
         /// A CI-sized run: two small scenes, k = 3, no exhaustive choice.
         #[arg(long)]
         quick: bool,
+        /// Instead of the sweep: the paper's scale end to end (512 x 512 x 5 x 5 x 13).
+        #[arg(long)]
+        paper_scale: bool,
     },
     /// Write the capture the device binary decodes (frames as .npy and `capture.rs` constants).
     DeviceCapture {
@@ -457,7 +460,11 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Baseline { patches, mask, snapshots } => baseline(patches, mask, snapshots),
-        Command::Bench { out, quick } => {
+        Command::Bench { paper_scale: true, .. } => {
+            println!("{}", slf_host::bench::paper_scale()?);
+            Ok(())
+        }
+        Command::Bench { out, quick, .. } => {
             let points = slf_host::bench::run(&slf_host::bench::BenchOptions { quick, progress: true })?;
             slf_host::bench::write(&points, &out)?;
             println!("{} points; wrote {}/bench.csv, bench.md, bench.png", points.len(), out.display());

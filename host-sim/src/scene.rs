@@ -9,6 +9,7 @@
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
 
 use crate::lightfield::LightField;
 use crate::spectra::{BANDS, COLORCHECKER, Spectrum, colorchecker, narrow_band, smooth_random, under_d65};
@@ -130,31 +131,30 @@ impl Scene {
             layers.iter().map(|l| l.reflectance.map(|r| under_d65(&r).map(|x| x * self.gain))).collect();
         let (cu, cv) = ((size.views.0 as f32 - 1.0) / 2.0, (size.views.1 as f32 - 1.0) / 2.0);
         let (h, w) = (size.rows as f32, size.cols as f32);
-        for u in 0..size.views.0 {
-            for v in 0..size.views.1 {
-                let (du, dv) = (u as f32 - cu, v as f32 - cv);
-                for y in 0..size.rows {
-                    for x in 0..size.cols {
-                        let mut acc = [0.0f32; BANDS];
-                        for (sy, sx) in [(0.25, 0.25), (0.25, 0.75), (0.75, 0.25), (0.75, 0.75)] {
-                            let (py, px) = (y as f32 + sy, x as f32 + sx);
-                            for (layer, rad) in layers.iter().zip(&radiance) {
-                                let (ly, lx) = (py + layer.disparity * du, px + layer.disparity * dv);
-                                if layer.shape.contains(ly / h, lx / w) {
-                                    let t = layer.texture.weight(ly, lx);
-                                    for (a, (r0, r1)) in acc.iter_mut().zip(rad[0].iter().zip(&rad[1])) {
-                                        *a += 0.25 * (r0 + t * (r1 - r0));
-                                    }
-                                    break;
-                                }
+        // One spatial row of one view per task (rayon): rows are independent and contiguous.
+        let row_len = size.cols * BANDS;
+        lf.data.par_chunks_mut(row_len).enumerate().for_each(|(r, out)| {
+            let (view, y) = (r / size.rows, r % size.rows);
+            let (u, v) = (view / size.views.1, view % size.views.1);
+            let (du, dv) = (u as f32 - cu, v as f32 - cv);
+            for (x, px_out) in out.chunks_exact_mut(BANDS).enumerate() {
+                let mut acc = [0.0f32; BANDS];
+                for (sy, sx) in [(0.25, 0.25), (0.25, 0.75), (0.75, 0.25), (0.75, 0.75)] {
+                    let (py, px) = (y as f32 + sy, x as f32 + sx);
+                    for (layer, rad) in layers.iter().zip(&radiance) {
+                        let (ly, lx) = (py + layer.disparity * du, px + layer.disparity * dv);
+                        if layer.shape.contains(ly / h, lx / w) {
+                            let t = layer.texture.weight(ly, lx);
+                            for (a, (r0, r1)) in acc.iter_mut().zip(rad[0].iter().zip(&rad[1])) {
+                                *a += 0.25 * (r0 + t * (r1 - r0));
                             }
+                            break;
                         }
-                        let i = lf.index(u, v, y, x, 0);
-                        lf.data[i..i + BANDS].copy_from_slice(&acc);
                     }
                 }
+                px_out.copy_from_slice(&acc);
             }
-        }
+        });
         lf
     }
 }
