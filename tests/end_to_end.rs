@@ -19,19 +19,19 @@
 //! (measured: 23.1 dB).
 
 use slf_host::camera::{CameraConfig, simulate};
-use slf_host::capture::{Capture, MaskDescription, MaskSource};
+use slf_host::capture::{Capture, MaskDescription};
 use slf_host::decode::{Basis, DecodeOptions, decode, decode_with};
-use slf_host::firmware::Dictionary;
+use slf_host::firmware::{Dictionary, MaskFamily};
 use slf_host::metrics::evaluate;
 use slf_host::scene::{self, SceneSize};
 
 fn mask(family: &str, k: u8) -> MaskDescription {
-    let src = MaskSource { snapshots: Some(k), seed: Some(7), tile: None };
-    match family {
-        "pixel" => MaskDescription::Pixel(src),
-        "lenslet" => MaskDescription::Lenslet(src),
-        _ => MaskDescription::Kronecker { snapshots: k, seed: 7, block: [5, 5] },
-    }
+    let family = match family {
+        "pixel" => MaskFamily::Pixel,
+        "lenslet" => MaskFamily::Lenslet,
+        _ => MaskFamily::Kronecker,
+    };
+    MaskDescription::seeded(family, 7, k)
 }
 
 #[test]

@@ -15,13 +15,13 @@ use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use plotters::prelude::*;
 use slf_firmware::{
-    ChoiceRule, DEFAULT_ENSEMBLE, Dictionary, Ended, MemberChoice, ModelOutcome, Outcome, PatchModel, Sl0Config,
-    SolveError, Workspace,
+    ChoiceRule, DEFAULT_ENSEMBLE, Dictionary, Ended, MaskFamily, MemberChoice, ModelOutcome, Outcome, PatchModel,
+    Sl0Config, SolveError, Workspace,
 };
 
 use crate::baseline::{Factors, solve_5d};
 use crate::camera::{CameraConfig, simulate};
-use crate::capture::{MaskDescription, MaskSource};
+use crate::capture::MaskDescription;
 use crate::decode::{Basis, DecodeOptions, decode, decode_with};
 use crate::lightfield::LightField;
 use crate::metrics::evaluate;
@@ -141,15 +141,6 @@ fn settings(quick: bool) -> Vec<(String, Decoder, Sl0Config)> {
     s
 }
 
-fn mask(family: &str, k: u8) -> MaskDescription {
-    let src = MaskSource { snapshots: Some(k), seed: Some(7), tile: None };
-    match family {
-        "pixel" => MaskDescription::Pixel(src),
-        "lenslet" => MaskDescription::Lenslet(src),
-        _ => MaskDescription::Kronecker { snapshots: k, seed: 7, block: [5, 5] },
-    }
-}
-
 fn run_decoder(
     capture: &crate::capture::Capture,
     dec: &Decoder,
@@ -175,7 +166,7 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Point>> {
         .collect::<Option<_>>()
         .context("named scene")?;
     let settings = settings(opts.quick);
-    let families = ["pixel", "lenslet", "kronecker"];
+    let families = [MaskFamily::Pixel, MaskFamily::Lenslet, MaskFamily::Kronecker];
     let total = (families.len() * ks.len() * settings.len() * truths.len()) as u64;
     let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::hidden());
     if opts.progress {
@@ -191,10 +182,11 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Point>> {
         for &k in ks {
             let captures: Vec<_> = truths
                 .iter()
-                .map(|t| simulate(t, &CameraConfig::pixel(7, k).with_mask(mask(family, k))))
+                .map(|t| simulate(t, &CameraConfig::pixel(7, k).with_mask(MaskDescription::seeded(family, 7, k))))
                 .collect::<Result<_>>()?;
             for (name, dec, sl0) in &settings {
-                bar.set_message(format!("{family} k={k} {name}"));
+                let family_name = format!("{family:?}").to_lowercase();
+                bar.set_message(format!("{family_name} k={k} {name}"));
                 let (mut p, mut s, mut a, mut t1, mut ta, mut solves, mut patches) =
                     (0.0, 0.0, 0.0, 0.0, 0.0, 0u64, 0u64);
                 for (truth, capture) in truths.iter().zip(&captures) {
@@ -213,7 +205,7 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Point>> {
                 let n = truths.len() as f64;
                 let np = patches.max(1) as f64;
                 points.push(Point {
-                    mask: family.into(),
+                    mask: family_name,
                     k,
                     setting: name.clone(),
                     psnr: p / n,

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail, ensure};
 use serde::{Deserialize, Serialize};
-use slf_firmware::{BandTile, DefectList, LensletSize, Mask, Pixel, RawFormat, SensorGeometry};
+use slf_firmware::{BandTile, DefectList, LensletSize, Mask, MaskFamily, Pixel, RawFormat, SensorGeometry};
 
 use crate::lightfield::{read_npy_u16_2d, write_npy_u16_2d};
 
@@ -29,6 +29,19 @@ pub enum MaskDescription {
     Lenslet(MaskSource),
     /// The paper's: band per block of `block` lenslets and snapshot.
     Kronecker { snapshots: u8, seed: u64, block: [u8; 2] },
+}
+
+impl MaskDescription {
+    /// A seeded mask of `family` with `snapshots` snapshots; a kronecker mask's block is the
+    /// decoder's patch (5 x 5 lenslets).
+    pub fn seeded(family: MaskFamily, seed: u64, snapshots: u8) -> Self {
+        let src = MaskSource { snapshots: Some(snapshots), seed: Some(seed), tile: None };
+        match family {
+            MaskFamily::Pixel => Self::Pixel(src),
+            MaskFamily::Lenslet => Self::Lenslet(src),
+            MaskFamily::Kronecker => Self::Kronecker { snapshots, seed, block: [5, 5] },
+        }
+    }
 }
 
 /// A seed and snapshot count, or a tile `tile[snapshot][row][col]` of band indices.

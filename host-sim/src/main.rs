@@ -9,11 +9,11 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
 use slf_host::baseline::{Dense1D, Factors};
 use slf_host::camera::{CameraConfig, simulate};
-use slf_host::capture::{Capture, MaskDescription, MaskSource};
+use slf_host::capture::{Capture, MaskDescription};
 use slf_host::decode::{Basis, DecodeOptions, DecodeReport, PaperDictionary, decode_with};
 use slf_host::firmware::{
-    ChoiceRule, DEFAULT_ENSEMBLE, Dictionary, LensletSize, Mask, MemberChoice, PaperShape, PaperWorkspace, Sl0Config,
-    blob, solve, write_blob,
+    ChoiceRule, DEFAULT_ENSEMBLE, Dictionary, LensletSize, Mask, MaskFamily, MemberChoice, PaperShape, PaperWorkspace,
+    Sl0Config, blob, solve, write_blob,
 };
 use slf_host::lightfield::{Dtype, LightField, read_npy, write_npy};
 use slf_host::metrics::{Metrics, evaluate};
@@ -37,12 +37,12 @@ enum Family {
 
 impl Family {
     fn mask(self, seed: u64, k: u8) -> MaskDescription {
-        let src = MaskSource { snapshots: Some(k), seed: Some(seed), tile: None };
-        match self {
-            Family::Pixel => MaskDescription::Pixel(src),
-            Family::Lenslet => MaskDescription::Lenslet(src),
-            Family::Kronecker => MaskDescription::Kronecker { snapshots: k, seed, block: [5, 5] },
-        }
+        let family = match self {
+            Family::Pixel => MaskFamily::Pixel,
+            Family::Lenslet => MaskFamily::Lenslet,
+            Family::Kronecker => MaskFamily::Kronecker,
+        };
+        MaskDescription::seeded(family, seed, k)
     }
 }
 
