@@ -193,6 +193,11 @@ fn modes<T: Real>(f: &[(usize, Vec<T>)], x: &[T], transpose: bool) -> Vec<T> {
     cur
 }
 
+/// The 5D analysis `x x_i D_i^T` in `T` (mode products one at a time, in mode order).
+pub fn analyze_5d<T: Real>(factors: &Factors<T>, x: &[T]) -> Vec<T> {
+    modes(&factors.0, x, true)
+}
+
 /// 5D SL0 (fast path) in `T`: the reference for the firmware's f32 decoder and for the
 /// 1D method. `measured[i]` is `Some(y)` for a measured entry.
 pub fn solve_5d<T: Real>(factors: &Factors<T>, measured: &[Option<T>], cfg: &Sl0Config) -> (Vec<T>, u32) {

@@ -19,7 +19,7 @@ use slf_firmware::{
     Sl0Config, SolveError, Workspace,
 };
 
-use crate::baseline::{Factors, solve_5d};
+use crate::baseline::{Factors, analyze_5d, solve_5d};
 use crate::camera::{CameraConfig, simulate};
 use crate::capture::MaskDescription;
 use crate::decode::{Basis, DecodeOptions, decode, decode_with};
@@ -31,12 +31,15 @@ use crate::scene::{self, SceneSize};
 /// through the workspace so it runs in the same tile pipeline as the f32 decoder.
 pub struct F64Dct {
     factors: Factors<f64>,
+    /// The f32 DCT tables widened to f64, for writing the result back through them.
+    widened: Factors<f64>,
     dict: Dictionary<5, 5, 4, 4, 13>,
 }
 
 impl Default for F64Dct {
     fn default() -> Self {
-        Self { factors: Factors::dct_f64(), dict: Dictionary::dct() }
+        let dict = Dictionary::dct();
+        Self { factors: Factors::dct_f64(), widened: Factors::from_dictionary(&dict), dict }
     }
 }
 
@@ -49,36 +52,9 @@ impl PatchModel<5, 5, 4, 4, 13, 5200> for F64Dct {
         }
         let meas: Vec<Option<f64>> = (0..5200).map(|i| m.get(i).map(f64::from)).collect();
         let (x, iterations) = solve_5d::<f64>(&self.factors, &meas, cfg);
-        // Write the f64 patch back: its DCT coefficients (f64 analysis), then one f32
-        // synthesis (rounding ~1e-7, far below the f32-vs-f64 differences measured).
-        let c = self.dict.analysis();
-        let mut s = x;
-        for (n, (d, m)) in [
-            (5usize, c.m1.as_flattened()),
-            (5, c.m2.as_flattened()),
-            (4, c.m3.as_flattened()),
-            (4, c.m4.as_flattened()),
-            (13, c.m5.as_flattened()),
-        ]
-        .into_iter()
-        .enumerate()
-        {
-            let dims = [5usize, 5, 4, 4, 13];
-            let inner: usize = dims[n + 1..].iter().product();
-            let outer = 5200 / (d * inner);
-            let mut next = vec![0.0f64; 5200];
-            for o in 0..outer {
-                for a in 0..d {
-                    for cc in 0..d {
-                        let w = f64::from(m[a * d + cc]);
-                        for j in 0..inner {
-                            next[(o * d + a) * inner + j] += w * s[(o * d + cc) * inner + j];
-                        }
-                    }
-                }
-            }
-            s = next;
-        }
+        // Write the f64 patch back: its DCT coefficients (f64 analysis with the f32 tables),
+        // then one f32 synthesis (rounding ~1e-7, far below the f32-vs-f64 differences).
+        let s = analyze_5d(&self.widened, &x);
         for (dst, v) in ws.coefficients_mut().iter_mut().zip(&s) {
             *dst = *v as f32;
         }

@@ -8,7 +8,10 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail, ensure};
 use serde::{Deserialize, Serialize};
-use slf_firmware::{BandTile, DefectList, LensletSize, Mask, MaskFamily, Pixel, RawFormat, SensorGeometry};
+use slf_firmware::{
+    BandTile, DecoderConfig, DefectList, LensletSize, Mask, MaskFamily, Pixel, RawFormat, RawFrame, SensorGeometry,
+    Sl0Config, TileDecoder,
+};
 
 use crate::lightfield::{read_npy_u16_2d, write_npy_u16_2d};
 
@@ -232,6 +235,30 @@ impl Capture {
     pub fn raw_format(&self) -> RawFormat {
         let d = &self.description;
         RawFormat { black: d.black_level, white: d.white_level, max_valid: d.saturation_level - 0.5 }
+    }
+
+    /// The firmware's tile decoder for this capture (the paper's 5 x 5 x 4 x 4 x 13 patch).
+    ///
+    /// # Errors
+    /// A mask or geometry the decoder does not take, with the reason.
+    pub fn decoder(&self, sl0: Sl0Config) -> Result<TileDecoder<'_, 5, 5, 4, 4, 13, 5200>> {
+        let config = DecoderConfig {
+            sensor: self.sensor(),
+            mask: self.mask()?,
+            raw: self.raw_format(),
+            defects: self.defects(),
+            sl0,
+        };
+        TileDecoder::new(config).map_err(|e| anyhow::anyhow!("decoder: {e}"))
+    }
+
+    /// The frames as the decoder reads them.
+    ///
+    /// # Errors
+    /// A frame whose size differs from the description's (checked in `new`, so not expected).
+    pub fn raw_frames(&self) -> Result<Vec<RawFrame<'_, u16>>> {
+        let (rows, cols) = self.frame_size();
+        self.frames.iter().map(|f| RawFrame::new(f, rows, cols).map_err(|e| anyhow::anyhow!("{e}"))).collect()
     }
 
     /// The defect list for the decoder.

@@ -12,8 +12,8 @@ use anyhow::{Result, anyhow, ensure};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use slf_firmware::{
-    DecoderConfig, Dictionary, FrameSource, PaperShape, PaperWorkspace, PatchModel, PatchOrigin, PatchReport,
-    PatchSink, RawFrame, Sl0Config, SolveError, Tile, TileDecoder, TileReport,
+    Dictionary, FrameSource, PaperShape, PaperWorkspace, PatchModel, PatchOrigin, PatchReport, PatchSink, Sl0Config,
+    SolveError, Tile, TileReport,
 };
 
 use crate::capture::Capture;
@@ -164,21 +164,8 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
     let start = Instant::now();
     let d = &capture.description;
     ensure!(d.bands_nm.len() == 13, "the decoder's patch has 13 bands, the capture {}", d.bands_nm.len());
-    let config = DecoderConfig {
-        sensor: capture.sensor(),
-        mask: capture.mask()?,
-        raw: capture.raw_format(),
-        defects: capture.defects(),
-        sl0: opts.sl0,
-    };
-    let decoder = TileDecoder::<5, 5, 4, 4, 13, 5200>::new(config).map_err(|e| anyhow!("decoder: {e}"))?;
-    let (rows, cols) = capture.frame_size();
-    let raw: Vec<RawFrame<u16>> = capture
-        .frames
-        .iter()
-        .map(|f| RawFrame::new(f, rows, cols))
-        .collect::<Result<_, _>>()
-        .map_err(|e| anyhow!("{e}"))?;
+    let decoder = capture.decoder(opts.sl0)?;
+    let raw = capture.raw_frames()?;
     let tiles: Vec<Tile> = decoder.tiles(opts.tile_patches).collect();
     ensure!(
         !tiles.is_empty(),

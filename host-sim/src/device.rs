@@ -13,8 +13,8 @@ use std::path::Path;
 
 use anyhow::{Context, Result, bail, ensure};
 use slf_firmware::{
-    ChoiceRule, DEFAULT_ENSEMBLE, DecoderConfig, Ensemble, EnsembleModel, FrameSource, MemberChoice, PatchOrigin,
-    PatchReport, PatchSink, RawFrame, Sl0Config, TileDecoder,
+    ChoiceRule, DEFAULT_ENSEMBLE, Ensemble, EnsembleModel, FrameSource, MemberChoice, PatchOrigin, PatchReport,
+    PatchSink, Sl0Config,
 };
 
 use crate::camera::{CameraConfig, simulate};
@@ -120,21 +120,8 @@ pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
     let capture = Capture::load(capture_dir)?;
     let ensemble = Ensemble::<5, 5, 4, 4, 13>::new(DEFAULT_ENSEMBLE).map_err(|e| anyhow::anyhow!("{e}"))?;
     let model = EnsembleModel::new(ensemble, MemberChoice::Screened(ChoiceRule::DEFAULT));
-    let config = DecoderConfig {
-        sensor: capture.sensor(),
-        mask: capture.mask()?,
-        raw: capture.raw_format(),
-        defects: capture.defects(),
-        sl0: Sl0Config::DEFAULT,
-    };
-    let decoder = TileDecoder::<5, 5, 4, 4, 13, 5200>::new(config).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let (rows, cols) = capture.frame_size();
-    let raw: Vec<RawFrame<u16>> = capture
-        .frames
-        .iter()
-        .map(|f| RawFrame::new(f, rows, cols))
-        .collect::<Result<_, _>>()
-        .map_err(|e| anyhow::anyhow!("{e}"))?;
+    let decoder = capture.decoder(Sl0Config::DEFAULT)?;
+    let raw = capture.raw_frames()?;
     let mut host = Collect(HashMap::new());
     let mut ws = Box::new(slf_firmware::PaperWorkspace::new());
     for tile in decoder.tiles((1, 1)) {
