@@ -5,7 +5,10 @@
 //! the core's f32 FMA peak: `macs / time / peak`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use slf_firmware::{Dictionary, LensletSize, Mask, PaperShape, PaperWorkspace, Sl0Config, analyze, solve, synthesize};
+use slf_firmware::{
+    ChoiceRule, DEFAULT_ENSEMBLE, Dictionary, Ensemble, EnsembleModel, LensletSize, Mask, MemberChoice, PaperShape,
+    PaperWorkspace, PatchModel, Sl0Config, analyze, solve, synthesize,
+};
 use std::hint::black_box;
 
 const L5: LensletSize = LensletSize { rows: 5, cols: 5 };
@@ -56,6 +59,15 @@ fn benches(c: &mut Criterion) {
         );
         c.bench_function(&format!("solve DCT default pixel k={k}"), |bench| {
             bench.iter(|| solve(&dict, &cfg, black_box(&mut ws)).unwrap())
+        });
+        let model = EnsembleModel::new(
+            Ensemble::new(DEFAULT_ENSEMBLE).unwrap(),
+            MemberChoice::Screened(ChoiceRule::DEFAULT),
+        );
+        let out = model.decode(&cfg, &mut ws).unwrap();
+        eprintln!("screened pixel k={k}: {} solves, member {:?}", out.solves, out.member);
+        c.bench_function(&format!("decode ensemble screened pixel k={k}"), |bench| {
+            bench.iter(|| model.decode(&cfg, black_box(&mut ws)).unwrap())
         });
     }
 }

@@ -19,7 +19,7 @@
 //! - **operators** ([`shape`], [`dct`], [`dictionary`], [`blob`], [`transform`]): the patch
 //!   geometry in the types, dictionaries (the 5D DCT and blobs in flash) and the separable
 //!   synthesis and analysis transforms.
-//! - **solver** ([`sl0`], [`pinv`], [`choice`]): nD SL0 with the orthonormal fast path, the
+//! - **solver** ([`sl0`], [`ascent`], [`pinv`], [`choice`]): nD SL0 with the orthonormal fast path, the
 //!   paper's general pseudo-inverse path for kronecker masks, and the choice of an ensemble
 //!   member per patch (exhaustive or screened).
 //! - **tile decoder** ([`tile`]): a rectangle of the raw frame, patch by patch, from a
@@ -73,6 +73,7 @@
 
 mod log;
 
+pub mod ascent;
 pub mod blob;
 pub mod choice;
 pub mod dct;

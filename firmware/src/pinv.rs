@@ -17,7 +17,8 @@ use nalgebra::{SMatrix, SVD};
 use crate::dictionary::{Dictionary, Factors, Matrix};
 use crate::mask::KroneckerPhi;
 use crate::shape::PatchShape;
-use crate::sl0::{Outcome, Sl0Config, SolveError, ascend, max_abs, run_schedule, start};
+use crate::ascent::ascend;
+use crate::sl0::{Outcome, Sl0Config, SolveError, max_abs, run_schedule, start};
 use crate::transform::{apply_in_place, synthesize};
 use crate::workspace::{Measurements, Workspace};
 

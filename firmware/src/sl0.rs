@@ -22,6 +22,7 @@
 
 use core::fmt;
 
+use crate::ascent::ascend;
 use crate::dictionary::Dictionary;
 use crate::transform::{analyze, synthesize};
 use crate::workspace::{Measurements, Workspace};
@@ -166,23 +167,6 @@ impl Outcome {
     /// Whether the hard iteration bound stopped the solve.
     pub fn hit_bound(&self) -> bool {
         self.ended == Ended::IterationBound
-    }
-}
-
-/// The ascent step `s <- s - mu * s * exp(-s^2 * inv)`, `inv = 1 / (2 sigma^2)`.
-///
-/// Where `x = s^2 * inv > 88 + ln(max(mu, 1))`, `mu * exp(-x) < exp(-88) < 2^-125`, so the
-/// step is far below half an ulp of `s` and `s` would round back to itself: `expf` is
-/// skipped there and the result is bit for bit the same. At small sigma most coefficients
-/// are there, and `expf` was about half of a solve's time.
-#[inline]
-pub(crate) fn ascend(coeffs: &mut [f32], mu: f32, inv: f32) {
-    let skip = 88.0 + libm::logf(mu.max(1.0));
-    for s in coeffs {
-        let x = *s * *s * inv;
-        if x <= skip {
-            *s -= mu * *s * libm::expf(-x);
-        }
     }
 }
 
