@@ -52,13 +52,33 @@ pub fn exp_neg(x: f32) -> f32 {
 /// Where `x = s^2 inv` exceeds `88 + ln(max(mu, 1))`, `mu * exp(-x) < 2^-125` and the step
 /// rounds away (`s` is unchanged); a select keeps that exact for any `mu`, and the clamp
 /// at 80 keeps `exp_neg` in range without a branch.
+///
+/// Returns the squared length of the step, `sum (mu s exp(-x))^2`: the solver's measure of
+/// how far the patch moved (see [`crate::sl0`]'s early stop).
 #[inline]
-pub fn ascend(coeffs: &mut [f32], mu: f32, inv: f32) {
+pub fn ascend(coeffs: &mut [f32], mu: f32, inv: f32) -> f32 {
     let skip = 88.0 + libm::logf(mu.max(1.0));
-    for s in coeffs {
-        let x = *s * *s * inv;
-        let e = exp_neg(x.min(X_MAX));
-        let step = if x <= skip { mu * *s * e } else { 0.0 };
-        *s -= step;
+    // Blocks of 64: the steps go to a small stack array in one plain loop (which the
+    // compiler vectorises), then eight running sums of their squares, one per lane. One
+    // running sum in the step loop would be a serial chain the compiler may not reorder
+    // (f32 addition is not associative), and it kept the whole step scalar.
+    let mut sums = [0.0f32; 8];
+    let mut d = [0.0f32; 64];
+    for block in coeffs.chunks_mut(64) {
+        let d = &mut d[..block.len()];
+        for (d, s) in d.iter_mut().zip(block.iter_mut()) {
+            let x = *s * *s * inv;
+            let e = exp_neg(x.min(X_MAX));
+            *d = if x <= skip { mu * *s * e } else { 0.0 };
+            *s -= *d;
+        }
+        let (lanes, tail) = d.as_chunks::<8>();
+        for lane in lanes {
+            for (sum, d) in sums.iter_mut().zip(lane) {
+                *sum += d * d;
+            }
+        }
+        sums[0] += tail.iter().map(|d| d * d).sum::<f32>();
     }
+    sums.iter().sum()
 }

@@ -18,7 +18,7 @@ use crate::dictionary::{Dictionary, Factors, Matrix};
 use crate::mask::KroneckerPhi;
 use crate::shape::PatchShape;
 use crate::ascent::ascend;
-use crate::sl0::{Outcome, Sl0Config, SolveError, max_abs, run_schedule, start};
+use crate::sl0::{Outcome, Sl0Config, SolveError, Step, max_abs, run_schedule, start};
 use crate::transform::{apply_in_place, synthesize};
 use crate::workspace::{Measurements, Workspace};
 
@@ -165,8 +165,9 @@ pub fn solve_pinv<
     apply_in_place(&op.a_pinv, coeffs);
     let sigma0 = max_abs(coeffs);
 
-    let outcome = run_schedule(cfg, sigma0, |inv| {
-        ascend(coeffs, cfg.mu, inv);
+    let outcome = run_schedule(cfg, sigma0, N, |inv| {
+        // The step's own length bounds how far the projected step moves the patch.
+        let moved = libm::sqrtf(ascend(coeffs, cfg.mu, inv));
         // R = S x_i A_i - I
         signal.copy_from_slice(coeffs);
         apply_in_place(&op.a, signal);
@@ -180,7 +181,7 @@ pub fn solve_pinv<
                 *s -= scale * r;
             }
         }
-        norm
+        Step { residual: norm, moved }
     });
 
     synthesize(&op.dict, coeffs, signal);

@@ -44,6 +44,9 @@ pub struct Sl0Config {
     /// Noise standard deviation per measurement (normalised units), >= 0; 0 forces
     /// equality with the measurements.
     pub noise: f32,
+    /// Early stop: the solve ends once a whole sigma level moves the patch by less than
+    /// this, as an RMS per value (normalised units), >= 0; 0 never stops early.
+    pub tolerance: f32,
 }
 
 impl Sl0Config {
@@ -51,7 +54,7 @@ impl Sl0Config {
     /// steps, exact projection. The start is `sigma0 = max |S0|` of the minimum-norm
     /// solution `S0`; from a patch of mean brightness 0.5 that is about 20 levels (60 steps).
     pub const DEFAULT: Self =
-        Self { sigma_f: 0.7, steps: 3, mu: 2.0, sigma_min: 1e-3, max_iterations: 300, noise: 0.0 };
+        Self { sigma_f: 0.7, steps: 3, mu: 2.0, sigma_min: 1e-3, max_iterations: 300, noise: 0.0, tolerance: 0.0 };
 
     /// Checks every field's range.
     ///
@@ -76,6 +79,9 @@ impl Sl0Config {
         }
         if !(self.noise >= 0.0 && self.noise.is_finite()) {
             return bad("noise");
+        }
+        if !(self.tolerance >= 0.0 && self.tolerance.is_finite()) {
+            return bad("tolerance");
         }
         Ok(())
     }
@@ -144,6 +150,9 @@ pub enum Ended {
     /// `sigma` fell so far that `1 / sigma^2` is not an f32 (only with a `sigma_min`
     /// below f32 resolution); the solution is as good as it gets.
     SigmaUnderflow,
+    /// A whole level moved the patch by less than [`Sl0Config::tolerance`] (RMS per
+    /// value): the solution stopped changing.
+    Converged,
 }
 
 /// How a solve ended.
@@ -213,11 +222,26 @@ pub(crate) fn start<const N: usize>(cfg: &Sl0Config, m: &Measurements<N>) -> Res
     Ok(cfg.noise * libm::sqrtf(m.count as f32))
 }
 
+/// What one step (ascent + projection) reports to the schedule.
+pub(crate) struct Step {
+    /// Residual norm before the projection.
+    pub residual: f32,
+    /// How far the step moved the patch (l2 norm), or an upper bound of it.
+    pub moved: f32,
+}
+
 /// The sigma schedule of Algorithm 1, shared by both projection paths: runs `step` (one
-/// ascent + projection, returning the residual) `L` times per level until `sigma_min`, the
-/// iteration bound, or sigma underflow.
-pub(crate) fn run_schedule(cfg: &Sl0Config, sigma0: f32, mut step: impl FnMut(f32) -> f32) -> Outcome {
+/// ascent + projection) `L` times per level until `sigma_min`, the iteration bound, sigma
+/// underflow, or (with a tolerance) a level that moved the patch by less than
+/// `tolerance * sqrt(values)` in all.
+pub(crate) fn run_schedule(
+    cfg: &Sl0Config,
+    sigma0: f32,
+    values: usize,
+    mut step: impl FnMut(f32) -> Step,
+) -> Outcome {
     let mut out = Outcome { iterations: 0, levels: 0, sigma0, residual: 0.0, ended: Ended::SigmaMin };
+    let stop = cfg.tolerance * libm::sqrtf(values as f32);
     let mut sigma = sigma0;
     out.ended = 'levels: loop {
         if sigma.is_nan() || sigma <= cfg.sigma_min {
@@ -227,15 +251,22 @@ pub(crate) fn run_schedule(cfg: &Sl0Config, sigma0: f32, mut step: impl FnMut(f3
         if !inv.is_finite() {
             break Ended::SigmaUnderflow;
         }
+        // The level's movement, bounded by the sum of its steps' (triangle inequality).
+        let mut moved = 0.0f32;
         for _ in 0..cfg.steps {
             if out.iterations >= cfg.max_iterations {
                 break 'levels Ended::IterationBound;
             }
-            out.residual = step(inv);
+            let s = step(inv);
+            out.residual = s.residual;
+            moved += s.moved;
             out.iterations += 1;
         }
         out.levels += 1;
         sigma *= cfg.sigma_f;
+        if moved < stop {
+            break Ended::Converged;
+        }
     };
     out
 }
@@ -262,12 +293,17 @@ pub fn solve<const PS: usize, const PT: usize, const PU: usize, const PV: usize,
     analyze(dict, signal, coeffs);
     let sigma0 = max_abs(coeffs);
 
-    let outcome = run_schedule(cfg, sigma0, |inv| {
-        ascend(coeffs, cfg.mu, inv);
+    let outcome = run_schedule(cfg, sigma0, N, |inv| {
+        let step2 = ascend(coeffs, cfg.mu, inv);
         synthesize(dict, coeffs, signal);
-        let r = project(signal, m, eps);
+        let residual = project(signal, m, eps);
         analyze(dict, signal, coeffs);
-        r
+        // From a point that meets the measurements, the step d moves the patch by D d on
+        // the unmeasured values only (the projection puts the measured ones back), and D
+        // is orthonormal: |moved|^2 = |d|^2 - residual^2, with no extra pass. With a noise
+        // ball the projection may leave part of the step on measured values: |d| bounds it.
+        let moved2 = if eps == 0.0 { step2 - residual * residual } else { step2 };
+        Step { residual, moved: libm::sqrtf(moved2.max(0.0)) }
     });
 
     synthesize(dict, coeffs, signal);

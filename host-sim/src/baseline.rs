@@ -92,9 +92,12 @@ pub fn kronecker<T: Real>(f: &Factors<T>) -> DMatrix<T> {
     k
 }
 
-/// The sigma schedule of Algorithm 1, the same as the firmware's (`sl0::run_schedule`).
-fn schedule<T: Real>(cfg: &Sl0Config, sigma0: T, mut step: impl FnMut(T)) -> (u32, Ended) {
+/// The sigma schedule of Algorithm 1, the same as the firmware's (`sl0::run_schedule`):
+/// `step` returns how far it moved the patch (l2), measured directly here; a level that
+/// moves it by less than `tolerance * sqrt(values)` in all ends the solve.
+fn schedule<T: Real>(cfg: &Sl0Config, sigma0: T, values: usize, mut step: impl FnMut(T) -> T) -> (u32, Ended) {
     let (sigma_min, sigma_f) = (T::from(cfg.sigma_min), T::from(cfg.sigma_f));
+    let stop = T::from(cfg.tolerance) * T::from(values as f32).sqrt();
     let mut sigma = sigma0;
     let mut iterations = 0u32;
     loop {
@@ -105,15 +108,24 @@ fn schedule<T: Real>(cfg: &Sl0Config, sigma0: T, mut step: impl FnMut(T)) -> (u3
         if !inv.is_finite() {
             return (iterations, Ended::SigmaUnderflow);
         }
+        let mut moved = T::zero();
         for _ in 0..cfg.steps {
             if iterations >= cfg.max_iterations {
                 return (iterations, Ended::IterationBound);
             }
-            step(inv);
+            moved += step(inv);
             iterations += 1;
         }
         sigma *= sigma_f;
+        if moved < stop {
+            return (iterations, Ended::Converged);
+        }
     }
+}
+
+/// The l2 distance between two vectors.
+fn distance<T: Real>(a: &[T], b: &[T]) -> T {
+    a.iter().zip(b).map(|(&x, &y)| (x - y) * (x - y)).fold(T::zero(), |acc, v| acc + v).sqrt()
 }
 
 fn ascend<T: Real>(s: &mut [T], mu: T, inv: T) {
@@ -154,12 +166,15 @@ impl<T: Real> Dense1D<T> {
     pub fn solve(&self, y: &[T], cfg: &Sl0Config) -> (Vec<T>, u32) {
         let mut s = matvec(&self.a_pinv, y);
         let mu = T::from(cfg.mu);
-        let (iterations, _) = schedule(cfg, max_abs(&s), |inv| {
+        let (iterations, _) = schedule(cfg, max_abs(&s), s.len(), |inv| {
+            let before = s.clone();
             ascend(&mut s, mu, inv);
             let r: Vec<T> = matvec(&self.a, &s).iter().zip(y).map(|(&a, &b)| a - b).collect();
             for (x, c) in s.iter_mut().zip(matvec(&self.a_pinv, &r)) {
                 *x -= c;
             }
+            // D is orthonormal: the patch moves as far as its coefficients.
+            distance(&before, &s)
         });
         (matvec(&self.d, &s), iterations)
     }
@@ -212,11 +227,12 @@ pub fn solve_5d<T: Real>(factors: &Factors<T>, measured: &[Option<T>], cfg: &Sl0
     let mut x: Vec<T> = measured.iter().map(|y| y.unwrap_or(T::zero())).collect();
     let mut s = modes(f, &x, true);
     let mu = T::from(cfg.mu);
-    let (iterations, _) = schedule(cfg, max_abs(&s), |inv| {
+    let (iterations, _) = schedule(cfg, max_abs(&s), x.len(), |inv| {
         ascend(&mut s, mu, inv);
-        x = modes(f, &s, false);
+        let before = std::mem::replace(&mut x, modes(f, &s, false));
         project(&mut x);
         s = modes(f, &x, true);
+        distance(&before, &x)
     });
     x = modes(f, &s, false);
     project(&mut x);

@@ -89,11 +89,15 @@ pub struct Point {
 }
 
 /// Sweep size.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct BenchOptions {
     /// Small scenes, two of them, k = 3 only, no exhaustive choice: CI-sized.
     pub quick: bool,
     pub progress: bool,
+    /// Only the settings whose name contains this.
+    pub only: Option<String>,
+    /// The mask families (empty: all three).
+    pub masks: Vec<MaskFamily>,
 }
 
 fn settings(quick: bool) -> Vec<(String, Decoder, Sl0Config)> {
@@ -111,6 +115,9 @@ fn settings(quick: bool) -> Vec<(String, Decoder, Sl0Config)> {
         ("DCT noise-aware".to_string(), dct(), Sl0Config { noise: 2.0 / 3628.0, ..d }),
         ("ensemble screened".to_string(), ens(MemberChoice::Screened(ChoiceRule::DEFAULT)), d),
     ];
+    for tolerance in [3e-3f32, 1e-3, 3e-4, 1e-4] {
+        s.push((format!("DCT tolerance {tolerance:e}"), dct(), Sl0Config { tolerance, ..d }));
+    }
     if !quick {
         s.push(("ensemble exhaustive".to_string(), ens(MemberChoice::Exhaustive(ChoiceRule::DEFAULT)), d));
     }
@@ -141,8 +148,15 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Point>> {
         .map(|n| scene::named(n).map(|s| s.render(SceneSize { views: (5, 5), rows: size, cols: size })))
         .collect::<Option<_>>()
         .context("named scene")?;
-    let settings = settings(opts.quick);
-    let families = [MaskFamily::Pixel, MaskFamily::Lenslet, MaskFamily::Kronecker];
+    let mut settings = settings(opts.quick);
+    if let Some(only) = &opts.only {
+        settings.retain(|(name, _, _)| name.contains(only.as_str()));
+    }
+    let families = if opts.masks.is_empty() {
+        vec![MaskFamily::Pixel, MaskFamily::Lenslet, MaskFamily::Kronecker]
+    } else {
+        opts.masks.clone()
+    };
     let total = (families.len() * ks.len() * settings.len() * truths.len()) as u64;
     let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::hidden());
     if opts.progress {
@@ -154,7 +168,7 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Point>> {
     }
     let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().context("one-thread pool")?;
     let mut points = Vec::new();
-    for family in families {
+    for &family in &families {
         for &k in ks {
             let captures: Vec<_> = truths
                 .iter()

@@ -36,13 +36,16 @@ enum Family {
 }
 
 impl Family {
-    fn mask(self, seed: u64, k: u8) -> MaskDescription {
-        let family = match self {
+    fn family(self) -> MaskFamily {
+        match self {
             Family::Pixel => MaskFamily::Pixel,
             Family::Lenslet => MaskFamily::Lenslet,
             Family::Kronecker => MaskFamily::Kronecker,
-        };
-        MaskDescription::seeded(family, seed, k)
+        }
+    }
+
+    fn mask(self, seed: u64, k: u8) -> MaskDescription {
+        MaskDescription::seeded(self.family(), seed, k)
     }
 }
 
@@ -132,6 +135,10 @@ struct SolverArgs {
     /// Noise standard deviation per measurement (normalised units); 0 forces equality.
     #[arg(long, default_value_t = 0.0)]
     noise: f32,
+    /// Early stop: end a patch's solve once a sigma level moves it by less than this RMS
+    /// per value (normalised units); 0 never stops early.
+    #[arg(long, default_value_t = Sl0Config::DEFAULT.tolerance)]
+    tolerance: f32,
 }
 
 impl SolverArgs {
@@ -143,6 +150,7 @@ impl SolverArgs {
             sigma_min: self.sigma_min,
             max_iterations: self.max_iterations,
             noise: self.noise,
+            tolerance: self.tolerance,
         };
         c.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
         Ok(c)
@@ -308,6 +316,13 @@ enum Command {
         /// Instead of the sweep: the paper's scale end to end (512 x 512 x 5 x 5 x 13).
         #[arg(long)]
         paper_scale: bool,
+        /// Only the settings whose name contains this (e.g. "screened"); the table and
+        /// plot then hold just those points.
+        #[arg(long)]
+        only: Option<String>,
+        /// Mask families to sweep (default: all three).
+        #[arg(long, value_delimiter = ',')]
+        masks: Vec<Family>,
     },
     /// Write the capture the device binary decodes (frames as .npy and `capture.rs` constants).
     DeviceCapture {
@@ -464,8 +479,10 @@ fn run(cli: Cli) -> Result<()> {
             println!("{}", slf_host::bench::paper_scale()?);
             Ok(())
         }
-        Command::Bench { out, quick, .. } => {
-            let points = slf_host::bench::run(&slf_host::bench::BenchOptions { quick, progress: true })?;
+        Command::Bench { out, quick, only, masks, .. } => {
+            let masks = masks.iter().map(|m| m.family()).collect();
+            let opts = slf_host::bench::BenchOptions { quick, progress: true, only, masks };
+            let points = slf_host::bench::run(&opts)?;
             slf_host::bench::write(&points, &out)?;
             println!("{} points; wrote {}/bench.csv, bench.md, bench.png", points.len(), out.display());
             Ok(())
