@@ -60,10 +60,8 @@ fn benches(c: &mut Criterion) {
         c.bench_function(&format!("solve DCT default pixel k={k}"), |bench| {
             bench.iter(|| solve(&dict, &cfg, black_box(&mut ws)).unwrap())
         });
-        let model = EnsembleModel::new(
-            Ensemble::new(DEFAULT_ENSEMBLE).unwrap(),
-            MemberChoice::Screened(ChoiceRule::DEFAULT),
-        );
+        let model =
+            EnsembleModel::new(Ensemble::new(DEFAULT_ENSEMBLE).unwrap(), MemberChoice::Screened(ChoiceRule::DEFAULT));
         let out = model.decode(&cfg, &mut ws).unwrap();
         eprintln!("screened pixel k={k}: {} solves, member {:?}", out.solves, out.member);
         c.bench_function(&format!("decode ensemble screened pixel k={k}"), |bench| {

@@ -6,10 +6,12 @@
 //! - **Exhaustive**: solve with every member, score each solution by a [`ChoiceRule`], then
 //!   solve once more with the best member (K + 1 solves; the workspace holds one patch).
 //! - **Screened**: solve once with the DCT, score that solution in every member (an
-//!   analysis each, no solve), then solve once with the best member (2 solves). A member
-//!   that is the DCT itself is not screened (a solution computed with the DCT is always
-//!   sparsest in the DCT, which would bias the screen); instead the DCT's own solution
-//!   competes with the chosen member's by the same rule, and wins with a third solve.
+//!   analysis each, no solve), then solve again with the best member, warm-started from
+//!   the DCT's solution ([`solve_warm`]: it skips the levels that found the large
+//!   coefficients, and measured better than a cold start). A member that is the DCT itself
+//!   is not screened (a solution computed with the DCT is always sparsest in the DCT, which
+//!   would bias the screen); instead the DCT's own solution competes with the chosen
+//!   member's by the same rule, and wins with a third (warm) solve.
 //!
 //! The raw SL0 residual is near zero for every member (each solution meets the
 //! measurements), so it cannot rank them; the rules look at how sparse the solution is in
@@ -19,7 +21,7 @@
 use crate::blob::Ensemble;
 use crate::dictionary::Dictionary;
 use crate::shape::PatchShape;
-use crate::sl0::{Outcome, Sl0Config, SolveError, solve};
+use crate::sl0::{Ended, Outcome, Sl0Config, SolveError, solve, solve_warm};
 use crate::transform::apply_in_place;
 use crate::workspace::Workspace;
 
@@ -80,8 +82,8 @@ fn residual_outside_top(s: &[f32], tau: usize) -> f32 {
 pub enum MemberChoice {
     /// Solve with every member, keep the best by the rule (K + 1 solves).
     Exhaustive(ChoiceRule),
-    /// Solve with the DCT, pick the member that best represents that solution, solve once
-    /// with it (2 solves).
+    /// Solve with the DCT, pick the member that best represents that solution, solve again
+    /// with it from the DCT's solution (2 solves, the second shorter; 3 if the DCT wins).
     Screened(ChoiceRule),
 }
 
@@ -198,7 +200,11 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let mut best = (f32::INFINITY, 0u16);
         for k in 0..self.ensemble.len() as u16 {
             let member = self.member(k)?;
-            solve(&member, cfg, ws)?;
+            let outcome = solve(&member, cfg, ws)?;
+            if outcome.ended == Ended::Flat {
+                // Flat patches decode the same with every member (no solve).
+                return Ok(ModelOutcome { outcome, member: Some(k), solves: 1 });
+            }
             let s = self.score(&member, rule, ws);
             if s < best.0 || best.0.is_infinite() {
                 best = (s, k);
@@ -216,7 +222,10 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         cfg: &Sl0Config,
         ws: &mut Ws<PS, PT, PU, PV, B, N>,
     ) -> Result<ModelOutcome, SolveError> {
-        solve(&self.screen, cfg, ws)?;
+        let first = solve(&self.screen, cfg, ws)?;
+        if first.ended == Ended::Flat {
+            return Ok(ModelOutcome { outcome: first, member: self.screen_member, solves: 1 });
+        }
         let dct_score = self.score(&self.screen, rule, ws);
         let mut best = (f32::INFINITY, None);
         for k in (0..self.ensemble.len() as u16).filter(|&k| Some(k) != self.screen_member) {
@@ -228,13 +237,13 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let (Some(chosen), Some(dct)) = (best.1, self.screen_member) else {
             // No other member, or no DCT member to compete: solve with the screen's pick.
             let k = best.1.or(self.screen_member).unwrap_or(0);
-            let outcome = solve(&self.member(k)?, cfg, ws)?;
+            let outcome = solve_warm(&self.member(k)?, cfg, ws)?;
             return Ok(ModelOutcome { outcome, member: Some(k), solves: 2 });
         };
         let member = self.member(chosen)?;
-        let outcome = solve(&member, cfg, ws)?;
+        let outcome = solve_warm(&member, cfg, ws)?;
         if dct_score < self.score(&member, rule, ws) {
-            let outcome = solve(&self.screen, cfg, ws)?;
+            let outcome = solve_warm(&self.screen, cfg, ws)?;
             return Ok(ModelOutcome { outcome, member: Some(dct), solves: 3 });
         }
         Ok(ModelOutcome { outcome, member: Some(chosen), solves: 2 })

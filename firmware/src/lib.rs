@@ -97,7 +97,7 @@ pub use mask::{BandTile, KroneckerPhi, LensletSize, Mask, MaskFamily, SensingErr
 pub use pinv::{PinvOperator, solve_pinv};
 pub use raw::{Frame, FrameSource, LeU16Frame, RawFormat, RawFrame};
 pub use shape::{FullViewShape, PaperShape, PatchShape};
-pub use sl0::{Ended, Outcome, Sl0Config, SolveError, solve};
+pub use sl0::{Ended, Outcome, Sl0Config, SolveError, solve, solve_warm};
 pub use spi::{SpiFrameBuffer, SpiSourceError};
 pub use tile::{
     ConfigError, DecoderConfig, PatchFlags, PatchOrigin, PatchReport, PatchSink, SensorGeometry, Tile, TileDecoder,

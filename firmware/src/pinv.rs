@@ -14,10 +14,10 @@
 
 use nalgebra::{SMatrix, SVD};
 
+use crate::ascent::ascend;
 use crate::dictionary::{Dictionary, Factors, Matrix};
 use crate::mask::KroneckerPhi;
 use crate::shape::PatchShape;
-use crate::ascent::ascend;
 use crate::sl0::{Outcome, Sl0Config, SolveError, Step, max_abs, run_schedule, start};
 use crate::transform::{apply_in_place, synthesize};
 use crate::workspace::{Measurements, Workspace};

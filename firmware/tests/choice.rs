@@ -54,8 +54,14 @@ fn sparse_in(dict: &Dictionary<5, 5, 4, 4, 13>, seed: u64) -> Vec<f32> {
     x.to_vec()
 }
 
+/// With a cold second solve (`warm_start` 1) both choices find the member an exactly
+/// sparse patch is made of. The default warm start (1e-2, +1.2 dB on real scenes at k = 1)
+/// does not: from a DCT solution that is wrong everywhere (relative error ~1, as only
+/// such a synthetic patch makes it) the member's solve starts too low to leave it, and the
+/// DCT keeps the patch. That limit is asserted too, so a change to it is seen.
 #[test]
 fn choice_finds_the_member_a_patch_is_made_of_at_the_stated_cost() {
+    let cold = Sl0Config { warm_start: 1.0, ..Sl0Config::DEFAULT };
     let members = vec![Dictionary::dct(), random_dictionary(11), random_dictionary(12), random_dictionary(13)];
     let e = Ensemble::<5, 5, 4, 4, 13>::new(blob(&members)).unwrap();
     let mask = Mask::pixel(3, 3, 13, L5).unwrap();
@@ -69,11 +75,16 @@ fn choice_finds_the_member_a_patch_is_made_of_at_the_stated_cost() {
             let truth = sparse_in(dict, 40 + m as u64);
             let mut ws = Box::new(PaperWorkspace::new());
             measure(&mask, (0, 0), &truth, &mut ws);
-            let out = model.decode(&Sl0Config::DEFAULT, &mut ws).unwrap();
+            let out = model.decode(&cold, &mut ws).unwrap();
             assert!(solves.contains(&out.solves), "{choice:?}: {} solves", out.solves);
             assert_eq!(out.member, Some(m as u16), "{choice:?}: patch made of member {m}");
             let e = rel_err32(ws.patch(), &truth);
             assert!(e < 0.05, "{choice:?} member {m}: rel err {e}");
+            if let (MemberChoice::Screened(_), true) = (choice, m > 0) {
+                let out = model.decode(&Sl0Config::DEFAULT, &mut ws).unwrap();
+                assert_eq!(out.member, Some(0), "warm start: the DCT keeps member {m}'s patch");
+                assert!(ws.patch().iter().all(|x| x.is_finite()));
+            }
         }
     }
 }

@@ -127,6 +127,13 @@ fn bad_config_is_a_typed_error() {
         (Sl0Config { sigma_min: 0.0, ..d }, "sigma_min"),
         (Sl0Config { max_iterations: 0, ..d }, "max_iterations"),
         (Sl0Config { noise: f32::INFINITY, ..d }, "noise"),
+        (Sl0Config { tolerance: -1e-3, ..d }, "tolerance"),
+        (Sl0Config { tolerance: f32::NAN, ..d }, "tolerance"),
+        (Sl0Config { warm_start: 0.0, ..d }, "warm_start"),
+        (Sl0Config { warm_start: 1.5, ..d }, "warm_start"),
+        (Sl0Config { warm_start: f32::NAN, ..d }, "warm_start"),
+        (Sl0Config { flat: -1.0, ..d }, "flat"),
+        (Sl0Config { flat: f32::INFINITY, ..d }, "flat"),
     ] {
         assert_eq!(solve(&dict, &cfg, &mut w).unwrap_err(), SolveError::InvalidConfig { field });
     }

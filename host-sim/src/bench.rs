@@ -118,6 +118,13 @@ fn settings(quick: bool) -> Vec<(String, Decoder, Sl0Config)> {
     for tolerance in [3e-3f32, 1e-3, 3e-4, 1e-4] {
         s.push((format!("DCT tolerance {tolerance:e}"), dct(), Sl0Config { tolerance, ..d }));
     }
+    for flat in [1e-3f32, 4e-3, 1.6e-2] {
+        s.push((format!("DCT flat {flat:e}"), dct(), Sl0Config { flat, ..d }));
+    }
+    let screened = || ens(MemberChoice::Screened(ChoiceRule::DEFAULT));
+    for warm_start in [1.0f32, 1e-1, 3e-2, 3e-3] {
+        s.push((format!("ensemble screened warm {warm_start:e}"), screened(), Sl0Config { warm_start, ..d }));
+    }
     if !quick {
         s.push(("ensemble exhaustive".to_string(), ens(MemberChoice::Exhaustive(ChoiceRule::DEFAULT)), d));
     }

@@ -139,6 +139,14 @@ struct SolverArgs {
     /// per value (normalised units); 0 never stops early.
     #[arg(long, default_value_t = Sl0Config::DEFAULT.tolerance)]
     tolerance: f32,
+    /// The ensemble's second solve starts from the DCT's patch at this fraction of its
+    /// largest coefficient, in (0, 1]; 1 is a cold start.
+    #[arg(long, default_value_t = Sl0Config::DEFAULT.warm_start)]
+    warm_start: f32,
+    /// Short path: a patch whose measurements of each band agree within this (normalised
+    /// units) is decoded as each band's mean, with no solve; 0: exactly flat patches only.
+    #[arg(long, default_value_t = Sl0Config::DEFAULT.flat)]
+    flat: f32,
 }
 
 impl SolverArgs {
@@ -151,6 +159,8 @@ impl SolverArgs {
             max_iterations: self.max_iterations,
             noise: self.noise,
             tolerance: self.tolerance,
+            warm_start: self.warm_start,
+            flat: self.flat,
         };
         c.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
         Ok(c)

@@ -1,0 +1,168 @@
+//! Modelling only what a patch needs: the early stop, the warm start and the flat short
+//! path, each against the full solve it shortens.
+
+mod common;
+
+use common::*;
+use slf_firmware::*;
+
+const L5: LensletSize = LensletSize { rows: 5, cols: 5 };
+type Ws = PaperWorkspace;
+
+fn measured(truth: &[f32], k: u8) -> Box<Ws> {
+    let mut ws = Box::new(Ws::new());
+    measure(&Mask::pixel(5, k, 13, L5).unwrap(), (0, 0), truth, &mut ws);
+    ws
+}
+
+/// Largest difference between the patch and the measurements it must meet.
+fn misfit(ws: &Ws) -> f32 {
+    (0..5200).filter_map(|i| ws.measurements().get(i).map(|y| (ws.patch()[i] - y).abs())).fold(0.0, f32::max)
+}
+
+fn dct() -> Dictionary<5, 5, 4, 4, 13> {
+    Dictionary::dct()
+}
+
+/// Tolerance 0 is the plain schedule; a loose tolerance ends the solve early with
+/// `Converged`, still on the measurements and finite, at a bounded cost in error.
+#[test]
+fn early_stop_ends_when_the_patch_stops_moving() {
+    let truth = smooth_patch::<5, 5, 4, 4, 13, 5200>(3);
+    let mut ws = measured(&truth, 3);
+    let full = solve(&dct(), &Sl0Config::DEFAULT, &mut ws).unwrap();
+    assert_eq!(full.ended, Ended::SigmaMin);
+    let full_err = rel_err32(ws.patch(), &truth);
+    let mut last = full.iterations;
+    for tolerance in [1e-5f32, 1e-4, 1e-3, 1e-2] {
+        let cfg = Sl0Config { tolerance, ..Sl0Config::DEFAULT };
+        let out = solve(&dct(), &cfg, &mut ws).unwrap();
+        assert!(out.iterations <= last, "a looser tolerance never takes longer");
+        last = out.iterations;
+        if out.ended == Ended::Converged {
+            assert!(out.iterations < full.iterations);
+            assert_eq!(out.iterations % 3, 0, "stops at the end of a level");
+        } else {
+            assert_eq!(out, full);
+        }
+        assert!(ws.patch().iter().all(|x| x.is_finite()));
+        assert!(misfit(&ws) <= 1e-5, "{tolerance}: misfit {}", misfit(&ws));
+        let err = rel_err32(ws.patch(), &truth);
+        assert!(err <= full_err + 20.0 * f64::from(tolerance) + 1e-6, "{tolerance}: {err} vs {full_err}");
+    }
+    assert!(last < full.iterations / 2, "at 1e-2 RMS the smooth patch stops early: {last} steps");
+}
+
+/// The solver's movement measure, |d|^2 - residual^2, against the patch's actual movement
+/// over each level, measured directly by solving level by level (`max_iterations` = L,
+/// 2L, ...) and differencing the patches: the two agree where it matters, at the stop.
+#[test]
+fn early_stop_measures_movement_like_the_obvious_difference() {
+    let truth = smooth_patch::<5, 5, 4, 4, 13, 5200>(7);
+    let mut ws = measured(&truth, 1);
+    let base = Sl0Config::DEFAULT;
+    // Patch after every level, by bounded solves (the schedule is deterministic).
+    let mut patches = Vec::new();
+    for levels in 1..=30u32 {
+        let cfg = Sl0Config { max_iterations: 3 * levels, ..base };
+        let out = solve(&dct(), &cfg, &mut ws).unwrap();
+        patches.push(ws.patch().to_vec());
+        if out.ended != Ended::IterationBound {
+            break;
+        }
+    }
+    let rms =
+        |a: &[f32], b: &[f32]| (a.iter().zip(b).map(|(x, y)| f64::from(x - y).powi(2)).sum::<f64>() / 5200.0).sqrt();
+    let moves: Vec<f64> = patches.windows(2).map(|w| rms(&w[0], &w[1])).collect();
+    let mut checked = 0;
+    for tolerance in [3e-3f32, 1e-3, 3e-4] {
+        let out = solve(&dct(), &Sl0Config { tolerance, ..base }, &mut ws).unwrap();
+        if out.ended != Ended::Converged {
+            continue;
+        }
+        checked += 1;
+        // Level l (1-based) ended the solve: it moved less than the tolerance (the
+        // solver sums its steps, an upper bound of the level's movement).
+        let l = out.levels as usize;
+        assert!(moves[l - 2] < f64::from(tolerance) * 1.01, "{tolerance}: level {l} moved {}", moves[l - 2]);
+    }
+    assert!(checked >= 2, "the loose tolerances stop this patch early");
+}
+
+/// A warm start from another dictionary's patch meets the measurements, stays finite,
+/// takes fewer steps than a cold solve, and from the same dictionary's own solution
+/// changes it little.
+#[test]
+fn warm_start_resumes_from_the_patch_in_the_workspace() {
+    let truth = smooth_patch::<5, 5, 4, 4, 13, 5200>(9);
+    let mut ws = measured(&truth, 3);
+    let cfg = Sl0Config::DEFAULT;
+    let cold = solve(&random_dictionary::<5, 5, 4, 4, 13>(3), &cfg, &mut ws).unwrap();
+    let warm = solve_warm(&dct(), &cfg, &mut ws).unwrap();
+    assert!(warm.iterations < cold.iterations, "{} vs {}", warm.iterations, cold.iterations);
+    assert!(misfit(&ws) <= 1e-5);
+    assert!(ws.patch().iter().all(|x| x.is_finite()));
+    // Warm from the DCT's own solution: a small correction only.
+    solve(&dct(), &cfg, &mut ws).unwrap();
+    let own = ws.patch().to_vec();
+    solve_warm(&dct(), &cfg, &mut ws).unwrap();
+    assert!(rel_err32(ws.patch(), &own) < 0.02, "{}", rel_err32(ws.patch(), &own));
+    // warm_start 1 starts where a cold start would from this patch: bounded like any solve.
+    let out = solve_warm(&dct(), &Sl0Config { warm_start: 1.0, max_iterations: 9, ..cfg }, &mut ws).unwrap();
+    assert_eq!((out.iterations, out.ended), (9, Ended::IterationBound));
+    // No measurement: the typed error, as for a cold solve.
+    ws.measurements_mut().clear();
+    assert_eq!(solve_warm(&dct(), &cfg, &mut ws).unwrap_err(), SolveError::NoMeasurements);
+}
+
+/// A patch flat in space and view (any spectrum) takes the short path: no step, every
+/// value exactly its band's level, measurements met.
+#[test]
+fn flat_patches_take_the_short_path() {
+    let spectrum = |b: usize| 0.1 + 0.05 * b as f32;
+    let truth: Vec<f32> = (0..5200).map(|i| spectrum(i % 13)).collect();
+    for k in [1u8, 3] {
+        let mut ws = measured(&truth, k);
+        let out = solve(&dct(), &Sl0Config::DEFAULT, &mut ws).unwrap();
+        assert_eq!((out.ended, out.iterations), (Ended::Flat, 0));
+        for (i, (x, t)) in ws.patch().iter().zip(&truth).enumerate() {
+            assert!((x - t).abs() <= 1e-6, "k {k} value {i}: {x} vs {t}");
+        }
+    }
+    // The ensemble stops after its first solve.
+    let model = EnsembleModel::new(
+        Ensemble::<5, 5, 4, 4, 13>::new(DEFAULT_ENSEMBLE).unwrap(),
+        MemberChoice::Screened(ChoiceRule::DEFAULT),
+    );
+    let mut ws = measured(&truth, 3);
+    let out = model.decode(&Sl0Config::DEFAULT, &mut ws).unwrap();
+    assert_eq!((out.solves, out.outcome.ended), (1, Ended::Flat));
+}
+
+/// Spread above `flat` in any band, or a band never measured, means a full solve; a dark
+/// patch within `flat` is decoded to within `flat` of the truth.
+#[test]
+fn the_short_path_only_takes_flat_patches() {
+    let mut truth: Vec<f32> = (0..5200).map(|i| 0.3 + 0.01 * (i % 13) as f32).collect();
+    truth[13 * 77 + 4] += 1e-4;
+    let mut ws = measured(&truth, 13);
+    assert_eq!(solve(&dct(), &Sl0Config::DEFAULT, &mut ws).unwrap().ended, Ended::SigmaMin);
+    let loose = Sl0Config { flat: 2e-4, ..Sl0Config::DEFAULT };
+    assert_eq!(solve(&dct(), &loose, &mut ws).unwrap().ended, Ended::Flat);
+    // Band 5 never measured: a flat short path cannot know its level.
+    let mut ws = Box::new(Ws::new());
+    for i in (0..5200).filter(|i| i % 13 != 5) {
+        ws.measurements_mut().set(i, 0.25).unwrap();
+    }
+    assert_ne!(solve(&dct(), &Sl0Config::DEFAULT, &mut ws).unwrap().ended, Ended::Flat);
+    // Dark: values 0..1e-3 with any structure; within flat 1e-3 the short path's error is
+    // below flat everywhere.
+    let dark: Vec<f32> = (0..5200).map(|i| 1e-3 * ((i * 37 % 101) as f32 / 100.0)).collect();
+    let mut ws = measured(&dark, 3);
+    let cfg = Sl0Config { flat: 1e-3, ..Sl0Config::DEFAULT };
+    assert_eq!(solve(&dct(), &cfg, &mut ws).unwrap().ended, Ended::Flat);
+    assert!(ws.patch().iter().zip(&dark).all(|(x, t)| (x - t).abs() <= 1e-3));
+    // Values whose band sums leave f32's range go to the full solve, which reports them.
+    let mut ws = measured(&vec![3e38f32; 5200], 3);
+    assert_eq!(solve(&dct(), &Sl0Config::DEFAULT, &mut ws).unwrap_err(), SolveError::NonFiniteResult);
+}
