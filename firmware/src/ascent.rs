@@ -55,6 +55,7 @@ pub fn exp_neg(x: f32) -> f32 {
 ///
 /// Returns the squared length of the step, `sum (mu s exp(-x))^2`: the solver's measure of
 /// how far the patch moved (see [`crate::sl0`]'s early stop).
+#[cfg(not(target_arch = "arm"))]
 #[inline]
 pub fn ascend(coeffs: &mut [f32], mu: f32, inv: f32) -> f32 {
     let skip = 88.0 + libm::logf(mu.max(1.0));
@@ -81,4 +82,27 @@ pub fn ascend(coeffs: &mut [f32], mu: f32, inv: f32) -> f32 {
         sums[0] += tail.iter().map(|d| d * d).sum::<f32>();
     }
     sums.iter().sum()
+}
+
+/// The ascent step on a scalar core (Cortex-M): no lanes to fill, so the coefficients the
+/// step cannot move (most of them at small sigma) are skipped by a branch instead of
+/// computed and discarded; each coefficient gets the same value as on the host, only the
+/// returned sum is added in another order. Measured on the emulated Cortex-M4
+/// (`scripts/budgets.sh`, DCT patch): 99.1 M instructions, against 102.4 M branch-free
+/// and 97.2 M with `libm::expf` (whose fewer instructions include a `VDIV`, 14 cycles on
+/// a Cortex-M4, per call; qemu counts instructions, not cycles).
+#[cfg(target_arch = "arm")]
+#[inline]
+pub fn ascend(coeffs: &mut [f32], mu: f32, inv: f32) -> f32 {
+    let skip = 88.0 + libm::logf(mu.max(1.0));
+    let mut moved = 0.0f32;
+    for s in coeffs {
+        let x = *s * *s * inv;
+        if x <= skip {
+            let d = mu * *s * exp_neg(x.min(X_MAX));
+            *s -= d;
+            moved += d * d;
+        }
+    }
+    moved
 }
