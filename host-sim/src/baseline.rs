@@ -6,7 +6,14 @@
 //! firmware is f32 only, as the device is.
 
 use nalgebra::{DMatrix, RealField};
-use slf_firmware::{Dictionary, Ended, Sl0Config};
+use std::time::Instant;
+
+use anyhow::Context;
+use slf_firmware::{
+    Dictionary, Ended, LensletSize, Mask, MaskFamily, PaperShape, PaperWorkspace, Sl0Config, blob, solve,
+};
+
+use crate::scene::{self, SceneSize};
 
 /// A scalar for both paths: f32 or f64.
 pub trait Real: RealField + Copy + From<f32> {
@@ -237,4 +244,67 @@ pub fn solve_5d<T: Real>(factors: &Factors<T>, measured: &[Option<T>], cfg: &Sl0
     x = modes(f, &s, false);
     project(&mut x);
     (x, iterations)
+}
+
+/// `slf baseline`: the 5D decoder against the 1D method on `patches` patches of the
+/// texture scene (4 x 4 views): time, memory and the largest difference, printed.
+///
+/// # Errors
+/// A mask that cannot be built, or a singular `A A^T`.
+pub fn compare_1d(patches: usize, family: MaskFamily, k: u8) -> anyhow::Result<()> {
+    let dict: crate::decode::PaperDictionary = Dictionary::dct();
+    let cfg = Sl0Config::DEFAULT;
+    let truth =
+        scene::named("texture").context("scene")?.render(SceneSize { views: (4, 4), rows: 5 * patches, cols: 5 });
+    let lenslet = LensletSize { rows: 4, cols: 4 };
+    let mask = match family {
+        MaskFamily::Pixel => Mask::pixel(3, k, 13, lenslet),
+        MaskFamily::Lenslet => Mask::lenslet(3, k, 13, lenslet),
+        MaskFamily::Kronecker => Mask::kronecker(3, k, 13, lenslet, (5, 5)),
+    }
+    .map_err(|e| anyhow::anyhow!("{e}"))?;
+    let (mut t5, mut t1, mut mem1) = (0.0, 0.0, 0usize);
+    let mut worst = 0.0f32;
+    for p in 0..patches {
+        let mut ws = Box::new(PaperWorkspace::new());
+        let mut measured = Vec::new();
+        for i in 0..5200 {
+            let [s, t, u, v, b] = PaperShape::coordinates(i);
+            if mask.bands_at((5 * p + s) * 4 + u, t * 4 + v).contains(&(b as u8)) {
+                let y = truth.get(u, v, 5 * p + s, t, b);
+                ws.measurements_mut().set(i, y).map_err(|e| anyhow::anyhow!("{e}"))?;
+                measured.push((i, y));
+            }
+        }
+        let start = Instant::now();
+        solve(&dict, &cfg, &mut ws).map_err(|e| anyhow::anyhow!("{e}"))?;
+        t5 += start.elapsed().as_secs_f64();
+        let idx: Vec<usize> = measured.iter().map(|m| m.0).collect();
+        let y: Vec<f32> = measured.iter().map(|m| m.1).collect();
+        let start = Instant::now();
+        let one = Dense1D::<f32>::new(&Factors::from_dictionary(&dict), &idx).context("A A^T is singular")?;
+        let setup = start.elapsed().as_secs_f64();
+        let start = Instant::now();
+        let (x1, _) = one.solve(&y, &cfg);
+        t1 += start.elapsed().as_secs_f64();
+        mem1 = mem1.max(one.memory_bytes());
+        worst = worst.max(x1.iter().zip(ws.patch()).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max));
+        if p == 0 {
+            println!("1D set-up (D, A, A^+ for one mask): {setup:.2} s");
+        }
+    }
+    // 5D: the five matrices (as stored in a blob) and the workspace; 1D: D, A and A^+.
+    let dict5 = blob::member_len(PaperShape::DIMS);
+    let ws5 = std::mem::size_of::<PaperWorkspace>();
+    println!("{patches} patches, {family:?} mask, k = {k}, default SL0; 1D vs 5D max abs difference {worst:.2e}");
+    println!("| method | time per patch | memory |\n| --- | --- | --- |");
+    println!("| 5D (firmware, f32) | {:.2} ms | {dict5} B dictionary + {ws5} B workspace |", 1e3 * t5 / patches as f64);
+    println!("| 1D (dense f32, f64 sums) | {:.2} ms | {mem1} B (D, A, A^+) |", 1e3 * t1 / patches as f64);
+    println!("time ratio 1D/5D {:.1}x (paper: 106x)", t1 / t5);
+    println!(
+        "memory ratio 1D/5D: dictionaries {:.0} (paper: 107,729), everything {:.0}",
+        (5200.0f64 * 5200.0 * 4.0) / dict5 as f64,
+        mem1 as f64 / (dict5 + ws5) as f64
+    );
+    Ok(())
 }

@@ -11,7 +11,8 @@
 //! - [`metrics`] (PSNR, SSIM, SA), [`preview`] (sRGB PNGs) and [`baseline`] (the paper's 1D
 //!   method) evaluate it.
 //!
-//! The `slf` command (`src/main.rs`) puts these together.
+//! [`report`] holds the tables of `slf demo`, `sweep` and `compare`, [`bench`] the speed
+//! against error sweep; the `slf` command (`src/main.rs`) parses arguments and calls them.
 
 pub use slf_firmware as firmware;
 
@@ -24,6 +25,7 @@ pub mod device;
 pub mod lightfield;
 pub mod metrics;
 pub mod preview;
+pub mod report;
 pub mod scene;
 pub mod spectra;
 pub mod spectra_data;

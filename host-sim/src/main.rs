@@ -1,25 +1,22 @@
 //! `slf`: simulate captures of the compressive spectral light-field camera, decode them
 //! with the firmware decoder, and measure the result. `slf --help` lists the commands.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
-use slf_host::baseline::{Dense1D, Factors};
 use slf_host::camera::{CameraConfig, simulate};
 use slf_host::capture::{Capture, MaskDescription};
-use slf_host::decode::{Basis, DecodeOptions, DecodeReport, PaperDictionary, decode_with};
+use slf_host::decode::{Basis, DecodeOptions, decode_with};
 use slf_host::firmware::{
-    ChoiceRule, DEFAULT_ENSEMBLE, Dictionary, LensletSize, Mask, MaskFamily, MemberChoice, PaperShape, PaperWorkspace,
-    Sl0Config, blob, solve, write_blob,
+    ChoiceRule, DEFAULT_ENSEMBLE, MaskFamily, MemberChoice, PaperShape, Sl0Config, blob, write_blob,
 };
-use slf_host::lightfield::{Dtype, LightField, read_npy, write_npy};
-use slf_host::metrics::{Metrics, evaluate};
-use slf_host::preview::write_comparison;
+use slf_host::lightfield::{Dtype, read_npy, write_npy};
+use slf_host::metrics::evaluate;
 use slf_host::scene::{self, SceneSize};
-use slf_host::train;
+use slf_host::{baseline, report, train};
 
 #[derive(Parser)]
 #[command(name = "slf", version, about = "Compressive spectral light-field camera: simulate, decode, measure")]
@@ -408,7 +405,7 @@ fn main() -> ExitCode {
 
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
-        Command::Demo { out, scene, size, basis } => demo(&out, &scene, size, &basis.basis()?),
+        Command::Demo { out, scene, size, basis } => report::demo(&out, &scene, size, &basis.basis()?),
         Command::Scene { name, output, seed, size, views, dtype } => {
             let s = if name == "random" {
                 scene::random(seed)
@@ -484,7 +481,7 @@ fn run(cli: Cli) -> Result<()> {
             println!("SA   {:.3} deg", m.sa);
             Ok(())
         }
-        Command::Baseline { patches, mask, snapshots } => baseline(patches, mask, snapshots),
+        Command::Baseline { patches, mask, snapshots } => baseline::compare_1d(patches, mask.family(), snapshots),
         Command::Bench { paper_scale: true, .. } => {
             println!("{}", slf_host::bench::paper_scale()?);
             Ok(())
@@ -499,9 +496,10 @@ fn run(cli: Cli) -> Result<()> {
         }
         Command::DeviceCapture { output } => slf_host::device::write_capture(&output),
         Command::DeviceCheck { log, capture } => slf_host::device::check(&log, &capture),
-        Command::Sweep { size, k, output, basis } => sweep(size, &k, output.as_deref(), &basis.basis()?),
+        Command::Sweep { size, k, output, basis } => report::sweep(size, &k, output.as_deref(), &basis.basis()?),
         Command::Compare { size, k, output, blob, masks, rule, rule_tau } => {
-            compare(size, &k, output.as_deref(), blob.as_deref(), &masks, rule.rule(rule_tau))
+            let masks: Vec<MaskFamily> = masks.iter().map(|m| m.family()).collect();
+            report::compare(size, &k, output.as_deref(), blob.as_deref(), &masks, rule.rule(rule_tau))
         }
         Command::Train {
             output,
@@ -557,202 +555,4 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
     }
-}
-
-fn row(scene: &str, family: &str, k: u8, m: &Metrics, seconds: f64) -> String {
-    format!("| {scene} | {family} | {k} | {:.2} | {:.4} | {:.2} | {:.2} |", m.psnr, m.ssim, m.sa, seconds)
-}
-
-const HEADER: &str =
-    "| scene | mask | k | PSNR dB | SSIM | SA deg | decode s |\n| --- | --- | --- | --- | --- | --- | --- |";
-
-fn run_one(
-    truth: &LightField,
-    cam: &CameraConfig,
-    basis: &Basis,
-    progress: bool,
-) -> Result<(LightField, Metrics, DecodeReport)> {
-    let capture = simulate(truth, cam)?;
-    let opts = DecodeOptions { progress, ..DecodeOptions::default() };
-    let (recon, report) = decode_with(&capture, basis, &opts)?;
-    if report.failed_tiles > 0 || report.uncovered > 0 {
-        bail!("decode lost {} tiles, {} values uncovered", report.failed_tiles, report.uncovered);
-    }
-    let metrics = evaluate(truth, &recon)?;
-    Ok((recon, metrics, report))
-}
-
-fn demo(out: &Path, name: &str, size: usize, basis: &Basis) -> Result<()> {
-    let start = Instant::now();
-    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
-    let s = scene::named(name).with_context(|| format!("unknown scene {name:?}: one of {:?}", scene::NAMES))?;
-    let truth = s.render(SceneSize { views: (5, 5), rows: size, cols: size });
-    write_npy(&out.join("truth.npy"), &truth, Dtype::F32)?;
-    println!(
-        "scene {name}: {size} x {size} lenslets, 5 x 5 views, 13 bands; pixel mask; {}; {} threads",
-        basis.name(),
-        rayon::current_num_threads()
-    );
-    println!("{HEADER}");
-    for k in [1u8, 3] {
-        let cam = CameraConfig::pixel(7, k);
-        let (recon, m, r) = run_one(&truth, &cam, basis, true)?;
-        println!("{}", row(name, "pixel", k, &m, r.seconds));
-        write_npy(&out.join(format!("recon_k{k}.npy")), &recon, Dtype::F32)?;
-        write_comparison(&out.join(format!("preview_k{k}.png")), &truth, &recon)?;
-    }
-    println!("PSNR data range = max of ground truth ({:.4}).", truth.max());
-    println!(
-        "previews (truth | reconstruction | error) in {}; total {:.1} s",
-        out.display(),
-        start.elapsed().as_secs_f64()
-    );
-    Ok(())
-}
-
-fn sweep(size: usize, ks: &[u8], output: Option<&Path>, basis: &Basis) -> Result<()> {
-    let mut lines = vec![HEADER.to_string()];
-    println!("{HEADER}");
-    for name in scene::NAMES {
-        let truth =
-            scene::named(name).context("named scene")?.render(SceneSize { views: (5, 5), rows: size, cols: size });
-        for family in [Family::Pixel, Family::Lenslet, Family::Kronecker] {
-            for &k in ks {
-                let cam = CameraConfig::pixel(7, k).with_mask(family.mask(7, k));
-                let (_, m, r) = run_one(&truth, &cam, basis, false)?;
-                let fam = format!("{family:?}").to_lowercase();
-                let line = row(name, &fam, k, &m, r.seconds);
-                println!("{line}");
-                lines.push(line);
-            }
-        }
-    }
-    if let Some(p) = output {
-        std::fs::write(p, lines.join("\n") + "\n").with_context(|| format!("cannot write {}", p.display()))?;
-    }
-    Ok(())
-}
-
-fn compare(
-    size: usize,
-    ks: &[u8],
-    output: Option<&Path>,
-    blob: Option<&Path>,
-    masks: &[Family],
-    rule: ChoiceRule,
-) -> Result<()> {
-    let blob = match blob {
-        Some(p) => std::fs::read(p).with_context(|| format!("cannot read {}", p.display()))?,
-        None => DEFAULT_ENSEMBLE.to_vec(),
-    };
-    let bases = [
-        Basis::Dct,
-        Basis::Ensemble { blob: blob.clone(), choice: MemberChoice::Exhaustive(rule) },
-        Basis::Ensemble { blob, choice: MemberChoice::Screened(rule) },
-    ];
-    let truths: Vec<LightField> = scene::NAMES
-        .iter()
-        .map(|n| scene::named(n).map(|s| s.render(SceneSize { views: (5, 5), rows: size, cols: size })))
-        .collect::<Option<_>>()
-        .context("named scene")?;
-    let mut lines = vec![
-        format!("| basis | mask | k | PSNR dB | SSIM | SA deg | solves / patch | ms / patch (1 core) |"),
-        "| --- | --- | --- | --- | --- | --- | --- | --- |".to_string(),
-    ];
-    lines.iter().for_each(|l| println!("{l}"));
-    let threads = rayon::current_num_threads() as f64;
-    let families =
-        if masks.is_empty() { vec![Family::Pixel, Family::Lenslet, Family::Kronecker] } else { masks.to_vec() };
-    for family in families {
-        for &k in ks {
-            for basis in &bases {
-                let cam = CameraConfig::pixel(7, k).with_mask(family.mask(7, k));
-                let (mut p, mut s, mut a, mut secs, mut solves, mut patches) = (0.0, 0.0, 0.0, 0.0, 0u64, 0u64);
-                for truth in &truths {
-                    let (_, m, r) = run_one(truth, &cam, basis, false)?;
-                    p += m.psnr;
-                    s += m.ssim;
-                    a += m.sa;
-                    secs += r.seconds;
-                    solves += r.solves;
-                    patches += u64::from(r.patches.decoded);
-                }
-                let n = truths.len() as f64;
-                let line = format!(
-                    "| {} | {} | {k} | {:.2} | {:.4} | {:.2} | {:.1} | {:.2} |",
-                    basis.name(),
-                    format!("{family:?}").to_lowercase(),
-                    p / n,
-                    s / n,
-                    a / n,
-                    solves as f64 / patches as f64,
-                    1e3 * secs * threads / patches as f64
-                );
-                println!("{line}");
-                lines.push(line);
-            }
-        }
-    }
-    if let Some(path) = output {
-        std::fs::write(path, lines.join("\n") + "\n").with_context(|| format!("cannot write {}", path.display()))?;
-    }
-    Ok(())
-}
-
-fn baseline(patches: usize, family: Family, k: u8) -> Result<()> {
-    let dict: PaperDictionary = Dictionary::dct();
-    let cfg = Sl0Config::DEFAULT;
-    let truth =
-        scene::named("texture").context("scene")?.render(SceneSize { views: (4, 4), rows: 5 * patches, cols: 5 });
-    let lenslet = LensletSize { rows: 4, cols: 4 };
-    let mask = match family {
-        Family::Pixel => Mask::pixel(3, k, 13, lenslet),
-        Family::Lenslet => Mask::lenslet(3, k, 13, lenslet),
-        Family::Kronecker => Mask::kronecker(3, k, 13, lenslet, (5, 5)),
-    }
-    .map_err(|e| anyhow::anyhow!("{e}"))?;
-    let (mut t5, mut t1, mut mem1) = (0.0, 0.0, 0usize);
-    let mut worst = 0.0f32;
-    for p in 0..patches {
-        let mut ws = Box::new(PaperWorkspace::new());
-        let mut measured = Vec::new();
-        for i in 0..5200 {
-            let [s, t, u, v, b] = PaperShape::coordinates(i);
-            if mask.bands_at((5 * p + s) * 4 + u, t * 4 + v).contains(&(b as u8)) {
-                let y = truth.get(u, v, 5 * p + s, t, b);
-                ws.measurements_mut().set(i, y).map_err(|e| anyhow::anyhow!("{e}"))?;
-                measured.push((i, y));
-            }
-        }
-        let start = Instant::now();
-        solve(&dict, &cfg, &mut ws).map_err(|e| anyhow::anyhow!("{e}"))?;
-        t5 += start.elapsed().as_secs_f64();
-        let idx: Vec<usize> = measured.iter().map(|m| m.0).collect();
-        let y: Vec<f32> = measured.iter().map(|m| m.1).collect();
-        let start = Instant::now();
-        let one = Dense1D::<f32>::new(&Factors::from_dictionary(&dict), &idx).context("A A^T is singular")?;
-        let setup = start.elapsed().as_secs_f64();
-        let start = Instant::now();
-        let (x1, _) = one.solve(&y, &cfg);
-        t1 += start.elapsed().as_secs_f64();
-        mem1 = mem1.max(one.memory_bytes());
-        worst = worst.max(x1.iter().zip(ws.patch()).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max));
-        if p == 0 {
-            println!("1D set-up (D, A, A^+ for one mask): {setup:.2} s");
-        }
-    }
-    // 5D: the five matrices (as stored in a blob) and the workspace; 1D: D, A and A^+.
-    let dict5 = blob::member_len(PaperShape::DIMS);
-    let ws5 = std::mem::size_of::<PaperWorkspace>();
-    println!("{patches} patches, {family:?} mask, k = {k}, default SL0; 1D vs 5D max abs difference {worst:.2e}");
-    println!("| method | time per patch | memory |\n| --- | --- | --- |");
-    println!("| 5D (firmware, f32) | {:.2} ms | {dict5} B dictionary + {ws5} B workspace |", 1e3 * t5 / patches as f64);
-    println!("| 1D (dense f32, f64 sums) | {:.2} ms | {mem1} B (D, A, A^+) |", 1e3 * t1 / patches as f64);
-    println!("time ratio 1D/5D {:.1}x (paper: 106x)", t1 / t5);
-    println!(
-        "memory ratio 1D/5D: dictionaries {:.0} (paper: 107,729), everything {:.0}",
-        (5200.0f64 * 5200.0 * 4.0) / dict5 as f64,
-        mem1 as f64 / (dict5 + ws5) as f64
-    );
-    Ok(())
 }

@@ -72,3 +72,45 @@ fn five_d_equals_one_d_for_every_mask_family() {
         }
     }
 }
+
+/// The early stop: the firmware's movement measure (|d|^2 - residual^2, no extra pass)
+/// stops at the same level, within one, as the f64 reference that measures each step's
+/// movement directly as the distance between successive patches.
+#[test]
+fn early_stop_matches_the_directly_measured_f64_stop() {
+    let dict = Dictionary::<5, 5, 4, 4, 13>::dct();
+    let lf = scene::named("texture").unwrap().render(SceneSize { views: (4, 4), rows: 20, cols: 20 });
+    let l4 = LensletSize { rows: 4, cols: 4 };
+    let f64_dct = Factors::dct_f64();
+    let mut stopped = 0;
+    for k in [1u8, 3] {
+        for mask in [Mask::pixel(5, k, 13, l4).unwrap(), Mask::lenslet(5, k, 13, l4).unwrap()] {
+            let mut ws = Box::new(PaperWorkspace::new());
+            let mut meas64 = vec![None; 5200];
+            for (i, m) in meas64.iter_mut().enumerate() {
+                let [s, t, u, v, b] = PaperShape::coordinates(i);
+                if mask.bands_at((10 + s) * 4 + u, (5 + t) * 4 + v).contains(&(b as u8)) {
+                    let y = lf.get(u, v, 10 + s, 5 + t, b);
+                    ws.measurements_mut().set(i, y).unwrap();
+                    *m = Some(f64::from(y));
+                }
+            }
+            for tolerance in [3e-3f32, 1e-3, 3e-4] {
+                let cfg = Sl0Config { tolerance, ..Sl0Config::DEFAULT };
+                let out = solve(&dict, &cfg, &mut ws).unwrap();
+                let (_, it64) = solve_5d::<f64>(&f64_dct, &meas64, &cfg);
+                let steps = u32::from(cfg.steps);
+                assert!(
+                    out.iterations.abs_diff(it64) <= steps,
+                    "{:?} k {k} tolerance {tolerance}: f32 {} steps, f64 {it64}",
+                    mask.family(),
+                    out.iterations
+                );
+                if out.ended == slf_host::firmware::Ended::Converged {
+                    stopped += 1;
+                }
+            }
+        }
+    }
+    assert!(stopped >= 4, "the tolerances stop these patches early ({stopped} of 12)");
+}
