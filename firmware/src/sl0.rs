@@ -307,7 +307,7 @@ pub fn solve<const PS: usize, const PT: usize, const PU: usize, const PV: usize,
     cfg: &Sl0Config,
     ws: &mut Workspace<PS, PT, PU, PV, B, N>,
 ) -> Result<Outcome, SolveError> {
-    start(cfg, &ws.measurements)?;
+    let eps = start(cfg, &ws.measurements)?;
     if let Some(outcome) = short_path(cfg, ws) {
         return Ok(outcome);
     }
@@ -316,7 +316,7 @@ pub fn solve<const PS: usize, const PT: usize, const PU: usize, const PV: usize,
     for ((x, &y), &k) in signal.iter_mut().zip(&m.values).zip(&m.measured) {
         *x = if k { y } else { 0.0 };
     }
-    descend(dict, cfg, ws, 1.0)
+    descend(dict, cfg, ws, eps, 1.0)
 }
 
 /// The short path for a flat patch: if every band is measured and each band's
@@ -377,19 +377,20 @@ pub fn solve_warm<
     cfg: &Sl0Config,
     ws: &mut Workspace<PS, PT, PU, PV, B, N>,
 ) -> Result<Outcome, SolveError> {
-    start(cfg, &ws.measurements)?;
-    descend(dict, cfg, ws, cfg.warm_start)
+    let eps = start(cfg, &ws.measurements)?;
+    descend(dict, cfg, ws, eps, cfg.warm_start)
 }
 
-/// The schedule from the patch in `ws.signal`, from `sigma0 = scale * max |S|`.
+/// The schedule from the patch in `ws.signal`, from `sigma0 = scale * max |S|`, projecting
+/// onto the noise ball of radius `eps` (0: exactly).
 fn descend<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
     dict: &Dictionary<PS, PT, PU, PV, B>,
     cfg: &Sl0Config,
     ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    eps: f32,
     scale: f32,
 ) -> Result<Outcome, SolveError> {
     let Workspace { coeffs, signal, measurements: m } = ws;
-    let eps = start(cfg, m)?;
     analyze(dict, signal, coeffs);
     let sigma0 = scale * max_abs(coeffs);
 
