@@ -3,16 +3,13 @@
 
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 use slf_host::camera::{CameraConfig, simulate};
 use slf_host::capture::{Capture, MaskDescription};
 use slf_host::decode::{Basis, DecodeOptions, decode_with};
-use slf_host::firmware::{
-    ChoiceRule, DEFAULT_ENSEMBLE, MaskFamily, MemberChoice, PaperShape, Sl0Config, blob, write_blob,
-};
+use slf_host::firmware::{ChoiceRule, DEFAULT_ENSEMBLE, MaskFamily, MemberChoice, Sl0Config};
 use slf_host::lightfield::{Dtype, read_npy, write_npy};
 use slf_host::metrics::evaluate;
 use slf_host::scene::{self, SceneSize};
@@ -514,20 +511,6 @@ fn run(cli: Cli) -> Result<()> {
             seed,
             no_dct_member,
         } => {
-            let start = Instant::now();
-            let fields = if input.is_empty() {
-                train::training_fields(scenes, size, 1000 + seed)
-            } else {
-                input.iter().map(|p| read_npy(p)).collect::<Result<Vec<_>, _>>()?
-            };
-            for (i, f) in fields.iter().enumerate() {
-                anyhow::ensure!(
-                    f.bands == 13 && f.views.0 >= 4 && f.views.1 >= 4 && f.rows >= 5 && f.cols >= 5,
-                    "training light field {i} is too small for 5x5x4x4x13 patches: {:?}",
-                    f.shape()
-                );
-            }
-            let data = train::sample_patches(&fields, patches, seed);
             let cfg = train::TrainConfig {
                 members,
                 tau,
@@ -537,22 +520,12 @@ fn run(cli: Cli) -> Result<()> {
                 dct_member: !no_dct_member,
                 progress: true,
             };
-            let (dicts, reports) = train::train(&data, &cfg);
-            println!("| iteration | members | ensemble coding error | DCT coding error |\n| --- | --- | --- | --- |");
-            for (i, r) in reports.iter().enumerate() {
-                println!("| {} | {} | {:.5} | {:.5} |", i + 1, r.members, r.ensemble_error, r.dct_error);
-            }
-            let final_err = train::ensemble_error(&data, &dicts, tau);
-            println!(
-                "final: {} members, coding error {final_err:.5} vs DCT {:.5} (tau {tau}, relative energy)",
-                dicts.len(),
-                reports.first().map_or(0.0, |r| r.dct_error)
-            );
-            let mut blob = vec![0u8; blob::blob_len(PaperShape::DIMS, dicts.len())];
-            write_blob(&dicts, &mut blob).map_err(|e| anyhow::anyhow!("{e}"))?;
-            std::fs::write(&output, &blob).with_context(|| format!("cannot write {}", output.display()))?;
-            println!("wrote {} ({} bytes) in {:.1} s", output.display(), blob.len(), start.elapsed().as_secs_f64());
-            Ok(())
+            let fields = if input.is_empty() {
+                train::training_fields(scenes, size, 1000 + seed)
+            } else {
+                input.iter().map(|p| read_npy(p)).collect::<Result<Vec<_>, _>>()?
+            };
+            train::train_blob(&fields, patches, &cfg, &output)
         }
     }
 }

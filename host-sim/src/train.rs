@@ -365,3 +365,43 @@ pub fn training_fields(count: usize, size: usize, seed: u64) -> Vec<LightField> 
         })
         .collect()
 }
+
+/// `slf train`: samples `patches` patches from `fields`, trains, prints the coding error per
+/// iteration as a markdown table, and writes the ensemble as a blob to `output`.
+///
+/// # Errors
+/// A light field too small for 5x5x4x4x13 patches, or an unwritable `output`.
+pub fn train_blob(
+    fields: &[LightField],
+    patches: usize,
+    cfg: &TrainConfig,
+    output: &std::path::Path,
+) -> anyhow::Result<()> {
+    use anyhow::Context;
+    let start = std::time::Instant::now();
+    for (i, f) in fields.iter().enumerate() {
+        anyhow::ensure!(
+            f.bands == 13 && f.views.0 >= 4 && f.views.1 >= 4 && f.rows >= 5 && f.cols >= 5,
+            "training light field {i} is too small for 5x5x4x4x13 patches: {:?}",
+            f.shape()
+        );
+    }
+    let data = sample_patches(fields, patches, cfg.seed);
+    let (dicts, reports) = train(&data, cfg);
+    println!("| iteration | members | ensemble coding error | DCT coding error |\n| --- | --- | --- | --- |");
+    for (i, r) in reports.iter().enumerate() {
+        println!("| {} | {} | {:.5} | {:.5} |", i + 1, r.members, r.ensemble_error, r.dct_error);
+    }
+    let tau = cfg.tau;
+    let final_err = ensemble_error(&data, &dicts, tau);
+    println!(
+        "final: {} members, coding error {final_err:.5} vs DCT {:.5} (tau {tau}, relative energy)",
+        dicts.len(),
+        reports.first().map_or(0.0, |r| r.dct_error)
+    );
+    let mut blob = vec![0u8; slf_firmware::blob::blob_len(PaperShape::DIMS, dicts.len())];
+    slf_firmware::write_blob(&dicts, &mut blob).map_err(|e| anyhow::anyhow!("{e}"))?;
+    std::fs::write(output, &blob).with_context(|| format!("cannot write {}", output.display()))?;
+    println!("wrote {} ({} bytes) in {:.1} s", output.display(), blob.len(), start.elapsed().as_secs_f64());
+    Ok(())
+}
