@@ -136,6 +136,11 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
 /// Decodes the patch whose measurements are in `ws` by the paper's general path. The
 /// measurements must be exactly the entries `op`'s `Phi` selects (no defects).
 ///
+/// This is the paper's method as a reference: of [`Sl0Config`]'s additions it honours the
+/// early stop (`tolerance`, with the ascent step's length as the movement, an upper bound)
+/// but not the flat short path (`flat`) or the warm start (`warm_start`), which belong to
+/// the fast path ([`crate::solve`], [`crate::solve_warm`]).
+///
 /// # Errors
 /// [`SolveError::InvalidConfig`], [`SolveError::NoMeasurements`],
 /// [`SolveError::IncompleteKronecker`], [`SolveError::NonFiniteResult`].
