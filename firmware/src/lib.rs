@@ -19,7 +19,7 @@
 //! - **operators** ([`shape`], [`dct`], [`dictionary`], [`blob`], [`transform`]): the patch
 //!   geometry in the types, dictionaries (the 5D DCT and blobs in flash) and the separable
 //!   synthesis and analysis transforms.
-//! - **solver** ([`sl0`], [`ascent`], [`pinv`], [`choice`]): nD SL0 with the orthonormal fast path, the
+//! - **solver** ([`sl0`], [`ascent`], [`projection`], [`pinv`], [`choice`]): nD SL0 with the orthonormal fast path, the
 //!   paper's general pseudo-inverse path for kronecker masks, and the choice of an ensemble
 //!   member per patch (exhaustive or screened).
 //! - **tile decoder** ([`tile`]): a rectangle of the raw frame, patch by patch, from a
@@ -81,6 +81,7 @@ pub mod defects;
 pub mod dictionary;
 pub mod mask;
 pub mod pinv;
+pub mod projection;
 pub mod raw;
 pub mod shape;
 pub mod sl0;
@@ -95,6 +96,7 @@ pub use defects::{DefectList, Pixel};
 pub use dictionary::{Dictionary, DictionaryError, Factors, Matrix};
 pub use mask::{BandTile, KroneckerPhi, LensletSize, Mask, MaskFamily, SensingError};
 pub use pinv::{PinvOperator, solve_pinv};
+pub use projection::project_coefficients;
 pub use raw::{Frame, FrameSource, LeU16Frame, RawFormat, RawFrame};
 pub use shape::{FullViewShape, PaperShape, PatchShape};
 pub use sl0::{Ended, Outcome, Sl0Config, SolveError, solve, solve_warm};
@@ -103,5 +105,5 @@ pub use tile::{
     ConfigError, DecoderConfig, PatchFlags, PatchOrigin, PatchReport, PatchSink, SensorGeometry, Tile, TileDecoder,
     TileError, TileReport, TileSource,
 };
-pub use transform::{analyze, synthesize};
+pub use transform::{analyze, analyze_preserving, synthesize};
 pub use workspace::{Measurements, PaperWorkspace, Workspace};

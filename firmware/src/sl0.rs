@@ -24,6 +24,7 @@ use core::fmt;
 
 use crate::ascent::ascend;
 use crate::dictionary::Dictionary;
+use crate::projection::project_coefficients;
 use crate::transform::{analyze, synthesize};
 use crate::workspace::{Measurements, Workspace};
 
@@ -396,9 +397,7 @@ fn descend<const PS: usize, const PT: usize, const PU: usize, const PV: usize, c
 
     let outcome = run_schedule(cfg, sigma0, N, |inv| {
         let step2 = ascend(coeffs, cfg.mu, inv);
-        synthesize(dict, coeffs, signal);
-        let residual = project(signal, m, eps);
-        analyze(dict, signal, coeffs);
+        let residual = project_coefficients(dict, coeffs, signal, m, eps);
         // From a point that meets the measurements, the step d moves the patch by D d on
         // the unmeasured values only (the projection puts the measured ones back), and D
         // is orthonormal: |moved|^2 = |d|^2 - residual^2, with no extra pass. With a noise

@@ -13,25 +13,56 @@
 use crate::dictionary::{Dictionary, Factors, Matrix};
 use crate::shape::PatchShape;
 
-/// `dst = src x_mode M` for a mode of size `D` with `inner` values after it (`inner > 1`).
+/// Columns of one register block: one AVX2 register of f32.
+const LANES: usize = 8;
+
+/// The mode product of one block of `D` rows of `inner` values, `LANES` columns at a time
+/// with all `D` output rows in registers: each input vector is loaded once for its `D`
+/// multiply-adds and each output vector stored once (written as `D` axpys over whole rows,
+/// every multiply-add also loaded and stored its output). `dst = src x M`, or with `ADD`
+/// `dst += scale * (src x M)`; each output is the sum over `c` in order either way.
 #[inline(always)]
-fn mode_rows<const D: usize>(m: &Matrix<D>, src: &[f32], dst: &mut [f32], inner: usize) {
-    debug_assert_eq!(src.len(), dst.len());
-    debug_assert_eq!(src.len() % (D * inner), 0);
-    for (sb, db) in src.chunks_exact(D * inner).zip(dst.chunks_exact_mut(D * inner)) {
-        for (row, out) in m.iter().zip(db.chunks_exact_mut(inner)) {
-            let mut rows = sb.chunks_exact(inner).zip(row);
-            if let Some((x0, &w0)) = rows.next() {
-                for (o, &x) in out.iter_mut().zip(x0) {
-                    *o = w0 * x;
-                }
+fn block_rows<const D: usize, const ADD: bool>(w: &Matrix<D>, sb: &[f32], db: &mut [f32], inner: usize) {
+    let groups = inner / LANES;
+    let rows: [&[[f32; LANES]]; D] = core::array::from_fn(|c| sb[c * inner..(c + 1) * inner].as_chunks().0);
+    for g in 0..groups {
+        let mut acc = [[0.0f32; LANES]; D];
+        if ADD {
+            for (a, acc) in acc.iter_mut().enumerate() {
+                acc.copy_from_slice(&db[a * inner + g * LANES..a * inner + (g + 1) * LANES]);
             }
-            for (xs, &w) in rows {
-                for (o, &x) in out.iter_mut().zip(xs) {
-                    *o += w * x;
+        }
+        for (c, row) in rows.iter().enumerate() {
+            let x = &row[g];
+            for (acc, weights) in acc.iter_mut().zip(w) {
+                let wc = weights[c];
+                for (o, &x) in acc.iter_mut().zip(x) {
+                    *o += wc * x;
                 }
             }
         }
+        for (a, acc) in acc.iter().enumerate() {
+            db[a * inner + g * LANES..a * inner + (g + 1) * LANES].copy_from_slice(acc);
+        }
+    }
+    for i in groups * LANES..inner {
+        for (a, weights) in w.iter().enumerate() {
+            let mut o = if ADD { db[a * inner + i] } else { 0.0 };
+            for (c, &wc) in weights.iter().enumerate() {
+                o += wc * sb[c * inner + i];
+            }
+            db[a * inner + i] = o;
+        }
+    }
+}
+
+/// `dst = src x_mode M` for a mode of size `D` with `inner` values after it (`inner > 1`).
+#[inline(always)]
+pub(crate) fn mode_rows<const D: usize>(m: &Matrix<D>, src: &[f32], dst: &mut [f32], inner: usize) {
+    debug_assert_eq!(src.len(), dst.len());
+    debug_assert_eq!(src.len() % (D * inner), 0);
+    for (sb, db) in src.chunks_exact(D * inner).zip(dst.chunks_exact_mut(D * inner)) {
+        block_rows::<D, false>(m, sb, db, inner);
     }
 }
 
@@ -68,7 +99,7 @@ fn chain<const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     mode_rows(&m.m1, a, b, PT * PU * PV * B);
     mode_rows(&m.m2, b, a, PU * PV * B);
     mode_rows(&m.m3, a, b, PV * B);
-    mode_rows(&m.m4, b, a, B);
+    mode_pixel(&m.m4, b.as_chunks::<B>().0, a.as_chunks_mut::<B>().0);
     mode_last(mt5, a, b);
 }
 
@@ -97,23 +128,150 @@ pub fn analyze<const PS: usize, const PT: usize, const PU: usize, const PV: usiz
     chain(&dict.t, &dict.d.m5, signal, coeffs);
 }
 
-/// `buf = buf x_mode M` in place, one fibre at a time (for the general projection path).
-fn mode_in_place<const D: usize>(m: &Matrix<D>, buf: &mut [f32], inner: usize) {
+/// Columns the in-place mode product copies to the stack at a time.
+const STRIP: usize = 64;
+
+/// `buf = buf x_mode M` in place for a mode of size `D` with `inner` values after it
+/// (`inner > 1`). Each block's `D` rows are copied a strip of at most [`STRIP`] columns at
+/// a time to a `D x STRIP` stack array (3.3 KiB for `D = 13`), then written back as
+/// [`mode_rows`] writes them: the same sums in the same order, contiguous axpys the
+/// compiler vectorises. No second patch buffer.
+#[inline(always)]
+fn mode_rows_in_place<const D: usize>(m: &Matrix<D>, buf: &mut [f32], inner: usize) {
+    debug_assert_eq!(buf.len() % (D * inner), 0);
+    let mut strip = [[0.0f32; STRIP]; D];
     for block in buf.chunks_exact_mut(D * inner) {
-        for i in 0..inner {
-            let mut fibre = [0.0f32; D];
-            for (c, f) in fibre.iter_mut().enumerate() {
-                *f = block[c * inner + i];
+        for i0 in (0..inner).step_by(STRIP) {
+            let w = STRIP.min(inner - i0);
+            for (s, row) in strip.iter_mut().zip(block.chunks_exact(inner)) {
+                s[..w].copy_from_slice(&row[i0..i0 + w]);
             }
-            for (a, row) in m.iter().enumerate() {
-                block[a * inner + i] = row.iter().zip(&fibre).map(|(w, x)| w * x).sum();
+            for (weights, row) in m.iter().zip(block.chunks_exact_mut(inner)) {
+                let out = &mut row[i0..i0 + w];
+                let mut terms = strip.iter().zip(weights);
+                if let Some((x0, &w0)) = terms.next() {
+                    for (o, &x) in out.iter_mut().zip(&x0[..w]) {
+                        *o = w0 * x;
+                    }
+                }
+                for (xs, &wc) in terms {
+                    for (o, &x) in out.iter_mut().zip(&xs[..w]) {
+                        *o += wc * x;
+                    }
+                }
             }
         }
     }
 }
 
-/// `buf = buf x1 M1 .. x5 M5` in place with one fibre of scratch; slower than the
-/// ping-pong chain but needs no second buffer. Used by the paper's general path.
+/// `dst += scale * (src x_mode M)` for a mode of size `D` with `inner` values after it.
+#[inline(always)]
+pub(crate) fn mode_rows_add<const D: usize>(m: &Matrix<D>, scale: f32, src: &[f32], dst: &mut [f32], inner: usize) {
+    debug_assert_eq!(src.len(), dst.len());
+    debug_assert_eq!(src.len() % (D * inner), 0);
+    let w: Matrix<D> = core::array::from_fn(|a| core::array::from_fn(|c| scale * m[a][c]));
+    for (sb, db) in src.chunks_exact(D * inner).zip(dst.chunks_exact_mut(D * inner)) {
+        block_rows::<D, true>(&w, sb, db, inner);
+    }
+}
+
+/// `dst = src x_mode M` for the mode just before the band axis (`inner = B`): each output
+/// row of `B` values is summed in registers and stored once. (As [`mode_rows`] with
+/// `inner = 13` the sums went through memory in overlapping 8 + 4 + 1 lane pieces, and the
+/// stores stalled the loads after them.)
+#[inline(always)]
+pub(crate) fn mode_pixel<const D: usize, const B: usize>(m: &Matrix<D>, src: &[[f32; B]], dst: &mut [[f32; B]]) {
+    debug_assert_eq!(src.len(), dst.len());
+    for (sb, db) in src.chunks_exact(D).zip(dst.chunks_exact_mut(D)) {
+        let mut acc = [[0.0f32; B]; D];
+        for (c, x) in sb.iter().enumerate() {
+            for (acc, row) in acc.iter_mut().zip(m) {
+                let w = row[c];
+                for (a, &x) in acc.iter_mut().zip(x) {
+                    *a += w * x;
+                }
+            }
+        }
+        db.copy_from_slice(&acc);
+    }
+}
+
+/// One spatial slice of a patch (all of its values with the first index fixed): the
+/// stack scratch of the slice-wise transforms, `N / PS` values (4,160 bytes for the
+/// paper's patch).
+pub(crate) type Slice<const PT: usize, const PU: usize, const PV: usize, const B: usize> = [[[[f32; B]; PV]; PU]; PT];
+
+/// A zeroed [`Slice`].
+pub(crate) const fn slice<const PT: usize, const PU: usize, const PV: usize, const B: usize>() -> Slice<PT, PU, PV, B> {
+    [[[[0.0; B]; PV]; PU]; PT]
+}
+
+/// A [`Slice`] as its values in patch order.
+pub(crate) fn flat<const PT: usize, const PU: usize, const PV: usize, const B: usize>(
+    s: &mut Slice<PT, PU, PV, B>,
+) -> &mut [f32] {
+    s.as_flattened_mut().as_flattened_mut().as_flattened_mut()
+}
+
+/// `dst = src x1 M1 .. x5 M5` (with `mt5 = M5^T`) with `src` only read: the first mode
+/// goes from `src` to `dst`, the other four work one spatial slice at a time between
+/// `dst` and a [`Slice`] on the stack. Scores a solution in a member without a copy.
+#[inline(never)]
+fn apply_preserving<
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+    const N: usize,
+>(
+    m: &Factors<PS, PT, PU, PV, B>,
+    mt5: &Matrix<B>,
+    src: &[f32; N],
+    dst: &mut [f32; N],
+) {
+    const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
+    mode_rows(&m.m1, src, dst, PT * PU * PV * B);
+    let mut scratch = slice::<PT, PU, PV, B>();
+    for part in dst.chunks_exact_mut(PT * PU * PV * B) {
+        let tmp = flat(&mut scratch);
+        mode_rows(&m.m2, part, tmp, PU * PV * B);
+        mode_rows(&m.m3, tmp, part, PV * B);
+        mode_pixel(&m.m4, part.as_chunks::<B>().0, tmp.as_chunks_mut::<B>().0);
+        mode_last(mt5, tmp, part);
+    }
+}
+
+/// Analysis that keeps its input: `coeffs = signal x1 D1^T .. x5 D5^T`, `signal` only read
+/// (a [`Slice`] of stack scratch instead of a clobbered input; a little slower than
+/// [`analyze`]). Scores a solution in each member of an ensemble.
+pub fn analyze_preserving<
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+    const N: usize,
+>(
+    dict: &Dictionary<PS, PT, PU, PV, B>,
+    signal: &[f32; N],
+    coeffs: &mut [f32; N],
+) {
+    apply_preserving(&dict.t, &dict.d.m5, signal, coeffs);
+}
+
+/// `buf = buf x5 M` in place for the last (band) mode, one fibre at a time.
+fn mode_last_in_place<const D: usize>(m: &Matrix<D>, buf: &mut [f32]) {
+    for fibre in buf.as_chunks_mut::<D>().0 {
+        let x = *fibre;
+        for (y, row) in fibre.iter_mut().zip(m) {
+            *y = row.iter().zip(&x).map(|(w, x)| w * x).sum();
+        }
+    }
+}
+
+/// `buf = buf x1 M1 .. x5 M5` in place, with a strip of stack scratch and no second patch
+/// buffer. Used to score a solution in a member and by the paper's general path.
 pub(crate) fn apply_in_place<
     const PS: usize,
     const PT: usize,
@@ -126,9 +284,9 @@ pub(crate) fn apply_in_place<
     buf: &mut [f32; N],
 ) {
     const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
-    mode_in_place(&m.m1, buf, PT * PU * PV * B);
-    mode_in_place(&m.m2, buf, PU * PV * B);
-    mode_in_place(&m.m3, buf, PV * B);
-    mode_in_place(&m.m4, buf, B);
-    mode_in_place(&m.m5, buf, 1);
+    mode_rows_in_place(&m.m1, buf, PT * PU * PV * B);
+    mode_rows_in_place(&m.m2, buf, PU * PV * B);
+    mode_rows_in_place(&m.m3, buf, PV * B);
+    mode_rows_in_place(&m.m4, buf, B);
+    mode_last_in_place(&m.m5, buf);
 }

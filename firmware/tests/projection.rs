@@ -1,0 +1,110 @@
+//! The measured-entries projection and the input-keeping analysis against dense f64
+//! references: `S + K^T P^T (I - P K S)` with `K` the dense Kronecker matrix.
+
+mod common;
+
+use common::*;
+use rand::Rng;
+use slf_firmware::{Dictionary, Measurements, analyze_preserving, project_coefficients};
+
+/// Measures `per_pixel` random bands of each pixel (none for every seventh pixel) with
+/// random values; returns the measurements and the measured indices.
+fn random_measurements<const B: usize, const N: usize>(seed: u64, per_pixel: usize) -> (Measurements<N>, Vec<usize>) {
+    let mut r = rng(seed);
+    let mut m = Measurements::new();
+    let mut idx = Vec::new();
+    for p in 0..N / B {
+        if p % 7 == 3 {
+            continue;
+        }
+        let mut bands: Vec<usize> = (0..B).collect();
+        for _ in 0..per_pixel {
+            let b = bands.swap_remove(r.random_range(0..bands.len()));
+            m.set(p * B + b, r.random_range(0.0f32..1.0)).unwrap();
+            idx.push(p * B + b);
+        }
+    }
+    (m, idx)
+}
+
+/// The projection in f64 with dense matrices: returns the projected coefficients and the
+/// residual norm before the move.
+fn dense_projection(k: &[f64], n: usize, s: &[f32], m_idx: &[usize], y: &[f32], eps: f64) -> (Vec<f64>, f64) {
+    let x = dense_apply(k, n, s);
+    let mut r = vec![0.0f64; n];
+    for &i in m_idx {
+        r[i] = f64::from(y[i]) - x[i];
+    }
+    let norm = r.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let scale = if eps == 0.0 {
+        1.0
+    } else if norm > eps {
+        1.0 - eps / norm
+    } else {
+        0.0
+    };
+    // K^T r: column i of K is row i of K^T.
+    let out = (0..n).map(|c| f64::from(s[c]) + scale * (0..n).map(|i| k[i * n + c] * r[i]).sum::<f64>()).collect();
+    (out, norm)
+}
+
+fn check<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>() {
+    for (dseed, dict) in [(0u64, Dictionary::<PS, PT, PU, PV, B>::dct()), (5, random_dictionary(5))] {
+        let (k, n) = dense_kronecker(dict.synthesis());
+        for (case, per_pixel) in [1usize, 3, B].into_iter().enumerate() {
+            let (m, idx) = random_measurements::<B, N>(10 * dseed + case as u64, per_pixel);
+            let y: Vec<f32> = (0..N).map(|i| m.get(i).unwrap_or(0.0)).collect();
+            let mut r = rng(99 + case as u64);
+            let s: Vec<f32> = (0..N).map(|_| r.random_range(-1.0f32..1.0)).collect();
+            let (_, norm0) = dense_projection(&k, n, &s, &idx, &y, 0.0);
+            // Exact, a ball the point lies outside of, and one it lies inside.
+            for eps in [0.0, 0.5 * norm0, 2.0 * norm0] {
+                let mut coeffs: Box<[f32; N]> = Box::new(s.clone().try_into().unwrap());
+                let mut scratch = Box::new([0.0f32; N]);
+                let residual = project_coefficients(&dict, &mut coeffs, &mut scratch, &m, eps as f32);
+                let (reference, norm) = dense_projection(&k, n, &s, &idx, &y, eps);
+                let e = rel_err(&coeffs[..], &reference);
+                assert!(e <= 2e-6, "dict {dseed}, {per_pixel} per pixel, eps {eps}: rel err {e}");
+                assert!((f64::from(residual) - norm).abs() <= 1e-5 * norm, "residual {residual} vs {norm}");
+                if eps > norm {
+                    assert_eq!(&coeffs[..], &s[..], "inside the ball nothing moves");
+                }
+                // Exactly projected coefficients synthesise to the measurements.
+                if eps == 0.0 {
+                    let x = dense_apply(&k, n, &coeffs[..]);
+                    let worst = idx.iter().map(|&i| (x[i] - f64::from(y[i])).abs()).fold(0.0, f64::max);
+                    assert!(worst <= 1e-5, "off the measurements by {worst}");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn paper_patch_projection_matches_dense_reference() {
+    check::<5, 5, 4, 4, 13, 5200>();
+}
+
+#[test]
+fn odd_patch_projection_matches_dense_reference() {
+    // Modes of 3 and 7 exercise the transforms' partial register blocks.
+    check::<3, 2, 7, 3, 5, 630>();
+}
+
+#[test]
+fn analysis_keeping_its_input_matches_dense_reference() {
+    fn case<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>() {
+        let dict = random_dictionary::<PS, PT, PU, PV, B>(8);
+        let (kt, n) = dense_kronecker(dict.analysis());
+        let mut r = rng(9);
+        let x: Vec<f32> = (0..N).map(|_| r.random_range(-1.0f32..1.0)).collect();
+        let signal: Box<[f32; N]> = Box::new(x.clone().try_into().unwrap());
+        let mut coeffs = Box::new([0.0f32; N]);
+        analyze_preserving(&dict, &signal, &mut coeffs);
+        assert_eq!(&signal[..], &x[..], "input kept");
+        let e = rel_err(&coeffs[..], &dense_apply(&kt, n, &x));
+        assert!(e <= 1e-5, "rel err {e}");
+    }
+    case::<5, 5, 4, 4, 13, 5200>();
+    case::<3, 2, 7, 3, 5, 630>();
+}
