@@ -7,8 +7,9 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use slf_firmware::{
     ChoiceRule, DEFAULT_ENSEMBLE, Dictionary, Ensemble, EnsembleModel, LensletSize, Mask, MemberChoice, PaperShape,
-    PaperWorkspace, PatchModel, Sl0Config, analyze, solve, synthesize,
+    PaperWorkspace, PatchModel, Sl0Config, analyze, analyze_preserving, project_coefficients, solve, synthesize,
 };
+use slf_firmware::{ascent::ascend, projection::projection_macs};
 use std::hint::black_box;
 
 const L5: LensletSize = LensletSize { rows: 5, cols: 5 };
@@ -51,8 +52,23 @@ fn benches(c: &mut Criterion) {
         let mask = Mask::pixel(1, k, 13, L5).unwrap();
         let mut ws = measured_workspace(&mask);
         let out = solve(&dict, &cfg, &mut ws).unwrap();
-        // Per step: synthesis + analysis; plus the start's analysis and the final synthesis.
-        let solve_macs = (2 * out.iterations as usize + 2) as f64 * macs;
+        // Per step: one projection; plus the start's analysis and the final synthesis.
+        let count = ws.measurements().count();
+        let step_macs = projection_macs::<5, 5, 4, 4, 13>(count);
+        let solve_macs = (out.iterations as usize * step_macs) as f64 + 2.0 * macs;
+        eprintln!("projection pixel k={k}: {step_macs} multiply-adds ({count} measurements)");
+        let mut coeffs = Box::new([0.0f32; 5200]);
+        let mut scratch = Box::new([0.0f32; 5200]);
+        analyze_preserving(&dict, ws.patch(), &mut coeffs);
+        c.bench_function(&format!("project pixel k={k}"), |bench| {
+            bench.iter(|| project_coefficients(&dict, black_box(&mut coeffs), &mut scratch, ws.measurements(), 0.0))
+        });
+        if k == 1 {
+            // The step is branch-free on the host: its time does not depend on sigma.
+            c.bench_function("ascend 5200", |bench| {
+                bench.iter(|| ascend(black_box(&mut coeffs[..]), cfg.mu, black_box(1.0 / (2.0 * 0.05 * 0.05))))
+            });
+        }
         eprintln!(
             "solve pixel k={k}: {} steps, {} levels, {solve_macs:.3e} multiply-adds in transforms",
             out.iterations, out.levels

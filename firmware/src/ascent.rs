@@ -60,27 +60,25 @@ pub fn exp_neg(x: f32) -> f32 {
 #[inline]
 pub fn ascend(coeffs: &mut [f32], mu: f32, inv: f32) -> f32 {
     let skip = 88.0 + libm::logf(mu.max(1.0));
-    // Blocks of 64: the steps go to a small stack array in one plain loop (which the
-    // compiler vectorises), then eight running sums of their squares, one per lane. One
-    // running sum in the step loop would be a serial chain the compiler may not reorder
-    // (f32 addition is not associative), and it kept the whole step scalar.
+    // Eight lanes at a time, with eight running sums of the squared steps, one per lane:
+    // one running sum would be a serial chain the compiler may not reorder (f32 addition
+    // is not associative), and it kept the whole step scalar.
     let mut sums = [0.0f32; 8];
-    let mut d = [0.0f32; 64];
-    for block in coeffs.chunks_mut(64) {
-        let d = &mut d[..block.len()];
-        for (d, s) in d.iter_mut().zip(block.iter_mut()) {
+    let (lanes, tail) = coeffs.as_chunks_mut::<8>();
+    for lane in lanes {
+        for (s, sum) in lane.iter_mut().zip(sums.iter_mut()) {
             let x = *s * *s * inv;
             let e = exp_neg(x.min(X_MAX));
-            *d = if x <= skip { mu * *s * e } else { 0.0 };
-            *s -= *d;
+            let d = if x <= skip { mu * *s * e } else { 0.0 };
+            *s -= d;
+            *sum += d * d;
         }
-        let (lanes, tail) = d.as_chunks::<8>();
-        for lane in lanes {
-            for (sum, d) in sums.iter_mut().zip(lane) {
-                *sum += d * d;
-            }
-        }
-        sums[0] += tail.iter().map(|d| d * d).sum::<f32>();
+    }
+    for s in tail {
+        let x = *s * *s * inv;
+        let d = if x <= skip { mu * *s * exp_neg(x.min(X_MAX)) } else { 0.0 };
+        *s -= d;
+        sums[0] += d * d;
     }
     sums.iter().sum()
 }
