@@ -23,17 +23,34 @@ const LANES: usize = 8;
 /// `dst += scale * (src x M)`; each output is the sum over `c` in order either way.
 #[inline(always)]
 fn block_rows<const D: usize, const ADD: bool>(w: &Matrix<D>, sb: &[f32], db: &mut [f32], inner: usize) {
-    let groups = inner / LANES;
-    let rows: [&[[f32; LANES]]; D] = core::array::from_fn(|c| sb[c * inner..(c + 1) * inner].as_chunks().0);
-    for g in 0..groups {
-        let mut acc = [[0.0f32; LANES]; D];
+    let full = inner / LANES * LANES;
+    block_columns::<D, ADD, LANES>(w, sb, db, inner, 0, full);
+    // The rest of a row (e.g. 4 of `inner = 52`) a half register, then one at a time.
+    let half = full + (inner - full) / (LANES / 2) * (LANES / 2);
+    block_columns::<D, ADD, { LANES / 2 }>(w, sb, db, inner, full, half);
+    block_columns::<D, ADD, 1>(w, sb, db, inner, half, inner);
+}
+
+/// [`block_rows`] on columns `from..to` of the block, `L` at a time (`to - from` a
+/// multiple of `L`).
+#[inline(always)]
+fn block_columns<const D: usize, const ADD: bool, const L: usize>(
+    w: &Matrix<D>,
+    sb: &[f32],
+    db: &mut [f32],
+    inner: usize,
+    from: usize,
+    to: usize,
+) {
+    for i in (from..to).step_by(L) {
+        let mut acc = [[0.0f32; L]; D];
         if ADD {
             for (a, acc) in acc.iter_mut().enumerate() {
-                acc.copy_from_slice(&db[a * inner + g * LANES..a * inner + (g + 1) * LANES]);
+                acc.copy_from_slice(&db[a * inner + i..a * inner + i + L]);
             }
         }
-        for (c, row) in rows.iter().enumerate() {
-            let x = &row[g];
+        for c in 0..D {
+            let x: &[f32] = &sb[c * inner + i..c * inner + i + L];
             for (acc, weights) in acc.iter_mut().zip(w) {
                 let wc = weights[c];
                 for (o, &x) in acc.iter_mut().zip(x) {
@@ -42,16 +59,7 @@ fn block_rows<const D: usize, const ADD: bool>(w: &Matrix<D>, sb: &[f32], db: &m
             }
         }
         for (a, acc) in acc.iter().enumerate() {
-            db[a * inner + g * LANES..a * inner + (g + 1) * LANES].copy_from_slice(acc);
-        }
-    }
-    for i in groups * LANES..inner {
-        for (a, weights) in w.iter().enumerate() {
-            let mut o = if ADD { db[a * inner + i] } else { 0.0 };
-            for (c, &wc) in weights.iter().enumerate() {
-                o += wc * sb[c * inner + i];
-            }
-            db[a * inner + i] = o;
+            db[a * inner + i..a * inner + i + L].copy_from_slice(acc);
         }
     }
 }
