@@ -20,7 +20,7 @@
 //!
 //! The first mode goes from the coefficients to the signal buffer and back; the other
 //! modes and the band step work one spatial slice at a time between the signal buffer and
-//! a [`Slice`] on the stack (4 KiB), so the workspace does not grow and the slice stays
+//! a `Slice` on the stack (4 KiB), so the workspace does not grow and the slice stays
 //! in the L1 cache from the synthesis to the analysis.
 
 use crate::dictionary::Dictionary;

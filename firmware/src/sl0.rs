@@ -7,10 +7,12 @@
 //!
 //! **Fast path.** With an orthonormal dictionary and one-hot (selection) measurements the
 //! projection `S - A^+(A S - I)` is exactly: synthesise `X`, overwrite the measured entries
-//! of `X` with the measurements, analyse back. The start, the minimum-norm solution
-//! `A^+ I`, is the analysis of the measurements with zeros elsewhere. This holds for every
-//! mask family; the paper's general pseudo-inverse form is in [`crate::pinv`], and a test
-//! shows the two agree on kronecker masks.
+//! of `X` with the measurements, analyse back; [`crate::projection`] computes the same in
+//! coefficient space, `S + D^T P^T (I - P D S)`, with the band mode only where a band is
+//! measured (197,600 instead of 322,400 multiply-adds a step at one measurement per pixel).
+//! The start, the minimum-norm solution `A^+ I`, is the analysis of the measurements with
+//! zeros elsewhere. This holds for every mask family; the paper's general pseudo-inverse
+//! form is in [`crate::pinv`], and a test shows the two agree on kronecker masks.
 //!
 //! **Noise-aware mode.** With a noise level `noise > 0` (standard deviation per
 //! measurement, normalised units) the projection is onto the ball `||A S - I|| <= eps`,
