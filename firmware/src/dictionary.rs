@@ -13,6 +13,7 @@
 use core::fmt;
 
 use crate::dct::dct_matrix;
+use crate::transform::Fold;
 
 /// A `D x D` matrix, row-major.
 pub type Matrix<const D: usize> = [[f32; D]; D];
@@ -149,6 +150,20 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
     }
 }
 
+/// How far from even / odd a row may be for the transforms to use the symmetry: the
+/// symmetric half of the row is what they read, so this bounds what they change.
+pub const PARITY_TOLERANCE: f32 = 1e-6;
+
+/// Whether every row `a` of `m` is even (`a` even) or odd about its middle to
+/// [`PARITY_TOLERANCE`]: `m[a][D-1-c] = (-1)^a m[a][c]`, and so the middle entry of an odd
+/// row of odd length is 0.
+pub fn has_parity<const D: usize>(m: &Matrix<D>) -> bool {
+    m.iter().enumerate().all(|(a, row)| {
+        let sign = if a % 2 == 0 { 1.0 } else { -1.0 };
+        (0..D).all(|c| (row[D - 1 - c] - sign * row[c]).abs() <= PARITY_TOLERANCE)
+    })
+}
+
 /// The transpose of a square matrix.
 pub const fn transpose<const D: usize>(m: &Matrix<D>) -> Matrix<D> {
     let mut t = [[0.0f32; D]; D];
@@ -187,6 +202,9 @@ pub struct Dictionary<const PS: usize, const PT: usize, const PU: usize, const P
     pub(crate) d: Factors<PS, PT, PU, PV, B>,
     /// `D_i^T`: analysis matrices.
     pub(crate) t: Factors<PS, PT, PU, PV, B>,
+    /// Per mode 1..=4, whether `D_i^T`'s rows are even or odd about their middle (the
+    /// DCT-II's symmetry), which the transforms use to halve their multiplies.
+    pub(crate) parity: [bool; 4],
 }
 
 impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> Dictionary<PS, PT, PU, PV, B> {
@@ -200,7 +218,7 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
             m4: dct_matrix::<PV>(),
             m5: dct_matrix::<B>(),
         };
-        Self { d: c.transposed(), t: c }
+        Self { d: c.transposed(), t: c, parity: [true; 4] }
     }
 
     /// A dictionary from its synthesis matrices `D_1..D_5`.
@@ -214,7 +232,25 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
 
     pub(crate) fn from_validated(d: Factors<PS, PT, PU, PV, B>) -> Self {
         let t = d.transposed();
-        Self { d, t }
+        let parity = [has_parity(&t.m1), has_parity(&t.m2), has_parity(&t.m3), has_parity(&t.m4)];
+        Self { d, t, parity }
+    }
+
+    /// How synthesis folds each of modes 1..=4 (see [`crate::transform`]).
+    pub(crate) fn synthesis_folds(&self) -> [Fold; 4] {
+        self.parity.map(|p| if p { Fold::Columns } else { Fold::Plain })
+    }
+
+    /// How analysis folds each of modes 1..=4.
+    pub(crate) fn analysis_folds(&self) -> [Fold; 4] {
+        self.parity.map(|p| if p { Fold::Rows } else { Fold::Plain })
+    }
+
+    /// Per mode 1..=4, whether the analysis matrix's rows are even or odd about their middle
+    /// (`M[a][D-1-c] = (-1)^a M[a][c]` to [`PARITY_TOLERANCE`]), as the DCT-II's are; the
+    /// transforms then use the symmetry and do about half the multiplies.
+    pub fn parity(&self) -> [bool; 4] {
+        self.parity
     }
 
     /// The synthesis matrices `D_1..D_5`.

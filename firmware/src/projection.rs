@@ -57,20 +57,21 @@ pub fn project_coefficients<
 ) -> f32 {
     const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
     let (d, t) = (&dict.d, &dict.t);
+    let (fd, ft) = (dict.synthesis_folds(), dict.analysis_folds());
     let part_len = PT * PU * PV * B;
-    mode_rows(&d.m1, coeffs, scratch, part_len);
+    mode_rows(&d.m1, fd[0], coeffs, scratch, part_len);
     let mut r2 = 0.0f32;
     let mut tmp: Slice<PT, PU, PV, B> = slice();
     let parts = scratch.chunks_exact_mut(part_len).zip(m.values.chunks_exact(part_len));
     for ((part, values), measured) in parts.zip(m.measured.chunks_exact(part_len)) {
         let tmp = flat(&mut tmp);
-        mode_rows(&d.m2, part, tmp, PU * PV * B);
-        mode_rows(&d.m3, tmp, part, PV * B);
-        mode_pixel(&d.m4, part.as_chunks::<B>().0, tmp.as_chunks_mut::<B>().0);
+        mode_rows(&d.m2, fd[1], part, tmp, PU * PV * B);
+        mode_rows(&d.m3, fd[2], tmp, part, PV * B);
+        mode_pixel(&d.m4, fd[3], part.as_chunks::<B>().0, tmp.as_chunks_mut::<B>().0);
         r2 += band_step(&d.m5, tmp.as_chunks_mut::<B>().0, values, measured);
-        mode_pixel(&t.m4, tmp.as_chunks::<B>().0, part.as_chunks_mut::<B>().0);
-        mode_rows(&t.m3, part, tmp, PV * B);
-        mode_rows(&t.m2, tmp, part, PU * PV * B);
+        mode_pixel(&t.m4, ft[3], tmp.as_chunks::<B>().0, part.as_chunks_mut::<B>().0);
+        mode_rows(&t.m3, ft[2], part, tmp, PV * B);
+        mode_rows(&t.m2, ft[1], tmp, part, PU * PV * B);
     }
     let norm = libm::sqrtf(r2);
     let scale = if eps == 0.0 {
@@ -80,7 +81,7 @@ pub fn project_coefficients<
     } else {
         return norm; // inside the ball: no move
     };
-    mode_rows_add(&t.m1, scale, scratch, coeffs, part_len);
+    mode_rows_add(&t.m1, ft[0], scale, scratch, coeffs, part_len);
     norm
 }
 

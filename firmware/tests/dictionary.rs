@@ -185,3 +185,37 @@ fn factors_report_the_mode_that_is_wrong() {
     assert_eq!(f.first_non_finite(), None);
     assert!(f.orthonormality_errors().iter().all(|&e| e <= 1e-6));
 }
+
+#[test]
+fn the_dct_symmetry_is_found_where_it_holds_and_used_correctly() {
+    use slf_firmware::dictionary::{has_parity, transpose};
+    use slf_firmware::{analyze, synthesize};
+    // The DCT-II's rows are even / odd about their middle, so its transforms fold.
+    assert_eq!(Dict::dct().parity(), [true; 4]);
+    assert!(has_parity(&dct_matrix::<13>()) && has_parity(&dct_matrix::<7>()) && has_parity(&dct_matrix::<1>()));
+    // Built from its matrices (as a blob member is), the DCT is found symmetric again.
+    assert_eq!(Dict::new(Dict::dct().synthesis().clone()).unwrap().parity(), [true; 4]);
+    assert_eq!(random_dictionary::<5, 5, 4, 4, 13>(3).parity(), [false; 4]);
+    // Two atoms swapped: still orthonormal, no longer even / odd in order.
+    let mut f = Dict::dct().synthesis().clone();
+    let t = transpose(&f.m2);
+    f.m2 = transpose(&[t[0], t[2], t[1], t[3], t[4]]);
+    assert_eq!(Dict::new(f).unwrap().parity(), [true, false, true, true]);
+    // A random dictionary with the DCT in mode 3 only folds mode 3, and its transforms still
+    // match the dense Kronecker matrix (f64) to 1e-5.
+    let mut f = random_dictionary::<5, 5, 4, 4, 13>(4).synthesis().clone();
+    f.m3 = transpose(&dct_matrix::<4>());
+    let mixed = Dict::new(f).unwrap();
+    assert_eq!(mixed.parity(), [false, false, true, false]);
+    let (k, n) = dense_kronecker(mixed.synthesis());
+    let (kt, _) = dense_kronecker(mixed.analysis());
+    let mut r = rng(5);
+    let s: Vec<f32> = (0..n).map(|_| rand::Rng::random_range(&mut r, -1.0f32..1.0)).collect();
+    let (mut a, mut x) = (Box::new([0.0f32; 5200]), Box::new([0.0f32; 5200]));
+    a.copy_from_slice(&s);
+    synthesize(&mixed, &mut a, &mut x);
+    assert!(rel_err(&x[..], &dense_apply(&k, n, &s)) <= 1e-5);
+    a.copy_from_slice(&s);
+    analyze(&mixed, &mut a, &mut x);
+    assert!(rel_err(&x[..], &dense_apply(&kt, n, &s)) <= 1e-5);
+}
