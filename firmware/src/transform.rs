@@ -164,13 +164,25 @@ fn block_columns<const D: usize, const ADD: bool, const FOLD: u8, const L: usize
 /// `dst = src x_mode M` for a mode of size `D` with `inner` values after it (`inner > 1`).
 #[inline(always)]
 pub(crate) fn mode_rows<const D: usize>(m: &Matrix<D>, fold: Fold, src: &[f32], dst: &mut [f32], inner: usize) {
+    mode_product::<D, false>(m, fold, src, dst, inner);
+}
+
+/// [`mode_rows`], or with `ADD` `dst += src x_mode w`.
+#[inline(always)]
+fn mode_product<const D: usize, const ADD: bool>(
+    w: &Matrix<D>,
+    fold: Fold,
+    src: &[f32],
+    dst: &mut [f32],
+    inner: usize,
+) {
     debug_assert_eq!(src.len(), dst.len());
     debug_assert_eq!(src.len() % (D * inner), 0);
     let blocks = src.chunks_exact(D * inner).zip(dst.chunks_exact_mut(D * inner));
     match fold {
-        Fold::Plain => blocks.for_each(|(sb, db)| block_rows::<D, false, PLAIN>(m, sb, db, inner)),
-        Fold::Rows => blocks.for_each(|(sb, db)| block_rows::<D, false, ROWS>(m, sb, db, inner)),
-        Fold::Columns => blocks.for_each(|(sb, db)| block_rows::<D, false, COLUMNS>(m, sb, db, inner)),
+        Fold::Plain => blocks.for_each(|(sb, db)| block_rows::<D, ADD, PLAIN>(w, sb, db, inner)),
+        Fold::Rows => blocks.for_each(|(sb, db)| block_rows::<D, ADD, ROWS>(w, sb, db, inner)),
+        Fold::Columns => blocks.for_each(|(sb, db)| block_rows::<D, ADD, COLUMNS>(w, sb, db, inner)),
     }
 }
 
@@ -283,15 +295,8 @@ pub(crate) fn mode_rows_add<const D: usize>(
     dst: &mut [f32],
     inner: usize,
 ) {
-    debug_assert_eq!(src.len(), dst.len());
-    debug_assert_eq!(src.len() % (D * inner), 0);
     let w: Matrix<D> = core::array::from_fn(|a| core::array::from_fn(|c| scale * m[a][c]));
-    let blocks = src.chunks_exact(D * inner).zip(dst.chunks_exact_mut(D * inner));
-    match fold {
-        Fold::Plain => blocks.for_each(|(sb, db)| block_rows::<D, true, PLAIN>(&w, sb, db, inner)),
-        Fold::Rows => blocks.for_each(|(sb, db)| block_rows::<D, true, ROWS>(&w, sb, db, inner)),
-        Fold::Columns => blocks.for_each(|(sb, db)| block_rows::<D, true, COLUMNS>(&w, sb, db, inner)),
-    }
+    mode_product::<D, true>(&w, fold, src, dst, inner);
 }
 
 /// `dst = src x_mode M` for the mode just before the band axis (`inner = B`): each block's
