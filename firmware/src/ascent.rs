@@ -4,62 +4,87 @@
 //! Profiling a solve (`perf record` on `cargo bench --bench solve`) showed the step with
 //! `libm::expf` at about 60 % of a screened-ensemble decode, more than the transforms:
 //! `expf` is a correctly rounded scalar routine with a branch and a division, so the loop
-//! over 5,200 coefficients runs one value at a time. The step here computes `exp(-x)` with
-//! no branch and no table: Cody-Waite range reduction `-x = n ln 2 + r`, `|r| <= ln 2 / 2`,
-//! Cephes' degree-5 minimax polynomial for `exp(r)` (as in Cephes `expf`, 1.2e-7 relative
-//! on that range), and `2^n` put straight into the exponent bits. Every operation is a
-//! plain f32 add, multiply, round or select, so the compiler vectorises the loop (8 lanes
-//! with AVX2), and on a Cortex-M4F it avoids `expf`'s 14-cycle `VDIV`.
+//! over 5,200 coefficients runs one value at a time. The step here computes the weight
+//! `exp(-s^2 / (2 sigma^2))` as `2^t` with `t = s^2 c`, `c = -log2(e) / (2 sigma^2)`
+//! computed once per step: `t = n + f` with `n` the nearest integer and `|f| <= 1/2`, a
+//! degree-5 minimax polynomial for `2^f` (2.2e-7 relative on that range, evaluated in
+//! Estrin's order so its multiplies overlap), and `2^n` put straight into the exponent
+//! bits. No branch, no table, no division, and no base-e range reduction: `t` carries the
+//! same rounding as `x = s^2 / (2 sigma^2)` in the base-e form, so the weight is as
+//! accurate either way, with 7 fewer operations per coefficient (27 instead of 34; the
+//! step `mu` is folded into the polynomial's coefficients). Every operation is a plain f32
+//! add, multiply, round or select, so the compiler vectorises the loop (8 lanes with
+//! AVX2), and on a Cortex-M4F it avoids `expf`'s 14-cycle `VDIV`.
 //!
-//! Accuracy (tests/ascent.rs, against f64 `exp` on a dense grid): at most 2.5e-7 relative
-//! over the whole range used, the same order as `libm::expf`. The decoded patch moves by
-//! rounding only: `slf bench` gave the same PSNR to 0.01 dB before and after (DCT, pixel
-//! k = 3: 30.73 dB), and the f32 decoder stays within 0.01 dB of the f64 reference.
+//! Accuracy (tests/ascent.rs): [`exp2`] within 2.5e-7 relative of f64 over its whole
+//! range; the step within 3e-7 of the `libm::expf` step's size.
 
-/// `exp(-x)` is used for `x` up to here; beyond it `mu * exp(-x)` is below `2^-25` for any
-/// `mu < 1.7e27`, so the step leaves `s` unchanged after rounding either way, and the
-/// clamp keeps `2^n` a normal number (subnormals are slow on some cores).
-const X_MAX: f32 = 80.0;
+/// `t` is clamped here: `2^-115` is a normal f32, and beyond it `mu * 2^t` is below
+/// `2^-25` for any `mu < 1e27`, so the step would leave `s` unchanged after rounding (the
+/// select in [`ascend`] makes that exact for any `mu`).
+const T_MIN: f32 = -115.0;
 /// `1.5 * 2^23`: adding and subtracting it rounds an f32 of magnitude below `2^22` to
 /// the nearest integer (ties to even).
 const ROUND: f32 = 12_582_912.0;
 const LOG2_E: f32 = core::f32::consts::LOG2_E;
-/// `ln 2` split so that `n * LN2_HI` is exact for `|n| < 2^11` (Cody and Waite).
-const LN2_HI: f32 = 0.693_359_4;
-const LN2_LO: f32 = -2.121_944_4e-4;
-/// Cephes `expf`: `exp(r) = 1 + r + r^2 P(r)` on `|r| <= ln 2 / 2`.
-const P: [f32; 6] = [1.987_569_1e-4, 1.398_199_9e-3, 8.333_452e-3, 4.166_579_6e-2, 0.166_666_65, 0.5];
+/// `2^f = 1 + Q[0] f + .. + Q[4] f^5` on `|f| <= 1/2`, minimax in relative error
+/// (9.2e-8 in exact arithmetic, 2.2e-7 evaluated in f32).
+/// (`Q[0]` is near `ln 2` but not it: the minimax fit trades its last digits for the
+/// error at the ends of the range.)
+#[allow(clippy::approx_constant)]
+const Q: [f32; 5] = [0.693_147, 0.240_222_42, 0.055_507_336, 0.009_671_506, 0.001_326_470_6];
 
-/// `exp(-x)` for `0 <= x <= 80` (callers clamp), branch-free; relative error below 2.5e-7.
+/// `k[0] + k[1] f + .. + k[5] f^5` in Estrin's order.
 #[inline(always)]
-pub fn exp_neg(x: f32) -> f32 {
-    let t = -x;
-    let shifted = t * LOG2_E + ROUND;
+fn poly(k: &[f32; 6], f: f32) -> f32 {
+    let f2 = f * f;
+    (k[0] + k[1] * f) + f2 * ((k[2] + k[3] * f) + f2 * (k[4] + k[5] * f))
+}
+
+/// `scale * 2^t` for `T_MIN <= t <= 0` (callers clamp), given `k = scale * [1, Q..]`.
+#[inline(always)]
+fn scaled_exp2(k: &[f32; 6], t: f32) -> f32 {
+    let shifted = t + ROUND;
     let n = shifted - ROUND;
-    let r = (t - n * LN2_HI) - n * LN2_LO;
-    let p = ((((P[0] * r + P[1]) * r + P[2]) * r + P[3]) * r + P[4]) * r + P[5];
-    let e = p * (r * r) + r + 1.0;
-    // n is an integer in [-116, 0], held in the low bits of `shifted` (its ulp is 1), so
+    let f = t - n;
+    // n is an integer in [-115, 0], held in the low bits of `shifted` (its ulp is 1), so
     // it is read off as an integer without a float-to-int conversion (which the compiler
     // does not vectorise: it saturates lane by lane). 2^n is the normal f32 with biased
     // exponent n + 127.
     let n_int = shifted.to_bits().wrapping_sub(ROUND.to_bits()).wrapping_add(127);
-    let two_n = f32::from_bits(n_int << 23);
-    e * two_n
+    poly(k, f) * f32::from_bits(n_int << 23)
+}
+
+/// The polynomial's coefficients times `scale`.
+fn scaled(scale: f32) -> [f32; 6] {
+    [scale, scale * Q[0], scale * Q[1], scale * Q[2], scale * Q[3], scale * Q[4]]
+}
+
+/// `2^t` for `-115 <= t <= 0` (clamped into that range otherwise), branch-free; relative
+/// error below 2.5e-7.
+pub fn exp2(t: f32) -> f32 {
+    scaled_exp2(&scaled(1.0), t.clamp(T_MIN, 0.0))
+}
+
+/// The exponent `t = s^2 c` of the step's weight `2^t`, and the `t` below which the step
+/// rounds away: `mu * exp(-x) < 2^-125` for `x > 88 + ln(max(mu, 1))`.
+fn exponents(mu: f32, inv: f32) -> (f32, f32) {
+    (-inv * LOG2_E, -(88.0 + libm::logf(mu.max(1.0))) * LOG2_E)
 }
 
 /// The ascent step on every coefficient, `inv = 1 / (2 sigma^2)`.
 ///
 /// Where `x = s^2 inv` exceeds `88 + ln(max(mu, 1))`, `mu * exp(-x) < 2^-125` and the step
-/// rounds away (`s` is unchanged); a select keeps that exact for any `mu`, and the clamp
-/// at 80 keeps `exp_neg` in range without a branch.
+/// rounds away (`s` is unchanged); a select keeps that exact for any `mu`, and a clamp
+/// keeps the weight's exponent in range without a branch.
 ///
 /// Returns the squared length of the step, `sum (mu s exp(-x))^2`: the solver's measure of
 /// how far the patch moved (see [`crate::sl0`]'s early stop).
 #[cfg(not(target_arch = "arm"))]
 #[inline]
 pub fn ascend(coeffs: &mut [f32], mu: f32, inv: f32) -> f32 {
-    let skip = 88.0 + libm::logf(mu.max(1.0));
+    let (c, skip) = exponents(mu, inv);
+    let k = scaled(mu);
     // Eight lanes at a time, with eight running sums of the squared steps, one per lane:
     // one running sum would be a serial chain the compiler may not reorder (f32 addition
     // is not associative), and it kept the whole step scalar.
@@ -67,20 +92,27 @@ pub fn ascend(coeffs: &mut [f32], mu: f32, inv: f32) -> f32 {
     let (lanes, tail) = coeffs.as_chunks_mut::<8>();
     for lane in lanes {
         for (s, sum) in lane.iter_mut().zip(sums.iter_mut()) {
-            let x = *s * *s * inv;
-            let e = exp_neg(x.min(X_MAX));
-            let d = if x <= skip { mu * *s * e } else { 0.0 };
+            let d = step(&k, c, skip, *s);
             *s -= d;
             *sum += d * d;
         }
     }
     for s in tail {
-        let x = *s * *s * inv;
-        let d = if x <= skip { mu * *s * exp_neg(x.min(X_MAX)) } else { 0.0 };
+        let d = step(&k, c, skip, *s);
         *s -= d;
         sums[0] += d * d;
     }
     sums.iter().sum()
+}
+
+/// The step `mu s 2^t` of one coefficient `s`, 0 where it rounds away (`t < skip`, and a
+/// non-finite `s`, whose `t` is NaN or `-inf`: it stays as it is).
+#[cfg(not(target_arch = "arm"))]
+#[inline(always)]
+fn step(k: &[f32; 6], c: f32, skip: f32, s: f32) -> f32 {
+    let t = s * s * c;
+    let d = s * scaled_exp2(k, t.max(T_MIN));
+    if t >= skip { d } else { 0.0 }
 }
 
 /// The ascent step on a scalar core (Cortex-M): no lanes to fill, so the coefficients the
@@ -93,12 +125,13 @@ pub fn ascend(coeffs: &mut [f32], mu: f32, inv: f32) -> f32 {
 #[cfg(target_arch = "arm")]
 #[inline]
 pub fn ascend(coeffs: &mut [f32], mu: f32, inv: f32) -> f32 {
-    let skip = 88.0 + libm::logf(mu.max(1.0));
+    let (c, skip) = exponents(mu, inv);
+    let k = scaled(mu);
     let mut moved = 0.0f32;
     for s in coeffs {
-        let x = *s * *s * inv;
-        if x <= skip {
-            let d = mu * *s * exp_neg(x.min(X_MAX));
+        let t = *s * *s * c;
+        if t >= skip {
+            let d = *s * scaled_exp2(&k, t.max(T_MIN));
             *s -= d;
             moved += d * d;
         }

