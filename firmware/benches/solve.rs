@@ -63,6 +63,11 @@ fn benches(c: &mut Criterion) {
         c.bench_function(&format!("project pixel k={k}"), |bench| {
             bench.iter(|| project_coefficients(&dict, black_box(&mut coeffs), &mut scratch, ws.measurements(), 0.0))
         });
+        let ensemble = Ensemble::<5, 5, 4, 4, 13>::new(DEFAULT_ENSEMBLE).unwrap();
+        let member = ensemble.member(1).unwrap(); // 0 is the DCT
+        c.bench_function(&format!("project pixel k={k} learned member"), |bench| {
+            bench.iter(|| project_coefficients(&member, black_box(&mut coeffs), &mut scratch, ws.measurements(), 0.0))
+        });
         if k == 1 {
             // The step is branch-free on the host: its time does not depend on sigma.
             c.bench_function("ascend 5200", |bench| {
