@@ -57,7 +57,7 @@ impl ChoiceRule {
 
 /// `sum f(x)` over `s` in eight running sums, one per lane, added at the end: one running
 /// sum is a serial chain of additions the compiler may not reorder (f32 addition is not
-/// associative), which kept every pass of the scoring scalar (13 us a score, a tenth of a
+/// associative), which kept every pass of the scoring scalar (13 us a score, 7 % of a
 /// screened decode, against about 6 us in lanes: `perf record` on the screened criterion
 /// bench).
 #[inline(always)]
