@@ -119,9 +119,10 @@ fn step(k: &[f32; 6], c: f32, skip: f32, s: f32) -> f32 {
 /// step cannot move (most of them at small sigma) are skipped by a branch instead of
 /// computed and discarded; each coefficient gets the same value as on the host, only the
 /// returned sum is added in another order. Measured on the emulated Cortex-M4
-/// (`scripts/budgets.sh`, DCT patch): 99.1 M instructions, against 102.4 M branch-free
-/// and 97.2 M with `libm::expf` (whose fewer instructions include a `VDIV`, 14 cycles on
-/// a Cortex-M4, per call; qemu counts instructions, not cycles).
+/// (`scripts/budgets.sh`, DCT patch, with the earlier base-e form of the weight): 99.1 M
+/// instructions, against 102.4 M branch-free and 97.2 M with `libm::expf` (whose fewer
+/// instructions include a `VDIV`, 14 cycles on a Cortex-M4, per call; qemu counts
+/// instructions, not cycles).
 #[cfg(target_arch = "arm")]
 #[inline]
 pub fn ascend(coeffs: &mut [f32], mu: f32, inv: f32) -> f32 {
