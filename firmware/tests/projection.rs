@@ -92,6 +92,12 @@ fn odd_patch_projection_matches_dense_reference() {
 }
 
 #[test]
+fn most_bands_projection_matches_dense_reference() {
+    // `MAX_BANDS` bands: the band step's bit mask gathers four bytes of flags.
+    check::<2, 1, 1, 2, 32, 128>();
+}
+
+#[test]
 fn analysis_keeping_its_input_matches_dense_reference() {
     fn case<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>() {
         let dict = random_dictionary::<PS, PT, PU, PV, B>(8);
