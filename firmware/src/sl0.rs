@@ -53,6 +53,12 @@ pub struct Sl0Config {
     /// Where a solve starts from another dictionary's patch ([`solve_warm`]: the ensemble's
     /// second solve), sigma starts at `warm_start * max |S|`, in (0, 1]; 1 is a cold start.
     pub warm_start: f32,
+    /// `sigma_f` of a warm solve, in (0, 1): it starts from a patch that has found its
+    /// large coefficients and only refines it, so a slower fall with fewer steps per level
+    /// ([`Sl0Config::warm_steps`]) does as well as the full schedule in fewer steps.
+    pub warm_sigma_f: f32,
+    /// `L` of a warm solve, >= 1.
+    pub warm_steps: u16,
     /// The short path: a patch whose measurements of each band all lie within `flat` of
     /// each other (normalised units, >= 0) is flat in space and view, and is decoded as
     /// each band's mean with no solve. Dark patches are flat (their spread is at most their
@@ -66,8 +72,10 @@ impl Sl0Config {
     /// solution `S0`; from a patch of mean brightness 0.5 that is about 20 levels (60 steps).
     /// No early stop (`tolerance` 0: measured, it only pays where it costs PSNR); warm
     /// start at 1e-2 (`slf bench`, pixel mask, five scenes: +1.2 dB at k = 1 and +0.2 dB at
-    /// k = 3 over a cold second solve, and a third less time); the short path for exactly
-    /// flat patches only (`flat` 0).
+    /// k = 3 over a cold second solve, and a third less time), annealed at `sigma_f` 0.85
+    /// with one step per level (against the main schedule 0.7 x 3: PSNR within 0.02-0.08
+    /// dB on the pixel and lenslet masks, 9-18 % less time a screened patch, 14 % fewer
+    /// device instructions); the short path for exactly flat patches only (`flat` 0).
     pub const DEFAULT: Self = Self {
         sigma_f: 0.7,
         steps: 3,
@@ -77,6 +85,8 @@ impl Sl0Config {
         noise: 0.0,
         tolerance: 0.0,
         warm_start: 1e-2,
+        warm_sigma_f: 0.85,
+        warm_steps: 1,
         flat: 0.0,
     };
 
@@ -109,6 +119,12 @@ impl Sl0Config {
         }
         if !(self.warm_start > 0.0 && self.warm_start <= 1.0) {
             return bad("warm_start");
+        }
+        if !(self.warm_sigma_f > 0.0 && self.warm_sigma_f < 1.0) {
+            return bad("warm_sigma_f");
+        }
+        if self.warm_steps == 0 {
+            return bad("warm_steps");
         }
         if !(self.flat >= 0.0 && self.flat.is_finite()) {
             return bad("flat");
@@ -359,10 +375,13 @@ fn short_path<const PS: usize, const PT: usize, const PU: usize, const PV: usize
 
 /// Decodes the patch again with `dict`, starting from the patch now in `ws.patch()`
 /// (another dictionary's solution, which meets the measurements) at
-/// `sigma = cfg.warm_start * max |S|` of its coefficients `S` in `dict`.
+/// `sigma = cfg.warm_start * max |S|` of its coefficients `S` in `dict`, falling by
+/// `cfg.warm_sigma_f` with `cfg.warm_steps` steps per level.
 ///
 /// A cold start's first levels find the patch's large coefficients; a patch solved with
-/// another dictionary has found them, so its re-solve starts lower and takes fewer levels.
+/// another dictionary has found them, so its re-solve starts lower and takes fewer levels,
+/// and it only refines them, so it anneals with one step per level where a cold solve
+/// needs three.
 /// The patch in `ws.patch()` is only read; if it does not meet the measurements the first
 /// projection moves it onto them.
 ///
@@ -381,7 +400,8 @@ pub fn solve_warm<
     ws: &mut Workspace<PS, PT, PU, PV, B, N>,
 ) -> Result<Outcome, SolveError> {
     let eps = start(cfg, &ws.measurements)?;
-    descend(dict, cfg, ws, eps, cfg.warm_start)
+    let warm = Sl0Config { sigma_f: cfg.warm_sigma_f, steps: cfg.warm_steps, ..*cfg };
+    descend(dict, &warm, ws, eps, cfg.warm_start)
 }
 
 /// The schedule from the patch in `ws.signal`, from `sigma0 = scale * max |S|`, projecting

@@ -110,6 +110,24 @@ fn warm_start_resumes_from_the_patch_in_the_workspace() {
     // warm_start 1 starts where a cold start would from this patch: bounded like any solve.
     let out = solve_warm(&dct(), &Sl0Config { warm_start: 1.0, max_iterations: 9, ..cfg }, &mut ws).unwrap();
     assert_eq!((out.iterations, out.ended), (9, Ended::IterationBound));
+    // The warm schedule: from its sigma0, `warm_steps` steps a level, sigma falling by
+    // `warm_sigma_f` until `sigma_min`; the level count from an f64 recount of the same
+    // schedule (f32 sigma may land one level either side of an exact boundary: none here).
+    for (sigma_f, steps) in [(0.85f32, 1u16), (0.6, 2), (0.7, 3)] {
+        let c = Sl0Config { warm_sigma_f: sigma_f, warm_steps: steps, ..cfg };
+        let out = solve_warm(&dct(), &c, &mut ws).unwrap();
+        let mut levels = 0u32;
+        let mut sigma = f64::from(out.sigma0);
+        while sigma > f64::from(c.sigma_min) {
+            sigma *= f64::from(sigma_f);
+            levels += 1;
+        }
+        assert_eq!(out.ended, Ended::SigmaMin);
+        assert_eq!((out.levels, out.iterations), (levels, levels * u32::from(steps)), "{sigma_f} L {steps}");
+        // The cold schedule is the main one, whatever the warm one is.
+        let cold = solve(&dct(), &c, &mut ws).unwrap();
+        assert_eq!(cold.iterations, cold.levels * u32::from(c.steps));
+    }
     // No measurement: the typed error, as for a cold solve.
     ws.measurements_mut().clear();
     assert_eq!(solve_warm(&dct(), &cfg, &mut ws).unwrap_err(), SolveError::NoMeasurements);

@@ -132,6 +132,10 @@ fn bad_config_is_a_typed_error() {
         (Sl0Config { warm_start: 0.0, ..d }, "warm_start"),
         (Sl0Config { warm_start: 1.5, ..d }, "warm_start"),
         (Sl0Config { warm_start: f32::NAN, ..d }, "warm_start"),
+        (Sl0Config { warm_sigma_f: 0.0, ..d }, "warm_sigma_f"),
+        (Sl0Config { warm_sigma_f: 1.0, ..d }, "warm_sigma_f"),
+        (Sl0Config { warm_sigma_f: f32::NAN, ..d }, "warm_sigma_f"),
+        (Sl0Config { warm_steps: 0, ..d }, "warm_steps"),
         (Sl0Config { flat: -1.0, ..d }, "flat"),
         (Sl0Config { flat: f32::INFINITY, ..d }, "flat"),
     ] {

@@ -133,8 +133,20 @@ fn settings(quick: bool) -> Vec<(String, Decoder, Sl0Config)> {
         } else {
             format!("ensemble screened warm {warm_start:e}")
         };
-        s.push((name, screened(), Sl0Config { warm_start, ..d }));
+        // A cold second solve is a first solve again: the main schedule too.
+        let c = if warm_start == 1.0 {
+            Sl0Config { warm_start, warm_sigma_f: d.sigma_f, warm_steps: d.steps, ..d }
+        } else {
+            Sl0Config { warm_start, ..d }
+        };
+        s.push((name, screened(), c));
     }
+    // The warm solve's schedule against the main one (the default before it had its own).
+    s.push((
+        format!("ensemble screened, warm sigma_f {} L {}", d.sigma_f, d.steps),
+        screened(),
+        Sl0Config { warm_sigma_f: d.sigma_f, warm_steps: d.steps, ..d },
+    ));
     s.push((
         "ensemble screened, tolerance 1e-3, flat 4e-3".to_string(),
         screened(),

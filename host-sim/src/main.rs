@@ -137,6 +137,12 @@ struct SolverArgs {
     /// largest coefficient, in (0, 1]; 1 is a cold start.
     #[arg(long, default_value_t = Sl0Config::DEFAULT.warm_start)]
     warm_start: f32,
+    /// The warm solve's sigma decrease factor per level, in (0, 1).
+    #[arg(long, default_value_t = Sl0Config::DEFAULT.warm_sigma_f)]
+    warm_sigma_f: f32,
+    /// The warm solve's steps per sigma level.
+    #[arg(long, default_value_t = Sl0Config::DEFAULT.warm_steps)]
+    warm_steps: u16,
     /// Short path: a patch whose measurements of each band agree within this (normalised
     /// units) is decoded as each band's mean, with no solve; 0: exactly flat patches only.
     #[arg(long, default_value_t = Sl0Config::DEFAULT.flat)]
@@ -154,6 +160,8 @@ impl SolverArgs {
             noise: self.noise,
             tolerance: self.tolerance,
             warm_start: self.warm_start,
+            warm_sigma_f: self.warm_sigma_f,
+            warm_steps: self.warm_steps,
             flat: self.flat,
         };
         c.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
