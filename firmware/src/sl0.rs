@@ -74,7 +74,7 @@ impl Sl0Config {
     /// start at 1e-2 (`slf bench`, pixel mask, five scenes: +1.2 dB at k = 1 and +0.2 dB at
     /// k = 3 over a cold second solve, and a third less time), annealed at `sigma_f` 0.85
     /// with one step per level (against the main schedule 0.7 x 3: PSNR within 0.02-0.08
-    /// dB on the pixel and lenslet masks, 9-18 % less time a screened patch, 14 % fewer
+    /// dB on the pixel and lenslet masks, 8-13 % less time a screened patch, 14 % fewer
     /// device instructions); the short path for exactly flat patches only (`flat` 0).
     pub const DEFAULT: Self = Self {
         sigma_f: 0.7,

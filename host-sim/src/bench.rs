@@ -127,6 +127,8 @@ fn settings(quick: bool) -> Vec<(String, Decoder, Sl0Config)> {
         s.push((format!("DCT flat {flat:e}"), dct(), Sl0Config { flat, ..d }));
     }
     let screened = || ens(MemberChoice::Screened(ChoiceRule::DEFAULT));
+    // The warm solves on the main schedule (the default before they had their own).
+    let main_schedule = Sl0Config { warm_sigma_f: d.sigma_f, warm_steps: d.steps, ..d };
     for &warm_start in warms {
         let name = if warm_start == 1.0 {
             "ensemble screened cold".to_string()
@@ -134,19 +136,10 @@ fn settings(quick: bool) -> Vec<(String, Decoder, Sl0Config)> {
             format!("ensemble screened warm {warm_start:e}")
         };
         // A cold second solve is a first solve again: the main schedule too.
-        let c = if warm_start == 1.0 {
-            Sl0Config { warm_start, warm_sigma_f: d.sigma_f, warm_steps: d.steps, ..d }
-        } else {
-            Sl0Config { warm_start, ..d }
-        };
-        s.push((name, screened(), c));
+        let base = if warm_start == 1.0 { main_schedule } else { d };
+        s.push((name, screened(), Sl0Config { warm_start, ..base }));
     }
-    // The warm solve's schedule against the main one (the default before it had its own).
-    s.push((
-        format!("ensemble screened, warm sigma_f {} L {}", d.sigma_f, d.steps),
-        screened(),
-        Sl0Config { warm_sigma_f: d.sigma_f, warm_steps: d.steps, ..d },
-    ));
+    s.push((format!("ensemble screened, warm sigma_f {} L {}", d.sigma_f, d.steps), screened(), main_schedule));
     s.push((
         "ensemble screened, tolerance 1e-3, flat 4e-3".to_string(),
         screened(),
