@@ -10,6 +10,11 @@ use crate::sl0::SolveError;
 
 /// The measurements of one patch, dense in the patch layout: entry `i` is measured (with
 /// its value in normalised units) or not. A one-hot mask measures each entry at most once.
+///
+/// The values of the entries that are not measured are zero between decodes; during a
+/// screened ensemble decode they hold the DCT's solution while the chosen member solves
+/// (see [`crate::MemberChoice::Screened`]): a solution that meets the measurements is known from its
+/// unmeasured entries alone, so it needs no buffer of its own.
 #[derive(Clone, Debug)]
 pub struct Measurements<const N: usize> {
     pub(crate) values: [f32; N],
@@ -61,6 +66,35 @@ impl<const N: usize> Measurements<N> {
     /// Number of measured entries.
     pub fn count(&self) -> usize {
         self.count as usize
+    }
+
+    /// Keeps the unmeasured entries of `patch` in the unmeasured slots of the values.
+    pub(crate) fn stash(&mut self, patch: &[f32; N]) {
+        for ((v, &k), &x) in self.values.iter_mut().zip(&self.measured).zip(patch) {
+            if !k {
+                *v = x;
+            }
+        }
+    }
+
+    /// Makes each unmeasured entry `x` of `patch` the weighted mean `w s + (1 - w) x` with
+    /// its stashed value `s`, and forgets the stash. Measured entries are left as they are.
+    pub(crate) fn blend_stash(&mut self, patch: &mut [f32; N], w: f32) {
+        for ((v, &k), x) in self.values.iter_mut().zip(&self.measured).zip(patch) {
+            if !k {
+                *x = w * *v + (1.0 - w) * *x;
+                *v = 0.0;
+            }
+        }
+    }
+
+    /// Forgets the stash: the unmeasured values are zero again.
+    pub(crate) fn drop_stash(&mut self) {
+        for (v, &k) in self.values.iter_mut().zip(&self.measured) {
+            if !k {
+                *v = 0.0;
+            }
+        }
     }
 }
 

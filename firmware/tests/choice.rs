@@ -67,7 +67,8 @@ fn choice_finds_the_member_a_patch_is_made_of_at_the_stated_cost() {
     let mask = Mask::pixel(3, 3, 13, L5).unwrap();
     for (choice, solves) in [
         (MemberChoice::Exhaustive(ChoiceRule::DEFAULT), &[5u16][..]),
-        (MemberChoice::Screened(ChoiceRule::DEFAULT), &[2, 3][..]),
+        (MemberChoice::Screened(ChoiceRule::DEFAULT), &[2][..]),
+        (MemberChoice::ScreenedResolve(ChoiceRule::DEFAULT), &[2, 3][..]),
     ] {
         let model = EnsembleModel::new(e, choice);
         assert_eq!(model.dct_member(), Some(0));
@@ -80,7 +81,7 @@ fn choice_finds_the_member_a_patch_is_made_of_at_the_stated_cost() {
             assert_eq!(out.member, Some(m as u16), "{choice:?}: patch made of member {m}");
             let e = rel_err32(ws.patch(), &truth);
             assert!(e < 0.05, "{choice:?} member {m}: rel err {e}");
-            if let (MemberChoice::Screened(_), true) = (choice, m > 0) {
+            if let (MemberChoice::Screened(_) | MemberChoice::ScreenedResolve(_), true) = (choice, m > 0) {
                 let out = model.decode(&Sl0Config::DEFAULT, &mut ws).unwrap();
                 assert_eq!(out.member, Some(0), "warm start: the DCT keeps member {m}'s patch");
                 assert!(ws.patch().iter().all(|x| x.is_finite()));
@@ -108,4 +109,98 @@ fn the_shipped_ensemble_decodes_a_patch() {
     // No measurement: the typed error comes through the model.
     ws.measurements_mut().clear();
     assert_eq!(model.decode(&Sl0Config::DEFAULT, &mut ws).unwrap_err(), SolveError::NoMeasurements);
+}
+
+/// A patch of a few DCT atoms plus small white noise: the DCT's solution scores sparser
+/// than a random member's, but not exactly sparse (its score is not 0).
+fn dct_win_patch() -> Vec<f32> {
+    let mut r = rng(77);
+    let mut x = sparse_in(&Dictionary::dct(), 76);
+    for v in &mut x {
+        *v += r.random_range(-0.05f32..0.05);
+    }
+    x
+}
+
+fn score(dict: &Dictionary<5, 5, 4, 4, 13>, patch: &[f32]) -> f64 {
+    let mut c = Box::new([0.0f32; 5200]);
+    analyze_preserving(dict, patch.try_into().unwrap(), &mut c);
+    f64::from(ChoiceRule::DEFAULT.score(&c[..]))
+}
+
+/// Screened choice where the DCT wins: the patch is the two solutions' mean, each weighted
+/// by the other's score, on the unmeasured entries; the measured ones are the member's.
+/// Reference: the two solves run one by one through the public API, the mean taken in
+/// f64. Stated tolerance: 1e-6 of the patch's largest value (the f32 weight and mean).
+#[test]
+fn a_dct_win_is_the_score_weighted_mean_of_the_two_solutions() {
+    let members = vec![Dictionary::dct(), random_dictionary(21)];
+    let e = Ensemble::<5, 5, 4, 4, 13>::new(blob(&members)).unwrap();
+    let mask = Mask::pixel(3, 3, 13, L5).unwrap();
+    let truth = dct_win_patch();
+    for noise in [0.0f32, 0.02] {
+        let cfg = Sl0Config { noise, ..Sl0Config::DEFAULT };
+        let mut ws = Box::new(PaperWorkspace::new());
+        measure(&mask, (0, 0), &truth, &mut ws);
+        let mut reference = ws.clone();
+        let out = EnsembleModel::new(e, MemberChoice::Screened(ChoiceRule::DEFAULT)).decode(&cfg, &mut ws).unwrap();
+        assert_eq!((out.member, out.solves), (Some(0), 2), "noise {noise}: the DCT wins with two solves");
+
+        solve(&members[0], &cfg, &mut reference).unwrap();
+        let a = reference.patch().to_vec();
+        let member = e.member(1).unwrap();
+        let second = solve_warm(&member, &cfg, &mut reference).unwrap();
+        assert_eq!(out.outcome, second, "the outcome is the member's solve");
+        let b = reference.patch().to_vec();
+        let (sd, sm) = (score(&members[0], &a), score(&member, &b));
+        let w = sm / (sm + sd);
+        // A real mean, not one side (with noise the DCT's solution is sparser still).
+        let most = if noise == 0.0 { 0.99 } else { 0.999_9 };
+        assert!(w > 0.5 && w < most, "noise {noise}: weight {w}");
+        let m = ws.measurements();
+        let expected: Vec<f64> = (0..5200)
+            .map(|i| match m.get(i) {
+                Some(_) => f64::from(b[i]),
+                None => w * f64::from(a[i]) + (1.0 - w) * f64::from(b[i]),
+            })
+            .collect();
+        let top = a.iter().fold(0.0f32, |t, x| t.max(x.abs()));
+        for (i, (&x, &y)) in ws.patch().iter().zip(&expected).enumerate() {
+            assert!((f64::from(x) - y).abs() <= 1e-6 * f64::from(top), "noise {noise}, entry {i}: {x} vs {y}");
+        }
+        // The mean meets the measurements as the member's solution does: exactly, or to
+        // the noise ball.
+        let (mut r2, mut count) = (0.0f64, 0usize);
+        for i in 0..5200 {
+            if let Some(y) = m.get(i) {
+                r2 += (f64::from(ws.patch()[i]) - f64::from(y)).powi(2);
+                count += 1;
+            }
+        }
+        let eps = f64::from(noise) * (count as f64).sqrt();
+        assert!(r2.sqrt() <= eps * (1.0 + 1e-3) + 1e-6, "noise {noise}: residual {} over {eps}", r2.sqrt());
+    }
+}
+
+/// The DCT's solution waits in the measurement buffer's unmeasured slots during a screened
+/// decode; afterwards the measurements are as they were, whichever solution won.
+#[test]
+fn a_screened_decode_leaves_the_measurements_as_they_were() {
+    let members = vec![Dictionary::dct(), random_dictionary(21)];
+    let e = Ensemble::<5, 5, 4, 4, 13>::new(blob(&members)).unwrap();
+    let mask = Mask::pixel(3, 3, 13, L5).unwrap();
+    let mut won = [false; 2];
+    for truth in [dct_win_patch(), sparse_in(&members[1], 5)] {
+        for choice in [MemberChoice::Screened(ChoiceRule::DEFAULT), MemberChoice::ScreenedResolve(ChoiceRule::DEFAULT)]
+        {
+            let cold = Sl0Config { warm_start: 1.0, ..Sl0Config::DEFAULT };
+            let mut ws = Box::new(PaperWorkspace::new());
+            measure(&mask, (0, 0), &truth, &mut ws);
+            let before = format!("{:?}", ws.measurements());
+            let out = EnsembleModel::new(e, choice).decode(&cold, &mut ws).unwrap();
+            won[usize::from(out.member.unwrap())] = true;
+            assert_eq!(format!("{:?}", ws.measurements()), before, "{choice:?}, member {:?}", out.member);
+        }
+    }
+    assert_eq!(won, [true, true], "both the DCT and the member won once");
 }

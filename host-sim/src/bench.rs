@@ -140,6 +140,12 @@ fn settings(quick: bool) -> Vec<(String, Decoder, Sl0Config)> {
         s.push((name, screened(), Sl0Config { warm_start, ..base }));
     }
     s.push((format!("ensemble screened, warm sigma_f {} L {}", d.sigma_f, d.steps), screened(), main_schedule));
+    // A DCT win solved again instead of averaged (the default before the mean).
+    s.push((
+        "ensemble screened, DCT wins re-solved".to_string(),
+        ens(MemberChoice::ScreenedResolve(ChoiceRule::DEFAULT)),
+        d,
+    ));
     s.push((
         "ensemble screened, tolerance 1e-3, flat 4e-3".to_string(),
         screened(),

@@ -48,6 +48,9 @@ impl Basis {
         match self {
             Self::Dct => "DCT",
             Self::Ensemble { choice: slf_firmware::MemberChoice::Screened(_), .. } => "ensemble screened",
+            Self::Ensemble { choice: slf_firmware::MemberChoice::ScreenedResolve(_), .. } => {
+                "ensemble screened, DCT wins re-solved"
+            }
             Self::Ensemble { choice: slf_firmware::MemberChoice::Exhaustive(_), .. } => "ensemble exhaustive",
         }
     }

@@ -53,8 +53,12 @@ enum DictionaryKind {
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 enum Choice {
-    /// Solve with the DCT, pick the member that best represents it, solve with that (2 solves).
+    /// Solve with the DCT, pick the member that best represents it, solve with that (2
+    /// solves); where the DCT's own solution is sparser, average the two.
     Screened,
+    /// As screened, but where the DCT's own solution is sparser, solve with the DCT again
+    /// from the member's solution (3 solves).
+    ScreenedResolve,
     /// Solve with every member, keep the sparsest (K + 1 solves).
     Exhaustive,
 }
@@ -101,6 +105,7 @@ impl BasisArgs {
                 let rule = ChoiceRule::DEFAULT;
                 let choice = match self.choice {
                     Choice::Screened => MemberChoice::Screened(rule),
+                    Choice::ScreenedResolve => MemberChoice::ScreenedResolve(rule),
                     Choice::Exhaustive => MemberChoice::Exhaustive(rule),
                 };
                 Basis::Ensemble { blob, choice }
