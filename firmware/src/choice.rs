@@ -23,12 +23,12 @@
 //! cannot represent it would halve its error only to add half of the member's. The DCT's
 //! solution waits in the unmeasured slots of the measurement buffer while the member
 //! solves ([`Measurements`]), so the mean costs no solve and no RAM. The weights measured
-//! the same as an equal mean on the scenes. Against the third solve in the same runs
-//! (`slf bench --only "ensemble screened"`, five scenes; `slf bench --paper-scale`): pixel
-//! mask k = 1 / 3 -0.04 / -0.01 dB, lenslet -0.03 / -0.03 dB, kronecker within 0.01 dB,
-//! for 2.0 solves a patch instead of 2.1-2.7 (5-13 % less time); at paper scale, where the
-//! DCT wins 70 % of the patches, +0.01 dB and 0.65 instead of 0.68 degrees SA for 14 %
-//! less time.
+//! the same as an equal mean on the scenes. Against the third solve in the same run (`slf
+//! bench`, five scenes, `docs/bench/README.md`), k = 1 / 3: pixel mask -0.04 / -0.01 dB,
+//! lenslet -0.04 / -0.05 dB, kronecker within 0.01 dB, for 2.0 solves a patch instead of
+//! 2.1-2.7 (2-13 % less time); at paper scale (`slf bench --paper-scale`), where the DCT
+//! wins 70 % of the patches, +0.01 dB and 0.65 instead of 0.68 degrees SA for 11-14 % less
+//! time.
 //!
 //! [`Measurements`]: crate::workspace::Measurements
 //!
