@@ -410,12 +410,13 @@ pub fn paper_scale() -> Result<String> {
     Ok(format!(
         "| | slf (this machine) | paper (5D AMDE) |\n| --- | --- | --- |\n\
          | light field | 512 x 512 x 5 x 5 x 13, depth scene, pixel mask, k = 1 | 512 x 512 x 5 x 5 x 13, k = 1 |\n\
-         | decode wall time | {t_dec:.1} s on {threads} threads | 79.5 s on 16 cores |\n\
+         | decode wall time | {t_dec:.1} s on {threads} thread{} | 79.5 s on 16 cores |\n\
          | decode core-seconds | {c_dec:.1} | 1,272 (79.5 x 16) |\n\
          | patches decoded | {patches} ({:.2} ms core time each, {:.1} solves each) | |\n\
          | end to end (render {t_render:.1} s, simulate {t_sim:.1} s, decode) | {total:.1} s, {:.1} core-seconds | |\n\
          | peak memory (resident) | {:.2} GB | |\n\
          | PSNR (data range = max of truth) / SA | {p:.2} dB / {sa:.2} deg | |\n",
+        if threads == 1 { "" } else { "s" },
         1e3 * c_dec / f64::from(patches.max(1)),
         report.solves as f64 / f64::from(patches.max(1)),
         cpu_seconds() - c0,
