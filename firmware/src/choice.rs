@@ -302,26 +302,23 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             return Ok(ModelOutcome { outcome, member: Some(k), solves: 2 });
         };
         let member = self.member(chosen)?;
-        if resolve {
-            let outcome = solve_warm(&member, cfg, ws)?;
-            if dct_score < self.score(&member, rule, ws) {
-                let outcome = solve_warm(&self.screen, cfg, ws)?;
-                return Ok(ModelOutcome { outcome, member: Some(dct), solves: 3 });
-            }
-            return Ok(ModelOutcome { outcome, member: Some(chosen), solves: 2 });
-        }
         ws.measurements.stash(&ws.signal);
         let solved = solve_warm(&member, cfg, ws).map(|outcome| (outcome, self.score(&member, rule, ws)));
-        let Workspace { signal, measurements, .. } = ws;
-        let (outcome, member_score) = solved.inspect_err(|_| measurements.drop_stash())?;
-        if dct_score < member_score {
+        let (outcome, member_score) = solved.inspect_err(|_| ws.measurements.drop_stash())?;
+        let dct_wins = dct_score < member_score;
+        if dct_wins && !resolve {
             // Both meet the measurements (the member's to its noise ball: the measured
             // entries stay the member's), and so does their mean. The DCT weighs more
             // (`member_score > dct_score >= 0`), all of it where its score is 0.
+            let Workspace { signal, measurements, .. } = ws;
             measurements.blend_stash(signal, member_score / (member_score + dct_score));
             return Ok(ModelOutcome { outcome, member: Some(dct), solves: 2 });
         }
-        measurements.drop_stash();
+        ws.measurements.drop_stash();
+        if dct_wins {
+            let outcome = solve_warm(&self.screen, cfg, ws)?;
+            return Ok(ModelOutcome { outcome, member: Some(dct), solves: 3 });
+        }
         Ok(ModelOutcome { outcome, member: Some(chosen), solves: 2 })
     }
 }
