@@ -13,8 +13,8 @@ use crate::sl0::SolveError;
 ///
 /// The values of the entries that are not measured are zero between decodes; during a
 /// screened ensemble decode they hold the DCT's solution while the chosen member solves
-/// (see [`crate::MemberChoice::Screened`]): a solution that meets the measurements is known from its
-/// unmeasured entries alone, so it needs no buffer of its own.
+/// (see [`crate::MemberChoice::Screened`]): a solution that meets the measurements is known
+/// from its unmeasured entries alone, so it needs no buffer of its own.
 #[derive(Clone, Debug)]
 pub struct Measurements<const N: usize> {
     pub(crate) values: [f32; N],
