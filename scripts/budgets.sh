@@ -2,13 +2,13 @@
 # Measures the device budgets on qemu's emulated Cortex-M4F and prints a markdown table:
 # flash (.text + .rodata), static RAM (.data + .bss), peak stack (painted), the Workspace,
 # instructions per transform multiply-add and per patch (5D DCT, shipped ensemble with
-# screened choice), counted by ../shared/tools/qemu-insn-count between bench_begin/bench_end.
+# screened choice), counted by the qemu plugin scripts/wincount/wincount.c between the
+# device binary's bench_begin / bench_end markers.
 # Needs: thumbv7em-none-eabihf target, qemu-system-arm, gcc, llvm-nm/llvm-size.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-plugin_src="${SLF_SHARED:-../shared}/tools/qemu-insn-count/wincount.c"
 mkdir -p target
-gcc -O2 -shared -fPIC -fvisibility=hidden -o target/libwincount.so "$plugin_src"
+gcc -O2 -shared -fPIC -fvisibility=hidden -o target/libwincount.so scripts/wincount/wincount.c
 cargo build --release -q -p slf-firmware --target thumbv7em-none-eabihf
 elf=target/thumbv7em-none-eabihf/release/slf-device
 # Thumb symbols carry bit 0; instruction addresses do not.

@@ -14,7 +14,7 @@
 //! | kronecker | 6.56 / 5.5 | 6.72 / 5.5 |
 //!
 //! The kronecker mask gives every pixel of a patch the same band, so the spectrum of a
-//! patch is guessed from k samples: DESIGN.md section 3 predicts the pixel mask is far
+//! patch is guessed from k samples: docs/design.md (section 3) predicts the pixel mask is far
 //! better at the same 5D cost, and the test holds it to at least 15 dB better at k = 3
 //! (measured: 23.1 dB).
 

@@ -112,7 +112,7 @@ fn pixel_mask_decodes_a_frame_far_better_than_the_kronecker_mask() {
     eprintln!("PSNR k=3: kronecker {kron:.2} dB, lenslet {lenslet:.2} dB, pixel {pixel:.2} dB; k=13 {all:.2} dB");
     // k = 13 is limited only by 12-bit-ish quantisation (1/8000 of the peak: ~78 dB).
     assert!(all > 70.0, "k = 13: {all:.2} dB");
-    // DESIGN.md section 3: per-pixel masks decode far better than one band per patch.
+    // docs/design.md, section 3: per-pixel masks decode far better than one band per patch.
     assert!(pixel > kron + 6.0, "pixel {pixel:.2} dB vs kronecker {kron:.2} dB");
     assert!(pixel > lenslet, "pixel {pixel:.2} dB vs lenslet {lenslet:.2} dB");
     assert!(pixel > 30.0, "pixel {pixel:.2} dB");

@@ -4,7 +4,9 @@
 //! light field (2 spatial, 2 angular, `B` spectral bands) as one raw frame per snapshot.
 //! This crate recovers the full spectral light field patch by patch by compressed sensing
 //! in the signal's own five dimensions: a small orthonormal matrix per dimension, separable
-//! operators, and the nD smoothed-l0 solver of Algorithm 1 of the seed paper. It is
+//! operators, and the nD smoothed-l0 solver of Algorithm 1 of X. Cao, E. Miandji and
+//! J. Unger, "Multidimensional Compressed Sensing for Spectral Light Field Imaging",
+//! VISAPP 2024 (the repository's `docs/design.md` says where slf goes past it). It is
 //! `no_std`, needs no heap, and is the code the host simulator calls, so host results are
 //! the device's results.
 //!

@@ -1,7 +1,7 @@
 //! The one logging shim: routes to `defmt` with the `defmt` feature, to nothing without.
 //!
 //! Host builds that call defmt macros need a global logger to link, so the decoder never
-//! calls defmt directly (see `../shared/TOOLCHAIN.md`). Arguments are still evaluated by
+//! calls defmt directly. Arguments are still evaluated by
 //! reference without the feature, so a variable used only in a log line is not "unused".
 
 /// `log!(level, "format {}", args..)` with `level` one of defmt's macros

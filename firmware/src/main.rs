@@ -6,7 +6,7 @@
 //! (f32 bit patterns) for `slf device-check` to compare with the host's decode. Then it
 //! decodes the same tiles with the 5D DCT. `bench_begin` / `bench_end` bracket one
 //! synthesis, then each ensemble tile, then each DCT tile, so the qemu plugin
-//! `../shared/tools/qemu-insn-count` counts instructions per transform and per patch. The
+//! `scripts/wincount/wincount.c` counts instructions per transform and per patch. The
 //! stack is painted at start and scanned at the end for its peak depth.
 //!
 //! Run: `cargo run --release -p slf-firmware --target thumbv7em-none-eabihf` (qemu is the

@@ -2,7 +2,7 @@
 //!
 //! Every mask is one-hot (a pixel integrates exactly one of the `bands` filter types per
 //! snapshot) and, over `k` snapshots, sees `k` *distinct* bands at each sensor position.
-//! Three mask families (DESIGN.md section 3):
+//! Three mask families (`docs/design.md`, section 3):
 //!
 //! | family | band chosen per | separable |
 //! | --- | --- | --- |

@@ -195,7 +195,7 @@ macro_rules! shape_suite {
 
             #[test]
             fn pixel_mask_beats_kronecker_mask_on_a_smooth_patch() {
-                // DESIGN.md section 3: one band per patch per snapshot leaves PD fully coherent.
+                // docs/design.md, section 3: one band per patch per snapshot leaves PD fully coherent.
                 let dict = Dict::dct();
                 let mut errs = [0.0; 3];
                 for seed in 0..3 {
@@ -296,7 +296,7 @@ macro_rules! shape_suite {
             /// The error bound of a hard case. Pixel and lenslet masks see several bands per patch and
             /// stay within the signal's own norm (measured at most 0.80). The kronecker mask gives
             /// every pixel of a patch the same bands, so any spectral atom explains the data equally
-            /// (DESIGN.md section 3): its bound only says the guess is no wilder than the signal
+            /// (docs/design.md, section 3): its bound only says the guess is no wilder than the signal
             /// (measured at most 1.22).
             fn error_bound(mask: &Mask) -> f64 {
                 match mask.family() {
