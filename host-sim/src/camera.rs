@@ -86,6 +86,31 @@ impl CameraConfig {
 /// A bad mask or sensor description.
 pub fn simulate(lf: &LightField, cam: &CameraConfig) -> Result<Capture> {
     ensure!(lf.bands == BAND_NM.len(), "light field has {} bands, the camera {}", lf.bands, BAND_NM.len());
+    ensure!(
+        lf.views.0 <= lf.rows && lf.views.1 <= lf.cols,
+        "the light field has more views ({} x {}) than lenslets ({} x {}): slf reads (U, V, H, W, B); \
+         is this array (H, W, U, V, B)? (numpy: np.transpose(a, (2, 3, 0, 1, 4)))",
+        lf.views.0,
+        lf.views.1,
+        lf.rows,
+        lf.cols
+    );
+    ensure!(
+        cam.full_well.is_none_or(|f| f.is_finite() && f > 0.0),
+        "full well {:?} electrons: must be finite and above 0",
+        cam.full_well
+    );
+    ensure!(
+        cam.read_noise.is_finite() && cam.read_noise >= 0.0,
+        "read noise {} DN: must be finite, at or above 0",
+        cam.read_noise
+    );
+    ensure!((0.0..1.0).contains(&cam.defect_fraction), "defect fraction {} out of [0, 1)", cam.defect_fraction);
+    ensure!(
+        cam.white_fraction.is_finite() && cam.white_fraction > 0.0 && cam.white_fraction <= 1.0,
+        "white fraction {} out of (0, 1]",
+        cam.white_fraction
+    );
     ensure!((1..=16).contains(&cam.bits), "bits {} out of 1..=16", cam.bits);
     let top = ((1u32 << cam.bits) - 1) as f32;
     let black = f32::from(cam.black_level);

@@ -6,7 +6,7 @@
 use std::fs;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail, ensure};
+use anyhow::{Context, Result, anyhow, bail, ensure};
 use serde::{Deserialize, Serialize};
 use slf_firmware::{
     BandTile, DecoderConfig, DefectList, LensletSize, Mask, MaskFamily, Pixel, RawFormat, RawFrame, SensorGeometry,
@@ -14,6 +14,11 @@ use slf_firmware::{
 };
 
 use crate::lightfield::{read_npy_u16_2d, write_npy_u16_2d};
+
+/// The largest `capture.json` read (a long defect list fits many times over).
+pub const MAX_DESCRIPTION: u64 = 64 << 20;
+
+use slf_firmware::shape::MAX_BANDS;
 
 /// The description file's name inside a capture folder.
 pub const DESCRIPTION: &str = "capture.json";
@@ -109,6 +114,8 @@ pub struct Capture {
     tile_bands: Vec<u8>,
     /// Defective pixels, sorted.
     defects: Vec<Pixel>,
+    /// The `capture.json` it was loaded from, if any.
+    source: Option<PathBuf>,
 }
 
 impl Capture {
@@ -118,21 +125,8 @@ impl Capture {
     /// A message naming the field that is wrong.
     pub fn new(description: CaptureDescription, frames: Vec<Vec<u16>>) -> Result<Self> {
         let d = &description;
-        ensure!(d.format == FORMAT, "format is {:?}, expected {FORMAT:?}", d.format);
-        ensure!(d.version == VERSION, "version {} is not supported (this slf reads {VERSION})", d.version);
-        ensure!(
-            d.lenslets.iter().all(|&x| (1..=u16::MAX as usize).contains(&x)),
-            "lenslets {:?} out of range",
-            d.lenslets
-        );
-        ensure!(d.views.iter().all(|&x| (1..=255).contains(&x)), "views {:?} out of range 1..=255", d.views);
-        ensure!((1..=32).contains(&d.bands_nm.len()), "bands_nm has {} entries, expected 1..=32", d.bands_nm.len());
-        ensure!(
-            d.black_level.is_finite() && d.white_level > d.black_level && d.saturation_level > d.black_level,
-            "levels: need black_level < white_level and black_level < saturation_level"
-        );
+        let (rows, cols) = d.frame_size()?;
         ensure!(frames.len() == d.frames.len(), "{} frames for {} names", frames.len(), d.frames.len());
-        let (rows, cols) = (d.lenslets[0] * d.views[0], d.lenslets[1] * d.views[1]);
         for (i, f) in frames.iter().enumerate() {
             ensure!(
                 f.len() == rows * cols,
@@ -146,6 +140,13 @@ impl Capture {
             | MaskDescription::Lenslet(MaskSource { tile: Some(t), .. }) => {
                 ensure!(!t.is_empty() && !t[0].is_empty() && !t[0][0].is_empty(), "mask.tile is empty");
                 let (r, c) = (t[0].len(), t[0][0].len());
+                ensure!(t.len() <= MAX_BANDS, "mask.tile has {} snapshots, at most {}", t.len(), MAX_BANDS);
+                ensure!(
+                    r <= usize::from(u16::MAX) && c <= usize::from(u16::MAX),
+                    "mask.tile is {r} x {c} cells, at most {} x {}",
+                    u16::MAX,
+                    u16::MAX
+                );
                 ensure!(
                     t.iter().all(|s| s.len() == r && s.iter().all(|row| row.len() == c)),
                     "mask.tile: every snapshot must be {r} rows of {c} columns"
@@ -164,7 +165,7 @@ impl Capture {
         }
         defects.sort();
         defects.dedup();
-        let capture = Self { description, frames, tile_bands, defects };
+        let capture = Self { description, frames, tile_bands, defects, source: None };
         let mask = capture.mask()?;
         ensure!(
             mask.snapshots() == capture.frames.len(),
@@ -173,6 +174,21 @@ impl Capture {
             capture.frames.len()
         );
         Ok(capture)
+    }
+
+    /// Pixels at or above the saturation level over all frames, defective pixels left out,
+    /// and all pixels.
+    pub fn saturated_pixels(&self) -> (usize, usize) {
+        let sat = self.description.saturation_level;
+        let cols = self.frame_size().1;
+        let mut count = 0;
+        for frame in &self.frames {
+            for (i, &x) in frame.iter().enumerate() {
+                let p = Pixel { row: (i / cols) as u16, col: (i % cols) as u16 };
+                count += usize::from(f32::from(x) >= sat && self.defects.binary_search(&p).is_err());
+            }
+        }
+        (count, self.frames.iter().map(Vec::len).sum())
     }
 
     /// Sensor geometry.
@@ -242,14 +258,10 @@ impl Capture {
     /// # Errors
     /// A mask or geometry the decoder does not take, with the reason.
     pub fn decoder(&self, sl0: Sl0Config) -> Result<TileDecoder<'_, 5, 5, 4, 4, 13, 5200>> {
-        let config = DecoderConfig {
-            sensor: self.sensor(),
-            mask: self.mask()?,
-            raw: self.raw_format(),
-            defects: self.defects(),
-            sl0,
-        };
-        TileDecoder::new(config).map_err(|e| anyhow::anyhow!("decoder: {e}"))
+        let mask = self.mask().map_err(|e| anyhow!("{}: {e:#}", self.source()))?;
+        let config =
+            DecoderConfig { sensor: self.sensor(), mask, raw: self.raw_format(), defects: self.defects(), sl0 };
+        TileDecoder::new(config).map_err(|e| anyhow!("{}: the decoder does not take this capture: {e}", self.source()))
     }
 
     /// The frames as the decoder reads them.
@@ -273,23 +285,48 @@ impl Capture {
     /// A message with the file and what is wrong in it.
     pub fn load(dir: &Path) -> Result<Self> {
         let desc_path = dir.join(DESCRIPTION);
-        let text = fs::read_to_string(&desc_path).with_context(|| format!("cannot read {}", desc_path.display()))?;
+        let named = |e: anyhow::Error| anyhow!("{}: {e:#}", desc_path.display());
+        let text = read_small_file(&desc_path, MAX_DESCRIPTION)?;
         let description: CaptureDescription = serde_json::from_str(&text)
-            .with_context(|| format!("{}: invalid capture description", desc_path.display()))?;
-        let (rows, cols) =
-            (description.lenslets[0] * description.views[0], description.lenslets[1] * description.views[1]);
+            .map_err(|e| anyhow!("{}: invalid capture description: {e}", desc_path.display()))?;
+        let (rows, cols) = description.frame_size().map_err(named)?;
+        ensure!(
+            (1..=MAX_BANDS).contains(&description.frames.len()),
+            "{}: frames lists {} files, expected 1..={MAX_BANDS} (one per snapshot)",
+            desc_path.display(),
+            description.frames.len()
+        );
         let mut frames = Vec::with_capacity(description.frames.len());
-        for name in &description.frames {
-            let path = dir.join(name);
-            let (data, r, c) = read_frame(&path)?;
+        for (i, name) in description.frames.iter().enumerate() {
+            let path = frame_path(dir, name).map_err(|e| anyhow!("{}: frames[{i}]: {e:#}", desc_path.display()))?;
+            let frame = read_frame(&path)?;
             ensure!(
-                (r, c) == (rows, cols),
-                "{}: frame is {r} x {c}, the description implies {rows} x {cols}",
-                path.display()
+                (frame.rows, frame.cols) == (rows, cols),
+                "{}: frame is {} x {}, {} implies {rows} x {cols}",
+                path.display(),
+                frame.rows,
+                frame.cols,
+                DESCRIPTION
             );
-            frames.push(data);
+            ensure!(
+                description.saturation_level <= frame.top as f32,
+                "{}: the file's largest value is {} (its MAXVAL or bit depth), below saturation_level {} in {}: \
+                 saturated pixels would read as measurements",
+                path.display(),
+                frame.top,
+                description.saturation_level,
+                DESCRIPTION
+            );
+            frames.push(frame.data);
         }
-        Self::new(description, frames).with_context(|| format!("{}: inconsistent capture", desc_path.display()))
+        let mut capture = Self::new(description, frames).map_err(named)?;
+        capture.source = Some(desc_path);
+        Ok(capture)
+    }
+
+    /// Where the capture was loaded from (its `capture.json`), for messages.
+    pub fn source(&self) -> String {
+        self.source.as_ref().map_or_else(|| "the capture".into(), |p| p.display().to_string())
     }
 
     /// Writes the capture folder: `capture.json` and the frames under their names
@@ -309,32 +346,84 @@ impl Capture {
     }
 }
 
-/// Reads a 16-bit raw frame: PGM or PNG (16-bit grey) or `.npy` (uint16, 2 axes).
+/// A raw frame as read from a file.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FrameFile {
+    /// Values as stored (DN), row-major.
+    pub data: Vec<u16>,
+    pub rows: usize,
+    pub cols: usize,
+    /// The largest value the file can hold: a PGM's MAXVAL, 255 or 65535 for PNG and `.npy`.
+    pub top: u32,
+}
+
+/// Reads a 16-bit raw frame: binary PGM (P5), 8- or 16-bit grey PNG, or `.npy` (uint16, 2
+/// axes). Values are DN as stored, whatever a PGM's MAXVAL says (image libraries rescale
+/// a MAXVAL of 4095 to 65535 for display; a decoder must not).
 ///
 /// # Errors
 /// A message with the file and what is wrong.
-pub fn read_frame(path: &Path) -> Result<(Vec<u16>, usize, usize)> {
+pub fn read_frame(path: &Path) -> Result<FrameFile> {
+    let meta = fs::metadata(path).with_context(|| format!("cannot read {}", path.display()))?;
+    ensure!(meta.is_file(), "{}: not a regular file (a FIFO, device or folder is not read)", path.display());
     match extension(path).as_str() {
-        "npy" => read_npy_u16_2d(path),
-        "pgm" | "png" => {
+        "npy" => {
+            let (data, rows, cols) = read_npy_u16_2d(path)?;
+            Ok(FrameFile { data, rows, cols, top: u32::from(u16::MAX) })
+        }
+        "pgm" => read_pgm(path, meta.len()),
+        "png" => {
             let img = image::open(path).with_context(|| format!("{}: cannot decode image", path.display()))?;
             let color = img.color();
-            ensure!(
-                matches!(color, image::ColorType::L16 | image::ColorType::L8),
-                "{}: raw frame must be single-channel grey, found {color:?}",
-                path.display()
-            );
+            let top = match color {
+                image::ColorType::L8 => 255,
+                image::ColorType::L16 => 65535,
+                _ => bail!("{}: raw frame must be single-channel grey, found {color:?}", path.display()),
+            };
             let g = img.into_luma16();
             let (w, h) = g.dimensions();
-            let data = if color == image::ColorType::L8 {
-                g.into_raw().iter().map(|&x| x / 257).collect()
-            } else {
-                g.into_raw()
-            };
-            Ok((data, h as usize, w as usize))
+            let data = if top == 255 { g.into_raw().iter().map(|&x| x / 257).collect() } else { g.into_raw() };
+            Ok(FrameFile { data, rows: h as usize, cols: w as usize, top })
         }
         other => bail!("{}: unknown frame format {other:?} (use .pgm, .png or .npy)", path.display()),
     }
+}
+
+/// A binary PGM: the header through the image library, the samples as stored.
+fn read_pgm(path: &Path, file_len: u64) -> Result<FrameFile> {
+    use image::codecs::pnm::{PnmDecoder, PnmSubtype, SampleEncoding};
+    let file = fs::File::open(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let decoder = PnmDecoder::new(std::io::BufReader::new(file))
+        .map_err(|e| anyhow!("{}: not a PGM file: {e}", path.display()))?;
+    let (mut reader, header) = decoder.into_inner();
+    ensure!(
+        header.subtype() == PnmSubtype::Graymap(SampleEncoding::Binary),
+        "{}: a raw frame is a binary PGM (P5), this file is {:?}",
+        path.display(),
+        header.subtype()
+    );
+    let (w, h, top) = (header.width(), header.height(), header.maximal_sample());
+    ensure!((1..=65535).contains(&top), "{}: MAXVAL {top} out of 1..=65535", path.display());
+    let bytes_per = if top > 255 { 2u64 } else { 1 };
+    let count = u64::from(w) * u64::from(h);
+    ensure!(
+        count * bytes_per <= file_len,
+        "{}: {w} x {h} pixels need {} bytes, the file has {file_len}",
+        path.display(),
+        count * bytes_per
+    );
+    let mut raw = vec![0u8; (count * bytes_per) as usize];
+    std::io::Read::read_exact(&mut reader, &mut raw)
+        .with_context(|| format!("{}: truncated: {w} x {h} pixels promised", path.display()))?;
+    let data: Vec<u16> = if bytes_per == 2 {
+        raw.chunks_exact(2).map(|c| u16::from_be_bytes([c[0], c[1]])).collect()
+    } else {
+        raw.iter().map(|&x| u16::from(x)).collect()
+    };
+    if let Some(i) = data.iter().position(|&x| u32::from(x) > top) {
+        bail!("{}: pixel ({}, {}) is {}, above MAXVAL {top}", path.display(), i / w as usize, i % w as usize, data[i]);
+    }
+    Ok(FrameFile { data, rows: h as usize, cols: w as usize, top })
 }
 
 /// Writes a 16-bit raw frame; the extension picks PGM, PNG or `.npy`.
@@ -344,7 +433,26 @@ pub fn read_frame(path: &Path) -> Result<(Vec<u16>, usize, usize)> {
 pub fn write_frame(path: &Path, data: &[u16], rows: usize, cols: usize) -> Result<()> {
     match extension(path).as_str() {
         "npy" => write_npy_u16_2d(path, data, rows, cols).with_context(|| format!("cannot write {}", path.display())),
-        "pgm" | "png" => {
+        "pgm" => {
+            // P5 with MAXVAL 65535, as docs/capture-format.md says: values as stored.
+            use image::codecs::pnm::{GraymapHeader, PnmEncoder, SampleEncoding};
+            ensure!(data.len() == rows * cols, "frame size does not match its data");
+            let header = GraymapHeader {
+                encoding: SampleEncoding::Binary,
+                height: rows as u32,
+                width: cols as u32,
+                maxwhite: u32::from(u16::MAX),
+            };
+            let file = fs::File::create(path).with_context(|| format!("cannot write {}", path.display()))?;
+            let mut out = std::io::BufWriter::new(file);
+            let bytes: Vec<u8> = data.iter().flat_map(|x| x.to_ne_bytes()).collect();
+            PnmEncoder::new(&mut out)
+                .with_header(header.into())
+                .encode(&bytes[..], cols as u32, rows as u32, image::ExtendedColorType::L16)
+                .with_context(|| format!("cannot write {}", path.display()))?;
+            std::io::Write::flush(&mut out).with_context(|| format!("cannot write {}", path.display()))
+        }
+        "png" => {
             let img =
                 image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_raw(cols as u32, rows as u32, data.to_vec())
                     .context("frame size does not match its data")?;
@@ -366,4 +474,76 @@ pub fn frame_names(k: usize, ext: &str) -> Vec<String> {
 /// The folder path's description file.
 pub fn description_path(dir: &Path) -> PathBuf {
     dir.join(DESCRIPTION)
+}
+
+/// Reads a regular file of at most `max` bytes as text; larger files, FIFOs and devices are
+/// refused before reading.
+///
+/// # Errors
+/// A message with the file and what is wrong.
+pub fn read_small_file(path: &Path, max: u64) -> Result<String> {
+    let meta = fs::metadata(path).with_context(|| format!("cannot read {}", path.display()))?;
+    ensure!(meta.is_file(), "{}: not a regular file (a FIFO, device or folder is not read)", path.display());
+    ensure!(meta.len() <= max, "{}: {} bytes, more than the {max} this file can need", path.display(), meta.len());
+    fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))
+}
+
+/// A frame's path: `name` must be a relative path inside the capture folder.
+///
+/// # Errors
+/// An absolute path, `..`, or an empty name.
+pub fn frame_path(dir: &Path, name: &str) -> Result<PathBuf> {
+    use std::path::Component;
+    let rel = Path::new(name);
+    ensure!(!name.is_empty(), "an empty file name");
+    ensure!(
+        rel.components().all(|c| matches!(c, Component::Normal(_) | Component::CurDir)),
+        "{name:?} is not a path inside the capture folder (no absolute paths, no '..')"
+    );
+    Ok(dir.join(rel))
+}
+
+impl CaptureDescription {
+    /// Checks the geometry, format and levels, and returns the frame size `(rows, cols)`.
+    ///
+    /// # Errors
+    /// A message naming the field that is wrong and its range.
+    pub fn frame_size(&self) -> Result<(usize, usize)> {
+        ensure!(self.format == FORMAT, "format is {:?}, expected {FORMAT:?}", self.format);
+        ensure!(self.version == VERSION, "version {} is not supported (this slf reads {VERSION})", self.version);
+        ensure!(
+            self.lenslets.iter().all(|&x| (1..=usize::from(u16::MAX)).contains(&x)),
+            "lenslets {:?} out of range 1..={}",
+            self.lenslets,
+            u16::MAX
+        );
+        ensure!(self.views.iter().all(|&x| (1..=255).contains(&x)), "views {:?} out of range 1..=255", self.views);
+        let rows = self.lenslets[0].checked_mul(self.views[0]);
+        let cols = self.lenslets[1].checked_mul(self.views[1]);
+        let (Some(rows), Some(cols)) = (rows, cols) else {
+            bail!("lenslets {:?} x views {:?} overflows", self.lenslets, self.views);
+        };
+        ensure!(
+            rows <= usize::from(u16::MAX) && cols <= usize::from(u16::MAX),
+            "lenslets {:?} x views {:?} is a {rows} x {cols} frame, at most {} x {}",
+            self.lenslets,
+            self.views,
+            u16::MAX,
+            u16::MAX
+        );
+        ensure!(
+            (1..=32).contains(&self.bands_nm.len()),
+            "bands_nm has {} entries, expected 1..=32",
+            self.bands_nm.len()
+        );
+        ensure!(
+            self.black_level.is_finite()
+                && self.white_level.is_finite()
+                && self.saturation_level.is_finite()
+                && self.white_level > self.black_level
+                && self.saturation_level > self.black_level,
+            "levels: need finite black_level < white_level and black_level < saturation_level"
+        );
+        Ok((rows, cols))
+    }
 }

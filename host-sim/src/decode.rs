@@ -56,6 +56,28 @@ impl Basis {
     }
 }
 
+/// The largest dictionary blob of the decoder's patch: 65,535 members, the format's limit.
+pub const MAX_BLOB: usize = slf_firmware::blob::blob_len([5, 5, 4, 4, 13], u16::MAX as usize);
+
+/// Reads and validates a dictionary blob file; a file larger than [`MAX_BLOB`], a FIFO or a
+/// device is refused before reading.
+///
+/// # Errors
+/// A message with the file and what is wrong.
+pub fn read_blob(path: &std::path::Path) -> Result<Vec<u8>> {
+    let meta = std::fs::metadata(path).map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
+    ensure!(meta.is_file(), "{}: not a regular file (a FIFO, device or folder is not read)", path.display());
+    ensure!(
+        meta.len() <= MAX_BLOB as u64,
+        "{}: {} bytes, larger than any dictionary blob of the decoder's patch ({MAX_BLOB} bytes at 65,535 members)",
+        path.display(),
+        meta.len()
+    );
+    let blob = std::fs::read(path).map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
+    slf_firmware::Ensemble::<5, 5, 4, 4, 13>::new(&blob).map_err(|e| anyhow!("{}: {e}", path.display()))?;
+    Ok(blob)
+}
+
 /// Decodes `capture` with `basis` (see [`decode`]).
 ///
 /// # Errors
@@ -64,8 +86,7 @@ pub fn decode_with(capture: &Capture, basis: &Basis, opts: &DecodeOptions) -> Re
     match basis {
         Basis::Dct => decode(capture, &Dictionary::dct(), opts),
         Basis::Ensemble { blob, choice } => {
-            let ensemble =
-                slf_firmware::Ensemble::<5, 5, 4, 4, 13>::new(blob).map_err(|e| anyhow!("dictionary blob: {e}"))?;
+            let ensemble = slf_firmware::Ensemble::<5, 5, 4, 4, 13>::new(blob).map_err(|e| anyhow!("{e}"))?;
             decode(capture, &slf_firmware::EnsembleModel::new(ensemble, *choice), opts)
         }
     }

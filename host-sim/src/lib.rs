@@ -4,7 +4,8 @@
 //! From a scene to numbers:
 //!
 //! - [`scene`] renders synthetic spectral light fields ([`spectra`] holds measured and
-//!   synthetic spectra); [`lightfield`] reads and writes them as `.npy`.
+//!   synthetic spectra); [`lightfield`] reads and writes them as `.npy` ([`npy`] reads
+//!   any `.npy` with every size checked first).
 //! - [`camera`] turns a light field into raw frames with the firmware's masks, noise,
 //!   black level, quantisation, saturation and defects; [`capture`] is the folder format.
 //! - [`decode`] runs the firmware's tile decoder over a capture in parallel.
@@ -24,6 +25,7 @@ pub mod decode;
 pub mod device;
 pub mod lightfield;
 pub mod metrics;
+pub mod npy;
 pub mod preview;
 pub mod report;
 pub mod scene;

@@ -7,7 +7,7 @@
 //! (`0..=65535` maps to `[0, 1]`).
 
 use std::fs::File;
-use std::io::{BufReader, BufWriter, Read};
+use std::io::BufWriter;
 use std::path::Path;
 
 use npyz::WriterBuilder;
@@ -45,6 +45,17 @@ impl LightField {
         (((u * self.views.1 + v) * self.rows + y) * self.cols + x) * self.bands + b
     }
 
+    /// The `(u, v, y, x, b)` of a data index.
+    pub fn coordinates(&self, i: usize) -> (usize, usize, usize, usize, usize) {
+        let b = i % self.bands;
+        let i = i / self.bands;
+        let x = i % self.cols;
+        let i = i / self.cols;
+        let y = i % self.rows;
+        let i = i / self.rows;
+        (i / self.views.1, i % self.views.1, y, x, b)
+    }
+
     /// Value at `(u, v, y, x, b)`.
     #[inline]
     pub fn get(&self, u: usize, v: usize, y: usize, x: usize, b: usize) -> f32 {
@@ -72,71 +83,55 @@ pub enum Dtype {
     U16,
 }
 
-/// Why a `.npy` file is not a light field.
-#[derive(Debug, thiserror::Error)]
-pub enum NpyError {
-    #[error("{path}: {source}")]
-    Io { path: String, source: std::io::Error },
-    #[error("{path}: dtype {found}, expected float32 ('<f4') or uint16 ('<u2')")]
-    Dtype { path: String, found: String },
-    #[error("{path}: {rank} axes {shape:?}, expected 5 (U, V, H, W, B)")]
-    Rank { path: String, rank: usize, shape: Vec<u64> },
-    #[error("{path}: shape {shape:?} has an empty axis")]
-    Empty { path: String, shape: Vec<u64> },
-    #[error("{path}: Fortran-order arrays are not supported; save with C order")]
-    Order { path: String },
-    #[error("{path}: truncated body: header promises {expected} values, file holds {found}")]
-    Truncated { path: String, expected: u64, found: u64 },
-}
+use crate::npy::{self, Values};
+pub use crate::npy::{NpyError, NpyErrorKind};
 
 fn io_err(path: &Path) -> impl Fn(std::io::Error) -> NpyError + '_ {
-    move |source| NpyError::Io { path: path.display().to_string(), source }
+    move |source| NpyError::new(path, NpyErrorKind::Io(source))
 }
 
-/// Reads a 5-axis `(U, V, H, W, B)` float32 or uint16 `.npy` file.
+/// Reads a 5-axis `(U, V, H, W, B)` light field from `.npy` (float32, float64 or uint16;
+/// C or Fortran order) and prints to stderr, as `note: FILE: ...`, any conversion made.
 ///
 /// # Errors
-/// [`NpyError`] saying what is wrong: I/O, dtype, rank, empty axis, order, truncation.
+/// [`NpyError`] saying what is wrong and where: I/O, header, dtype, rank, an empty axis,
+/// truncation, values that are not finite.
 pub fn read_npy(path: &Path) -> Result<LightField, NpyError> {
-    let p = path.display().to_string();
-    let file = File::open(path).map_err(io_err(path))?;
-    let npy = npyz::NpyFile::new(BufReader::new(file)).map_err(io_err(path))?;
-    let shape = npy.shape().to_vec();
-    if shape.len() != 5 {
-        return Err(NpyError::Rank { path: p, rank: shape.len(), shape });
+    let (lf, notes) = read_npy_with_notes(path)?;
+    for n in notes {
+        eprintln!("note: {}: {n}", path.display());
     }
-    if shape.contains(&0) {
-        return Err(NpyError::Empty { path: p, shape });
-    }
-    if npy.order() != npyz::Order::C {
-        return Err(NpyError::Order { path: p });
-    }
-    let descr = npy.dtype().descr();
-    let expected: u64 = shape.iter().product();
-    let s: Vec<usize> = shape.iter().map(|&x| x as usize).collect();
-    let mut lf = LightField { views: (s[0], s[1]), rows: s[2], cols: s[3], bands: s[4], data: Vec::new() };
-    let (item, f32_data) = match descr.as_str() {
-        "'<f4'" => (4, true),
-        "'<u2'" => (2, false),
-        _ => {
-            return Err(NpyError::Dtype { path: p, found: descr });
-        }
-    };
-    // Read the whole body and check its length before converting: a short body is reported
-    // as truncation, with counts, not as an I/O error in the middle of a value.
-    let mut body = Vec::new();
-    npy.into_inner().read_to_end(&mut body).map_err(io_err(path))?;
-    let found = body.len() as u64 / item;
-    if found < expected {
-        return Err(NpyError::Truncated { path: p, expected, found });
-    }
-    let body = &body[..(expected * item) as usize];
-    lf.data = if f32_data {
-        body.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect()
-    } else {
-        body.chunks_exact(2).map(|c| f32::from(u16::from_le_bytes([c[0], c[1]])) / 65535.0).collect()
-    };
     Ok(lf)
+}
+
+/// As [`read_npy`], returning the conversion notes instead of printing them.
+///
+/// # Errors
+/// As [`read_npy`].
+pub fn read_npy_with_notes(path: &Path) -> Result<(LightField, Vec<String>), NpyError> {
+    let a = npy::read(path)?;
+    let shape_err = |what: String| NpyError::new(path, NpyErrorKind::Shape(what));
+    let s = &a.shape;
+    if s.len() != 5 {
+        return Err(shape_err(format!("{} axes {s:?}, expected 5 (U, V, H, W, B)", s.len())));
+    }
+    if s.contains(&0) {
+        return Err(shape_err(format!("shape {s:?} has an empty axis")));
+    }
+    let data = match a.values {
+        Values::F32(v) => v,
+        Values::U16(v) => v.into_iter().map(|x| f32::from(x) / 65535.0).collect(),
+    };
+    let lf = LightField { views: (s[0], s[1]), rows: s[2], cols: s[3], bands: s[4], data };
+    let bad = lf.data.iter().filter(|x| !x.is_finite()).count();
+    if let Some(first) = lf.data.iter().position(|x| !x.is_finite()) {
+        let (u, v, y, x, b) = lf.coordinates(first);
+        return Err(shape_err(format!(
+            "{bad} of {} values are not finite (NaN or infinite), the first at (u, v, y, x, b) = ({u}, {v}, {y}, {x}, {b})",
+            lf.data.len()
+        )));
+    }
+    Ok((lf, a.notes))
 }
 
 /// Writes a light field as a 5-axis `.npy` file of `dtype` (uint16 clamps to `[0, 1]`).
@@ -184,16 +179,15 @@ pub fn write_npy_u16_2d(path: &Path, data: &[u16], rows: usize, cols: usize) -> 
 /// Reads a uint16 2D `.npy` array (a raw frame): `(data, rows, cols)`.
 ///
 /// # Errors
-/// A message saying what is wrong.
-pub fn read_npy_u16_2d(path: &Path) -> anyhow::Result<(Vec<u16>, usize, usize)> {
-    let file = File::open(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    let npy = npyz::NpyFile::new(BufReader::new(file)).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    let shape = npy.shape().to_vec();
-    anyhow::ensure!(shape.len() == 2, "{}: raw frame must have 2 axes, found {shape:?}", path.display());
-    let descr = npy.dtype().descr();
-    anyhow::ensure!(descr == "'<u2'", "{}: raw frame dtype {descr}, expected uint16 ('<u2')", path.display());
-    anyhow::ensure!(npy.order() == npyz::Order::C, "{}: Fortran order not supported", path.display());
-    let data: Vec<u16> =
-        npy.into_vec().map_err(|e| anyhow::anyhow!("{}: truncated or unreadable body: {e}", path.display()))?;
-    Ok((data, shape[0] as usize, shape[1] as usize))
+/// [`NpyError`]: what is wrong and where.
+pub fn read_npy_u16_2d(path: &Path) -> Result<(Vec<u16>, usize, usize), NpyError> {
+    let a = npy::read(path)?;
+    let shape_err = |what: String| NpyError::new(path, NpyErrorKind::Shape(what));
+    if a.shape.len() != 2 {
+        return Err(shape_err(format!("a raw frame has 2 axes (H, W), this array {:?}", a.shape)));
+    }
+    match a.values {
+        Values::U16(v) => Ok((v, a.shape[0], a.shape[1])),
+        Values::F32(_) => Err(shape_err("a raw frame holds uint16 ('<u2') values, this array floats".into())),
+    }
 }

@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 use slf_host::camera::{CameraConfig, simulate};
 use slf_host::capture::{Capture, MaskDescription};
-use slf_host::decode::{Basis, DecodeOptions, decode_with};
+use slf_host::decode::{Basis, DecodeOptions, decode_with, read_blob};
 use slf_host::firmware::{ChoiceRule, DEFAULT_ENSEMBLE, MaskFamily, MemberChoice, Sl0Config};
 use slf_host::lightfield::{Dtype, read_npy, write_npy};
 use slf_host::metrics::evaluate;
@@ -20,6 +20,47 @@ use slf_host::{baseline, report, train};
 struct Cli {
     #[command(subcommand)]
     command: Command,
+}
+
+/// A whole number in `LO..=HI`, for clap: the error names the range (clap names the argument).
+fn ranged<const LO: usize, const HI: usize>(s: &str) -> Result<usize, String> {
+    let v: usize = s.parse().map_err(|_| format!("{s:?} is not a whole number in {LO}..={HI}"))?;
+    if (LO..=HI).contains(&v) { Ok(v) } else { Err(format!("{v} is out of range {LO}..={HI}")) }
+}
+
+/// A finite number above zero, for clap.
+fn positive(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("{s:?} is not a finite number above 0")),
+    }
+}
+
+/// A finite number at or above zero, for clap.
+fn non_negative(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err(format!("{s:?} is not a finite number at or above 0")),
+    }
+}
+
+/// A fraction in `[0, 1)`, for clap.
+fn fraction(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if (0.0..1.0).contains(&v) => Ok(v),
+        _ => Err(format!("{s:?} is not a fraction in [0, 1)")),
+    }
+}
+
+/// The frame file format `slf simulate` writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum FrameFormat {
+    /// Binary 16-bit PGM (P5).
+    Pgm,
+    /// 16-bit grey PNG.
+    Png,
+    /// uint16 `.npy`, 2 axes.
+    Npy,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -99,7 +140,7 @@ impl BasisArgs {
             DictionaryKind::Dct => Basis::Dct,
             DictionaryKind::Ensemble => {
                 let blob = match &self.blob {
-                    Some(p) => std::fs::read(p).with_context(|| format!("cannot read {}", p.display()))?,
+                    Some(p) => read_blob(p)?,
                     None => DEFAULT_ENSEMBLE.to_vec(),
                 };
                 let rule = ChoiceRule::DEFAULT;
@@ -181,11 +222,11 @@ enum Command {
         /// Where previews and files go.
         #[arg(long, default_value = "slf-demo")]
         out: PathBuf,
-        /// Named scene.
+        /// Named scene (smooth, texture, depth, saturated, dark).
         #[arg(long, default_value = "depth")]
         scene: String,
-        /// Spatial size (lenslets per side).
-        #[arg(long, default_value_t = 100)]
+        /// Spatial size (lenslets per side), 5..=2048.
+        #[arg(long, default_value_t = 100, value_parser = ranged::<5, 2048>)]
         size: usize,
         #[command(flatten)]
         basis: BasisArgs,
@@ -200,11 +241,11 @@ enum Command {
         /// Seed of a random scene.
         #[arg(long, default_value_t = 0)]
         seed: u64,
-        /// Spatial rows and columns.
-        #[arg(long, default_value_t = 100)]
+        /// Spatial rows and columns, 1..=4096.
+        #[arg(long, default_value_t = 100, value_parser = ranged::<1, 4096>)]
         size: usize,
-        /// Views per side.
-        #[arg(long, default_value_t = 5)]
+        /// Views per side, 1..=16.
+        #[arg(long, default_value_t = 5, value_parser = ranged::<1, 16>)]
         views: usize,
         /// Stored dtype.
         #[arg(long, value_enum, default_value_t = Dtype::F32)]
@@ -217,6 +258,7 @@ enum Command {
         /// Capture folder to write.
         #[arg(short, long)]
         output: PathBuf,
+        /// Mask family: which band each pixel sees in each snapshot.
         #[arg(long, value_enum, default_value_t = Family::Pixel)]
         mask: Family,
         /// Snapshots k (1..=13).
@@ -225,21 +267,21 @@ enum Command {
         /// Seed of the mask, noise and defects.
         #[arg(long, default_value_t = 1)]
         seed: u64,
-        /// Read noise, DN.
-        #[arg(long, default_value_t = 2.0)]
+        /// Read noise, DN (finite, at or above 0).
+        #[arg(long, default_value_t = 2.0, value_parser = non_negative)]
         read_noise: f32,
-        /// Electrons at white (shot noise).
-        #[arg(long, default_value_t = 20_000.0)]
+        /// Electrons at white (shot noise); finite, above 0.
+        #[arg(long, default_value_t = 20_000.0, value_parser = positive)]
         full_well: f32,
         /// No shot or read noise.
         #[arg(long)]
         no_noise: bool,
-        /// Fraction of defective pixels.
-        #[arg(long, default_value_t = 0.0)]
+        /// Fraction of defective pixels, in [0, 1).
+        #[arg(long, default_value_t = 0.0, value_parser = fraction)]
         defects: f64,
-        /// Frame file format: pgm, png or npy.
-        #[arg(long, default_value = "pgm")]
-        format: String,
+        /// Frame file format.
+        #[arg(long, value_enum, default_value_t = FrameFormat::Pgm)]
+        format: FrameFormat,
     },
     /// Decode a capture folder into a light field .npy.
     Decode {
@@ -263,14 +305,21 @@ enum Command {
         quiet: bool,
     },
     /// PSNR, SSIM and spectral angle of a reconstruction against the ground truth.
-    Eval { truth: PathBuf, recon: PathBuf },
+    Eval {
+        /// The ground truth light field, (U, V, H, W, B) .npy.
+        truth: PathBuf,
+        /// The reconstruction, same shape.
+        recon: PathBuf,
+    },
     /// The paper's 1D method against the 5D decoder on the same patches: time and memory.
     Baseline {
-        /// Patches (each a fresh measurement of a test patch).
-        #[arg(long, default_value_t = 3)]
+        /// Patches (each a fresh measurement of a test patch), 1..=1000.
+        #[arg(long, default_value_t = 3, value_parser = ranged::<1, 1000>)]
         patches: usize,
+        /// Mask family.
         #[arg(long, value_enum, default_value_t = Family::Pixel)]
         mask: Family,
+        /// Snapshots k (1..=13).
         #[arg(short, long, default_value_t = 1)]
         snapshots: u8,
     },
@@ -282,36 +331,39 @@ enum Command {
         /// Training light fields (.npy); without them, random training scenes are rendered.
         #[arg(long, num_args = 1..)]
         input: Vec<PathBuf>,
-        /// Random training scenes to render when no --input is given.
-        #[arg(long, default_value_t = 24)]
+        /// Random training scenes to render when no --input is given, 1..=1000.
+        #[arg(long, default_value_t = 24, value_parser = ranged::<1, 1000>)]
         scenes: usize,
-        /// Spatial size of each rendered training scene.
-        #[arg(long, default_value_t = 60)]
+        /// Spatial size of each rendered training scene, 5..=1024.
+        #[arg(long, default_value_t = 60, value_parser = ranged::<5, 1024>)]
         size: usize,
-        /// Patches sampled for training.
-        #[arg(long, default_value_t = 6000)]
+        /// Patches sampled for training, 1..=1000000.
+        #[arg(long, default_value_t = 6000, value_parser = ranged::<1, 1_000_000>)]
         patches: usize,
-        /// Members K.
-        #[arg(long, default_value_t = 8)]
+        /// Members K, 1..=256.
+        #[arg(long, default_value_t = 8, value_parser = ranged::<1, 256>)]
         members: usize,
-        /// Coefficients kept per patch when coding.
-        #[arg(long, default_value_t = 100)]
+        /// Coefficients kept per patch when coding, 1..=5200.
+        #[arg(long, default_value_t = 100, value_parser = ranged::<1, 5200>)]
         tau: usize,
-        #[arg(long, default_value_t = 10)]
+        /// Training iterations (assign patches to members, update each member), 0..=1000.
+        #[arg(long, default_value_t = 10, value_parser = ranged::<0, 1000>)]
         iterations: usize,
-        /// Patches per member for the HOSVD initialisation.
-        #[arg(long, default_value_t = 32)]
+        /// Patches per member for the HOSVD initialisation, 1..=100000.
+        #[arg(long, default_value_t = 32, value_parser = ranged::<1, 100_000>)]
         group: usize,
+        /// Seed of the patch sampling, initialisation and rendered scenes.
         #[arg(long, default_value_t = 1)]
         seed: u64,
         /// Learn every member (by default member 0 is the fixed 5D DCT).
         #[arg(long)]
         no_dct_member: bool,
     },
-    /// PSNR / SSIM / SA of every test scene x mask family x k, with the DCT; a markdown table.
+    /// PSNR / SSIM / SA of every test scene x mask family x k, decoded with --dictionary
+    /// (default: the shipped ensemble, screened); a markdown table.
     Sweep {
-        /// Spatial size (lenslets per side).
-        #[arg(long, default_value_t = 60)]
+        /// Spatial size (lenslets per side), 5..=1024.
+        #[arg(long, default_value_t = 60, value_parser = ranged::<5, 1024>)]
         size: usize,
         /// Snapshot counts.
         #[arg(long, value_delimiter = ',', default_value = "1,3,5,7")]
@@ -359,9 +411,10 @@ enum Command {
     /// Mean PSNR / SSIM / SA over the test scenes for {DCT, ensemble exhaustive, ensemble
     /// screened} x {pixel, lenslet, kronecker} x k, and time per patch; a markdown table.
     Compare {
-        /// Spatial size (lenslets per side).
-        #[arg(long, default_value_t = 40)]
+        /// Spatial size (lenslets per side), 5..=1024.
+        #[arg(long, default_value_t = 40, value_parser = ranged::<5, 1024>)]
         size: usize,
+        /// Snapshot counts.
         #[arg(long, value_delimiter = ',', default_value = "1,3,5,7")]
         k: Vec<u8>,
         /// Also write the table to this file.
@@ -381,6 +434,9 @@ enum Command {
         rule_tau: u16,
     },
 }
+
+/// `slf decode` warns when more than this fraction of patches failed or were flagged.
+const WARN_FRACTION: f64 = 0.01;
 
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
@@ -423,7 +479,9 @@ fn run(cli: Cli) -> Result<()> {
                 scene::named(&name)
                     .with_context(|| format!("unknown scene {name:?}: one of {:?} or random", scene::NAMES))?
             };
-            let lf = s.render(SceneSize { views: (views, views), rows: size, cols: size });
+            let size = SceneSize { views: (views, views), rows: size, cols: size };
+            size.check().map_err(|e| anyhow::anyhow!("--size {} with --views {views}: {e}", size.rows))?;
+            let lf = s.render(size);
             write_npy(&output, &lf, dtype)?;
             println!("wrote {} ({:?})", output.display(), lf.shape());
             Ok(())
@@ -445,11 +503,22 @@ fn run(cli: Cli) -> Result<()> {
             cam.read_noise = read_noise;
             cam.full_well = Some(full_well);
             cam.defect_fraction = defects;
-            cam.frame_ext = format;
+            cam.frame_ext = format!("{format:?}").to_lowercase();
             if no_noise {
                 cam = cam.noiseless();
             }
-            let capture = simulate(&lf, &cam)?;
+            let capture = simulate(&lf, &cam).map_err(|e| anyhow::anyhow!("{}: {e:#}", input.display()))?;
+            let (clipped, total) = capture.saturated_pixels();
+            if clipped > 0 {
+                eprintln!(
+                    "warning: {}: {clipped} of {total} pixels ({:.2} %) saturated: the light field exceeds white \
+                     (max {:.3}, clips at {:.3}); saturated pixels are not measurements",
+                    input.display(),
+                    100.0 * clipped as f64 / total as f64,
+                    lf.max(),
+                    1.0 / cam.white_fraction
+                );
+            }
             capture.save(&output)?;
             println!("wrote {} ({} snapshots)", output.display(), capture.frames.len());
             Ok(())
@@ -471,6 +540,26 @@ fn run(cli: Cli) -> Result<()> {
                     );
                 }
                 std::fs::write(&path, csv).with_context(|| format!("cannot write {}", path.display()))?;
+            }
+            let p = &r.patches;
+            let all = p.decoded + p.failed;
+            anyhow::ensure!(
+                p.decoded > 0,
+                "{}: no patch decoded ({} failed, {} of {} tiles failed): every patch saturated, defective or \
+                 unreadable; nothing written",
+                capture.display(),
+                p.failed,
+                r.failed_tiles,
+                r.tiles
+            );
+            if (p.failed + p.flagged) as f64 > WARN_FRACTION * f64::from(all) || r.failed_tiles > 0 {
+                eprintln!(
+                    "warning: {}: {} of {all} patches failed and {} were flagged (pixels left out), {} tiles failed",
+                    capture.display(),
+                    p.failed,
+                    p.flagged,
+                    r.failed_tiles
+                );
             }
             write_npy(&output, &lf, dtype)?;
             println!(

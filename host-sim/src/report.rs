@@ -112,7 +112,7 @@ pub fn compare(
     rule: ChoiceRule,
 ) -> Result<()> {
     let blob = match blob {
-        Some(p) => std::fs::read(p).with_context(|| format!("cannot read {}", p.display()))?,
+        Some(p) => crate::decode::read_blob(p)?,
         None => DEFAULT_ENSEMBLE.to_vec(),
     };
     let bases = [

@@ -110,3 +110,114 @@ fn bad_files_and_arguments_are_one_line_errors() {
         assert_eq!(e.lines().count(), 1, "{args:?}: {e}");
     }
 }
+
+fn stderr_of_success(cmd: &mut Command) -> String {
+    let out = cmd.assert().success().get_output().stderr.clone();
+    String::from_utf8(out).unwrap()
+}
+
+#[test]
+fn out_of_range_arguments_name_the_argument_and_its_range() {
+    let dir = tempfile::tempdir().unwrap();
+    let x = dir.path().join("x.npy");
+    // Before: panics (size 0), a 63 TB allocation (views 100000), an unusable file (views 0).
+    let cases: &[(&[&str], &str)] = &[
+        (&["scene", "depth", "--size", "0"], "'--size <SIZE>': 0 is out of range 1..=4096"),
+        (&["scene", "depth", "--size", "100000000"], "100000000 is out of range 1..=4096"),
+        (&["scene", "depth", "--views", "100000", "--size", "11"], "'--views <VIEWS>': 100000 is out of range 1..=16"),
+        (&["scene", "depth", "--views", "0"], "'--views <VIEWS>': 0 is out of range 1..=16"),
+        (&["scene", "depth", "--views", "16", "--size", "4096"], "--size 4096 with --views 16"),
+        (&["demo", "--size", "0"], "0 is out of range 5..=2048"),
+        (&["compare", "--size", "0"], "0 is out of range 5..=1024"),
+        (&["sweep", "--size", "3"], "3 is out of range 5..=1024"),
+        (&["train", "--members", "0"], "'--members <MEMBERS>': 0 is out of range 1..=256"),
+        (&["baseline", "--patches", "0"], "'--patches <PATCHES>': 0 is out of range 1..=1000"),
+    ];
+    for (args, want) in cases {
+        let mut cmd = slf();
+        cmd.current_dir(dir.path()).args(*args);
+        if args[0] == "scene" {
+            cmd.arg("-o").arg(&x);
+        }
+        let e = failure(&mut cmd);
+        assert!(e.contains(want), "{args:?}: {e}");
+        assert_eq!(e.lines().count(), 1, "{args:?}: {e}");
+    }
+    assert!(!x.exists(), "no file written");
+    let cap = dir.path().join("cap");
+    stdout(slf().args(["scene", "smooth", "--size", "12", "-o"]).arg(&x));
+    for (flag, value, want) in [
+        ("--full-well", "0", "not a finite number above 0"),
+        ("--full-well", "NaN", "not a finite number above 0"),
+        ("--read-noise", "-1", "not a finite number at or above 0"),
+        ("--defects", "1", "not a fraction in [0, 1)"),
+        ("--defects", "-0.1", "not a fraction in [0, 1)"),
+        ("--format", "tiff", "invalid value 'tiff' for '--format"),
+    ] {
+        let e = failure(slf().arg("simulate").arg(&x).arg("-o").arg(&cap).arg(format!("{flag}={value}")));
+        assert!(e.contains(want) && e.contains(flag), "{flag} {value}: {e}");
+    }
+    assert!(!cap.exists());
+}
+
+#[test]
+fn nothing_decoded_is_a_failure_and_many_flagged_patches_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    stdout(slf().args(["scene", "smooth", "--size", "12", "-o"]).arg(p("lf.npy")));
+    // A light field far above white: simulate warns, and every patch is saturated.
+    let lf = slf_host::lightfield::read_npy(&p("lf.npy")).unwrap();
+    let bright = slf_host::lightfield::LightField { data: lf.data.iter().map(|_| 50.0).collect(), ..lf.clone() };
+    slf_host::lightfield::write_npy(&p("bright.npy"), &bright, slf_host::lightfield::Dtype::F32).unwrap();
+    let warn = stderr_of_success(slf().arg("simulate").arg(p("bright.npy")).arg("-o").arg(p("cap")));
+    assert!(warn.contains("warning") && warn.contains("3600 of 3600 pixels (100.00 %) saturated"), "{warn}");
+    // Before: exit 0 and a file of zeros.
+    let e = failure(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("out.npy")).arg("-q"));
+    assert!(e.contains("no patch decoded (36 failed"), "{e}");
+    assert!(!p("out.npy").exists(), "nothing written");
+    // Half the pixels defective: every patch flagged, decoded, and a warning with the count.
+    stdout(slf().arg("simulate").arg(p("lf.npy")).arg("-o").arg(p("cap2")).arg("--defects=0.5"));
+    let out = slf().arg("decode").arg(p("cap2")).arg("-o").arg(p("out.npy")).arg("-q").assert().success();
+    let err = String::from_utf8(out.get_output().stderr.clone()).unwrap();
+    assert!(err.contains("warning") && err.contains("36 were flagged"), "{err}");
+    // No warning on a clean capture.
+    stdout(slf().arg("simulate").arg(p("lf.npy")).arg("-o").arg(p("cap3")));
+    let err = stderr_of_success(slf().arg("decode").arg(p("cap3")).arg("-o").arg(p("out3.npy")).arg("-q"));
+    assert!(err.is_empty(), "{err}");
+}
+
+#[test]
+fn bad_light_fields_are_refused_with_what_is_wrong() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    stdout(slf().args(["scene", "smooth", "--size", "12", "-o"]).arg(p("lf.npy")));
+    let lf = slf_host::lightfield::read_npy(&p("lf.npy")).unwrap();
+    // (H, W, U, V, B) read as (U, V, H, W, B): more views than lenslets.
+    let mut swapped = slf_host::lightfield::LightField::zeros((12, 12), 5, 5, 13);
+    for (u, v, y, x, b) in (0..5).flat_map(|u| {
+        (0..5).flat_map(move |v| {
+            (0..12).flat_map(move |y| (0..12).flat_map(move |x| (0..13).map(move |b| (u, v, y, x, b))))
+        })
+    }) {
+        let i = swapped.index(y, x, u, v, b);
+        swapped.data[i] = lf.get(u, v, y, x, b);
+    }
+    slf_host::lightfield::write_npy(&p("swapped.npy"), &swapped, slf_host::lightfield::Dtype::F32).unwrap();
+    let e = failure(slf().arg("simulate").arg(p("swapped.npy")).arg("-o").arg(p("cap")));
+    assert!(e.contains("swapped.npy") && e.contains("(H, W, U, V, B)"), "{e}");
+    // NaN in a light field: eval, simulate and train refuse it (before: "PSNR NaN", exit 0;
+    // train panicked).
+    let mut nan = lf.clone();
+    nan.data.iter_mut().for_each(|x| *x = f32::NAN);
+    slf_host::lightfield::write_npy(&p("nan.npy"), &nan, slf_host::lightfield::Dtype::F32).unwrap();
+    for args in [
+        vec!["eval", "lf.npy", "nan.npy"],
+        vec!["eval", "nan.npy", "lf.npy"],
+        vec!["simulate", "nan.npy", "-o", "c"],
+        vec!["train", "-o", "t.slfd", "--input", "nan.npy"],
+    ] {
+        let e = failure(slf().current_dir(dir.path()).args(&args));
+        assert!(e.contains("nan.npy") && e.contains("values are not finite"), "{args:?}: {e}");
+        assert_eq!(e.lines().count(), 1, "{e}");
+    }
+}

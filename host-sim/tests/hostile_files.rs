@@ -1,0 +1,391 @@
+//! Hostile and unusual input files: every one a clear one-line error or a documented
+//! conversion, never a hang, a panic or an allocation the file cannot back.
+//!
+//! `.npy` files are written byte by byte here (no numpy needed), so each case is exactly the
+//! file named in the test.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::mpsc;
+use std::time::Duration;
+
+use slf_host::camera::{CameraConfig, simulate};
+use slf_host::capture::{Capture, read_frame, write_frame};
+use slf_host::lightfield::{LightField, read_npy, read_npy_with_notes};
+use slf_host::npy::{self, NpyErrorKind, Values};
+
+/// An `.npy` file: magic, version, header length field as given, header text, body.
+fn npy_bytes(version: u8, header: &str, body: &[u8]) -> Vec<u8> {
+    let mut out = b"\x93NUMPY".to_vec();
+    out.extend_from_slice(&[version, 0]);
+    if version == 1 {
+        out.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    } else {
+        out.extend_from_slice(&(header.len() as u32).to_le_bytes());
+    }
+    out.extend_from_slice(header.as_bytes());
+    out.extend_from_slice(body);
+    out
+}
+
+fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::File::create(&p).unwrap().write_all(bytes).unwrap();
+    p
+}
+
+/// Runs `f` on another thread and fails the test if it takes longer than `secs`.
+fn within<T: Send + 'static>(secs: u64, f: impl FnOnce() -> T + Send + 'static) -> T {
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = tx.send(f());
+    });
+    rx.recv_timeout(Duration::from_secs(secs)).expect("did not finish in time (or panicked)")
+}
+
+#[test]
+fn nested_brackets_in_a_header_are_refused_at_once() {
+    // Before: the header parser backtracked exponentially (12 braces 1.6 s, 14 braces 14 s,
+    // 20 braces hours). Now the header is read in one pass.
+    let dir = tempfile::tempdir().unwrap();
+    for open in ["{", "(", "["] {
+        let close = match open {
+            "{" => "}",
+            "(" => ")",
+            _ => "]",
+        };
+        let header =
+            format!("{{'descr': '<f4', 'fortran_order': False, 'shape': {}{}}}", open.repeat(40), close.repeat(40));
+        let p = write(dir.path(), "nested.npy", &npy_bytes(1, &header, &[]));
+        let e = within(5, move || read_npy(&p).unwrap_err().to_string());
+        assert!(e.contains("nested.npy") && e.contains("header, byte"), "{e}");
+        assert_eq!(e.lines().count(), 1, "{e}");
+    }
+    // Also as the descr and as a key.
+    let header = format!("{{'descr': {}", "[".repeat(60));
+    let p = write(dir.path(), "nested2.npy", &npy_bytes(1, &header, &[]));
+    let e = within(5, move || read_npy(&p).unwrap_err().to_string());
+    assert!(e.contains("structured dtypes are not supported"), "{e}");
+}
+
+#[test]
+fn a_header_longer_than_numpys_limit_is_refused_before_reading() {
+    let dir = tempfile::tempdir().unwrap();
+    // A 20-byte v3 file whose header length field says 0xfffffff7: refused, nothing allocated.
+    let mut bytes = b"\x93NUMPY\x03\x00".to_vec();
+    bytes.extend_from_slice(&0xffff_fff7u32.to_le_bytes());
+    bytes.extend_from_slice(b"{'descr'");
+    assert_eq!(bytes.len(), 20);
+    let p = write(dir.path(), "v3.npy", &bytes);
+    let e = read_npy(&p).unwrap_err();
+    assert!(matches!(e.kind, NpyErrorKind::HeaderTooLong(0xffff_fff7)), "{e}");
+    // Within the limit but past the end of the file.
+    let mut bytes = b"\x93NUMPY\x02\x00".to_vec();
+    bytes.extend_from_slice(&9000u32.to_le_bytes());
+    bytes.extend_from_slice(b"{}");
+    let p = write(dir.path(), "short.npy", &bytes);
+    let e = read_npy(&p).unwrap_err();
+    assert!(matches!(e.kind, NpyErrorKind::HeaderPastEnd { header: 9000, file: 14 }), "{e}");
+}
+
+#[test]
+fn shapes_that_overflow_or_outgrow_the_file_are_refused_before_allocating() {
+    let dir = tempfile::tempdir().unwrap();
+    // The product wraps u64 to 256 values (2^56 + 1) * 256 = 2^64 + 256: before, this read
+    // 256 values and then indexed out of bounds.
+    let header = "{'descr': '<f4', 'fortran_order': False, 'shape': (72057594037927937, 1, 16, 16, 1), }";
+    let p = write(dir.path(), "wrap.npy", &npy_bytes(1, header, &[0; 1024]));
+    let e = read_npy(&p).unwrap_err();
+    assert!(matches!(e.kind, NpyErrorKind::Overflow { .. }), "{e}");
+    assert!(e.to_string().contains("wrap.npy"), "{e}");
+    // A shape that fits u64 but not the file (2.8 EB): truncation, counted, not allocated.
+    let header = "{'descr': '<f4', 'fortran_order': False, 'shape': (1000000000, 1000, 1000, 1, 1), }";
+    let p = write(dir.path(), "huge.npy", &npy_bytes(1, header, &[0; 64]));
+    let e = read_npy(&p).unwrap_err();
+    assert!(matches!(e.kind, NpyErrorKind::Truncated { expected: 1_000_000_000_000_000, found: 16 }), "{e}");
+    // An axis length beyond u64.
+    let header = "{'descr': '<f4', 'fortran_order': False, 'shape': (99999999999999999999, 1), }";
+    let p = write(dir.path(), "digits.npy", &npy_bytes(1, header, &[]));
+    assert!(read_npy(&p).unwrap_err().to_string().contains("does not fit in 64 bits"));
+}
+
+#[test]
+fn fifos_and_folders_are_not_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let e = read_npy(dir.path()).unwrap_err();
+    assert!(matches!(e.kind, NpyErrorKind::NotAFile), "{e}");
+    #[cfg(unix)]
+    {
+        let fifo = dir.path().join("fifo.npy");
+        assert!(std::process::Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+        let e = within(5, move || read_npy(&fifo).unwrap_err().to_string());
+        assert!(e.contains("not a regular file"), "{e}");
+    }
+}
+
+/// `data` (C order, shape `s`) laid out in Fortran order, by the obvious index formula.
+fn to_fortran(data: &[f64], s: &[usize]) -> Vec<f64> {
+    let mut out = vec![0.0; data.len()];
+    for (c, &x) in data.iter().enumerate() {
+        let mut rest = c;
+        let mut idx = vec![0; s.len()];
+        for a in (0..s.len()).rev() {
+            idx[a] = rest % s[a];
+            rest /= s[a];
+        }
+        let mut f = 0;
+        for a in (0..s.len()).rev() {
+            f = f * s[a] + idx[a];
+        }
+        out[f] = x;
+    }
+    out
+}
+
+#[test]
+fn numpys_defaults_are_converted_with_a_note() {
+    // np.save of a float64 array, and of np.asfortranarray: accepted, converted, noted.
+    let dir = tempfile::tempdir().unwrap();
+    let shape = [2usize, 3, 4, 5, 2];
+    let c: Vec<f64> = (0..240).map(|i| f64::from(i) / 240.0 + 1e-9).collect();
+    let body = |v: &[f64]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
+    let want: Vec<f32> = c.iter().map(|&x| x as f32).collect();
+
+    let h = "{'descr': '<f8', 'fortran_order': False, 'shape': (2, 3, 4, 5, 2), }";
+    let p = write(dir.path(), "f64.npy", &npy_bytes(1, h, &body(&c)));
+    let (lf, notes) = read_npy_with_notes(&p).unwrap();
+    assert_eq!(lf.data, want);
+    assert_eq!(lf.shape(), shape);
+    assert_eq!(notes, ["float64 converted to float32"]);
+
+    let h = "{'descr': '<f8', 'fortran_order': True, 'shape': (2, 3, 4, 5, 2), }";
+    let p = write(dir.path(), "fortran.npy", &npy_bytes(1, h, &body(&to_fortran(&c, &shape))));
+    let (lf, notes) = read_npy_with_notes(&p).unwrap();
+    assert_eq!(lf.data, want, "Fortran order read back in C order");
+    assert!(notes.iter().any(|n| n.contains("Fortran")), "{notes:?}");
+
+    // Big-endian float32, in a version 2 file, with a Python 2 long suffix.
+    let h = "{'descr': '>f4', 'fortran_order': False, 'shape': (1L, 1L, 1L, 2L, 2L), }";
+    let be: Vec<u8> = [0.25f32, 0.5, 0.75, 1.0].iter().flat_map(|x| x.to_be_bytes()).collect();
+    let p = write(dir.path(), "be.npy", &npy_bytes(2, h, &be));
+    let (lf, notes) = read_npy_with_notes(&p).unwrap();
+    assert_eq!(lf.data, [0.25, 0.5, 0.75, 1.0]);
+    assert!(notes[0].contains("big-endian"), "{notes:?}");
+
+    // A plain file: no notes. Double quotes and no trailing comma are valid Python too.
+    let h = r#"{"descr": "<u2", "fortran_order": False, "shape": (1, 1, 1, 1, 2)}"#;
+    let p = write(dir.path(), "u2.npy", &npy_bytes(1, h, &[0, 0, 255, 255]));
+    let (lf, notes) = read_npy_with_notes(&p).unwrap();
+    assert_eq!(lf.data, [0.0, 1.0]);
+    assert!(notes.is_empty());
+}
+
+#[test]
+fn malformed_headers_are_one_line_errors_with_the_byte() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        ("{'descr': '<f4', 'fortran_order': Flase, 'shape': (1,), }", "expected True or False"),
+        ("{'descr': '<f4', 'shape': (1,), }", "\"fortran_order\" is missing"),
+        ("{'descr': '<f4', 'descr': '<f4', 'fortran_order': False, 'shape': (1,)}", "given twice"),
+        ("{'descr': '<f4', 'fortran_order': False, 'shape': (1,), 'x': 1}", "unexpected key \"x\""),
+        ("{'descr': '<f4', 'fortran_order': False, 'shape': (1,)} trailing", "after the header's closing brace"),
+        ("{'descr': '<f4\\n', 'fortran_order': False, 'shape': (1,)}", "unexpected character"),
+        ("{'descr': '<f4', 'fortran_order': False, 'shape': (-1,)}", "expected an axis length"),
+        ("{'descr': '<c8', 'fortran_order': False, 'shape': (1,)}", "dtype '<c8'"),
+    ];
+    for (header, want) in cases {
+        let p = write(dir.path(), "h.npy", &npy_bytes(1, header, &[0; 16]));
+        let e = read_npy(&p).unwrap_err().to_string();
+        assert!(e.contains(want) && e.contains("h.npy"), "{header}: {e}");
+        assert_eq!(e.lines().count(), 1, "{e}");
+    }
+    // Too many axes.
+    let header = format!("{{'descr': '<f4', 'fortran_order': False, 'shape': ({})}}", "1, ".repeat(65));
+    let p = write(dir.path(), "axes.npy", &npy_bytes(1, &header, &[0; 4]));
+    assert!(read_npy(&p).unwrap_err().to_string().contains("more than 64 axes"));
+}
+
+#[test]
+fn light_fields_with_nan_or_inf_are_refused_with_the_first_place() {
+    let dir = tempfile::tempdir().unwrap();
+    let h = "{'descr': '<f4', 'fortran_order': False, 'shape': (1, 1, 2, 2, 2), }";
+    let mut v = [0.5f32; 8];
+    v[5] = f32::NAN;
+    v[7] = f32::INFINITY;
+    let body: Vec<u8> = v.iter().flat_map(|x| x.to_le_bytes()).collect();
+    let p = write(dir.path(), "nan.npy", &npy_bytes(1, h, &body));
+    let e = read_npy(&p).unwrap_err().to_string();
+    assert!(e.contains("2 of 8 values are not finite") && e.contains("(0, 0, 1, 0, 1)"), "{e}");
+}
+
+#[test]
+fn the_reader_agrees_with_npyz_on_files_npyz_writes() {
+    // npyz still writes slf's files; the reader must read them back exactly.
+    let dir = tempfile::tempdir().unwrap();
+    let lf = LightField {
+        views: (2, 3),
+        rows: 4,
+        cols: 5,
+        bands: 3,
+        data: (0..360).map(|i| (i as f32 * 0.37).sin().abs()).collect(),
+    };
+    let p = dir.path().join("lf.npy");
+    slf_host::lightfield::write_npy(&p, &lf, slf_host::lightfield::Dtype::F32).unwrap();
+    let a = npy::read(&p).unwrap();
+    assert_eq!(a.shape, [2, 3, 4, 5, 3]);
+    assert_eq!(a.values, Values::F32(lf.data.clone()));
+}
+
+/// A binary PGM as a 12-bit camera tool writes it: MAXVAL 4095, big-endian samples.
+fn pgm_4095(path: &Path, rows: usize, cols: usize, data: &[u16]) {
+    let mut bytes = format!("P5\n# 12-bit raw\n{cols} {rows}\n4095\n").into_bytes();
+    bytes.extend(data.iter().flat_map(|x| x.to_be_bytes()));
+    std::fs::write(path, bytes).unwrap();
+}
+
+#[test]
+fn pgm_values_are_dn_as_stored_whatever_maxval_says() {
+    // Before: the image library rescaled MAXVAL 4095 by 65535 / 4095, so every pixel read
+    // as saturated and the decode "succeeded" at 1 dB.
+    let dir = tempfile::tempdir().unwrap();
+    let data: Vec<u16> = (0..60u16).map(|i| i * 68).collect(); // 0..=4012
+    let p = dir.path().join("f.pgm");
+    pgm_4095(&p, 6, 10, &data);
+    let f = read_frame(&p).unwrap();
+    assert_eq!((f.rows, f.cols, f.top), (6, 10, 4095));
+    assert_eq!(f.data, data);
+    // A sample above MAXVAL is an invalid file.
+    let mut bad = data.clone();
+    bad[13] = 4096;
+    pgm_4095(&p, 6, 10, &bad);
+    let e = format!("{:#}", read_frame(&p).unwrap_err());
+    assert!(e.contains("pixel (1, 3) is 4096, above MAXVAL 4095"), "{e}");
+    // slf writes P5 (not P7/PAM) with the values as they are.
+    let q = dir.path().join("w.pgm");
+    write_frame(&q, &data, 6, 10).unwrap();
+    assert_eq!(&std::fs::read(&q).unwrap()[..3], b"P5\n");
+    assert_eq!(read_frame(&q).unwrap().data, data);
+}
+
+#[test]
+fn a_capture_from_a_12_bit_tool_decodes_like_its_16_bit_copy() {
+    let lf = slf_host::scene::named("smooth").unwrap().render(slf_host::scene::SceneSize {
+        views: (5, 5),
+        rows: 10,
+        cols: 10,
+    });
+    let dir = tempfile::tempdir().unwrap();
+    let cap = simulate(&lf, &CameraConfig::pixel(3, 1)).unwrap();
+    cap.save(dir.path()).unwrap();
+    let (rows, cols) = cap.frame_size();
+    pgm_4095(&dir.path().join("snapshot_0.pgm"), rows, cols, &cap.frames[0]);
+    let back = Capture::load(dir.path()).unwrap();
+    assert_eq!(back.frames, cap.frames);
+    // MAXVAL below the capture's saturation level: saturated pixels would pass as
+    // measurements, so the file is refused.
+    let mut bytes = format!("P5\n{cols} {rows}\n255\n").into_bytes();
+    bytes.extend(cap.frames[0].iter().map(|&x| (x / 16) as u8));
+    std::fs::write(dir.path().join("snapshot_0.pgm"), bytes).unwrap();
+    let e = format!("{:#}", Capture::load(dir.path()).unwrap_err());
+    assert!(e.contains("snapshot_0.pgm") && e.contains("below saturation_level 4095"), "{e}");
+    assert_eq!(e.lines().count(), 1, "{e}");
+}
+
+fn saved_capture() -> (tempfile::TempDir, serde_json::Value) {
+    let lf = slf_host::scene::named("smooth").unwrap().render(slf_host::scene::SceneSize {
+        views: (5, 5),
+        rows: 10,
+        cols: 10,
+    });
+    let dir = tempfile::tempdir().unwrap();
+    simulate(&lf, &CameraConfig::pixel(3, 1)).unwrap().save(dir.path()).unwrap();
+    let json = std::fs::read_to_string(dir.path().join("capture.json")).unwrap();
+    (dir, serde_json::from_str(&json).unwrap())
+}
+
+#[test]
+fn hostile_capture_descriptions_are_one_line_errors() {
+    type Edit = Box<dyn Fn(&mut serde_json::Value)>;
+    let tile_rows = |rows: usize| serde_json::json!({"family": "pixel", "tile": [vec![vec![0]; rows]]});
+    let cases: Vec<(&str, Edit, &str)> = vec![
+        // Before: a debug build panicked on the multiplication, a release build wrapped.
+        (
+            "overflow",
+            Box::new(|j| j["lenslets"] = serde_json::json!([9223372036854775808u64, 5])),
+            "lenslets [9223372036854775808, 5] out of range 1..=65535",
+        ),
+        ("big frame", Box::new(|j| j["lenslets"] = serde_json::json!([60000, 2])), "at most 65535 x 65535"),
+        // Before: "tile size is zero" (65536 as u16) and "0 snapshots" (256 as u8).
+        ("tile rows", Box::new(move |j| j["mask"] = tile_rows(65536)), "mask.tile is 65536 x 1 cells, at most 65535"),
+        (
+            "tile snapshots",
+            Box::new(|j| j["mask"] = serde_json::json!({"family": "pixel", "tile": vec![[[0]]; 256]})),
+            "mask.tile has 256 snapshots, at most 32",
+        ),
+        (
+            "absolute",
+            Box::new(|j| j["frames"][0] = "/etc/passwd".into()),
+            "frames[0]: \"/etc/passwd\" is not a path inside the capture folder",
+        ),
+        (
+            "dot dot",
+            Box::new(|j| j["frames"][0] = "../x/snapshot_0.pgm".into()),
+            "is not a path inside the capture folder",
+        ),
+        ("no frames", Box::new(|j| j["frames"] = serde_json::json!([])), "frames lists 0 files"),
+        ("nan level", Box::new(|j| j["white_level"] = serde_json::json!(1e39)), "finite black_level"),
+    ];
+    for (what, edit, want) in cases {
+        let (dir, mut json) = saved_capture();
+        edit(&mut json);
+        std::fs::write(dir.path().join("capture.json"), json.to_string()).unwrap();
+        let e = within(30, {
+            let d = dir.path().to_owned();
+            move || format!("{:#}", Capture::load(&d).unwrap_err())
+        });
+        assert!(e.contains(want), "{what}: {e}");
+        assert!(e.contains("capture.json"), "{what}: names no file: {e}");
+        assert_eq!(e.lines().count(), 1, "{what}: {e}");
+    }
+    // A FIFO as a frame is refused, not read forever.
+    #[cfg(unix)]
+    {
+        let (dir, mut json) = saved_capture();
+        let fifo = dir.path().join("fifo.pgm");
+        assert!(std::process::Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+        json["frames"][0] = "fifo.pgm".into();
+        std::fs::write(dir.path().join("capture.json"), json.to_string()).unwrap();
+        let d = dir.path().to_owned();
+        let e = within(5, move || format!("{:#}", Capture::load(&d).unwrap_err()));
+        assert!(e.contains("fifo.pgm: not a regular file"), "{e}");
+    }
+    // An oversized capture.json is refused before reading (a sparse file: no disk used).
+    let (dir, _) = saved_capture();
+    let f = std::fs::OpenOptions::new().write(true).open(dir.path().join("capture.json")).unwrap();
+    f.set_len(slf_host::capture::MAX_DESCRIPTION + 1).unwrap();
+    let e = format!("{:#}", Capture::load(dir.path()).unwrap_err());
+    assert!(e.contains("more than the"), "{e}");
+}
+
+#[test]
+fn blobs_larger_than_any_real_blob_are_refused_before_reading() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("big.slfd");
+    let f = std::fs::File::create(&p).unwrap();
+    f.set_len(slf_host::decode::MAX_BLOB as u64 + 1).unwrap(); // sparse
+    let e = format!("{:#}", slf_host::decode::read_blob(&p).unwrap_err());
+    assert!(e.contains("big.slfd") && e.contains("larger than any dictionary blob"), "{e}");
+    #[cfg(unix)]
+    {
+        let e = format!("{:#}", slf_host::decode::read_blob(Path::new("/dev/zero")).unwrap_err());
+        assert!(e.contains("not a regular file"), "{e}");
+    }
+    // The shipped blob passes, with its name in any error of a damaged copy.
+    std::fs::write(&p, slf_host::firmware::DEFAULT_ENSEMBLE).unwrap();
+    assert_eq!(slf_host::decode::read_blob(&p).unwrap(), slf_host::firmware::DEFAULT_ENSEMBLE);
+    let mut bad = slf_host::firmware::DEFAULT_ENSEMBLE.to_vec();
+    bad[100] ^= 1;
+    std::fs::write(&p, bad).unwrap();
+    let e = format!("{:#}", slf_host::decode::read_blob(&p).unwrap_err());
+    assert!(e.contains("big.slfd: dictionary blob checksum mismatch"), "{e}");
+}
