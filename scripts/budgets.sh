@@ -9,7 +9,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 mkdir -p target
 gcc -O2 -shared -fPIC -fvisibility=hidden -o target/libwincount.so scripts/wincount/wincount.c
-cargo build --release -q -p slf-firmware --target thumbv7em-none-eabihf
+cargo build --release -q -p slf-device --target thumbv7em-none-eabihf
 elf=target/thumbv7em-none-eabihf/release/slf-device
 # Thumb symbols carry bit 0; instruction addresses do not.
 addr() { local v; v=$(llvm-nm "$elf" | awk -v s="$1" '$3 == s { print $1 }'); printf '0x%x' $(( 0x$v & ~1 )); }

@@ -148,7 +148,9 @@ impl<'a> BandTile<'a> {
 
     fn bands_at(&self, row: usize, col: usize) -> BandList {
         let cells = self.rows as usize * self.cols as usize;
-        let cell = (row % self.rows as usize) * self.cols as usize + col % self.cols as usize;
+        // `rows`, `cols` > 0 by construction; `checked_rem` says so without a panic path.
+        let (r, c) = (row.checked_rem(self.rows as usize), col.checked_rem(self.cols as usize));
+        let cell = r.unwrap_or(0) * self.cols as usize + c.unwrap_or(0);
         let mut list = BandList::new();
         for j in 0..self.snapshots as usize {
             let _ = list.push(self.bands.get(j * cells + cell).copied().unwrap_or(0));
@@ -211,7 +213,7 @@ impl Stream {
     /// Uniform in `0..n` (n > 0; the modulo bias is below 2^-58).
     fn below(&mut self, n: usize) -> usize {
         self.0 = mix(self.0);
-        (self.0 % n as u64) as usize
+        self.0.checked_rem(n as u64).unwrap_or(0) as usize
     }
 
     /// The first `k` entries of a random permutation of `0..n` (partial Fisher-Yates).
@@ -223,7 +225,8 @@ impl Stream {
         let n = n.min(MAX_BANDS);
         let mut out = BandList::new();
         for j in 0..k.min(n) {
-            let r = j + self.below(n - j);
+            // r < n <= MAX_BANDS; the `min` lets the compiler see it (no panic path).
+            let r = (j + self.below(n - j)).min(MAX_BANDS - 1);
             all.swap(j, r);
             let _ = out.push(all[j]);
         }
@@ -338,7 +341,10 @@ impl<'a> Mask<'a> {
 
     /// The `k` distinct bands sensor pixel `(row, col)` sees, in snapshot order.
     pub fn bands_at(&self, row: usize, col: usize) -> BandList {
-        let (lr, lc) = (row / self.lenslet.rows as usize, col / self.lenslet.cols as usize);
+        // Lenslet and block sizes are > 0 by construction; `checked_div` says so without a
+        // panic path in the decoder.
+        let div = |a: usize, b: u8| a.checked_div(b as usize).unwrap_or(0);
+        let (lr, lc) = (div(row, self.lenslet.rows), div(col, self.lenslet.cols));
         let k = self.snapshots as usize;
         let n = self.bands as usize;
         match (self.pattern, self.family) {
@@ -347,7 +353,7 @@ impl<'a> Mask<'a> {
             (Pattern::Seeded(seed), MaskFamily::Pixel) => Stream::new(seed, TAG_PIXEL, row, col).distinct(k, n),
             (Pattern::Seeded(seed), MaskFamily::Lenslet) => Stream::new(seed, TAG_LENSLET, lr, lc).distinct(k, n),
             (Pattern::Seeded(seed), MaskFamily::Kronecker) => {
-                let (br, bc) = (lr / self.block.0 as usize, lc / self.block.1 as usize);
+                let (br, bc) = (div(lr, self.block.0), div(lc, self.block.1));
                 Stream::new(seed, TAG_BLOCK, br, bc).distinct(k, n)
             }
         }

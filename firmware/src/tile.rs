@@ -18,6 +18,7 @@
 //! ends that tile only, and [`TileDecoder::decode_frame`] goes on with the next tile.
 
 use core::fmt;
+use core::num::NonZeroUsize;
 
 use crate::choice::PatchModel;
 use crate::defects::DefectList;
@@ -287,9 +288,12 @@ fn window_origins(views: usize, patch: usize) -> impl Iterator<Item = usize> {
 
 /// Spans `(start, length)` of tiles along one axis of `total` lenslets for patches of
 /// `patch` lenslets, `per_tile` patches a tile: the grid, then an end-aligned strip.
-fn spans(total: usize, patch: usize, per_tile: usize) -> impl Iterator<Item = (usize, usize)> {
+/// (Sizes as `NonZeroUsize`: dividing by one has no division-by-zero panic path.)
+fn spans(total: usize, patch: NonZeroUsize, per_tile: NonZeroUsize) -> impl Iterator<Item = (usize, usize)> {
     let whole = total / patch;
-    let grid = (0..whole.div_ceil(per_tile)).map(move |i| {
+    let tiles = whole / per_tile + usize::from(whole % per_tile != 0);
+    let (patch, per_tile) = (patch.get(), per_tile.get());
+    let grid = (0..tiles).map(move |i| {
         let first = i * per_tile;
         (first * patch, per_tile.min(whole - first) * patch)
     });
@@ -345,9 +349,11 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     /// smaller than one patch.
     pub fn tiles(&self, patches: (u16, u16)) -> impl Iterator<Item = Tile> + use<'a, PS, PT, PU, PV, B, N> {
         let (rows, cols) = (self.config.sensor.lenslets.0 as usize, self.config.sensor.lenslets.1 as usize);
-        let per = (patches.0.max(1) as usize, patches.1.max(1) as usize);
-        spans(rows, PS, per.0).flat_map(move |(r0, nr)| {
-            spans(cols, PT, per.1).map(move |(c0, nc)| Tile {
+        let nonzero = |n: usize| NonZeroUsize::new(n).unwrap_or(NonZeroUsize::MIN);
+        let per = (nonzero(patches.0 as usize), nonzero(patches.1 as usize));
+        let (ps, pt) = (nonzero(PS), nonzero(PT));
+        spans(rows, ps, per.0).flat_map(move |(r0, nr)| {
+            spans(cols, pt, per.1).map(move |(c0, nc)| Tile {
                 lenslet_row: r0 as u16,
                 lenslet_col: c0 as u16,
                 lenslet_rows: nr as u16,

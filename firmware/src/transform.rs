@@ -65,9 +65,15 @@ fn block_rows<const D: usize, const ADD: bool, const FOLD: u8>(
 }
 
 /// `out = (ADD ? out : 0) + x`, for `L` lanes at `db[at..]`.
+///
+/// The callers keep `at + L` within `db`; the `get` states it so the compiler needs no
+/// panic path (a miss, which cannot happen, would skip the store).
 #[inline(always)]
 fn put<const ADD: bool, const L: usize>(db: &mut [f32], at: usize, x: &[f32; L]) {
-    let out = &mut db[at..at + L];
+    debug_assert!(at + L <= db.len());
+    let Some(out) = db.get_mut(at..).and_then(|d| d.first_chunk_mut::<L>()) else {
+        return;
+    };
     if ADD {
         for (o, &x) in out.iter_mut().zip(x) {
             *o += x;
@@ -92,7 +98,10 @@ fn block_columns<const D: usize, const ADD: bool, const FOLD: u8, const L: usize
     for i in (from..to).step_by(L) {
         let mut x = [[0.0f32; L]; D];
         for (c, x) in x.iter_mut().enumerate() {
-            x.copy_from_slice(&sb[c * inner + i..c * inner + i + L]);
+            debug_assert!(c * inner + i + L <= sb.len());
+            if let Some(src) = sb.get(c * inner + i..).and_then(|s| s.first_chunk::<L>()) {
+                *x = *src;
+            }
         }
         match FOLD {
             ROWS => {

@@ -9,7 +9,7 @@
 //! `scripts/wincount/wincount.c` counts instructions per transform and per patch. The
 //! stack is painted at start and scanned at the end for its peak depth.
 //!
-//! Run: `cargo run --release -p slf-firmware --target thumbv7em-none-eabihf` (qemu is the
+//! Run: `cargo run --release -p slf-device --target thumbv7em-none-eabihf` (qemu is the
 //! runner, see `.cargo/config.toml`). On the host this file builds to a stub that says so.
 #![cfg_attr(target_os = "none", no_std, no_main)]
 
@@ -29,7 +29,7 @@ pub extern "C" fn bench_end(x: u32) -> u32 {
 
 #[cfg(target_os = "none")]
 mod device {
-    include!("../device/capture.rs");
+    include!("../capture.rs");
 
     use cortex_m_rt::entry;
     use cortex_m_semihosting::{debug, hprint, hprintln};
@@ -45,9 +45,9 @@ mod device {
     use super::{bench_begin, bench_end};
 
     static FRAMES: [&[u8]; 3] = [
-        include_bytes!("../device/capture/snapshot_0.npy"),
-        include_bytes!("../device/capture/snapshot_1.npy"),
-        include_bytes!("../device/capture/snapshot_2.npy"),
+        include_bytes!("../capture/snapshot_0.npy"),
+        include_bytes!("../capture/snapshot_1.npy"),
+        include_bytes!("../capture/snapshot_2.npy"),
     ];
 
     /// The body of an `.npy` v1 file: past the 10-byte preamble and the header whose length

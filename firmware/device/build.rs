@@ -9,6 +9,6 @@ fn main() {
             println!("cargo:rustc-link-arg-bins=-Tdefmt.x");
         }
     }
-    println!("cargo:rerun-if-changed=../memory.x");
+    println!("cargo:rerun-if-changed=../../memory.x");
     println!("cargo:rerun-if-changed=build.rs");
 }
