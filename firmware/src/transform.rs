@@ -187,11 +187,26 @@ fn mode_product<const D: usize, const ADD: bool>(
 ) {
     debug_assert_eq!(src.len(), dst.len());
     debug_assert_eq!(src.len() % (D * inner), 0);
+    // Plain `for` loops, not `for_each`: `Zip::fold` is not always inlined, and inside it
+    // `inner` is no longer the constant it is at the call site (the bounds then need
+    // checks at run time).
     let blocks = src.chunks_exact(D * inner).zip(dst.chunks_exact_mut(D * inner));
     match fold {
-        Fold::Plain => blocks.for_each(|(sb, db)| block_rows::<D, ADD, PLAIN>(w, sb, db, inner)),
-        Fold::Rows => blocks.for_each(|(sb, db)| block_rows::<D, ADD, ROWS>(w, sb, db, inner)),
-        Fold::Columns => blocks.for_each(|(sb, db)| block_rows::<D, ADD, COLUMNS>(w, sb, db, inner)),
+        Fold::Plain => {
+            for (sb, db) in blocks {
+                block_rows::<D, ADD, PLAIN>(w, sb, db, inner);
+            }
+        }
+        Fold::Rows => {
+            for (sb, db) in blocks {
+                block_rows::<D, ADD, ROWS>(w, sb, db, inner);
+            }
+        }
+        Fold::Columns => {
+            for (sb, db) in blocks {
+                block_rows::<D, ADD, COLUMNS>(w, sb, db, inner);
+            }
+        }
     }
 }
 
