@@ -5,11 +5,13 @@
 //! the core's f32 FMA peak: `macs / time / peak`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use slf_firmware::ascent::ascend;
+use slf_firmware::projection::{project_coefficients, projection_macs};
+use slf_firmware::transform::{analyze, analyze_preserving, synthesize};
 use slf_firmware::{
     ChoiceRule, DEFAULT_ENSEMBLE, Dictionary, Ensemble, EnsembleModel, LensletSize, Mask, MemberChoice, PaperShape,
-    PaperWorkspace, PatchModel, Sl0Config, analyze, analyze_preserving, project_coefficients, solve, synthesize,
+    PaperWorkspace, PatchModel, Sl0Config, solve,
 };
-use slf_firmware::{ascent::ascend, projection::projection_macs};
 use std::hint::black_box;
 
 const L5: LensletSize = LensletSize { rows: 5, cols: 5 };

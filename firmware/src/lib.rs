@@ -92,20 +92,23 @@ pub mod tile;
 pub mod transform;
 pub mod workspace;
 
-pub use blob::{DEFAULT_ENSEMBLE, Ensemble, write_blob};
+pub mod prelude;
+
+// The public API at the root: what decoding needs, by layer. The operators' and the
+// solver's internals (`transform::synthesize`, `projection::project_coefficients`,
+// `blob::write_blob`, `pinv::solve_pinv`, `sl0::solve_warm`, ...) stay in their modules.
+pub use blob::{DEFAULT_ENSEMBLE, Ensemble};
 pub use choice::{ChoiceRule, EnsembleModel, MemberChoice, ModelOutcome, PatchModel};
 pub use defects::{DefectList, Pixel};
-pub use dictionary::{Dictionary, DictionaryError, Factors, Matrix};
-pub use mask::{BandTile, KroneckerPhi, LensletSize, Mask, MaskFamily, SensingError};
-pub use pinv::{PinvOperator, solve_pinv};
-pub use projection::project_coefficients;
+pub use dictionary::{Dictionary, DictionaryError};
+pub use mask::{BandTile, LensletSize, Mask, MaskFamily, SensingError};
+pub use prelude::{PAPER_N, PaperDecoder, PaperDictionary, PaperEnsemble, PaperEnsembleModel, PaperPatch, SetupError};
 pub use raw::{Frame, FrameSource, LeU16Frame, RawFormat, RawFrame};
 pub use shape::{FullViewShape, PaperShape, PatchShape};
-pub use sl0::{Ended, Outcome, Sl0Config, SolveError, solve, solve_warm};
+pub use sl0::{Ended, Outcome, Sl0Config, SolveError, solve};
 pub use spi::{SpiFrameBuffer, SpiSourceError};
 pub use tile::{
-    ConfigError, DecoderConfig, PatchFlags, PatchOrigin, PatchReport, PatchSink, SensorGeometry, Tile, TileDecoder,
-    TileError, TileReport, TileSource,
+    ConfigError, DecoderConfig, FrameReport, PatchFlags, PatchOrigin, PatchReport, PatchSink, SensorGeometry, Tile,
+    TileDecoder, TileError, TileReport, TileSource,
 };
-pub use transform::{analyze, analyze_preserving, synthesize};
 pub use workspace::{Measurements, PaperWorkspace, Workspace};

@@ -5,6 +5,9 @@ mod common;
 
 use common::*;
 use rand::Rng;
+use slf_firmware::blob::write_blob;
+use slf_firmware::sl0::solve_warm;
+use slf_firmware::transform::{analyze_preserving, synthesize};
 use slf_firmware::*;
 
 const L5: LensletSize = LensletSize { rows: 5, cols: 5 };

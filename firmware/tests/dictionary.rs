@@ -3,10 +3,12 @@
 mod common;
 
 use common::*;
+use slf_firmware::blob::write_blob;
 use slf_firmware::blob::{BLOB_VERSION, HEADER_LEN, blob_len};
 use slf_firmware::dct::dct_matrix;
+use slf_firmware::dictionary::Factors;
 use slf_firmware::dictionary::{ORTHONORMAL_TOLERANCE, orthonormality_error};
-use slf_firmware::{Dictionary, DictionaryError, Ensemble, Factors, write_blob};
+use slf_firmware::{Dictionary, DictionaryError, Ensemble};
 
 type Dict = Dictionary<5, 5, 4, 4, 13>;
 const DIMS: [usize; 5] = [5, 5, 4, 4, 13];
@@ -189,7 +191,7 @@ fn factors_report_the_mode_that_is_wrong() {
 #[test]
 fn the_dct_symmetry_is_found_where_it_holds_and_used_correctly() {
     use slf_firmware::dictionary::{has_parity, transpose};
-    use slf_firmware::{analyze, synthesize};
+    use slf_firmware::transform::{analyze, synthesize};
     // The DCT-II's rows are even / odd about their middle, so its transforms fold.
     assert_eq!(Dict::dct().parity(), [true; 4]);
     assert!(has_parity(&dct_matrix::<13>()) && has_parity(&dct_matrix::<7>()) && has_parity(&dct_matrix::<1>()));

@@ -5,7 +5,9 @@ mod common;
 
 use common::*;
 use rand::Rng;
-use slf_firmware::{Dictionary, Measurements, analyze_preserving, project_coefficients};
+use slf_firmware::projection::project_coefficients;
+use slf_firmware::transform::analyze_preserving;
+use slf_firmware::{Dictionary, Measurements};
 
 /// Measures `per_pixel` random bands of each pixel (none for every seventh pixel) with
 /// random values; returns the measurements and the measured indices.

@@ -4,6 +4,7 @@
 mod common;
 
 use common::*;
+use slf_firmware::sl0::solve_warm;
 use slf_firmware::*;
 
 const L5: LensletSize = LensletSize { rows: 5, cols: 5 };

@@ -5,9 +5,10 @@ mod common;
 
 use common::*;
 use rand::Rng;
+use slf_firmware::pinv::{PinvOperator, solve_pinv};
 use slf_firmware::{
-    Dictionary, Ended, LensletSize, Mask, MaskFamily, PaperWorkspace, PatchShape, PinvOperator, Sl0Config, SolveError,
-    Workspace, solve, solve_pinv,
+    Dictionary, Ended, LensletSize, Mask, MaskFamily, PaperWorkspace, PatchShape, Sl0Config, SolveError, Workspace,
+    solve,
 };
 
 const L5: LensletSize = LensletSize { rows: 5, cols: 5 };
@@ -174,7 +175,7 @@ macro_rules! shape_suite {
                         r.random_range(0.5f32..2.0) * if r.random_bool(0.5) { 1.0 } else { -1.0 };
                 }
                 let mut x = Box::new([0.0f32; N]);
-                slf_firmware::synthesize(&dict, &mut s, &mut x);
+                slf_firmware::transform::synthesize(&dict, &mut s, &mut x);
                 x.to_vec()
             }
 

@@ -5,7 +5,8 @@ mod common;
 use common::*;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
-use slf_firmware::{Dictionary, analyze, synthesize};
+use slf_firmware::Dictionary;
+use slf_firmware::transform::{analyze, synthesize};
 
 /// Synthesis and analysis of random patches with a random orthonormal dictionary and with
 /// the DCT match `K s` and `K^T x` (K built densely in f64) to 1e-5 relative.

@@ -28,7 +28,9 @@ use rand::seq::index::sample;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
-use slf_firmware::{Dictionary, Factors, PaperShape, analyze};
+use slf_firmware::dictionary::Factors;
+use slf_firmware::transform::analyze;
+use slf_firmware::{Dictionary, PaperShape};
 
 use crate::decode::PaperDictionary;
 use crate::lightfield::LightField;
@@ -400,7 +402,7 @@ pub fn train_blob(
         reports.first().map_or(0.0, |r| r.dct_error)
     );
     let mut blob = vec![0u8; slf_firmware::blob::blob_len(PaperShape::DIMS, dicts.len())];
-    slf_firmware::write_blob(&dicts, &mut blob).map_err(|e| anyhow::anyhow!("{e}"))?;
+    slf_firmware::blob::write_blob(&dicts, &mut blob).map_err(|e| anyhow::anyhow!("{e}"))?;
     std::fs::write(output, &blob).with_context(|| format!("cannot write {}", output.display()))?;
     println!("wrote {} ({} bytes) in {:.1} s", output.display(), blob.len(), start.elapsed().as_secs_f64());
     Ok(())

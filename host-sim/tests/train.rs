@@ -1,9 +1,7 @@
 //! Ensemble training: monotone at fixed assignments, orthonormal members, better than the
 //! DCT on held-out patches, reproducible to the byte; and the shipped ensemble.
 
-use slf_host::firmware::{
-    ChoiceRule, DEFAULT_ENSEMBLE, Dictionary, Ensemble, EnsembleModel, MemberChoice, blob, write_blob,
-};
+use slf_host::firmware::{ChoiceRule, DEFAULT_ENSEMBLE, Dictionary, Ensemble, EnsembleModel, MemberChoice, blob};
 use slf_host::train::{self, TrainConfig};
 
 fn patches(seed: u64, scenes: usize, count: usize) -> Vec<f32> {
@@ -56,7 +54,7 @@ fn training_is_reproducible_to_the_byte() {
     let run = |seed| {
         let (dicts, _) = train::train(&data, &TrainConfig { seed, iterations: 2, ..small() });
         let mut out = vec![0u8; blob::blob_len([5, 5, 4, 4, 13], dicts.len())];
-        write_blob(&dicts, &mut out).unwrap();
+        blob::write_blob(&dicts, &mut out).unwrap();
         out
     };
     let a = run(9);

@@ -3,7 +3,8 @@
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use slf_firmware::{Dictionary, Factors, Mask, Matrix, PatchShape, Workspace};
+use slf_firmware::dictionary::{Factors, Matrix};
+use slf_firmware::{Dictionary, Mask, PatchShape, Workspace};
 
 pub fn rng(seed: u64) -> ChaCha8Rng {
     ChaCha8Rng::seed_from_u64(seed)

@@ -1,0 +1,88 @@
+//! The front door: what an integrator needs to decode frames, in one `use`.
+//!
+//! ```
+//! use slf_firmware::prelude::*;
+//! ```
+//!
+//! brings the tile decoder and its configuration, the frame sources, the patch sink, the
+//! shipped ensemble, the workspace, the error types, and names for the paper's patch
+//! (5 x 5 lenslets x 4 x 4 views x 13 bands, 5,200 values) so that no code repeats
+//! `5, 5, 4, 4, 13, 5200`. The solver's and the operators' internals (transforms, the
+//! projection, the blob writer, the paper's pseudo-inverse path) stay in their modules.
+
+use core::fmt;
+
+pub use crate::blob::{DEFAULT_ENSEMBLE, Ensemble};
+pub use crate::choice::{ChoiceRule, EnsembleModel, MemberChoice, PatchModel};
+pub use crate::defects::{DefectList, Pixel};
+pub use crate::dictionary::{Dictionary, DictionaryError};
+pub use crate::mask::{BandTile, LensletSize, Mask, MaskFamily, SensingError};
+pub use crate::raw::{FrameSource, LeU16Frame, RawFormat, RawFrame};
+pub use crate::sl0::{Ended, Outcome, Sl0Config, SolveError};
+pub use crate::spi::{SpiFrameBuffer, SpiSourceError};
+pub use crate::tile::{
+    ConfigError, DecoderConfig, FrameReport, PatchOrigin, PatchReport, PatchSink, SensorGeometry, Tile, TileDecoder,
+    TileError, TileReport, TileSource,
+};
+pub use crate::workspace::{PaperWorkspace, Workspace};
+
+/// Values in the paper's patch: 5 x 5 x 4 x 4 x 13.
+pub const PAPER_N: usize = 5200;
+
+/// One decoded patch of the paper's shape, in `(s, t, u, v, band)` order, band fastest.
+pub type PaperPatch = [f32; PAPER_N];
+
+/// The tile decoder for the paper's patch.
+pub type PaperDecoder<'a> = TileDecoder<'a, 5, 5, 4, 4, 13, PAPER_N>;
+
+/// A dictionary (one member, or the 5D DCT) of the paper's patch.
+pub type PaperDictionary = Dictionary<5, 5, 4, 4, 13>;
+
+/// An ensemble blob of the paper's patch, validated.
+pub type PaperEnsemble<'a> = Ensemble<'a, 5, 5, 4, 4, 13>;
+
+/// An ensemble with its member choice, the decoder's default model.
+pub type PaperEnsembleModel<'a> = EnsembleModel<'a, 5, 5, 4, 4, 13>;
+
+/// What can go wrong while setting a decoder up, so that set-up code can use `?` across
+/// layers. Decoding itself reports per tile and per patch ([`TileError`], [`TileReport`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum SetupError {
+    /// A mask, band tile, raw frame or defect list was refused.
+    Sensing(SensingError),
+    /// The decoder configuration was refused.
+    Config(ConfigError),
+    /// A dictionary blob was refused.
+    Dictionary(DictionaryError),
+}
+
+impl fmt::Display for SetupError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Sensing(e) => write!(f, "sensing: {e}"),
+            Self::Config(e) => write!(f, "decoder: {e}"),
+            Self::Dictionary(e) => write!(f, "dictionary: {e}"),
+        }
+    }
+}
+
+impl core::error::Error for SetupError {}
+
+impl From<SensingError> for SetupError {
+    fn from(e: SensingError) -> Self {
+        Self::Sensing(e)
+    }
+}
+
+impl From<ConfigError> for SetupError {
+    fn from(e: ConfigError) -> Self {
+        Self::Config(e)
+    }
+}
+
+impl From<DictionaryError> for SetupError {
+    fn from(e: DictionaryError) -> Self {
+        Self::Dictionary(e)
+    }
+}
