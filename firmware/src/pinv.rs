@@ -139,7 +139,7 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
 /// This is the paper's method as a reference: of [`Sl0Config`]'s additions it honours the
 /// early stop (`tolerance`, with the ascent step's length as the movement, an upper bound)
 /// but not the flat short path (`flat`) or the warm solve (`warm_start`, `warm_sigma_f`,
-/// `warm_steps`), which belong to the fast path ([`crate::solve`], [`crate::solve_warm`]).
+/// `warm_steps`), which belong to the fast path ([`crate::solve`], [`crate::sl0::solve_warm`]).
 ///
 /// # Errors
 /// [`SolveError::InvalidConfig`], [`SolveError::NoMeasurements`],
