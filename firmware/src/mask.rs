@@ -133,7 +133,8 @@ impl<'a> BandTile<'a> {
             let (row, col) = ((cell / cols as usize) as u16, (cell % cols as usize) as u16);
             let mut seen = 0u32;
             for j in 0..snapshots as usize {
-                let band = bands[j * cells + cell];
+                // In range: the length was checked above (`get` says so without a panic path).
+                let band = bands.get(j * cells + cell).copied().unwrap_or(u8::MAX);
                 if band >= band_count {
                     return Err(SensingError::BandOutOfRange { band, row, col });
                 }

@@ -38,7 +38,15 @@ fn pseudo_inverse<const D: usize>(a: &Matrix<D>, mode: u8) -> Result<Matrix<D>, 
             m[(i, j)] = f64::from(x);
         }
     }
-    let svd = SVD::try_new(m, true, true, f64::EPSILON, 10_000).ok_or(fail)?;
+    // Set-up only, once per kronecker block. nalgebra's SVD has panic paths of its own
+    // (bounds and shape checks, and `try_new`'s `expect` on a NaN singular value): a finite
+    // input of bounded size reaches none of them, so non-finite input is refused first, and
+    // the unordered SVD is used (the pseudo-inverse needs no ordering, and it skips the sort
+    // whose `expect` a NaN would reach).
+    if m.iter().any(|x| !x.is_finite()) {
+        return Err(fail);
+    }
+    let svd = SVD::try_new_unordered(m, true, true, f64::EPSILON, 10_000).ok_or(fail)?;
     let tol = svd.singular_values.max() * 1e-9;
     let p = svd.pseudo_inverse(tol).map_err(|_| fail)?;
     let mut out = [[0.0f32; D]; D];
@@ -74,8 +82,16 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
 {
     /// Forms `A_i = Phi_i D_i` and computes each `A_i^+` once.
     ///
+    /// Set-up only: call it once per kronecker block, before decoding, never per patch. It
+    /// is the one place the decoder runs code with panic paths of its own (nalgebra's SVD:
+    /// its matrix index and shape checks, 17 call sites in a release device image, counted
+    /// by `scripts/panic-sites.py` on `slf-surface`). Their inputs here are fixed-size
+    /// (`PINV_MAX_DIM` square) and checked finite first, which none of those paths can fail
+    /// on; the decode path itself ([`solve_pinv`] and everything in the tile decoder) has
+    /// no panic call at all.
+    ///
     /// # Errors
-    /// [`SolveError::PseudoInverse`] if an SVD does not converge.
+    /// [`SolveError::PseudoInverse`] if an SVD does not converge or an input is not finite.
     pub fn new(dict: &Dictionary<PS, PT, PU, PV, B>, phi: &KroneckerPhi<PS, PT, PU, PV>) -> Result<Self, SolveError> {
         let d = &dict.d;
         let mut a5 = [[0.0f32; B]; B];
