@@ -71,27 +71,62 @@ fn heat(t: f64) -> Rgb<u8> {
 }
 
 /// Writes a PNG of the central view: ground truth | reconstruction | error map (mean
-/// absolute error over bands, full scale = 10 % of the truth's maximum).
+/// absolute error over bands, full scale = 10 % of the truth's maximum), each panel scaled
+/// up at least 4 times (nearest neighbour), labelled, with the error map's colour bar and
+/// its scale in the image.
 ///
 /// # Errors
 /// Shapes that differ, or the file cannot be written.
 pub fn write_comparison(path: &Path, truth: &LightField, recon: &LightField) -> Result<()> {
+    use plotters::prelude::*;
     ensure!(truth.shape() == recon.shape(), "shapes differ");
     let e = exposure(truth);
     let (a, b) = (render(truth, e), render(recon, e));
     let (w, h) = (truth.cols as u32, truth.rows as u32);
-    let gap = 4;
-    let mut out = RgbImage::from_pixel(3 * w + 2 * gap, h, Rgb([40, 40, 40]));
+    // At least 4x, and at least about 300 pixels a panel.
+    let scale = 4.max(300u32.div_ceil(w.max(h).max(1)));
+    let (pw, ph) = (w * scale, h * scale);
+    let (gap, top, bottom) = (12, 34, 64);
+    let (width, height) = (3 * pw + 4 * gap, top + ph + bottom);
+    let mut out = RgbImage::from_pixel(width, height, Rgb([32, 32, 32]));
     let full = 0.1 * f64::from(truth.max()).max(1e-12);
     let (u, v) = central(truth);
-    for y in 0..h {
-        for x in 0..w {
-            out.put_pixel(x, y, *a.get_pixel(x, y));
-            out.put_pixel(w + gap + x, y, *b.get_pixel(x, y));
-            let (ts, rs) = (truth.spectrum(u, v, y as usize, x as usize), recon.spectrum(u, v, y as usize, x as usize));
+    let x0 = [gap, 2 * gap + pw, 3 * gap + 2 * pw];
+    for y in 0..ph {
+        for x in 0..pw {
+            let (sx, sy) = (x / scale, y / scale);
+            out.put_pixel(x0[0] + x, top + y, *a.get_pixel(sx, sy));
+            out.put_pixel(x0[1] + x, top + y, *b.get_pixel(sx, sy));
+            let (ts, rs) =
+                (truth.spectrum(u, v, sy as usize, sx as usize), recon.spectrum(u, v, sy as usize, sx as usize));
             let err = ts.iter().zip(rs).map(|(&p, &q)| f64::from((p - q).abs())).sum::<f64>() / ts.len() as f64;
-            out.put_pixel(2 * (w + gap) + x, y, heat(err / full));
+            out.put_pixel(x0[2] + x, top + y, heat(err / full));
         }
     }
-    out.save(path).with_context(|| format!("cannot write {}", path.display()))
+    // The error map's colour bar, under it: 0 to full scale.
+    let bar = (x0[2], top + ph + 10, pw, 14);
+    for x in 0..bar.2 {
+        for y in 0..bar.3 {
+            out.put_pixel(bar.0 + x, bar.1 + y, heat(f64::from(x) / f64::from(bar.2.max(2) - 1)));
+        }
+    }
+    let mut raw = out.into_raw();
+    {
+        let root = BitMapBackend::with_buffer(&mut raw, (width, height)).into_drawing_area();
+        let font = ("sans-serif", 17).into_font().color(&WHITE);
+        let small = ("sans-serif", 14).into_font().color(&WHITE);
+        let text = |s: &str, x: u32, y: u32, f: &TextStyle| {
+            root.draw(&Text::new(s.to_string(), (x as i32, y as i32), f.clone())).map_err(|e| anyhow::anyhow!("{e}"))
+        };
+        text(&format!("ground truth, view ({u}, {v})"), x0[0], 8, &font)?;
+        text("reconstruction", x0[1], 8, &font)?;
+        text("mean |error| over bands", x0[2], 8, &font)?;
+        text("0", bar.0, bar.1 + bar.3 + 4, &small)?;
+        let hi = format!("{full:.3} (10 % of max)");
+        text(&hi, (bar.0 + bar.2).saturating_sub(8 * hi.len() as u32), bar.1 + bar.3 + 4, &small)?;
+        text(&format!("{} x {} lenslets, sRGB at the truth's exposure", w, h), x0[0], top + ph + 12, &small)?;
+        root.present().map_err(|e| anyhow::anyhow!("{e}"))?;
+    }
+    let img = RgbImage::from_raw(width, height, raw).context("preview buffer")?;
+    img.save(path).with_context(|| format!("cannot write {}", path.display()))
 }

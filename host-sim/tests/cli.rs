@@ -221,3 +221,43 @@ fn bad_light_fields_are_refused_with_what_is_wrong() {
         assert_eq!(e.lines().count(), 1, "{e}");
     }
 }
+
+#[test]
+fn every_argument_of_every_command_is_documented_in_its_help() {
+    let commands = [
+        "demo",
+        "scene",
+        "simulate",
+        "decode",
+        "eval",
+        "baseline",
+        "train",
+        "sweep",
+        "bench",
+        "device-capture",
+        "device-check",
+        "compare",
+    ];
+    for c in commands {
+        let help = stdout(slf().args([c, "--help"]));
+        let lines: Vec<&str> = help.lines().collect();
+        for (i, line) in lines.iter().enumerate() {
+            let t = line.trim_start();
+            // An option or argument line: `-o, --output <OUTPUT>  text` or `<TRUTH>  text`,
+            // or (clap's long form) the spec alone with its text on the next, deeper line.
+            let is_arg = (2..=6).contains(&(line.len() - t.len())) && (t.starts_with('-') || t.starts_with('<'));
+            if !is_arg || t.starts_with("-h, --help") || t.starts_with("-V, --version") {
+                continue;
+            }
+            let same_line = t.split_once("  ").map_or("", |(_, rest)| rest.trim());
+            let indent = line.len() - t.len();
+            let next = lines.get(i + 1).copied().unwrap_or("");
+            let next_doc = if next.len() - next.trim_start().len() > indent { next.trim() } else { "" };
+            let doc = if same_line.is_empty() { next_doc } else { same_line };
+            assert!(
+                !doc.is_empty() && !doc.starts_with('[') && !doc.starts_with("Possible values"),
+                "slf {c}: undocumented argument: {line}"
+            );
+        }
+    }
+}

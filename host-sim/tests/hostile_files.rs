@@ -389,3 +389,20 @@ fn blobs_larger_than_any_real_blob_are_refused_before_reading() {
     let e = format!("{:#}", slf_host::decode::read_blob(&p).unwrap_err());
     assert!(e.contains("big.slfd: dictionary blob checksum mismatch"), "{e}");
 }
+
+#[test]
+fn a_capture_the_decoder_refuses_names_its_description() {
+    // Before: "decoder: patch has more views than a lenslet", with no file named.
+    let lf = slf_host::scene::named("smooth").unwrap().render(slf_host::scene::SceneSize {
+        views: (3, 3),
+        rows: 10,
+        cols: 10,
+    });
+    let dir = tempfile::tempdir().unwrap();
+    simulate(&lf, &CameraConfig::pixel(3, 1)).unwrap().save(dir.path()).unwrap();
+    let cap = Capture::load(dir.path()).unwrap();
+    let opts = slf_host::decode::DecodeOptions::default();
+    let e = format!("{:#}", slf_host::decode::decode_with(&cap, &slf_host::decode::Basis::Dct, &opts).unwrap_err());
+    assert!(e.contains("capture.json") && e.contains("more views than a lenslet"), "{e}");
+    assert_eq!(e.lines().count(), 1, "{e}");
+}
