@@ -364,14 +364,13 @@ pub struct FrameFile {
 /// # Errors
 /// A message with the file and what is wrong.
 pub fn read_frame(path: &Path) -> Result<FrameFile> {
-    let meta = fs::metadata(path).with_context(|| format!("cannot read {}", path.display()))?;
-    ensure!(meta.is_file(), "{}: not a regular file (a FIFO, device or folder is not read)", path.display());
+    let len = regular_file(path, u64::MAX, "")?;
     match extension(path).as_str() {
         "npy" => {
             let (data, rows, cols) = read_npy_u16_2d(path)?;
             Ok(FrameFile { data, rows, cols, top: u32::from(u16::MAX) })
         }
-        "pgm" => read_pgm(path, meta.len()),
+        "pgm" => read_pgm(path, len),
         "png" => {
             let img = image::open(path).with_context(|| format!("{}: cannot decode image", path.display()))?;
             let color = img.color();
@@ -482,10 +481,21 @@ pub fn description_path(dir: &Path) -> PathBuf {
 /// # Errors
 /// A message with the file and what is wrong.
 pub fn read_small_file(path: &Path, max: u64) -> Result<String> {
+    regular_file(path, max, "this file can need")?;
+    fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))
+}
+
+/// The size of `path`, checked before anything opens it: a regular file (opening a FIFO
+/// blocks until a writer comes, a device may never end) of at most `max` bytes (`why` says
+/// where the limit comes from).
+///
+/// # Errors
+/// A message with the file and what is wrong.
+pub fn regular_file(path: &Path, max: u64, why: &str) -> Result<u64> {
     let meta = fs::metadata(path).with_context(|| format!("cannot read {}", path.display()))?;
     ensure!(meta.is_file(), "{}: not a regular file (a FIFO, device or folder is not read)", path.display());
-    ensure!(meta.len() <= max, "{}: {} bytes, more than the {max} this file can need", path.display(), meta.len());
-    fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))
+    ensure!(meta.len() <= max, "{}: {} bytes, more than the {max} {why}", path.display(), meta.len());
+    Ok(meta.len())
 }
 
 /// A frame's path: `name` must be a relative path inside the capture folder.

@@ -65,14 +65,11 @@ pub const MAX_BLOB: usize = slf_firmware::blob::blob_len([5, 5, 4, 4, 13], u16::
 /// # Errors
 /// A message with the file and what is wrong.
 pub fn read_blob(path: &std::path::Path) -> Result<Vec<u8>> {
-    let meta = std::fs::metadata(path).map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
-    ensure!(meta.is_file(), "{}: not a regular file (a FIFO, device or folder is not read)", path.display());
-    ensure!(
-        meta.len() <= MAX_BLOB as u64,
-        "{}: {} bytes, larger than any dictionary blob of the decoder's patch ({MAX_BLOB} bytes at 65,535 members)",
-        path.display(),
-        meta.len()
-    );
+    crate::capture::regular_file(
+        path,
+        MAX_BLOB as u64,
+        "of the largest dictionary blob of the decoder's patch (65,535 members)",
+    )?;
     let blob = std::fs::read(path).map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
     slf_firmware::Ensemble::<5, 5, 4, 4, 13>::new(&blob).map_err(|e| anyhow!("{}: {e}", path.display()))?;
     Ok(blob)

@@ -527,20 +527,6 @@ fn run(cli: Cli) -> Result<()> {
             let cap = Capture::load(&capture)?;
             let opts = DecodeOptions { sl0: solver.config()?, progress: !quiet, ..DecodeOptions::default() };
             let (lf, r) = decode_with(&cap, &basis.basis()?, &opts)?;
-            if let Some(path) = member_map {
-                let mut csv = String::from(
-                    "lenslet_row,lenslet_col,view_row,view_col,member
-",
-                );
-                for (o, m) in &r.member_map {
-                    csv += &format!(
-                        "{},{},{},{},{m}
-",
-                        o.lenslet_row, o.lenslet_col, o.view_row, o.view_col
-                    );
-                }
-                std::fs::write(&path, csv).with_context(|| format!("cannot write {}", path.display()))?;
-            }
             let p = &r.patches;
             let all = p.decoded + p.failed;
             anyhow::ensure!(
@@ -560,6 +546,20 @@ fn run(cli: Cli) -> Result<()> {
                     p.flagged,
                     r.failed_tiles
                 );
+            }
+            if let Some(path) = member_map {
+                let mut csv = String::from(
+                    "lenslet_row,lenslet_col,view_row,view_col,member
+",
+                );
+                for (o, m) in &r.member_map {
+                    csv += &format!(
+                        "{},{},{},{},{m}
+",
+                        o.lenslet_row, o.lenslet_col, o.view_row, o.view_col
+                    );
+                }
+                std::fs::write(&path, csv).with_context(|| format!("cannot write {}", path.display()))?;
             }
             write_npy(&output, &lf, dtype)?;
             println!(

@@ -374,7 +374,7 @@ fn blobs_larger_than_any_real_blob_are_refused_before_reading() {
     let f = std::fs::File::create(&p).unwrap();
     f.set_len(slf_host::decode::MAX_BLOB as u64 + 1).unwrap(); // sparse
     let e = format!("{:#}", slf_host::decode::read_blob(&p).unwrap_err());
-    assert!(e.contains("big.slfd") && e.contains("larger than any dictionary blob"), "{e}");
+    assert!(e.contains("big.slfd") && e.contains("of the largest dictionary blob"), "{e}");
     #[cfg(unix)]
     {
         let e = format!("{:#}", slf_host::decode::read_blob(Path::new("/dev/zero")).unwrap_err());
