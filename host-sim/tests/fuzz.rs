@@ -16,6 +16,9 @@ use slf_host::camera::{CameraConfig, simulate};
 use slf_host::capture::Capture;
 use slf_host::npy::{self, Values};
 
+mod common;
+use common::{npy_bytes, small_smooth};
+
 /// Inputs that were read (or loaded) successfully.
 static READ: AtomicU32 = AtomicU32::new(0);
 static LOADED: AtomicU32 = AtomicU32::new(0);
@@ -78,19 +81,6 @@ fn header_text() -> impl Strategy<Value = String> {
     prop::collection::vec(token, 0..60).prop_map(|t| t.concat())
 }
 
-fn npy_file(version: u8, header: &str, body: &[u8]) -> Vec<u8> {
-    let mut out = b"\x93NUMPY".to_vec();
-    out.extend_from_slice(&[version, 0]);
-    if version == 1 {
-        out.extend_from_slice(&(header.len() as u16).to_le_bytes());
-    } else {
-        out.extend_from_slice(&(header.len() as u32).to_le_bytes());
-    }
-    out.extend_from_slice(header.as_bytes());
-    out.extend_from_slice(body);
-    out
-}
-
 #[test]
 fn fuzz_npy_reader() {
     // Random bytes, with and without the magic.
@@ -103,7 +93,7 @@ fn fuzz_npy_reader() {
     // Headers built from the grammar's own tokens, any order, any nesting.
     runner()
         .run(&(header_text(), 1u8..4, prop::collection::vec(any::<u8>(), 0..256)), |(h, v, body)| {
-            check_npy(&npy_file(v, &h, &body))
+            check_npy(&npy_bytes(v, &h, &body))
         })
         .unwrap();
     // Valid headers with any shape and dtype, and a body of any length.
@@ -118,7 +108,7 @@ fn fuzz_npy_reader() {
             let shape: String = shape.iter().map(|n| format!("{n}, ")).collect();
             let t = if fortran { "True" } else { "False" };
             let h = format!("{{'descr': '{descr}', 'fortran_order': {t}, 'shape': ({}), }}", shape.trim_end());
-            check_npy(&npy_file(1, &h, &vec![0x3f; body]))
+            check_npy(&npy_bytes(1, &h, &vec![0x3f; body]))
         })
         .unwrap();
     let read = READ.load(Ordering::Relaxed);
@@ -149,11 +139,7 @@ fn json_value() -> impl Strategy<Value = serde_json::Value> {
 #[test]
 fn fuzz_capture_loader() {
     // One valid capture, its description mutated field by field, its frames corrupted.
-    let lf = slf_host::scene::named("smooth").unwrap().render(slf_host::scene::SceneSize {
-        views: (5, 5),
-        rows: 10,
-        cols: 10,
-    });
+    let lf = small_smooth(5);
     let base = tempfile::tempdir().unwrap();
     let mut cam = CameraConfig::pixel(3, 2);
     cam.frame_ext = "pgm".into();

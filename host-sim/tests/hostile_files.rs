@@ -14,19 +14,8 @@ use slf_host::capture::{Capture, read_frame, write_frame};
 use slf_host::lightfield::{LightField, read_npy, read_npy_with_notes};
 use slf_host::npy::{self, NpyErrorKind, Values};
 
-/// An `.npy` file: magic, version, header length field as given, header text, body.
-fn npy_bytes(version: u8, header: &str, body: &[u8]) -> Vec<u8> {
-    let mut out = b"\x93NUMPY".to_vec();
-    out.extend_from_slice(&[version, 0]);
-    if version == 1 {
-        out.extend_from_slice(&(header.len() as u16).to_le_bytes());
-    } else {
-        out.extend_from_slice(&(header.len() as u32).to_le_bytes());
-    }
-    out.extend_from_slice(header.as_bytes());
-    out.extend_from_slice(body);
-    out
-}
+mod common;
+use common::{npy_bytes, small_smooth};
 
 fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
     let p = dir.join(name);
@@ -269,11 +258,7 @@ fn pgm_values_are_dn_as_stored_whatever_maxval_says() {
 
 #[test]
 fn a_capture_from_a_12_bit_tool_decodes_like_its_16_bit_copy() {
-    let lf = slf_host::scene::named("smooth").unwrap().render(slf_host::scene::SceneSize {
-        views: (5, 5),
-        rows: 10,
-        cols: 10,
-    });
+    let lf = small_smooth(5);
     let dir = tempfile::tempdir().unwrap();
     let cap = simulate(&lf, &CameraConfig::pixel(3, 1)).unwrap();
     cap.save(dir.path()).unwrap();
@@ -292,11 +277,7 @@ fn a_capture_from_a_12_bit_tool_decodes_like_its_16_bit_copy() {
 }
 
 fn saved_capture() -> (tempfile::TempDir, serde_json::Value) {
-    let lf = slf_host::scene::named("smooth").unwrap().render(slf_host::scene::SceneSize {
-        views: (5, 5),
-        rows: 10,
-        cols: 10,
-    });
+    let lf = small_smooth(5);
     let dir = tempfile::tempdir().unwrap();
     simulate(&lf, &CameraConfig::pixel(3, 1)).unwrap().save(dir.path()).unwrap();
     let json = std::fs::read_to_string(dir.path().join("capture.json")).unwrap();
@@ -393,11 +374,7 @@ fn blobs_larger_than_any_real_blob_are_refused_before_reading() {
 #[test]
 fn a_capture_the_decoder_refuses_names_its_description() {
     // Before: "decoder: patch has more views than a lenslet", with no file named.
-    let lf = slf_host::scene::named("smooth").unwrap().render(slf_host::scene::SceneSize {
-        views: (3, 3),
-        rows: 10,
-        cols: 10,
-    });
+    let lf = small_smooth(3);
     let dir = tempfile::tempdir().unwrap();
     simulate(&lf, &CameraConfig::pixel(3, 1)).unwrap().save(dir.path()).unwrap();
     let cap = Capture::load(dir.path()).unwrap();

@@ -1,0 +1,26 @@
+//! Helpers shared by the host's tests: hand-made `.npy` files and a small test scene.
+#![allow(dead_code)] // each test binary uses a part
+
+use slf_host::lightfield::LightField;
+use slf_host::scene::{SceneSize, named};
+
+/// An `.npy` file byte by byte: magic, version, the header length field, header, body.
+pub fn npy_bytes(version: u8, header: &str, body: &[u8]) -> Vec<u8> {
+    let mut out = b"\x93NUMPY".to_vec();
+    out.extend_from_slice(&[version, 0]);
+    if version == 1 {
+        out.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    } else {
+        out.extend_from_slice(&(header.len() as u32).to_le_bytes());
+    }
+    out.extend_from_slice(header.as_bytes());
+    out.extend_from_slice(body);
+    out
+}
+
+/// The `smooth` test scene at 10 x 10 lenslets with `views` x `views` views.
+pub fn small_smooth(views: usize) -> LightField {
+    named("smooth")
+        .map(|s| s.render(SceneSize { views: (views, views), rows: 10, cols: 10 }))
+        .unwrap_or_else(|| unreachable!("smooth is a named scene"))
+}
