@@ -15,22 +15,11 @@
 use std::sync::atomic::{AtomicU32, Ordering};
 
 use proptest::prelude::*;
-use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
+
+#[path = "common/fuzz_runner.rs"]
+mod fuzz_runner;
+use fuzz_runner::{cases, runner};
 use slf_firmware::prelude::*;
-
-/// Cases per target, from `SLF_FUZZ_CASES`.
-fn cases() -> u32 {
-    std::env::var("SLF_FUZZ_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(64)
-}
-
-/// A runner with a fixed seed (`SLF_FUZZ_SEED` to change it) and no failure files.
-fn runner() -> TestRunner {
-    let seed: u64 = std::env::var("SLF_FUZZ_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or(1);
-    let mut bytes = [0u8; 32];
-    bytes[..8].copy_from_slice(&seed.to_le_bytes());
-    let config = Config { cases: cases(), failure_persistence: None, ..Config::default() };
-    TestRunner::new_with_rng(config, TestRng::from_seed(RngAlgorithm::ChaCha, &bytes))
-}
 
 /// Edits applied to a valid input: flip bits, overwrite, truncate, extend.
 #[derive(Clone, Debug)]

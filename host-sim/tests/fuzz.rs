@@ -11,7 +11,10 @@
 use std::sync::atomic::{AtomicU32, Ordering};
 
 use proptest::prelude::*;
-use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
+
+#[path = "../../firmware/tests/common/fuzz_runner.rs"]
+mod fuzz_runner;
+use fuzz_runner::{cases, runner};
 use slf_host::camera::{CameraConfig, simulate};
 use slf_host::capture::Capture;
 use slf_host::npy::{self, Values};
@@ -22,18 +25,6 @@ use common::{npy_bytes, small_smooth};
 /// Inputs that were read (or loaded) successfully.
 static READ: AtomicU32 = AtomicU32::new(0);
 static LOADED: AtomicU32 = AtomicU32::new(0);
-
-fn cases() -> u32 {
-    std::env::var("SLF_FUZZ_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(64)
-}
-
-fn runner() -> TestRunner {
-    let seed: u64 = std::env::var("SLF_FUZZ_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or(1);
-    let mut bytes = [0u8; 32];
-    bytes[..8].copy_from_slice(&seed.to_le_bytes());
-    let config = Config { cases: cases(), failure_persistence: None, ..Config::default() };
-    TestRunner::new_with_rng(config, TestRng::from_seed(RngAlgorithm::ChaCha, &bytes))
-}
 
 /// Reads `bytes` as an `.npy`; a success must be consistent with its shape and with the
 /// number of bytes it came from.
