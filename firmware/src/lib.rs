@@ -27,7 +27,17 @@
 //! - **tile decoder** ([`tile`]): a rectangle of the raw frame, patch by patch, from a
 //!   [`TileSource`] to a [`PatchSink`], into a caller-owned [`Workspace`].
 //!
-//! The device application (the Cortex-M binary) sits on top of the tile decoder.
+//! The device application sits on top of the tile decoder, in a crate of its own
+//! (`slf-device`, in `firmware/device/` of the repository), so that this library depends on
+//! nothing Cortex-M specific: no runtime, no critical-section implementation, no panic
+//! handler. [`prelude`] is the front door: `use slf_firmware::prelude::*;` brings what an
+//! integrator needs, with names for the paper's patch ([`PaperDecoder`], [`PaperPatch`]).
+//!
+//! # Panics
+//!
+//! None on any input: the decode path compiles to no panic call (CI counts the panic call
+//! sites of a release device image that links every public decode entry point). The one
+//! exception is set-up code, not decoding: [`pinv::PinvOperator::new`] runs nalgebra's SVD.
 //!
 //! # Example
 //!
