@@ -1,5 +1,7 @@
 //! The workstation side of slf. It decodes with the firmware crate's own code
-//! ([`slf_firmware`]), so host results are the device's results.
+//! ([`slf_firmware`]), so host results are the device's results. The method is that of
+//! X. Cao, E. Miandji and J. Unger, "Multidimensional Compressed Sensing for Spectral Light
+//! Field Imaging", VISAPP 2024; [`baseline`] is that paper's 1D formulation.
 //!
 //! From a scene to numbers:
 //!
