@@ -263,3 +263,21 @@ fn every_argument_of_every_command_is_documented_in_its_help() {
         }
     }
 }
+
+#[test]
+fn sweep_files_name_their_basis_and_command() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("dct.md");
+    stdout(slf().args(["sweep", "--size", "11", "--k", "1", "--dictionary", "dct", "-o"]).arg(&out));
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(text.starts_with("# Quality with the DCT"), "{text}");
+    assert!(text.contains("sweep --size 11 --k 1 --dictionary dct"), "{text}");
+    assert_eq!(
+        text.lines().filter(|l| l.starts_with("| ") && !l.starts_with("| scene") && !l.starts_with("| ---")).count(),
+        15
+    );
+    stdout(slf().args(["sweep", "--size", "11", "--k", "1", "-o"]).arg(&out));
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(text.starts_with("# Quality with the ensemble screened"), "{text}");
+    assert!(text.contains("--dictionary ensemble --choice screened"), "{text}");
+}

@@ -159,3 +159,26 @@ fn a_capture_written_by_another_tool_loads() {
     assert_eq!(mask.bands_at(3, 2).as_slice(), &[8, 9]);
     assert!(matches!(cap.description.mask, MaskDescription::Pixel(MaskSource { tile: Some(_), .. })));
 }
+
+#[test]
+fn previews_are_scaled_at_least_4x_and_labelled() {
+    let truth = small();
+    let mut recon = truth.clone();
+    recon.data.iter_mut().enumerate().for_each(|(i, x)| *x += 0.01 * (i % 7) as f32);
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("preview.png");
+    slf_host::preview::write_comparison(&p, &truth, &recon).unwrap();
+    let img = image::open(&p).unwrap().into_rgb8();
+    let (w, h) = (truth.cols as u32, truth.rows as u32);
+    // Three panels, each at least 4x, with room for the labels and the colour bar.
+    assert!(img.width() >= 3 * 4 * w && img.height() >= 4 * h + 60, "{} x {}", img.width(), img.height());
+    // Labels: bright text pixels in the band above the panels (the background is dark grey).
+    let text =
+        (0..img.width()).flat_map(|x| (0..30).map(move |y| (x, y))).filter(|&(x, y)| img.get_pixel(x, y)[0] > 150);
+    assert!(text.count() > 200, "no labels drawn");
+    // The colour bar's ends: black at 0, white at full scale.
+    let scale = 4.max(300u32.div_ceil(w.max(h)));
+    let (bar_x, bar_y) = (3 * 12 + 2 * w * scale, 34 + h * scale + 10 + 7);
+    assert_eq!(img.get_pixel(bar_x, bar_y).0, [0, 0, 0]);
+    assert_eq!(img.get_pixel(bar_x + w * scale - 1, bar_y).0, [255, 255, 255]);
+}
