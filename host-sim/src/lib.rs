@@ -10,7 +10,8 @@
 //!   any `.npy` with every size checked first).
 //! - [`camera`] turns a light field into raw frames with the firmware's masks, noise,
 //!   black level, quantisation, saturation and defects; [`capture`] is the folder format.
-//! - [`decode`] runs the firmware's tile decoder over a capture in parallel.
+//! - [`decode`] runs the firmware's tile decoder over a capture in parallel; [`demosaic`]
+//!   holds the baselines a user would pick instead of compressed sensing.
 //! - [`metrics`] (PSNR, SSIM, SA), [`preview`] (sRGB PNGs) and [`baseline`] (the paper's 1D
 //!   method) evaluate it.
 //!
@@ -24,6 +25,7 @@ pub mod bench;
 pub mod camera;
 pub mod capture;
 pub mod decode;
+pub mod demosaic;
 pub mod device;
 pub mod lightfield;
 pub mod metrics;

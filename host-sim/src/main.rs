@@ -85,6 +85,17 @@ impl Family {
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum Method {
+    /// Compressed sensing: the firmware's SL0 decoder with --dictionary.
+    Cs,
+    /// Baseline: per pixel, the spectrum interpolated between the bands it measured.
+    Interpolate,
+    /// Baseline: each band from the nearby pixels and views that measured it, matched to
+    /// each pixel's own measurements.
+    Demosaic,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 enum DictionaryKind {
     /// The 5D DCT.
     Dct,
@@ -290,6 +301,9 @@ enum Command {
         /// Output .npy file.
         #[arg(short, long)]
         output: PathBuf,
+        /// Decode method: compressed sensing, or a baseline without it.
+        #[arg(long, value_enum, default_value_t = Method::Cs)]
+        method: Method,
         #[command(flatten)]
         solver: SolverArgs,
         #[command(flatten)]
@@ -523,8 +537,25 @@ fn run(cli: Cli) -> Result<()> {
             println!("wrote {} ({} snapshots)", output.display(), capture.frames.len());
             Ok(())
         }
-        Command::Decode { capture, output, solver, basis, member_map, dtype, quiet } => {
+        Command::Decode { capture, output, method, solver, basis, member_map, dtype, quiet } => {
             let cap = Capture::load(&capture)?;
+            if method != Method::Cs {
+                anyhow::ensure!(member_map.is_none(), "--member-map needs --method cs (baselines use no ensemble)");
+                let (lf, r) = match method {
+                    Method::Interpolate => slf_host::demosaic::interpolate(&cap)?,
+                    _ => slf_host::demosaic::demosaic(&cap, &slf_host::demosaic::DemosaicConfig::default())?,
+                };
+                write_npy(&output, &lf, dtype)?;
+                println!(
+                    "{:?}: {} sensor positions measured, {} filled from their neighbours, in {:.2} s; wrote {}",
+                    method,
+                    r.measured,
+                    r.filled,
+                    r.seconds,
+                    output.display()
+                );
+                return Ok(());
+            }
             let opts = DecodeOptions { sl0: solver.config()?, progress: !quiet, ..DecodeOptions::default() };
             let (lf, r) = decode_with(&cap, &basis.basis()?, &opts)?;
             let p = &r.patches;

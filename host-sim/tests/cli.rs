@@ -281,3 +281,29 @@ fn sweep_files_name_their_basis_and_command() {
     assert!(text.starts_with("# Quality with the ensemble screened"), "{text}");
     assert!(text.contains("--dictionary ensemble --choice screened"), "{text}");
 }
+
+#[test]
+fn baselines_decode_from_the_command_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    stdout(slf().args(["scene", "smooth", "--size", "15", "-o"]).arg(p("truth.npy")));
+    stdout(slf().arg("simulate").arg(p("truth.npy")).arg("-o").arg(p("cap")));
+    let mut psnr = Vec::new();
+    for method in ["interpolate", "demosaic", "cs"] {
+        let out = stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("r.npy")).args(["--method", method, "-q"]));
+        assert!(out.contains("wrote"), "{method}: {out}");
+        let e = stdout(slf().arg("eval").arg(p("truth.npy")).arg(p("r.npy")));
+        psnr.push(e.split_whitespace().nth(1).unwrap().parse::<f64>().unwrap());
+    }
+    assert!(psnr[0] < psnr[1], "interpolate {:.2} dB, demosaic {:.2} dB", psnr[0], psnr[1]);
+    let e = failure(
+        slf()
+            .arg("decode")
+            .arg(p("cap"))
+            .arg("-o")
+            .arg(p("x.npy"))
+            .args(["--method", "demosaic", "--member-map"])
+            .arg(p("m.csv")),
+    );
+    assert!(e.contains("--member-map needs --method cs"), "{e}");
+}

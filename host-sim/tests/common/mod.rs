@@ -18,9 +18,9 @@ pub fn npy_bytes(version: u8, header: &str, body: &[u8]) -> Vec<u8> {
     out
 }
 
-/// The `smooth` test scene at 10 x 10 lenslets with `views` x `views` views.
+/// The `smooth` test scene at 12 x 12 lenslets with `views` x `views` views.
 pub fn small_smooth(views: usize) -> LightField {
     named("smooth")
-        .map(|s| s.render(SceneSize { views: (views, views), rows: 10, cols: 10 }))
+        .map(|s| s.render(SceneSize { views: (views, views), rows: 12, cols: 12 }))
         .unwrap_or_else(|| unreachable!("smooth is a named scene"))
 }

@@ -1,0 +1,322 @@
+//! Baselines: decode methods without compressed sensing, the yardsticks a user would pick
+//! instead of CS.
+//!
+//! Both read a capture's measurements exactly as the CS decoder does (the firmware's mask,
+//! raw format and defect list: saturated, defective and non-finite samples are not
+//! measurements) and return the light field `(U, V, S, T, B)`.
+//!
+//! - [`interpolate`]: per pixel, the spectrum interpolated linearly in band index between
+//!   the bands that pixel measured, held constant beyond the first and last. At one
+//!   snapshot a pixel measures one band, so its spectrum is flat: what a camera without
+//!   any spatial reasoning would give.
+//! - [`demosaic`]: each band estimated from the pixels that measured it nearby, all views
+//!   of the lenslets within [`DemosaicConfig::radius`] lenslets weighted by a Gaussian of
+//!   the lenslet distance; the estimate is then matched to each pixel's own measurements
+//!   (scaled by the ratio of the pixel's measured values to the estimate at those bands,
+//!   the colour-ratio rule of classic demosaicking, limited to
+//!   [`DemosaicConfig::max_ratio`]) and the measured bands keep their measured values.
+//!
+//! A pixel with no measurement (all its samples invalid) takes, in [`interpolate`], the mean
+//! spectrum of the measured pixels of its lenslet and the lenslets around it, and in
+//! [`demosaic`] the neighbourhood's estimate; the report counts them.
+
+use anyhow::{Result, ensure};
+use rayon::prelude::*;
+
+use crate::capture::Capture;
+use crate::lightfield::LightField;
+
+/// The neighbourhood demosaic's settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DemosaicConfig {
+    /// Lenslets either side that contribute to a band's estimate.
+    pub radius: usize,
+    /// Standard deviation of the Gaussian weight, in lenslets.
+    pub sigma: f32,
+    /// Largest factor (and smallest, as its inverse) by which the match to a pixel's own
+    /// measurements scales the neighbourhood's spectrum.
+    pub max_ratio: f32,
+}
+
+impl Default for DemosaicConfig {
+    /// Radius 2 (5 x 5 lenslets, 625 samples at 5 x 5 views: about 48 a band at one
+    /// snapshot), sigma 1 lenslet, ratios within 1/4..4.
+    fn default() -> Self {
+        Self { radius: 2, sigma: 1.0, max_ratio: 4.0 }
+    }
+}
+
+/// What a baseline did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BaselineReport {
+    /// Sensor positions (lenslet x view) with at least one measurement.
+    pub measured: usize,
+    /// Sensor positions with none, filled from their neighbourhood.
+    pub filled: usize,
+    /// Wall time, seconds.
+    pub seconds: f64,
+}
+
+/// Every sensor position's valid measurements as `(band, value)`, in snapshot order,
+/// indexed `(row * cols + col) * k + j`; `None` where a sample is not a measurement.
+struct Samples {
+    cols: usize,
+    k: usize,
+    bands: usize,
+    views: (usize, usize),
+    lenslets: (usize, usize),
+    values: Vec<Option<(u8, f32)>>,
+}
+
+impl Samples {
+    fn read(capture: &Capture) -> Result<Self> {
+        let mask = capture.mask()?;
+        let raw = capture.raw_format();
+        let defects = capture.defects();
+        let (rows, cols) = capture.frame_size();
+        let k = capture.frames.len();
+        let d = &capture.description;
+        let mut values = vec![None; rows * cols * k];
+        values.par_chunks_mut(cols * k).enumerate().for_each(|(row, out)| {
+            for col in 0..cols {
+                let bands = mask.bands_at(row, col);
+                if defects.contains(row, col) {
+                    continue;
+                }
+                for (j, (&band, frame)) in bands.iter().zip(&capture.frames).enumerate() {
+                    if let Ok(v) = raw.classify(f32::from(frame[row * cols + col])) {
+                        out[col * k + j] = Some((band, v));
+                    }
+                }
+            }
+        });
+        Ok(Self {
+            cols,
+            k,
+            bands: d.bands_nm.len(),
+            views: (d.views[0], d.views[1]),
+            lenslets: (d.lenslets[0], d.lenslets[1]),
+            values,
+        })
+    }
+
+    fn at(&self, row: usize, col: usize) -> &[Option<(u8, f32)>] {
+        let i = (row * self.cols + col) * self.k;
+        &self.values[i..i + self.k]
+    }
+
+    /// The sensor pixel of lenslet `(s, t)`, view `(u, v)`.
+    fn pixel(&self, s: usize, t: usize, u: usize, v: usize) -> (usize, usize) {
+        (s * self.views.0 + u, t * self.views.1 + v)
+    }
+
+    fn empty_field(&self) -> LightField {
+        LightField::zeros(self.views, self.lenslets.0, self.lenslets.1, self.bands)
+    }
+}
+
+/// The spectrum through `(band, value)` points (distinct bands, any order): linear in band
+/// index between them, constant beyond. `None` without a point.
+fn through(points: &mut [(u8, f32)], out: &mut [f32]) -> Option<()> {
+    points.sort_by_key(|p| p.0);
+    let (&first, &last) = (points.first()?, points.last()?);
+    for (b, o) in out.iter_mut().enumerate() {
+        let b8 = b as u8;
+        *o = if b8 <= first.0 {
+            first.1
+        } else if b8 >= last.0 {
+            last.1
+        } else {
+            let i = points.partition_point(|p| p.0 <= b8);
+            let (lo, hi) = (points[i - 1], points[i]);
+            let t = f32::from(b8 - lo.0) / f32::from(hi.0 - lo.0);
+            lo.1 + t * (hi.1 - lo.1)
+        };
+    }
+    Some(())
+}
+
+/// Fills positions without a measurement (`missing[i]`, `i` over `(u, v, s, t)` pixel
+/// order of `lf`) with the mean spectrum of the measured ones in the 3 x 3 lenslets around.
+fn fill(lf: &mut LightField, missing: &[bool]) {
+    let (vu, vv) = lf.views;
+    let (rows, cols, bands) = (lf.rows, lf.cols, lf.bands);
+    let position = |u: usize, v: usize, s: usize, t: usize| ((u * vv + v) * rows + s) * cols + t;
+    let mut filled = lf.data.clone();
+    for u in 0..vu {
+        for v in 0..vv {
+            for s in 0..rows {
+                for t in 0..cols {
+                    if !missing[position(u, v, s, t)] {
+                        continue;
+                    }
+                    let mut sum = vec![0.0f32; bands];
+                    let mut n = 0u32;
+                    for ss in s.saturating_sub(1)..(s + 2).min(rows) {
+                        for tt in t.saturating_sub(1)..(t + 2).min(cols) {
+                            for uu in 0..vu {
+                                for vv2 in 0..vv {
+                                    if !missing[position(uu, vv2, ss, tt)] {
+                                        n += 1;
+                                        for (a, &x) in sum.iter_mut().zip(lf.spectrum(uu, vv2, ss, tt)) {
+                                            *a += x;
+                                        }
+                                    }
+                                }
+                            }
+                        }
+                    }
+                    let at = lf.index(u, v, s, t, 0);
+                    for (o, a) in filled[at..at + bands].iter_mut().zip(&sum) {
+                        *o = if n > 0 { a / n as f32 } else { 0.0 };
+                    }
+                }
+            }
+        }
+    }
+    lf.data = filled;
+}
+
+/// Per-pixel spectral interpolation between the measured bands (see the module docs).
+///
+/// # Errors
+/// A capture whose mask cannot be built, or one without a single measurement.
+pub fn interpolate(capture: &Capture) -> Result<(LightField, BaselineReport)> {
+    let start = std::time::Instant::now();
+    let samples = Samples::read(capture)?;
+    let mut lf = samples.empty_field();
+    let (vu, vv) = samples.views;
+    let (ls, lt) = samples.lenslets;
+    let mut missing = vec![false; vu * vv * ls * lt];
+    let mut report = BaselineReport::default();
+    for u in 0..vu {
+        for v in 0..vv {
+            for s in 0..ls {
+                for t in 0..lt {
+                    let (row, col) = samples.pixel(s, t, u, v);
+                    let mut points: Vec<(u8, f32)> = samples.at(row, col).iter().flatten().copied().collect();
+                    let at = lf.index(u, v, s, t, 0);
+                    if through(&mut points, &mut lf.data[at..at + samples.bands]).is_some() {
+                        report.measured += 1;
+                    } else {
+                        missing[((u * vv + v) * ls + s) * lt + t] = true;
+                        report.filled += 1;
+                    }
+                }
+            }
+        }
+    }
+    ensure!(report.measured > 0, "{}: no pixel holds a measurement (all saturated or defective)", capture.source());
+    fill(&mut lf, &missing);
+    report.seconds = start.elapsed().as_secs_f64();
+    Ok((lf, report))
+}
+
+/// Neighbourhood demosaic matched to each pixel's own measurements (see the module docs).
+///
+/// # Errors
+/// A capture whose mask cannot be built, one without a single measurement, or settings out
+/// of range.
+pub fn demosaic(capture: &Capture, cfg: &DemosaicConfig) -> Result<(LightField, BaselineReport)> {
+    ensure!(cfg.sigma.is_finite() && cfg.sigma > 0.0, "demosaic sigma {} must be above 0", cfg.sigma);
+    ensure!(cfg.max_ratio.is_finite() && cfg.max_ratio >= 1.0, "demosaic max_ratio {} must be >= 1", cfg.max_ratio);
+    let start = std::time::Instant::now();
+    let samples = Samples::read(capture)?;
+    let (vu, vv) = samples.views;
+    let (ls, lt) = samples.lenslets;
+    let nb = samples.bands;
+    // Per lenslet and band: the sum and count of its views' measurements of that band.
+    let mut sum = vec![0.0f32; ls * lt * nb];
+    let mut count = vec![0.0f32; ls * lt * nb];
+    for s in 0..ls {
+        for t in 0..lt {
+            for u in 0..vu {
+                for v in 0..vv {
+                    let (row, col) = samples.pixel(s, t, u, v);
+                    for &(b, x) in samples.at(row, col).iter().flatten() {
+                        let i = (s * lt + t) * nb + usize::from(b);
+                        sum[i] += x;
+                        count[i] += 1.0;
+                    }
+                }
+            }
+        }
+    }
+    ensure!(
+        count.iter().any(|&c| c > 0.0),
+        "{}: no pixel holds a measurement (all saturated or defective)",
+        capture.source()
+    );
+    // Per lenslet and band: the Gaussian-weighted mean over the neighbourhood. A band no
+    // neighbour measured takes the interpolation of the lenslet's other band estimates.
+    let r = cfg.radius as isize;
+    let weight = |d2: f32| (-d2 / (2.0 * cfg.sigma * cfg.sigma)).exp();
+    let estimate: Vec<Vec<f32>> = (0..ls * lt)
+        .into_par_iter()
+        .map(|st| {
+            let (s, t) = ((st / lt) as isize, (st % lt) as isize);
+            let (mut num, mut den) = (vec![0.0f32; nb], vec![0.0f32; nb]);
+            for ds in -r..=r {
+                for dt in -r..=r {
+                    let (ss, tt) = (s + ds, t + dt);
+                    if ss < 0 || tt < 0 || ss >= ls as isize || tt >= lt as isize {
+                        continue;
+                    }
+                    let w = weight((ds * ds + dt * dt) as f32);
+                    let i = (ss as usize * lt + tt as usize) * nb;
+                    for b in 0..nb {
+                        num[b] += w * sum[i + b];
+                        den[b] += w * count[i + b];
+                    }
+                }
+            }
+            let mut points: Vec<(u8, f32)> =
+                (0..nb).filter(|&b| den[b] > 0.0).map(|b| (b as u8, num[b] / den[b])).collect();
+            let mut out = vec![0.0f32; nb];
+            // Within the known bands, interpolation equals the estimates themselves.
+            let _ = through(&mut points, &mut out);
+            for b in 0..nb {
+                if den[b] > 0.0 {
+                    out[b] = num[b] / den[b];
+                }
+            }
+            out
+        })
+        .collect();
+    let mut lf = samples.empty_field();
+    let mut report = BaselineReport::default();
+    for u in 0..vu {
+        for v in 0..vv {
+            for s in 0..ls {
+                for t in 0..lt {
+                    let (row, col) = samples.pixel(s, t, u, v);
+                    let own: Vec<(u8, f32)> = samples.at(row, col).iter().flatten().copied().collect();
+                    let e = &estimate[s * lt + t];
+                    let at = lf.index(u, v, s, t, 0);
+                    if own.is_empty() {
+                        // No measurement here: the neighbourhood's spectrum as it is.
+                        report.filled += 1;
+                        lf.data[at..at + nb].copy_from_slice(e);
+                        continue;
+                    }
+                    report.measured += 1;
+                    let (mine, theirs): (f32, f32) =
+                        own.iter().fold((0.0, 0.0), |(a, b), &(band, x)| (a + x, b + e[usize::from(band)]));
+                    let ratio = if theirs > 1e-6 && mine > 0.0 {
+                        (mine / theirs).clamp(1.0 / cfg.max_ratio, cfg.max_ratio)
+                    } else {
+                        1.0
+                    };
+                    for (o, &x) in lf.data[at..at + nb].iter_mut().zip(e) {
+                        *o = x * ratio;
+                    }
+                    for &(band, x) in &own {
+                        lf.data[at + usize::from(band)] = x;
+                    }
+                }
+            }
+        }
+    }
+    report.seconds = start.elapsed().as_secs_f64();
+    Ok((lf, report))
+}

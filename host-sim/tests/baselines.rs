@@ -1,0 +1,131 @@
+//! The no-CS baselines against values worked out by hand.
+
+use slf_host::camera::{CameraConfig, simulate};
+use slf_host::capture::Capture;
+use slf_host::demosaic::{DemosaicConfig, demosaic, interpolate};
+use slf_host::lightfield::LightField;
+use slf_host::metrics::evaluate;
+
+mod common;
+use common::small_smooth;
+
+/// A light field whose spectrum at every position is `f(u, v, y, x, b)`.
+fn field(f: impl Fn(usize, usize, usize, usize, usize) -> f32) -> LightField {
+    let mut lf = LightField::zeros((5, 5), 12, 12, 13);
+    for u in 0..5 {
+        for v in 0..5 {
+            for y in 0..12 {
+                for x in 0..12 {
+                    for b in 0..13 {
+                        let i = lf.index(u, v, y, x, b);
+                        lf.data[i] = f(u, v, y, x, b);
+                    }
+                }
+            }
+        }
+    }
+    lf
+}
+
+/// One DN in normalised units (the default sensor: white at 90 % of 12 bits above black 64).
+const DN: f32 = 1.0 / (0.9 * (4095.0 - 64.0));
+
+#[test]
+fn interpolation_is_linear_between_a_pixels_measured_bands_and_flat_beyond() {
+    // Every position its own spectrum, so a wrong pixel or band would show.
+    let truth = field(|u, v, y, x, b| 0.1 + 0.02 * b as f32 + 0.01 * ((u + 2 * v + 3 * y + 5 * x) % 7) as f32);
+    let cap = simulate(&truth, &CameraConfig::pixel(5, 3).noiseless()).unwrap();
+    let (lf, report) = interpolate(&cap).unwrap();
+    assert_eq!((report.measured, report.filled), (5 * 5 * 12 * 12, 0));
+    let mask = cap.mask().unwrap();
+    for &(u, v, y, x) in &[(0, 0, 0, 0), (2, 3, 7, 5), (4, 4, 11, 11), (1, 0, 6, 9)] {
+        let mut bands: Vec<usize> = mask.bands_at(y * 5 + u, x * 5 + v).iter().map(|&b| usize::from(b)).collect();
+        bands.sort_unstable();
+        let m = |b: usize| truth.get(u, v, y, x, b);
+        for b in 0..13 {
+            // By hand: the measured value at a measured band, a straight line between the
+            // two measured bands around b, the end values beyond.
+            let want = if b <= bands[0] {
+                m(bands[0])
+            } else if b >= bands[2] {
+                m(bands[2])
+            } else {
+                let (lo, hi) = if b <= bands[1] { (bands[0], bands[1]) } else { (bands[1], bands[2]) };
+                m(lo) + (b - lo) as f32 / (hi - lo) as f32 * (m(hi) - m(lo))
+            };
+            let got = lf.get(u, v, y, x, b);
+            assert!((got - want).abs() <= DN, "({u}, {v}, {y}, {x}) band {b}: {got} against {want}");
+        }
+    }
+}
+
+#[test]
+fn the_demosaic_recovers_a_flat_field_and_keeps_measured_values() {
+    // One spectrum everywhere: every neighbourhood estimate is that spectrum, the ratio 1.
+    let spectrum = |b: usize| 0.2 + 0.5 * ((b as f32 - 6.0) / 6.0).powi(2);
+    let truth = field(|_, _, _, _, b| spectrum(b));
+    let cap = simulate(&truth, &CameraConfig::pixel(9, 1).noiseless()).unwrap();
+    let (lf, report) = demosaic(&cap, &DemosaicConfig::default()).unwrap();
+    assert_eq!(report.filled, 0);
+    let worst = lf.data.iter().zip(&truth.data).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+    assert!(worst <= 2.0 * DN, "flat field off by {worst}");
+    // A measured band keeps its measured value exactly (here: the quantised truth).
+    let mask = cap.mask().unwrap();
+    let b = usize::from(mask.bands_at(13, 17)[0]);
+    let raw = f32::from(cap.frames[0][13 * 60 + 17]);
+    let fmt = cap.raw_format();
+    assert_eq!(lf.get(3, 2, 2, 3, b), (raw - fmt.black) / (fmt.white - fmt.black));
+}
+
+#[test]
+fn the_demosaic_scales_to_each_pixels_own_brightness() {
+    // A spectrum times a brightness that changes per view: the neighbourhood's spectrum
+    // shape is right, its level is matched per pixel.
+    let truth = field(|u, v, _, _, b| (0.3 + 0.02 * b as f32) * (0.5 + 0.1 * (u + v) as f32));
+    let cap = simulate(&truth, &CameraConfig::pixel(2, 1).noiseless()).unwrap();
+    let psnr = |max_ratio: f32| {
+        let cfg = DemosaicConfig { max_ratio, ..DemosaicConfig::default() };
+        evaluate(&truth, &demosaic(&cap, &cfg).unwrap().0).unwrap().psnr
+    };
+    // Without the match (ratio limited to 1) every view takes the neighbourhood's mean
+    // level; with it each pixel's level is its own, and what is left is the spread of the
+    // levels of the views that happened to measure each band.
+    let (matched, unmatched) = (psnr(4.0), psnr(1.0));
+    assert!(matched > unmatched + 8.0, "matched {matched:.2} dB, unmatched {unmatched:.2} dB");
+}
+
+#[test]
+fn the_demosaic_beats_per_pixel_interpolation_at_one_snapshot() {
+    let truth = small_smooth(5);
+    let cap = simulate(&truth, &CameraConfig::pixel(7, 1)).unwrap();
+    let a = evaluate(&truth, &interpolate(&cap).unwrap().0).unwrap().psnr;
+    let b = evaluate(&truth, &demosaic(&cap, &DemosaicConfig::default()).unwrap().0).unwrap().psnr;
+    assert!(b > a + 5.0, "demosaic {b:.2} dB against interpolation {a:.2} dB");
+}
+
+#[test]
+fn positions_without_a_measurement_are_filled_and_counted() {
+    let truth = small_smooth(5);
+    let mut cam = CameraConfig::pixel(3, 1);
+    cam.defect_fraction = 0.2;
+    let cap = simulate(&truth, &cam).unwrap();
+    let defects = cap.description.defective_pixels.len();
+    let saturated = cap.saturated_pixels().0;
+    for (lf, r) in [interpolate(&cap).unwrap(), demosaic(&cap, &DemosaicConfig::default()).unwrap()] {
+        assert_eq!(r.filled, defects + saturated);
+        assert_eq!(r.measured + r.filled, 5 * 5 * 12 * 12);
+        assert!(lf.data.iter().all(|x| x.is_finite()));
+    }
+}
+
+#[test]
+fn a_capture_with_no_measurement_is_an_error_naming_it() {
+    let truth = field(|_, _, _, _, _| 50.0); // far above white: every pixel saturated
+    let dir = tempfile::tempdir().unwrap();
+    simulate(&truth, &CameraConfig::pixel(1, 1)).unwrap().save(dir.path()).unwrap();
+    let cap = Capture::load(dir.path()).unwrap();
+    for e in [interpolate(&cap).unwrap_err(), demosaic(&cap, &DemosaicConfig::default()).unwrap_err()] {
+        let e = format!("{e:#}");
+        assert!(e.contains("capture.json") && e.contains("no pixel holds a measurement"), "{e}");
+    }
+}
