@@ -22,7 +22,8 @@ use slf_firmware::{
 use crate::baseline::{Factors, analyze_5d, solve_5d};
 use crate::camera::{CameraConfig, simulate};
 use crate::capture::MaskDescription;
-use crate::decode::{Basis, DecodeOptions, decode, decode_with};
+use crate::decode::{Basis, DecodeOptions, decode, decode_with, patch_count};
+use crate::demosaic::Baseline;
 use crate::lightfield::LightField;
 use crate::metrics::evaluate;
 use crate::scene::{self, SceneSize};
@@ -69,6 +70,8 @@ impl PatchModel<5, 5, 4, 4, 13, 5200> for F64Dct {
 enum Decoder {
     Basis(Basis),
     F64,
+    /// A method without compressed sensing; its time is per CS patch of the same capture.
+    Baseline(Baseline),
 }
 
 /// One point of the sweep.
@@ -115,6 +118,8 @@ fn settings(quick: bool) -> Vec<(String, Decoder, Sl0Config)> {
         ("DCT noise-aware".to_string(), dct(), Sl0Config { noise: 2.0 / 3628.0, ..d }),
         ("ensemble screened".to_string(), ens(MemberChoice::Screened(ChoiceRule::DEFAULT)), d),
     ];
+    // What a user would pick instead of CS: the baselines, in every run.
+    s.extend(Baseline::ALL.map(|m| (m.name().to_string(), Decoder::Baseline(m), d)));
     // Modelling only what a patch needs: the early stop, the flat short path, and the
     // ensemble's warm start (default 1e-2) against a cold second solve. The quick run keeps
     // one point of each.
@@ -166,6 +171,12 @@ fn run_decoder(
     match dec {
         Decoder::Basis(b) => decode_with(capture, b, &opts),
         Decoder::F64 => decode(capture, &F64Dct::default(), &opts),
+        Decoder::Baseline(m) => {
+            let (lf, _) = m.run(capture)?;
+            let mut report = crate::decode::DecodeReport::default();
+            report.patches.decoded = u32::try_from(patch_count(capture)?).unwrap_or(u32::MAX);
+            Ok((lf, report))
+        }
     }
 }
 

@@ -89,6 +89,17 @@ pub fn decode_with(capture: &Capture, basis: &Basis, opts: &DecodeOptions) -> Re
     }
 }
 
+/// Patches the CS decoder decodes in `capture` (every tile's patches in every angular
+/// window): the unit that times per patch are given in, also for methods without patches.
+///
+/// # Errors
+/// A capture the decoder does not take.
+pub fn patch_count(capture: &Capture) -> Result<u64> {
+    let decoder = capture.decoder(Sl0Config::DEFAULT)?;
+    let windows = decoder.windows().count() as u64;
+    Ok(decoder.tiles((2, 2)).map(|t| u64::from(t.lenslet_rows / 5) * u64::from(t.lenslet_cols / 5) * windows).sum())
+}
+
 /// How to decode.
 #[derive(Clone, Copy, Debug)]
 pub struct DecodeOptions {

@@ -46,6 +46,39 @@ impl Default for DemosaicConfig {
     }
 }
 
+/// A baseline decode method, by name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Baseline {
+    /// [`interpolate`].
+    Interpolate,
+    /// [`demosaic`] with [`DemosaicConfig::default`].
+    Demosaic,
+}
+
+impl Baseline {
+    /// Every baseline, weakest first.
+    pub const ALL: [Baseline; 2] = [Baseline::Interpolate, Baseline::Demosaic];
+
+    /// A short name for reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Baseline::Interpolate => "baseline: per-pixel interpolation",
+            Baseline::Demosaic => "baseline: neighbourhood demosaic",
+        }
+    }
+
+    /// Decodes `capture` with this baseline.
+    ///
+    /// # Errors
+    /// As [`interpolate`] and [`demosaic`].
+    pub fn run(self, capture: &Capture) -> Result<(LightField, BaselineReport)> {
+        match self {
+            Baseline::Interpolate => interpolate(capture),
+            Baseline::Demosaic => demosaic(capture, &DemosaicConfig::default()),
+        }
+    }
+}
+
 /// What a baseline did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct BaselineReport {

@@ -9,6 +9,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use slf_host::camera::{CameraConfig, simulate};
 use slf_host::capture::{Capture, MaskDescription};
 use slf_host::decode::{Basis, DecodeOptions, decode_with, read_blob};
+use slf_host::demosaic::Baseline;
 use slf_host::firmware::{ChoiceRule, DEFAULT_ENSEMBLE, MaskFamily, MemberChoice, Sl0Config};
 use slf_host::lightfield::{Dtype, read_npy, write_npy};
 use slf_host::metrics::evaluate;
@@ -541,10 +542,11 @@ fn run(cli: Cli) -> Result<()> {
             let cap = Capture::load(&capture)?;
             if method != Method::Cs {
                 anyhow::ensure!(member_map.is_none(), "--member-map needs --method cs (baselines use no ensemble)");
-                let (lf, r) = match method {
-                    Method::Interpolate => slf_host::demosaic::interpolate(&cap)?,
-                    _ => slf_host::demosaic::demosaic(&cap, &slf_host::demosaic::DemosaicConfig::default())?,
+                let baseline = match method {
+                    Method::Interpolate => Baseline::Interpolate,
+                    _ => Baseline::Demosaic,
                 };
+                let (lf, r) = baseline.run(&cap)?;
                 write_npy(&output, &lf, dtype)?;
                 println!(
                     "{:?}: {} sensor positions measured, {} filled from their neighbours, in {:.2} s; wrote {}",

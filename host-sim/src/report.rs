@@ -10,6 +10,7 @@ use slf_firmware::{ChoiceRule, DEFAULT_ENSEMBLE, MaskFamily, MemberChoice};
 use crate::camera::{CameraConfig, simulate};
 use crate::capture::MaskDescription;
 use crate::decode::{Basis, DecodeOptions, DecodeReport, decode_with};
+use crate::demosaic::Baseline;
 use crate::lightfield::{Dtype, LightField, write_npy};
 use crate::metrics::{Metrics, evaluate};
 use crate::preview::write_comparison;
@@ -125,8 +126,8 @@ pub fn sweep(size: usize, ks: &[u8], output: Option<&Path>, basis: &Basis) -> Re
     Ok(())
 }
 
-/// `slf compare`: the DCT against the ensemble (exhaustive and screened) on every named
-/// scene, per mask family and k, with solves and time per patch.
+/// `slf compare`: the DCT against the ensemble (exhaustive and screened) and the baselines
+/// without CS on every named scene, per mask family and k, with solves and time per patch.
 ///
 /// # Errors
 /// An unreadable blob, a failed decode or an unwritable `output`.
@@ -165,6 +166,7 @@ pub fn compare(
     };
     for family in families {
         for &k in ks {
+            let mut patches_per_field = 0.0;
             for basis in &bases {
                 let cam = CameraConfig::pixel(7, k).with_mask(MaskDescription::seeded(family, 7, k));
                 let (mut p, mut s, mut a, mut secs, mut solves, mut patches) = (0.0, 0.0, 0.0, 0.0, 0u64, 0u64);
@@ -187,6 +189,32 @@ pub fn compare(
                     a / n,
                     solves as f64 / patches as f64,
                     1e3 * secs * threads / patches as f64
+                );
+                println!("{line}");
+                lines.push(line);
+                patches_per_field = patches as f64 / n;
+            }
+            // The baselines, timed on one thread (their time per patch is per CS patch of
+            // the same sensor, to compare).
+            let one = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
+            for baseline in Baseline::ALL {
+                let cam = CameraConfig::pixel(7, k).with_mask(MaskDescription::seeded(family, 7, k));
+                let (mut p, mut s, mut a, mut secs) = (0.0, 0.0, 0.0, 0.0);
+                for truth in &truths {
+                    let capture = simulate(truth, &cam)?;
+                    let (recon, r) = one.install(|| baseline.run(&capture))?;
+                    let m = evaluate(truth, &recon)?;
+                    (p, s, a, secs) = (p + m.psnr, s + m.ssim, a + m.sa, secs + r.seconds);
+                }
+                let n = truths.len() as f64;
+                let line = format!(
+                    "| {} | {} | {k} | {:.2} | {:.4} | {:.2} | 0 | {:.3} |",
+                    baseline.name(),
+                    format!("{family:?}").to_lowercase(),
+                    p / n,
+                    s / n,
+                    a / n,
+                    1e3 * secs / n / patches_per_field.max(1.0)
                 );
                 println!("{line}");
                 lines.push(line);

@@ -129,3 +129,24 @@ fn a_capture_with_no_measurement_is_an_error_naming_it() {
         assert!(e.contains("capture.json") && e.contains("no pixel holds a measurement"), "{e}");
     }
 }
+
+#[test]
+fn patch_count_is_what_the_cs_decoder_decodes() {
+    // Baselines are timed per CS patch of the same capture: the count must be the decoder's.
+    for (views, size) in [(5, 12), (4, 12), (5, 11)] {
+        let truth = slf_host::scene::named("smooth").unwrap().render(slf_host::scene::SceneSize {
+            views: (views, views),
+            rows: size,
+            cols: size,
+        });
+        let cap = simulate(&truth, &CameraConfig::pixel(3, 1)).unwrap();
+        let (_, r) = slf_host::decode::decode_with(
+            &cap,
+            &slf_host::decode::Basis::Dct,
+            &slf_host::decode::DecodeOptions::default(),
+        )
+        .unwrap();
+        let n = slf_host::decode::patch_count(&cap).unwrap();
+        assert_eq!(n, u64::from(r.patches.decoded + r.patches.failed), "{views} views, {size} lenslets");
+    }
+}
