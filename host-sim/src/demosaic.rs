@@ -143,6 +143,19 @@ impl Samples {
         (s * self.views.0 + u, t * self.views.1 + v)
     }
 
+    /// Every sensor position in the light field's order `(u, v, s, t)`: its index in that
+    /// order (its spectrum starts at `index * bands` in the light field's data), its
+    /// lenslet `(s, t)` and its valid measurements.
+    fn positions(&self) -> impl Iterator<Item = (usize, (usize, usize), Vec<(u8, f32)>)> + '_ {
+        let (vv, (ls, lt)) = (self.views.1, self.lenslets);
+        (0..self.views.0 * vv * ls * lt).map(move |i| {
+            let (uv, st) = (i / (ls * lt), i % (ls * lt));
+            let (u, v, s, t) = (uv / vv, uv % vv, st / lt, st % lt);
+            let (row, col) = self.pixel(s, t, u, v);
+            (i, (s, t), self.at(row, col).iter().flatten().copied().collect())
+        })
+    }
+
     fn empty_field(&self) -> LightField {
         LightField::zeros(self.views, self.lenslets.0, self.lenslets.1, self.bands)
     }
@@ -218,25 +231,15 @@ pub fn interpolate(capture: &Capture) -> Result<(LightField, BaselineReport)> {
     let start = std::time::Instant::now();
     let samples = Samples::read(capture)?;
     let mut lf = samples.empty_field();
-    let (vu, vv) = samples.views;
-    let (ls, lt) = samples.lenslets;
-    let mut missing = vec![false; vu * vv * ls * lt];
+    let nb = samples.bands;
+    let mut missing = vec![false; lf.data.len() / nb];
     let mut report = BaselineReport::default();
-    for u in 0..vu {
-        for v in 0..vv {
-            for s in 0..ls {
-                for t in 0..lt {
-                    let (row, col) = samples.pixel(s, t, u, v);
-                    let mut points: Vec<(u8, f32)> = samples.at(row, col).iter().flatten().copied().collect();
-                    let at = lf.index(u, v, s, t, 0);
-                    if through(&mut points, &mut lf.data[at..at + samples.bands]).is_some() {
-                        report.measured += 1;
-                    } else {
-                        missing[((u * vv + v) * ls + s) * lt + t] = true;
-                        report.filled += 1;
-                    }
-                }
-            }
+    for (i, _, mut points) in samples.positions() {
+        if through(&mut points, &mut lf.data[i * nb..(i + 1) * nb]).is_some() {
+            report.measured += 1;
+        } else {
+            missing[i] = true;
+            report.filled += 1;
         }
     }
     ensure!(report.measured > 0, "{}: no pixel holds a measurement (all saturated or defective)", capture.source());
@@ -255,24 +258,16 @@ pub fn demosaic(capture: &Capture, cfg: &DemosaicConfig) -> Result<(LightField, 
     ensure!(cfg.max_ratio.is_finite() && cfg.max_ratio >= 1.0, "demosaic max_ratio {} must be >= 1", cfg.max_ratio);
     let start = std::time::Instant::now();
     let samples = Samples::read(capture)?;
-    let (vu, vv) = samples.views;
     let (ls, lt) = samples.lenslets;
     let nb = samples.bands;
     // Per lenslet and band: the sum and count of its views' measurements of that band.
     let mut sum = vec![0.0f32; ls * lt * nb];
     let mut count = vec![0.0f32; ls * lt * nb];
-    for s in 0..ls {
-        for t in 0..lt {
-            for u in 0..vu {
-                for v in 0..vv {
-                    let (row, col) = samples.pixel(s, t, u, v);
-                    for &(b, x) in samples.at(row, col).iter().flatten() {
-                        let i = (s * lt + t) * nb + usize::from(b);
-                        sum[i] += x;
-                        count[i] += 1.0;
-                    }
-                }
-            }
+    for (_, (s, t), own) in samples.positions() {
+        for (b, x) in own {
+            let i = (s * lt + t) * nb + usize::from(b);
+            sum[i] += x;
+            count[i] += 1.0;
         }
     }
     ensure!(
@@ -318,36 +313,25 @@ pub fn demosaic(capture: &Capture, cfg: &DemosaicConfig) -> Result<(LightField, 
         .collect();
     let mut lf = samples.empty_field();
     let mut report = BaselineReport::default();
-    for u in 0..vu {
-        for v in 0..vv {
-            for s in 0..ls {
-                for t in 0..lt {
-                    let (row, col) = samples.pixel(s, t, u, v);
-                    let own: Vec<(u8, f32)> = samples.at(row, col).iter().flatten().copied().collect();
-                    let e = &estimate[s * lt + t];
-                    let at = lf.index(u, v, s, t, 0);
-                    if own.is_empty() {
-                        // No measurement here: the neighbourhood's spectrum as it is.
-                        report.filled += 1;
-                        lf.data[at..at + nb].copy_from_slice(e);
-                        continue;
-                    }
-                    report.measured += 1;
-                    let (mine, theirs): (f32, f32) =
-                        own.iter().fold((0.0, 0.0), |(a, b), &(band, x)| (a + x, b + e[usize::from(band)]));
-                    let ratio = if theirs > 1e-6 && mine > 0.0 {
-                        (mine / theirs).clamp(1.0 / cfg.max_ratio, cfg.max_ratio)
-                    } else {
-                        1.0
-                    };
-                    for (o, &x) in lf.data[at..at + nb].iter_mut().zip(e) {
-                        *o = x * ratio;
-                    }
-                    for &(band, x) in &own {
-                        lf.data[at + usize::from(band)] = x;
-                    }
-                }
-            }
+    for (i, (s, t), own) in samples.positions() {
+        let e = &estimate[s * lt + t];
+        let at = i * nb;
+        if own.is_empty() {
+            // No measurement here: the neighbourhood's spectrum as it is.
+            report.filled += 1;
+            lf.data[at..at + nb].copy_from_slice(e);
+            continue;
+        }
+        report.measured += 1;
+        let (mine, theirs): (f32, f32) =
+            own.iter().fold((0.0, 0.0), |(a, b), &(band, x)| (a + x, b + e[usize::from(band)]));
+        let ratio =
+            if theirs > 1e-6 && mine > 0.0 { (mine / theirs).clamp(1.0 / cfg.max_ratio, cfg.max_ratio) } else { 1.0 };
+        for (o, &x) in lf.data[at..at + nb].iter_mut().zip(e) {
+            *o = x * ratio;
+        }
+        for &(band, x) in &own {
+            lf.data[at + usize::from(band)] = x;
         }
     }
     report.seconds = start.elapsed().as_secs_f64();
