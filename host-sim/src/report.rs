@@ -164,6 +164,7 @@ pub fn compare(
     } else {
         masks.to_vec()
     };
+    let one = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
     for family in families {
         for &k in ks {
             let mut patches_per_field = 0.0;
@@ -196,7 +197,6 @@ pub fn compare(
             }
             // The baselines, timed on one thread (their time per patch is per CS patch of
             // the same sensor, to compare).
-            let one = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
             for baseline in Baseline::ALL {
                 let cam = CameraConfig::pixel(7, k).with_mask(MaskDescription::seeded(family, 7, k));
                 let (mut p, mut s, mut a, mut secs) = (0.0, 0.0, 0.0, 0.0);
