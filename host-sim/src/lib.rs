@@ -5,6 +5,8 @@
 //!
 //! From a scene to numbers:
 //!
+//! - [`import`] brings real data in (views, hyperspectral cubes, other light fields) as
+//!   the camera's 13 bands.
 //! - [`scene`] renders synthetic spectral light fields ([`spectra`] holds measured and
 //!   synthetic spectra); [`lightfield`] reads and writes them as `.npy` ([`npy`] reads
 //!   any `.npy` with every size checked first).
@@ -27,6 +29,7 @@ pub mod capture;
 pub mod decode;
 pub mod demosaic;
 pub mod device;
+pub mod import;
 pub mod lightfield;
 pub mod metrics;
 pub mod npy;

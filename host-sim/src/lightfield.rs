@@ -176,6 +176,17 @@ pub fn write_npy_u16_2d(path: &Path, data: &[u16], rows: usize, cols: usize) -> 
     w.finish()
 }
 
+/// Writes an f32 2D `.npy` array (a disparity map).
+///
+/// # Errors
+/// I/O errors.
+pub fn write_npy_f32_2d(path: &Path, data: &[f32], rows: usize, cols: usize) -> std::io::Result<()> {
+    let file = BufWriter::new(File::create(path)?);
+    let mut w = npyz::WriteOptions::new().default_dtype().shape(&[rows as u64, cols as u64]).writer(file).begin_nd()?;
+    w.extend(data.iter().copied())?;
+    w.finish()
+}
+
 /// Reads a uint16 2D `.npy` array (a raw frame): `(data, rows, cols)`.
 ///
 /// # Errors

@@ -3,6 +3,8 @@
 
 use assert_cmd::Command;
 
+mod common;
+
 fn slf() -> Command {
     Command::cargo_bin("slf").unwrap()
 }
@@ -306,4 +308,43 @@ fn baselines_decode_from_the_command_line() {
             .arg(p("m.csv")),
     );
     assert!(e.contains("--member-map needs --method cs"), "{e}");
+}
+
+#[test]
+fn import_from_the_command_line_and_other_band_counts_resampled() {
+    use slf_host::lightfield::{Dtype, LightField, read_npy, write_npy};
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    // A 31-band light field, 400..=700 nm by 10, flat 0.4: refused without its
+    // wavelengths, resampled with them (flat stays 0.4 in all 13 bands).
+    let mut lf = LightField::zeros((5, 5), 10, 10, 31);
+    lf.data.iter_mut().for_each(|v| *v = 0.4);
+    write_npy(&p("b31.npy"), &lf, Dtype::F32).unwrap();
+    let e = failure(slf().arg("simulate").arg(p("b31.npy")).arg("-o").arg(p("cap")));
+    assert!(e.contains("31 bands") && e.contains("--wavelengths"), "{e}");
+    stdout(slf().arg("simulate").arg(p("b31.npy")).args(["--wavelengths", "400:700:10", "-o"]).arg(p("cap")));
+    stdout(
+        slf().args(["import", "bands"]).arg(p("b31.npy")).args(["--wavelengths", "400:700:10", "-o"]).arg(p("b13.npy")),
+    );
+    let b13 = read_npy(&p("b13.npy")).unwrap();
+    assert_eq!(b13.shape(), [5, 5, 10, 10, 13]);
+    assert!(b13.data.iter().all(|v| (v - 0.4).abs() < 1e-6));
+    // A cube as .npy: needs wavelengths; then a 5 x 5 light field.
+    let body: Vec<u8> = (0..6 * 7 * 4).flat_map(|_| 0.5f32.to_le_bytes()).collect();
+    let header = "{'descr': '<f4', 'fortran_order': False, 'shape': (6, 7, 4), }";
+    std::fs::write(p("cube.npy"), common::npy_bytes(1, header, &body)).unwrap();
+    let e = failure(slf().args(["import", "cube"]).arg(p("cube.npy")).arg("-o").arg(p("c.npy")));
+    assert!(e.contains("4 bands") && e.contains("--wavelengths"), "{e}");
+    stdout(
+        slf()
+            .args(["import", "cube"])
+            .arg(p("cube.npy"))
+            .args(["--wavelengths", "400,500,600,700", "-o"])
+            .arg(p("c.npy")),
+    );
+    assert_eq!(read_npy(&p("c.npy")).unwrap().shape(), [5, 5, 6, 7, 13]);
+    // A folder of views with none in the window is one error line naming a file.
+    std::fs::create_dir(p("views")).unwrap();
+    let e = failure(slf().args(["import", "views"]).arg(p("views")).arg("-o").arg(p("v.npy")));
+    assert!(e.contains("input_Cam020.png"), "{e}");
 }
