@@ -17,7 +17,8 @@
 //! - [`metrics`] (PSNR, SSIM, SA), [`preview`] (sRGB PNGs) and [`baseline`] (the paper's 1D
 //!   method) evaluate it.
 //!
-//! [`report`] holds the tables of `slf demo`, `sweep` and `compare`, [`bench`] the speed
+//! [`evaluation`] runs every method a user could pick (baselines, DCT, ensemble) on light
+//! fields they bring. [`report`] holds the tables of `slf demo`, `sweep` and `compare`, [`bench`] the speed
 //! against error sweep; the `slf` command (`src/main.rs`) parses arguments and calls them.
 
 pub use slf_firmware as firmware;
@@ -29,6 +30,7 @@ pub mod capture;
 pub mod decode;
 pub mod demosaic;
 pub mod device;
+pub mod evaluation;
 pub mod import;
 pub mod lightfield;
 pub mod metrics;

@@ -94,6 +94,8 @@ enum Method {
     /// Baseline: each band from the nearby pixels and views that measured it, matched to
     /// each pixel's own measurements.
     Demosaic,
+    /// Baseline: PPID, demosaicking by the pseudo-panchromatic image (Mihoubi et al. 2017).
+    Ppid,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -418,6 +420,20 @@ enum Command {
         #[arg(long, value_delimiter = ',')]
         masks: Vec<Family>,
     },
+    /// Every baseline, the DCT and the ensemble on the given light fields at pixel k = 1, 3
+    /// and lenslet k = 3: PSNR / SSIM / SA and ms per patch per scene and mean (table.md),
+    /// and previews of a zoomed crop at pixel k = 1.
+    Evaluate {
+        /// Light fields, (U, V, H, W, 13) .npy; each is named by its file stem.
+        #[arg(required = true, num_args = 1..)]
+        inputs: Vec<PathBuf>,
+        /// Output folder (table.md and previews).
+        #[arg(short, long, default_value = "slf-evaluate")]
+        out: PathBuf,
+        /// Ensemble blob (default: the shipped one).
+        #[arg(long)]
+        blob: Option<PathBuf>,
+    },
     /// Write the capture the device binary decodes (frames as .npy and `capture.rs` constants).
     DeviceCapture {
         /// Folder (firmware/device).
@@ -556,6 +572,7 @@ fn run(cli: Cli) -> Result<()> {
                 anyhow::ensure!(member_map.is_none(), "--member-map needs --method cs (baselines use no ensemble)");
                 let baseline = match method {
                     Method::Interpolate => Baseline::Interpolate,
+                    Method::Ppid => Baseline::Ppid,
                     _ => Baseline::Demosaic,
                 };
                 let (lf, r) = baseline.run(&cap)?;
@@ -641,6 +658,24 @@ fn run(cli: Cli) -> Result<()> {
         Command::DeviceCapture { output } => slf_host::device::write_capture(&output),
         Command::DeviceCheck { log, capture } => slf_host::device::check(&log, &capture),
         Command::Sweep { size, k, output, basis } => report::sweep(size, &k, output.as_deref(), &basis.basis()?),
+        Command::Evaluate { inputs, out, blob } => {
+            use slf_host::evaluation::{SETTINGS, evaluate_set, table};
+            let blob = match blob {
+                Some(p) => read_blob(&p)?,
+                None => DEFAULT_ENSEMBLE.to_vec(),
+            };
+            let mut scenes = Vec::new();
+            for p in &inputs {
+                let name = p.file_stem().map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+                scenes.push((name, with_camera_bands(read_npy(p)?, None, p)?));
+            }
+            let rows = evaluate_set(&scenes, &SETTINGS, &blob, &out)?;
+            let t = table(&rows, &SETTINGS);
+            let path = out.join("table.md");
+            std::fs::write(&path, &t).with_context(|| format!("cannot write {}", path.display()))?;
+            println!("{t}wrote {}", path.display());
+            Ok(())
+        }
         Command::Compare { size, k, output, blob, masks, rule, rule_tau } => {
             let masks: Vec<MaskFamily> = masks.iter().map(|m| m.family()).collect();
             report::compare(size, &k, output.as_deref(), blob.as_deref(), &masks, rule.rule(rule_tau))
