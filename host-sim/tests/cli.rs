@@ -348,3 +348,19 @@ fn import_from_the_command_line_and_other_band_counts_resampled() {
     let e = failure(slf().args(["import", "views"]).arg(p("views")).arg("-o").arg(p("v.npy")));
     assert!(e.contains("input_Cam020.png"), "{e}");
 }
+
+#[test]
+fn evaluate_compares_every_method_per_scene_and_on_average() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    stdout(slf().args(["scene", "smooth", "--size", "15", "-o"]).arg(p("a.npy")));
+    stdout(slf().args(["scene", "texture", "--size", "15", "-o"]).arg(p("b.npy")));
+    stdout(slf().arg("evaluate").arg(p("a.npy")).arg(p("b.npy")).arg("-o").arg(p("out")));
+    let table = std::fs::read_to_string(p("out/table.md")).unwrap();
+    // 3 settings x (2 scenes + mean) x 5 methods, and a header of 2 lines.
+    assert_eq!(table.lines().count(), 2 + 3 * 3 * 5, "{table}");
+    for m in ["per-pixel interpolation", "neighbourhood demosaic", "PPID", "| DCT |", "ensemble screened"] {
+        assert_eq!(table.matches(m).count(), 9, "{m}: {table}");
+    }
+    assert!(p("out/a_dct.png").exists() && p("out/b_baseline-ppid-mihoubi-et-al-2017.png").exists());
+}
