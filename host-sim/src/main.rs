@@ -851,6 +851,28 @@ enum ImportSource {
         #[arg(long)]
         wavelengths: String,
     },
+    /// A light field in an HDF5 file (read in pure Rust: no C library needed).
+    Hdf5 {
+        /// The .h5 file.
+        input: PathBuf,
+        /// Output light field .npy (U, V, H, W, 13).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// The dataset's path in the file, e.g. /lf/data.
+        #[arg(long)]
+        dataset: String,
+        /// The dataset's axes, slowest first, as a permutation of u, v (views), h, w
+        /// (space), b (bands), e.g. uvhwb or hwuvb.
+        #[arg(long, default_value = "uvhwb")]
+        axes: String,
+        /// Wavelengths of its bands when it does not have the camera's 13 (START:STOP:STEP
+        /// or a comma list, nm).
+        #[arg(long)]
+        wavelengths: Option<String>,
+        /// The value of white (every value is divided by it).
+        #[arg(long, default_value_t = 1.0, value_parser = positive)]
+        white: f32,
+    },
 }
 
 /// A light field with the camera's bands: as read if it has 13, resampled from
@@ -977,6 +999,14 @@ fn import_command(source: ImportSource) -> Result<()> {
         }
         ImportSource::Bands { input, output, wavelengths } => {
             let lf = with_camera_bands(read_npy(&input)?, Some(&wavelengths), &input)?;
+            write_npy(&output, &lf, Dtype::F32)?;
+            println!("wrote {} ({:?})", output.display(), lf.shape());
+            Ok(())
+        }
+        ImportSource::Hdf5 { input, output, dataset, axes, wavelengths, white } => {
+            use slf_host::import::hdf5::{Hdf5Layout, read_hdf5};
+            let lf = read_hdf5(&input, &Hdf5Layout { dataset, axes }, white)?;
+            let lf = with_camera_bands(lf, wavelengths.as_deref(), &input)?;
             write_npy(&output, &lf, Dtype::F32)?;
             println!("wrote {} ({:?})", output.display(), lf.shape());
             Ok(())

@@ -378,3 +378,50 @@ fn cube_and_geometry_errors_say_what_is_wrong() {
     let e = cube::band_files(dir.path()).unwrap_err().to_string();
     assert!(e.contains("no band images"), "{e}");
 }
+
+/// A tiny HDF5 file: group `lf`, dataset `data` of `shape`, values from `f` in file order.
+fn write_h5(path: &Path, shape: &[u64], f: impl Fn(usize) -> f32) {
+    let n = shape.iter().product::<u64>() as usize;
+    let values: Vec<f32> = (0..n).map(f).collect();
+    let mut b = hdf5_pure::FileBuilder::new();
+    let mut g = b.create_group("lf");
+    g.create_dataset("data").with_f32_data(&values).with_shape(shape);
+    b.add_group(g.finish());
+    std::fs::write(path, b.finish().unwrap()).unwrap();
+}
+
+#[test]
+fn hdf5_light_fields_are_read_in_any_axis_order() {
+    use slf_host::import::hdf5::{Hdf5Layout, read_hdf5};
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("lf.h5");
+    // Stored as (H, W, U, V, B) = (3, 4, 2, 5, 13); value = 1000 h + 100 w + 10 u + v + b / 100.
+    let shape = [3u64, 4, 2, 5, 13];
+    write_h5(&path, &shape, |i| {
+        let (b, i) = (i % 13, i / 13);
+        let (v, i) = (i % 5, i / 5);
+        let (u, i) = (i % 2, i / 2);
+        let (w, h) = (i % 4, i / 4);
+        (1000 * h + 100 * w + 10 * u + v) as f32 + b as f32 / 100.0
+    });
+    let layout = Hdf5Layout { dataset: "/lf/data".into(), axes: "hwuvb".into() };
+    let lf = read_hdf5(&path, &layout, 2.0).unwrap();
+    assert_eq!(lf.shape(), [2, 5, 3, 4, 13]);
+    for (u, v, h, w, b) in [(0, 0, 0, 0, 0), (1, 4, 2, 3, 12), (1, 2, 1, 0, 7)] {
+        let want = ((1000 * h + 100 * w + 10 * u + v) as f32 + b as f32 / 100.0) / 2.0;
+        assert_eq!(lf.get(u, v, h, w, b), want, "({u}, {v}, {h}, {w}, {b})");
+    }
+    for (axes, why) in [("uvhwx", "'x' is not one of"), ("uvhwu", "appears twice"), ("uvhw", "need 5 letters")] {
+        let e = read_hdf5(&path, &Hdf5Layout { dataset: "lf/data".into(), axes: axes.into() }, 1.0).unwrap_err();
+        assert!(e.to_string().contains(why), "{axes}: {e}");
+    }
+    let e = read_hdf5(&path, &Hdf5Layout { dataset: "lf/nope".into(), axes: "uvhwb".into() }, 1.0).unwrap_err();
+    assert!(e.to_string().contains("no dataset \"lf/nope\""), "{e}");
+    let flat = dir.path().join("flat.h5");
+    write_h5(&flat, &[4, 13], |_| 0.5);
+    let e = read_hdf5(&flat, &Hdf5Layout { dataset: "lf/data".into(), axes: "uvhwb".into() }, 1.0).unwrap_err();
+    assert!(e.to_string().contains("has 2 axes"), "{e}");
+    std::fs::write(dir.path().join("junk.h5"), b"not hdf5 at all").unwrap();
+    let e = read_hdf5(&dir.path().join("junk.h5"), &layout, 1.0).unwrap_err();
+    assert!(e.to_string().contains("not an HDF5 file"), "{e}");
+}

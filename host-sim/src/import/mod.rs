@@ -10,7 +10,8 @@
 //!   map), estimated by a plane sweep where no map is given.
 //! - [`views`] (folders of RGB views: the HCI benchmark's layout, or a pattern with row and
 //!   column placeholders), [`cube`] (hyperspectral `.npy` cubes and folders of band images,
-//!   CAVE's layout): the sources, each to a [`crate::lightfield::LightField`];
+//!   CAVE's layout), [`hdf5`] (light fields in HDF5 files, any axis order): the sources,
+//!   each to a [`crate::lightfield::LightField`];
 //!   [`resample_lightfield`] takes a light field of any band count to the camera's.
 //!
 //! Values are radiance scaled so a white reflector is 1 in the brightest band under D65,
@@ -18,6 +19,7 @@
 
 pub mod bands;
 pub mod cube;
+pub mod hdf5;
 pub mod parallax;
 pub mod pfm;
 pub mod rgb;
