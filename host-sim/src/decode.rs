@@ -100,6 +100,30 @@ pub fn patch_count(capture: &Capture) -> Result<u64> {
     Ok(decoder.tiles((2, 2)).map(|t| u64::from(t.lenslet_rows / 5) * u64::from(t.lenslet_cols / 5) * windows).sum())
 }
 
+/// How overlapping patches are averaged where they meet.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Window {
+    /// Every value of a patch counts the same.
+    #[default]
+    Uniform,
+    /// A patch's lenslets weigh `TAPER` by their distance from its edge (1 at the rim, 3
+    /// in the centre, per axis, multiplied), so a value is taken mostly from the patches
+    /// it sits in the middle of, where a patch's model is best constrained.
+    Tapered,
+}
+
+/// Per-axis weight of a patch's lenslet in [`Window::Tapered`].
+pub const TAPER: [f32; 5] = [1.0, 2.0, 3.0, 2.0, 1.0];
+
+impl Window {
+    fn weight(self, s: usize, t: usize) -> f32 {
+        match self {
+            Window::Uniform => 1.0,
+            Window::Tapered => TAPER[s] * TAPER[t],
+        }
+    }
+}
+
 /// How to decode.
 #[derive(Clone, Copy, Debug)]
 pub struct DecodeOptions {
@@ -108,12 +132,49 @@ pub struct DecodeOptions {
     pub tile_patches: (u16, u16),
     /// Show a progress bar once the run has taken a second.
     pub progress: bool,
+    /// Lenslets between patch origins (rows, cols), each in 1..=5. 5 (the default) is the
+    /// grid of disjoint patches; smaller strides add patch grids shifted by multiples of
+    /// the stride, (5 / stride)^2 times the patches, averaged by [`Self::window`].
+    pub stride: (u8, u8),
+    /// How overlapping patches are averaged.
+    pub window: Window,
 }
 
 impl Default for DecodeOptions {
     fn default() -> Self {
-        Self { sl0: Sl0Config::DEFAULT, tile_patches: (2, 2), progress: false }
+        Self { sl0: Sl0Config::DEFAULT, tile_patches: (2, 2), progress: false, stride: (5, 5), window: Window::Uniform }
     }
+}
+
+/// The tiles of the patch grids shifted by `(dy, dx)` lenslets for every multiple of the
+/// stride below 5 other than (0, 0), each of at most `per` patches, whole patches only
+/// (the unshifted grid, with its edge strips, already covers every lenslet).
+pub fn shifted_tiles(lenslets: (usize, usize), stride: (u8, u8), per: (u16, u16)) -> Vec<Tile> {
+    let offsets = |s: u8| (0..5usize).step_by(usize::from(s.clamp(1, 5)));
+    let spans = |total: usize, off: usize, per: usize| -> Vec<(usize, usize)> {
+        let whole = total.saturating_sub(off) / 5;
+        let per = per.max(1);
+        (0..whole.div_ceil(per)).map(|i| (off + i * per * 5, per.min(whole - i * per) * 5)).collect()
+    };
+    let mut tiles = Vec::new();
+    for dy in offsets(stride.0) {
+        for dx in offsets(stride.1) {
+            if (dy, dx) == (0, 0) {
+                continue;
+            }
+            for &(r0, nr) in &spans(lenslets.0, dy, usize::from(per.0)) {
+                for &(c0, nc) in &spans(lenslets.1, dx, usize::from(per.1)) {
+                    tiles.push(Tile {
+                        lenslet_row: r0 as u16,
+                        lenslet_col: c0 as u16,
+                        lenslet_rows: nr as u16,
+                        lenslet_cols: nc as u16,
+                    });
+                }
+            }
+        }
+    }
+    tiles
 }
 
 /// What a decode did.
@@ -135,21 +196,22 @@ pub struct DecodeReport {
     pub seconds: f64,
 }
 
-/// Sums of the patch estimates over one tile's lenslets, all views and bands.
+/// Weighted sums of the patch estimates over one tile's lenslets, all views and bands.
 struct TileSums {
     tile: Tile,
     views: (usize, usize),
+    window: Window,
     sum: Vec<f32>,
-    count: Vec<u16>,
+    weight: Vec<f32>,
     steps: u64,
     solves: u64,
     members: Vec<(PatchOrigin, u16)>,
 }
 
 impl TileSums {
-    fn new(tile: Tile, views: (usize, usize)) -> Self {
+    fn new(tile: Tile, views: (usize, usize), window: Window) -> Self {
         let n = tile.lenslet_rows as usize * tile.lenslet_cols as usize * views.0 * views.1 * 13;
-        Self { tile, views, sum: vec![0.0; n], count: vec![0; n], steps: 0, solves: 0, members: Vec::new() }
+        Self { tile, views, window, sum: vec![0.0; n], weight: vec![0.0; n], steps: 0, solves: 0, members: Vec::new() }
     }
 
     /// Index in the tile's `(s, t, u, v, b)` buffer.
@@ -172,8 +234,9 @@ impl PatchSink<5200> for TileSums {
         for (i, &x) in patch.iter().enumerate() {
             let [s, t, u, v, b] = PaperShape::coordinates(i);
             let j = self.at(s0 + s, t0 + t, o.view_row as usize + u, o.view_col as usize + v, b);
-            self.sum[j] += x;
-            self.count[j] += 1;
+            let w = self.window.weight(s, t);
+            self.sum[j] += w * x;
+            self.weight[j] += w;
         }
         Ok(())
     }
@@ -198,7 +261,13 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
     ensure!(d.bands_nm.len() == 13, "the decoder's patch has 13 bands, the capture {}", d.bands_nm.len());
     let decoder = capture.decoder(opts.sl0)?;
     let raw = capture.raw_frames()?;
-    let tiles: Vec<Tile> = decoder.tiles(opts.tile_patches).collect();
+    ensure!(
+        (1..=5).contains(&opts.stride.0) && (1..=5).contains(&opts.stride.1),
+        "stride {:?}: each axis must be in 1..=5 lenslets",
+        opts.stride
+    );
+    let mut tiles: Vec<Tile> = decoder.tiles(opts.tile_patches).collect();
+    tiles.extend(shifted_tiles((d.lenslets[0], d.lenslets[1]), opts.stride, opts.tile_patches));
     ensure!(
         !tiles.is_empty(),
         "the sensor ({} x {} lenslets) is smaller than one 5 x 5 patch",
@@ -218,7 +287,7 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
         .map_init(
             || Box::new(PaperWorkspace::new()),
             |ws, &tile| {
-                let mut sums = TileSums::new(tile, views);
+                let mut sums = TileSums::new(tile, views, opts.window);
                 let mut source = FrameSource::new(&raw);
                 let r = decoder.decode_tile(model, tile, &mut source, &mut sums, ws).map_err(|e| e.to_string());
                 bar.inc(1);
@@ -233,7 +302,7 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
 
     let mut lf = LightField::zeros(views, d.lenslets[0], d.lenslets[1], 13);
     let mut sum = vec![0.0f32; lf.data.len()];
-    let mut count = vec![0u16; lf.data.len()];
+    let mut weight = vec![0.0f32; lf.data.len()];
     let mut report = DecodeReport { tiles: tiles.len(), ..DecodeReport::default() };
     for (sums, r) in &results {
         match r {
@@ -256,16 +325,16 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
                         let dst = lf.index(u, v, tile.lenslet_row as usize + s, tile.lenslet_col as usize + t, 0);
                         for b in 0..13 {
                             sum[dst + b] += sums.sum[src + b];
-                            count[dst + b] += sums.count[src + b];
+                            weight[dst + b] += sums.weight[src + b];
                         }
                     }
                 }
             }
         }
     }
-    for ((x, &s), &c) in lf.data.iter_mut().zip(&sum).zip(&count) {
-        if c > 0 {
-            *x = s / f32::from(c);
+    for ((x, &s), &w) in lf.data.iter_mut().zip(&sum).zip(&weight) {
+        if w > 0.0 {
+            *x = s / w;
         } else {
             report.uncovered += 1;
         }

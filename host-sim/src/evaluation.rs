@@ -19,7 +19,7 @@ use slf_firmware::{ChoiceRule, MaskFamily, MemberChoice};
 
 use crate::camera::{CameraConfig, simulate};
 use crate::capture::MaskDescription;
-use crate::decode::{Basis, DecodeOptions, decode_with, patch_count};
+use crate::decode::{Basis, DecodeOptions, Window, decode_with, patch_count};
 use crate::demosaic::Baseline;
 use crate::lightfield::LightField;
 use crate::metrics::{Metrics, evaluate};
@@ -49,14 +49,24 @@ pub struct Row {
     pub ms_per_patch: f64,
 }
 
-/// The methods compared: the baselines, then CS with the DCT and with `blob` screened.
-fn methods(blob: &[u8]) -> Vec<(String, Option<Baseline>, Option<Basis>)> {
-    let mut m: Vec<(String, Option<Baseline>, Option<Basis>)> =
-        Baseline::ALL.iter().map(|b| (b.name().to_string(), Some(*b), None)).collect();
-    for basis in
-        [Basis::Dct, Basis::Ensemble { blob: blob.to_vec(), choice: MemberChoice::Screened(ChoiceRule::DEFAULT) }]
-    {
-        m.push((basis.name().to_string(), None, Some(basis)));
+/// A method: a baseline, or CS with a basis at a stride and window.
+type Method = (String, Option<Baseline>, Option<(Basis, (u8, u8), Window)>);
+
+/// The methods compared: the baselines, then CS with the DCT and with `blob` screened on
+/// disjoint patches, then both again at each of `strides`.
+fn methods(blob: &[u8], strides: &[(u8, u8)], window: Window) -> Vec<Method> {
+    let mut m: Vec<Method> = Baseline::ALL.iter().map(|b| (b.name().to_string(), Some(*b), None)).collect();
+    let bases =
+        [Basis::Dct, Basis::Ensemble { blob: blob.to_vec(), choice: MemberChoice::Screened(ChoiceRule::DEFAULT) }];
+    for &stride in std::iter::once(&(5, 5)).chain(strides) {
+        for basis in &bases {
+            let name = if stride == (5, 5) {
+                basis.name().to_string()
+            } else {
+                format!("{}, stride {}, {}", basis.name(), stride.0, format!("{window:?}").to_lowercase())
+            };
+            m.push((name, None, Some((basis.clone(), stride, window))));
+        }
     }
     m
 }
@@ -92,6 +102,8 @@ pub fn evaluate_set(
     scenes: &[(String, LightField)],
     settings: &[Setting],
     blob: &[u8],
+    strides: &[(u8, u8)],
+    window: Window,
     out: &Path,
 ) -> Result<Vec<Row>> {
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
@@ -103,14 +115,19 @@ pub fn evaluate_set(
         for (name, truth) in scenes {
             let capture = simulate(truth, &cam).with_context(|| name.clone())?;
             let patches = patch_count(&capture)? as f64;
-            for (method, baseline, basis) in methods(blob) {
+            for (method, baseline, basis) in methods(blob, strides, window) {
                 let (recon, ms) = match (baseline, &basis) {
                     (Some(b), _) => {
                         let (recon, r) = one.install(|| b.run(&capture))?;
                         (recon, 1e3 * r.seconds / patches)
                     }
-                    (None, Some(basis)) => {
-                        let opts = DecodeOptions { progress: false, ..DecodeOptions::default() };
+                    (None, Some((basis, stride, window))) => {
+                        let opts = DecodeOptions {
+                            progress: false,
+                            stride: *stride,
+                            window: *window,
+                            ..DecodeOptions::default()
+                        };
                         let (recon, r) = decode_with(&capture, basis, &opts)?;
                         anyhow::ensure!(r.failed_tiles == 0 && r.uncovered == 0, "{name}: {method} lost tiles");
                         (recon, 1e3 * r.seconds * threads / f64::from(r.patches.decoded.max(1)))

@@ -99,6 +99,23 @@ enum Method {
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum WindowArg {
+    /// Every value of a patch counts the same.
+    Uniform,
+    /// Lenslets weigh 1, 2, 3, 2, 1 across a patch (per axis, multiplied).
+    Tapered,
+}
+
+impl WindowArg {
+    fn window(self) -> slf_host::decode::Window {
+        match self {
+            WindowArg::Uniform => slf_host::decode::Window::Uniform,
+            WindowArg::Tapered => slf_host::decode::Window::Tapered,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 enum DictionaryKind {
     /// The 5D DCT.
     Dct,
@@ -324,6 +341,13 @@ enum Command {
         /// Also write which ensemble member each patch used (CSV).
         #[arg(long)]
         member_map: Option<PathBuf>,
+        /// Lenslets between patch origins, 1..=5 (5: disjoint patches; smaller strides
+        /// decode (5 / stride)^2 times the patches and average them).
+        #[arg(long, default_value_t = 5, value_parser = ranged::<1, 5>)]
+        stride: usize,
+        /// How overlapping patches are averaged.
+        #[arg(long, value_enum, default_value_t = WindowArg::Uniform)]
+        window: WindowArg,
         /// Stored dtype.
         #[arg(long, value_enum, default_value_t = Dtype::F32)]
         dtype: Dtype,
@@ -433,6 +457,13 @@ enum Command {
         /// Ensemble blob (default: the shipped one).
         #[arg(long)]
         blob: Option<PathBuf>,
+        /// Also decode with overlapping patches at these strides (1..=4 lenslets), as
+        /// extra rows for the DCT and the ensemble.
+        #[arg(long, value_delimiter = ',', value_parser = ranged::<1, 4>)]
+        stride: Vec<usize>,
+        /// How overlapping patches are averaged in those rows.
+        #[arg(long, value_enum, default_value_t = WindowArg::Uniform)]
+        window: WindowArg,
     },
     /// Write the capture the device binary decodes (frames as .npy and `capture.rs` constants).
     DeviceCapture {
@@ -566,7 +597,7 @@ fn run(cli: Cli) -> Result<()> {
             println!("wrote {} ({} snapshots)", output.display(), capture.frames.len());
             Ok(())
         }
-        Command::Decode { capture, output, method, solver, basis, member_map, dtype, quiet } => {
+        Command::Decode { capture, output, method, solver, basis, member_map, stride, window, dtype, quiet } => {
             let cap = Capture::load(&capture)?;
             if method != Method::Cs {
                 anyhow::ensure!(member_map.is_none(), "--member-map needs --method cs (baselines use no ensemble)");
@@ -587,7 +618,13 @@ fn run(cli: Cli) -> Result<()> {
                 );
                 return Ok(());
             }
-            let opts = DecodeOptions { sl0: solver.config()?, progress: !quiet, ..DecodeOptions::default() };
+            let opts = DecodeOptions {
+                sl0: solver.config()?,
+                progress: !quiet,
+                stride: (stride as u8, stride as u8),
+                window: window.window(),
+                ..DecodeOptions::default()
+            };
             let (lf, r) = decode_with(&cap, &basis.basis()?, &opts)?;
             let p = &r.patches;
             let all = p.decoded + p.failed;
@@ -658,7 +695,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::DeviceCapture { output } => slf_host::device::write_capture(&output),
         Command::DeviceCheck { log, capture } => slf_host::device::check(&log, &capture),
         Command::Sweep { size, k, output, basis } => report::sweep(size, &k, output.as_deref(), &basis.basis()?),
-        Command::Evaluate { inputs, out, blob } => {
+        Command::Evaluate { inputs, out, blob, stride, window } => {
             use slf_host::evaluation::{SETTINGS, evaluate_set, table};
             let blob = match blob {
                 Some(p) => read_blob(&p)?,
@@ -669,7 +706,8 @@ fn run(cli: Cli) -> Result<()> {
                 let name = p.file_stem().map_or("scene".into(), |s| s.to_string_lossy().into_owned());
                 scenes.push((name, with_camera_bands(read_npy(p)?, None, p)?));
             }
-            let rows = evaluate_set(&scenes, &SETTINGS, &blob, &out)?;
+            let strides: Vec<(u8, u8)> = stride.iter().map(|&s| (s as u8, s as u8)).collect();
+            let rows = evaluate_set(&scenes, &SETTINGS, &blob, &strides, window.window(), &out)?;
             let t = table(&rows, &SETTINGS);
             let path = out.join("table.md");
             std::fs::write(&path, &t).with_context(|| format!("cannot write {}", path.display()))?;

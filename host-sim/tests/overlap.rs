@@ -1,0 +1,135 @@
+//! Overlapping patches against the slow obvious reference: every patch decoded on its own
+//! (a one-patch tile each), then averaged with the window's weights in f64.
+
+use slf_host::camera::{CameraConfig, simulate};
+use slf_host::decode::{Basis, DecodeOptions, TAPER, Window, decode_with};
+use slf_host::firmware::{
+    Dictionary, FrameSource, PaperShape, PaperWorkspace, PatchOrigin, PatchReport, PatchSink, Sl0Config, SolveError,
+    Tile,
+};
+use slf_host::lightfield::LightField;
+
+mod common;
+
+/// Keeps the patches a one-patch tile sends (one per angular window).
+struct Kept(Vec<(PatchOrigin, Vec<f32>)>);
+
+impl PatchSink<5200> for Kept {
+    type Error = core::convert::Infallible;
+    fn accept(&mut self, o: PatchOrigin, patch: &[f32; 5200], _: &PatchReport) -> Result<(), Self::Error> {
+        self.0.push((o, patch.to_vec()));
+        Ok(())
+    }
+    fn reject(&mut self, _: PatchOrigin, _: SolveError) -> Result<(), Self::Error> {
+        Ok(())
+    }
+}
+
+/// Patch origins along an axis of `total` lenslets for offset `off`: every `off + 5 i`
+/// with the patch inside; the unshifted grid also has the last patch flush with the edge.
+fn origins(total: usize, off: usize) -> Vec<usize> {
+    let mut v: Vec<usize> = (0..).map(|i| off + 5 * i).take_while(|&o| o + 5 <= total).collect();
+    if off == 0 && !total.is_multiple_of(5) {
+        v.push(total - 5);
+    }
+    v
+}
+
+fn reference(truth: &LightField, k: u8, stride: usize, window: Window) -> Vec<f32> {
+    let capture = simulate(truth, &CameraConfig::pixel(3, k)).unwrap();
+    let decoder = capture.decoder(Sl0Config::DEFAULT).unwrap();
+    let raw = capture.raw_frames().unwrap();
+    let dct = Dictionary::dct();
+    let mut ws = Box::new(PaperWorkspace::new());
+    let (rows, cols) = (truth.rows, truth.cols);
+    let mut sum = vec![0.0f64; truth.data.len()];
+    let mut weight = vec![0.0f64; truth.data.len()];
+    for dy in (0..5).step_by(stride) {
+        for dx in (0..5).step_by(stride) {
+            // The unshifted grid's edge patch exists per axis only with offset 0 on that axis.
+            let rs = if dx == 0 {
+                origins(rows, dy)
+            } else {
+                origins(rows, dy).into_iter().filter(|&r| r % 5 == dy).collect()
+            };
+            let cs = if dy == 0 {
+                origins(cols, dx)
+            } else {
+                origins(cols, dx).into_iter().filter(|&c| c % 5 == dx).collect()
+            };
+            for &r in &rs {
+                for &c in &cs {
+                    let tile = Tile { lenslet_row: r as u16, lenslet_col: c as u16, lenslet_rows: 5, lenslet_cols: 5 };
+                    let mut kept = Kept(Vec::new());
+                    decoder.decode_tile(&dct, tile, &mut FrameSource::new(&raw), &mut kept, &mut ws).unwrap();
+                    assert_eq!(kept.0.len(), 4, "4 angular windows of 4 x 4 in 5 x 5 views");
+                    for (o, patch) in &kept.0 {
+                        for (i, &x) in patch.iter().enumerate() {
+                            let [s, t, u, v, b] = PaperShape::coordinates(i);
+                            let w = match window {
+                                Window::Uniform => 1.0,
+                                Window::Tapered => f64::from(TAPER[s] * TAPER[t]),
+                            };
+                            let j = truth.index(o.view_row as usize + u, o.view_col as usize + v, r + s, c + t, b);
+                            sum[j] += w * f64::from(x);
+                            weight[j] += w;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    sum.iter().zip(&weight).map(|(s, w)| (s / w) as f32).collect()
+}
+
+#[test]
+fn overlapping_patches_average_as_every_patch_decoded_alone() {
+    // 12 x 13 lenslets: edge strips on both axes, and shifted grids that stop short.
+    let mut truth = common::small_smooth(5);
+    // Cut one lenslet column so the axes differ (12 x 11... keep 12 x 12 and 12 x 11 views).
+    let cols = 11;
+    let mut cut = LightField::zeros(truth.views, truth.rows, cols, truth.bands);
+    for u in 0..5 {
+        for v in 0..5 {
+            for y in 0..truth.rows {
+                let src = truth.index(u, v, y, 0, 0);
+                let dst = cut.index(u, v, y, 0, 0);
+                cut.data[dst..dst + cols * 13].copy_from_slice(&truth.data[src..src + cols * 13]);
+            }
+        }
+    }
+    truth = cut;
+    for (stride, window, k) in
+        [(5, Window::Uniform, 1), (2, Window::Uniform, 1), (3, Window::Tapered, 3), (1, Window::Tapered, 1)]
+    {
+        let capture = simulate(&truth, &CameraConfig::pixel(3, k)).unwrap();
+        let opts = DecodeOptions { stride: (stride as u8, stride as u8), window, ..DecodeOptions::default() };
+        let (fast, report) = decode_with(&capture, &Basis::Dct, &opts).unwrap();
+        assert_eq!(report.uncovered, 0);
+        let slow = reference(&truth, k, stride, window);
+        let worst = fast.data.iter().zip(&slow).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+        assert!(worst <= 1e-6, "stride {stride}, {window:?}, k = {k}: off by {worst}");
+    }
+}
+
+#[test]
+fn stride_five_is_todays_decode_and_bad_strides_are_refused() {
+    let truth = common::small_smooth(5);
+    let capture = simulate(&truth, &CameraConfig::pixel(4, 1)).unwrap();
+    let (a, ra) = decode_with(&capture, &Basis::Dct, &DecodeOptions::default()).unwrap();
+    let tapered = DecodeOptions { window: Window::Tapered, ..DecodeOptions::default() };
+    let (b, _) = decode_with(&capture, &Basis::Dct, &tapered).unwrap();
+    // With disjoint patches (and the edge strips) a taper changes only where patches overlap.
+    let differ = a.data.iter().zip(&b.data).filter(|(x, y)| x != y).count();
+    assert!(differ > 0 && differ < a.data.len() / 2, "{differ}");
+    let three = DecodeOptions { stride: (3, 3), ..DecodeOptions::default() };
+    let (_, r3) = decode_with(&capture, &Basis::Dct, &three).unwrap();
+    // 12 x 12 lenslets, 4 angular windows: rows and columns {0, 5, 7} give 9 patches a
+    // window; stride 3 adds the grids at offsets (0, 3), (3, 0), (3, 3): 2 + 2 + 1.
+    assert_eq!((ra.patches.decoded, r3.patches.decoded), (9 * 4, 14 * 4));
+    for bad in [(0, 5), (5, 6)] {
+        let e =
+            decode_with(&capture, &Basis::Dct, &DecodeOptions { stride: bad, ..DecodeOptions::default() }).unwrap_err();
+        assert!(e.to_string().contains("1..=5"), "{e}");
+    }
+}
