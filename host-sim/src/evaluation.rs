@@ -7,9 +7,10 @@
 //! as the mean over scenes, as a markdown table. Every method decodes the same capture
 //! (same mask, same noise).
 //!
-//! Times are on one thread for every method, per 5 x 5-lenslet patch of the sensor (the
-//! baselines have no patches: their whole-frame time is divided by the CS decoder's patch
-//! count), so the columns compare. Previews (truth, reconstruction, error) of a zoomed
+//! Times are on one thread for every method, per 5 x 5-lenslet patch of the sensor's
+//! disjoint grid: the whole frame's time divided by that grid's patch count, for the
+//! baselines (which have no patches) and for overlapping patches (which decode more), so
+//! the column is a cost per frame and compares. Previews (truth, reconstruction, error) of a zoomed
 //! central crop of each scene at the first setting go to the output folder.
 
 use std::path::Path;
@@ -130,7 +131,7 @@ pub fn evaluate_set(
                         };
                         let (recon, r) = decode_with(&capture, basis, &opts)?;
                         anyhow::ensure!(r.failed_tiles == 0 && r.uncovered == 0, "{name}: {method} lost tiles");
-                        (recon, 1e3 * r.seconds * threads / f64::from(r.patches.decoded.max(1)))
+                        (recon, 1e3 * r.seconds * threads / patches)
                     }
                     _ => unreachable!("a method is a baseline or a basis"),
                 };
