@@ -75,18 +75,7 @@ fn methods(blob: &[u8], strides: &[(u8, u8)], window: Window) -> Vec<Method> {
 /// A central `CROP x CROP` window of every view (the whole field if smaller).
 fn central_crop(lf: &LightField) -> LightField {
     let (r, c) = (lf.rows.min(CROP), lf.cols.min(CROP));
-    let (r0, c0) = ((lf.rows - r) / 2, (lf.cols - c) / 2);
-    let mut out = LightField::zeros(lf.views, r, c, lf.bands);
-    for u in 0..lf.views.0 {
-        for v in 0..lf.views.1 {
-            for y in 0..r {
-                let src = lf.index(u, v, r0 + y, c0, 0);
-                let dst = out.index(u, v, y, 0, 0);
-                out.data[dst..dst + c * lf.bands].copy_from_slice(&lf.data[src..src + c * lf.bands]);
-            }
-        }
-    }
-    out
+    lf.window((lf.rows - r) / 2, (lf.cols - c) / 2, r, c)
 }
 
 /// A file-name-safe version of a method's name.

@@ -34,6 +34,38 @@ impl LightField {
         Self { views, rows, cols, bands, data: vec![0.0; n] }
     }
 
+    /// A light field whose value at `(u, v, y, x, b)` is `f(u, v, y, x, b)`.
+    pub fn from_fn(
+        views: (usize, usize),
+        rows: usize,
+        cols: usize,
+        bands: usize,
+        f: impl Fn(usize, usize, usize, usize, usize) -> f32,
+    ) -> Self {
+        let mut lf = Self::zeros(views, rows, cols, bands);
+        for i in 0..lf.data.len() {
+            let (u, v, y, x, b) = lf.coordinates(i);
+            lf.data[i] = f(u, v, y, x, b);
+        }
+        lf
+    }
+
+    /// The spatial window `rows x cols` from `(row, col)` of every view (inside the field).
+    pub fn window(&self, row: usize, col: usize, rows: usize, cols: usize) -> Self {
+        let mut out = Self::zeros(self.views, rows, cols, self.bands);
+        let n = cols * self.bands;
+        for u in 0..self.views.0 {
+            for v in 0..self.views.1 {
+                for y in 0..rows {
+                    let src = self.index(u, v, row + y, col, 0);
+                    let dst = out.index(u, v, y, 0, 0);
+                    out.data[dst..dst + n].copy_from_slice(&self.data[src..src + n]);
+                }
+            }
+        }
+        out
+    }
+
     /// The shape as `[U, V, H, W, B]`.
     pub fn shape(&self) -> [usize; 5] {
         [self.views.0, self.views.1, self.rows, self.cols, self.bands]
@@ -118,10 +150,7 @@ pub fn read_npy_with_notes(path: &Path) -> Result<(LightField, Vec<String>), Npy
     if s.contains(&0) {
         return Err(shape_err(format!("shape {s:?} has an empty axis")));
     }
-    let data = match a.values {
-        Values::F32(v) => v,
-        Values::U16(v) => v.into_iter().map(|x| f32::from(x) / 65535.0).collect(),
-    };
+    let data = a.values.into_f32();
     let lf = LightField { views: (s[0], s[1]), rows: s[2], cols: s[3], bands: s[4], data };
     let bad = lf.data.iter().filter(|x| !x.is_finite()).count();
     if let Some(first) = lf.data.iter().position(|x| !x.is_finite()) {
@@ -170,10 +199,7 @@ pub fn write_npy(path: &Path, lf: &LightField, dtype: Dtype) -> Result<(), NpyEr
 /// # Errors
 /// I/O errors.
 pub fn write_npy_u16_2d(path: &Path, data: &[u16], rows: usize, cols: usize) -> std::io::Result<()> {
-    let file = BufWriter::new(File::create(path)?);
-    let mut w = npyz::WriteOptions::new().default_dtype().shape(&[rows as u64, cols as u64]).writer(file).begin_nd()?;
-    w.extend(data.iter().copied())?;
-    w.finish()
+    write_npy_2d(path, data, rows, cols)
 }
 
 /// Writes an f32 2D `.npy` array (a disparity map).
@@ -181,6 +207,15 @@ pub fn write_npy_u16_2d(path: &Path, data: &[u16], rows: usize, cols: usize) -> 
 /// # Errors
 /// I/O errors.
 pub fn write_npy_f32_2d(path: &Path, data: &[f32], rows: usize, cols: usize) -> std::io::Result<()> {
+    write_npy_2d(path, data, rows, cols)
+}
+
+fn write_npy_2d<T: npyz::AutoSerialize + Copy>(
+    path: &Path,
+    data: &[T],
+    rows: usize,
+    cols: usize,
+) -> std::io::Result<()> {
     let file = BufWriter::new(File::create(path)?);
     let mut w = npyz::WriteOptions::new().default_dtype().shape(&[rows as u64, cols as u64]).writer(file).begin_nd()?;
     w.extend(data.iter().copied())?;

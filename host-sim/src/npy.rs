@@ -55,6 +55,16 @@ pub enum Values {
     U16(Vec<u16>),
 }
 
+impl Values {
+    /// As f32: uint16 as a fraction of 65535 (slf's convention for light fields and cubes).
+    pub fn into_f32(self) -> Vec<f32> {
+        match self {
+            Values::F32(v) => v,
+            Values::U16(v) => v.into_iter().map(|x| f32::from(x) / 65535.0).collect(),
+        }
+    }
+}
+
 /// A `.npy` array in C order.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Npy {

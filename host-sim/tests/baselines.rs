@@ -9,22 +9,9 @@ use slf_host::metrics::evaluate;
 mod common;
 use common::small_smooth;
 
-/// A light field whose spectrum at every position is `f(u, v, y, x, b)`.
+/// A 5 x 5-view, 12 x 12-lenslet light field whose value is `f(u, v, y, x, b)`.
 fn field(f: impl Fn(usize, usize, usize, usize, usize) -> f32) -> LightField {
-    let mut lf = LightField::zeros((5, 5), 12, 12, 13);
-    for u in 0..5 {
-        for v in 0..5 {
-            for y in 0..12 {
-                for x in 0..12 {
-                    for b in 0..13 {
-                        let i = lf.index(u, v, y, x, b);
-                        lf.data[i] = f(u, v, y, x, b);
-                    }
-                }
-            }
-        }
-    }
-    lf
+    LightField::from_fn((5, 5), 12, 12, 13, f)
 }
 
 /// One DN in normalised units (the default sensor: white at 90 % of 12 bits above black 64).
@@ -57,24 +44,6 @@ fn interpolation_is_linear_between_a_pixels_measured_bands_and_flat_beyond() {
             assert!((got - want).abs() <= DN, "({u}, {v}, {y}, {x}) band {b}: {got} against {want}");
         }
     }
-}
-
-#[test]
-fn the_demosaic_recovers_a_flat_field_and_keeps_measured_values() {
-    // One spectrum everywhere: every neighbourhood estimate is that spectrum, the ratio 1.
-    let spectrum = |b: usize| 0.2 + 0.5 * ((b as f32 - 6.0) / 6.0).powi(2);
-    let truth = field(|_, _, _, _, b| spectrum(b));
-    let cap = simulate(&truth, &CameraConfig::pixel(9, 1).noiseless()).unwrap();
-    let (lf, report) = demosaic(&cap, &DemosaicConfig::default()).unwrap();
-    assert_eq!(report.filled, 0);
-    let worst = lf.data.iter().zip(&truth.data).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
-    assert!(worst <= 2.0 * DN, "flat field off by {worst}");
-    // A measured band keeps its measured value exactly (here: the quantised truth).
-    let mask = cap.mask().unwrap();
-    let b = usize::from(mask.bands_at(13, 17)[0]);
-    let raw = f32::from(cap.frames[0][13 * 60 + 17]);
-    let fmt = cap.raw_format();
-    assert_eq!(lf.get(3, 2, 2, 3, b), (raw - fmt.black) / (fmt.white - fmt.black));
 }
 
 #[test]
@@ -156,21 +125,28 @@ fn patch_count_is_what_the_cs_decoder_decodes() {
 }
 
 #[test]
-fn ppid_recovers_a_flat_field_and_keeps_measured_values() {
-    // One spectrum everywhere: the PPI is its mean, each band's difference to it is exact.
+fn the_demosaic_and_ppid_recover_a_flat_field_and_keep_measured_values() {
+    // One spectrum everywhere: every neighbourhood estimate is that spectrum (the
+    // demosaic's ratio is 1; PPID's PPI is its mean and each band's difference to it exact).
     let spectrum = |b: usize| 0.2 + 0.5 * ((b as f32 - 6.0) / 6.0).powi(2);
     let truth = field(|_, _, _, _, b| spectrum(b));
     for k in [1, 3] {
         let cap = simulate(&truth, &CameraConfig::pixel(9, k).noiseless()).unwrap();
-        let (lf, report) = ppid(&cap, &PpidConfig::default()).unwrap();
-        assert_eq!(report.filled, 0);
-        let worst = lf.data.iter().zip(&truth.data).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
-        assert!(worst <= 2.0 * DN, "k = {k}: flat field off by {worst}");
-        let mask = cap.mask().unwrap();
-        let b = usize::from(mask.bands_at(13, 17)[0]);
-        let raw = f32::from(cap.frames[0][13 * 60 + 17]);
-        let fmt = cap.raw_format();
-        assert_eq!(lf.get(3, 2, 2, 3, b), (raw - fmt.black) / (fmt.white - fmt.black));
+        let runs = [
+            ("demosaic", demosaic(&cap, &DemosaicConfig::default()).unwrap()),
+            ("PPID", ppid(&cap, &PpidConfig::default()).unwrap()),
+        ];
+        for (name, (lf, report)) in runs {
+            assert_eq!(report.filled, 0);
+            let worst = lf.data.iter().zip(&truth.data).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+            assert!(worst <= 2.0 * DN, "{name}, k = {k}: flat field off by {worst}");
+            // A measured band keeps its measured value exactly (here: the quantised truth).
+            let mask = cap.mask().unwrap();
+            let b = usize::from(mask.bands_at(13, 17)[0]);
+            let raw = f32::from(cap.frames[0][13 * 60 + 17]);
+            let fmt = cap.raw_format();
+            assert_eq!(lf.get(3, 2, 2, 3, b), (raw - fmt.black) / (fmt.white - fmt.black), "{name}, k = {k}");
+        }
     }
 }
 

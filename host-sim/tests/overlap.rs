@@ -84,21 +84,9 @@ fn reference(truth: &LightField, k: u8, stride: usize, window: Window) -> Vec<f3
 
 #[test]
 fn overlapping_patches_average_as_every_patch_decoded_alone() {
-    // 12 x 13 lenslets: edge strips on both axes, and shifted grids that stop short.
-    let mut truth = common::small_smooth(5);
-    // Cut one lenslet column so the axes differ (12 x 11... keep 12 x 12 and 12 x 11 views).
-    let cols = 11;
-    let mut cut = LightField::zeros(truth.views, truth.rows, cols, truth.bands);
-    for u in 0..5 {
-        for v in 0..5 {
-            for y in 0..truth.rows {
-                let src = truth.index(u, v, y, 0, 0);
-                let dst = cut.index(u, v, y, 0, 0);
-                cut.data[dst..dst + cols * 13].copy_from_slice(&truth.data[src..src + cols * 13]);
-            }
-        }
-    }
-    truth = cut;
+    // 12 x 11 lenslets: edge strips on both axes, shifted grids that stop short, and
+    // axes that differ.
+    let truth = common::small_smooth(5).window(0, 0, 12, 11);
     for (stride, window, k) in
         [(5, Window::Uniform, 1), (2, Window::Uniform, 1), (3, Window::Tapered, 3), (1, Window::Tapered, 1)]
     {
@@ -163,19 +151,9 @@ fn steps(lf: &LightField) -> (f64, f64) {
 fn with_overlap_the_grid_is_gone_on_a_smooth_ramp() {
     // A ramp in x and y, smooth in the bands: every true step is the same size, so a step
     // across patch borders larger than inside is the decoder's grid.
-    let mut truth = LightField::zeros((5, 5), 20, 20, 13);
-    for u in 0..5 {
-        for v in 0..5 {
-            for y in 0..20 {
-                for x in 0..20 {
-                    for b in 0..13 {
-                        let i = truth.index(u, v, y, x, b);
-                        truth.data[i] = (0.15 + 0.02 * x as f32 + 0.01 * y as f32) * (0.8 + 0.03 * b as f32);
-                    }
-                }
-            }
-        }
-    }
+    let truth = LightField::from_fn((5, 5), 20, 20, 13, |_, _, y, x, b| {
+        (0.15 + 0.02 * x as f32 + 0.01 * y as f32) * (0.8 + 0.03 * b as f32)
+    });
     // Without noise, the error is the decoder's alone.
     let capture = simulate(&truth, &CameraConfig::pixel(6, 1).noiseless()).unwrap();
     // Steps of the error (reconstruction - truth): the truth's own steps are all alike,

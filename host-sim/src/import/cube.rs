@@ -21,9 +21,9 @@ use super::bands::{BandFilter, Resampler};
 use super::parallax::{Disparity, warp};
 use super::pfm::read_pfm;
 use super::rgb_basis_data::{D65_5NM, FIRST_NM, STEP_NM};
-use super::{Geometry, Plane};
+use super::{Geometry, MAX_SIDE, Plane, read_rgb};
 use crate::lightfield::LightField;
-use crate::npy::{self, Values};
+use crate::npy;
 
 /// How a cube's values relate to light.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -78,9 +78,6 @@ impl Default for CubeConfig {
 /// The most bands a cube may have.
 const MAX_BANDS: usize = 4096;
 
-/// The largest side of a cube.
-const MAX_SIDE: usize = 16_384;
-
 /// Reads a `(H, W, B)` `.npy` cube (float32, float64 or uint16 as a fraction of 65535).
 pub fn read_cube_npy(path: &Path) -> Result<(Plane, Vec<String>)> {
     let a = npy::read(path)?;
@@ -91,10 +88,7 @@ pub fn read_cube_npy(path: &Path) -> Result<(Plane, Vec<String>)> {
         "{}: shape {s:?}: need H and W in 1..={MAX_SIDE}, B in 1..={MAX_BANDS}",
         path.display()
     );
-    let data = match a.values {
-        Values::F32(v) => v,
-        Values::U16(v) => v.into_iter().map(|x| f32::from(x) / 65535.0).collect(),
-    };
+    let data = a.values.into_f32();
     if let Some(i) = data.iter().position(|v| !v.is_finite()) {
         let b = i % s[2];
         let px = i / s[2];
@@ -150,17 +144,9 @@ pub fn read_band_folder(folder: &Path) -> Result<Plane> {
     let mut cube: Option<Plane> = None;
     let bands = files.len();
     for (b, f) in files.iter().enumerate() {
-        let (w, h) = image::ImageReader::open(f)
-            .and_then(|r| r.with_guessed_format())
-            .with_context(|| format!("{}: cannot open", f.display()))?
-            .into_dimensions()
-            .with_context(|| format!("{}: not an image slf reads", f.display()))?;
-        let (w, h) = (w as usize, h as usize);
-        ensure!(
-            (1..=MAX_SIDE).contains(&w) && (1..=MAX_SIDE).contains(&h),
-            "{}: {w} x {h} pixels is not within 1..={MAX_SIDE} a side",
-            f.display()
-        );
+        // Grey (some CAVE files are stored as RGB(A) with equal channels): the first channel.
+        let img = read_rgb(f)?;
+        let (h, w) = (img.rows, img.cols);
         let c = cube.get_or_insert_with(|| Plane::zeros(h, w, bands));
         ensure!(
             (c.rows, c.cols) == (h, w),
@@ -169,10 +155,8 @@ pub fn read_band_folder(folder: &Path) -> Result<Plane> {
             c.cols,
             c.rows
         );
-        // Grey (some CAVE files are stored as RGB(A) with equal channels): the first channel.
-        let img = image::open(f).with_context(|| format!("{}: cannot decode", f.display()))?.into_rgb32f();
-        for (px, v) in img.pixels().enumerate() {
-            c.data[px * bands + b] = v.0[0];
+        for (px, v) in img.data.chunks_exact(3).enumerate() {
+            c.data[px * bands + b] = v[0];
         }
     }
     cube.ok_or_else(|| anyhow::anyhow!("{}: no band images", folder.display()))
@@ -244,10 +228,7 @@ pub fn to_lightfield(image: &Plane, cfg: &CubeConfig, source: (usize, usize)) ->
                 source.1,
                 source.0
             );
-            let (_, sx) = cfg.geometry.scale(source.0, source.1)?;
-            let mut m = cfg.geometry.apply(&m)?;
-            m.data.iter_mut().for_each(|v| *v *= sx as f32);
-            Some(m)
+            Some(cfg.geometry.apply_disparity(&m)?)
         }
     };
     let disparity = match (&cfg.depth, &map) {

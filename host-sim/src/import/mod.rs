@@ -26,9 +26,32 @@ pub mod rgb;
 pub mod rgb_basis_data;
 pub mod views;
 
-use anyhow::{Result, ensure};
+use std::path::Path;
+
+use anyhow::{Context, Result, ensure};
 use image::ImageBuffer;
 use image::imageops::{FilterType, resize};
+
+/// The largest side of an image or cube read.
+pub const MAX_SIDE: usize = 16_384;
+
+/// Reads an image file (8- or 16-bit, grey or colour, values as fractions of full scale)
+/// as three channels; its size is checked against [`MAX_SIDE`] before it is decoded.
+pub fn read_rgb(path: &Path) -> Result<Plane> {
+    let (w, h) = image::ImageReader::open(path)
+        .and_then(|r| r.with_guessed_format())
+        .with_context(|| format!("{}: cannot open", path.display()))?
+        .into_dimensions()
+        .with_context(|| format!("{}: not an image slf reads", path.display()))?;
+    let (w, h) = (w as usize, h as usize);
+    ensure!(
+        (1..=MAX_SIDE).contains(&w) && (1..=MAX_SIDE).contains(&h),
+        "{}: {w} x {h} pixels is not within 1..={MAX_SIDE} a side",
+        path.display()
+    );
+    let img = image::open(path).with_context(|| format!("{}: cannot decode", path.display()))?.into_rgb32f();
+    Ok(Plane { rows: h, cols: w, channels: 3, data: img.into_raw() })
+}
 
 /// An image in memory: `rows x cols` pixels of `channels` f32 values, interleaved,
 /// row-major.
@@ -95,15 +118,14 @@ impl Geometry {
         Ok((r, c))
     }
 
-    /// The horizontal and vertical scale factors of the resize (output over cropped input);
-    /// disparities, in pixels, scale by the horizontal one.
-    pub fn scale(&self, rows: usize, cols: usize) -> Result<(f64, f64)> {
-        let (cr, cc) = match self.crop {
-            Some(k) => (k.rows, k.cols),
-            None => (rows, cols),
-        };
-        let (r, c) = self.output_size(rows, cols)?;
-        Ok((r as f64 / cr as f64, c as f64 / cc as f64))
+    /// Crops and resizes a disparity map (pixels per view step) of the input's size: its
+    /// values scale with the image's width, so they stay in output pixels.
+    pub fn apply_disparity(&self, map: &Plane) -> Result<Plane> {
+        let cropped_cols = self.crop.map_or(map.cols, |k| k.cols);
+        let mut out = self.apply(map)?;
+        let scale = out.cols as f32 / cropped_cols as f32;
+        out.data.iter_mut().for_each(|v| *v *= scale);
+        Ok(out)
     }
 
     /// Crops and resizes a plane.

@@ -17,12 +17,12 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail, ensure};
+use anyhow::{Result, bail, ensure};
 
 use super::parallax::{Disparity, estimate, warp};
 use super::pfm::read_pfm;
 use super::rgb::{RgbLift, srgb_to_linear};
-use super::{Geometry, Plane};
+use super::{Geometry, Plane, read_rgb};
 use crate::lightfield::LightField;
 
 /// How view files are named.
@@ -98,9 +98,6 @@ pub struct Imported {
     pub notes: Vec<String>,
 }
 
-/// The largest side of a view image.
-const MAX_SIDE: u32 = 16_384;
-
 /// The file name of grid view `(row, col)`.
 pub fn view_name(cfg: &ViewsConfig, row: usize, col: usize) -> Result<String> {
     Ok(match &cfg.naming {
@@ -131,22 +128,11 @@ pub fn view_name(cfg: &ViewsConfig, row: usize, col: usize) -> Result<String> {
 
 /// Reads one view as linear RGB, its size checked before it is decoded.
 fn read_view(path: &Path, linear: bool) -> Result<Plane> {
-    let reader = image::ImageReader::open(path)
-        .with_context(|| format!("{}: cannot open", path.display()))?
-        .with_guessed_format()
-        .with_context(|| format!("{}: cannot read", path.display()))?;
-    let (w, h) = reader.into_dimensions().with_context(|| format!("{}: not an image slf reads", path.display()))?;
-    ensure!(
-        (1..=MAX_SIDE).contains(&w) && (1..=MAX_SIDE).contains(&h),
-        "{}: {w} x {h} pixels is not within 1..={MAX_SIDE} a side",
-        path.display()
-    );
-    let img = image::open(path).with_context(|| format!("{}: cannot decode", path.display()))?.into_rgb32f();
-    let mut data = img.into_raw();
+    let mut view = read_rgb(path)?;
     if !linear {
-        data.iter_mut().for_each(|v| *v = srgb_to_linear(*v));
+        view.data.iter_mut().for_each(|v| *v = srgb_to_linear(*v));
     }
-    Ok(Plane { rows: h as usize, cols: w as usize, channels: 3, data })
+    Ok(view)
 }
 
 /// Imports the window of views `cfg` describes from `folder`, lifted to bands centred at
@@ -292,14 +278,6 @@ pub fn import_views(folder: &Path, cfg: &ViewsConfig, lift: &RgbLift) -> Result<
             lift.lift([px[0], px[1], px[2]], o);
         }
     }
-    let disparity = match disparity {
-        Some(d) => {
-            let (_, sx) = cfg.geometry.scale(rows, cols)?;
-            let mut d = cfg.geometry.apply(&d)?;
-            d.data.iter_mut().for_each(|v| *v *= sx as f32);
-            Some(d)
-        }
-        None => None,
-    };
+    let disparity = disparity.map(|d| cfg.geometry.apply_disparity(&d)).transpose()?;
     Ok(Imported { lightfield: lf, disparity, notes })
 }
