@@ -6,6 +6,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use slf_firmware::ascent::ascend;
+use slf_firmware::ball::Ball;
 use slf_firmware::projection::{project_coefficients, projection_macs};
 use slf_firmware::transform::{analyze, analyze_preserving, synthesize};
 use slf_firmware::{
@@ -61,14 +62,16 @@ fn benches(c: &mut Criterion) {
         eprintln!("projection pixel k={k}: {step_macs} multiply-adds ({count} measurements)");
         let mut coeffs = Box::new([0.0f32; 5200]);
         let mut scratch = Box::new([0.0f32; 5200]);
+        let exact = Ball::new(0.0, 0.0, count as u32, 0);
         analyze_preserving(&dict, ws.patch(), &mut coeffs);
         c.bench_function(&format!("project pixel k={k}"), |bench| {
-            bench.iter(|| project_coefficients(&dict, black_box(&mut coeffs), &mut scratch, ws.measurements(), 0.0))
+            bench.iter(|| project_coefficients(&dict, black_box(&mut coeffs), &mut scratch, ws.measurements(), &exact))
         });
         let ensemble = Ensemble::<5, 5, 4, 4, 13>::new(DEFAULT_ENSEMBLE).unwrap();
         let member = ensemble.member(1).unwrap(); // 0 is the DCT
         c.bench_function(&format!("project pixel k={k} learned member"), |bench| {
-            bench.iter(|| project_coefficients(&member, black_box(&mut coeffs), &mut scratch, ws.measurements(), 0.0))
+            bench
+                .iter(|| project_coefficients(&member, black_box(&mut coeffs), &mut scratch, ws.measurements(), &exact))
         });
         if k == 1 {
             // The step is branch-free on the host: its time does not depend on sigma.

@@ -6,3 +6,6 @@ pub const MASK_SEED: u64 = 7;
 pub const BLACK: f32 = 64.0;
 pub const WHITE: f32 = 3691.9;
 pub const MAX_VALID: f32 = 4094.5;
+// The sensor's noise (`Sl0Config::noise`, `Sl0Config::shot`): the decode's noise ball.
+pub const NOISE: f32 = 0.00055699603;
+pub const SHOT: f32 = 5e-5;

@@ -21,9 +21,10 @@
 //! - **operators** ([`shape`], [`dct`], [`dictionary`], [`blob`], [`transform`]): the patch
 //!   geometry in the types, dictionaries (the 5D DCT and blobs in flash) and the separable
 //!   synthesis and analysis transforms.
-//! - **solver** ([`sl0`], [`ascent`], [`projection`], [`pinv`], [`choice`]): nD SL0 with the orthonormal fast path, the
-//!   paper's general pseudo-inverse path for kronecker masks, and the choice of an ensemble
-//!   member per patch (exhaustive or screened).
+//! - **solver** ([`sl0`], [`ascent`], [`ball`], [`projection`], [`pinv`], [`choice`]): nD
+//!   SL0 with the orthonormal fast path, the noise ball a projection moves onto, the paper's
+//!   general pseudo-inverse path for kronecker masks, and the choice of an ensemble member
+//!   per patch (exhaustive or screened).
 //! - **tile decoder** ([`tile`]): a rectangle of the raw frame, patch by patch, from a
 //!   [`TileSource`] to a [`PatchSink`], into a caller-owned [`Workspace`].
 //!
@@ -86,6 +87,7 @@
 mod log;
 
 pub mod ascent;
+pub mod ball;
 pub mod blob;
 pub mod choice;
 pub mod dct;

@@ -15,6 +15,7 @@
 use nalgebra::{SMatrix, SVD};
 
 use crate::ascent::ascend;
+use crate::ball::Move;
 use crate::dictionary::{Dictionary, Factors, Matrix};
 use crate::mask::KroneckerPhi;
 use crate::shape::PatchShape;
@@ -173,7 +174,7 @@ pub fn solve_pinv<
     ws: &mut Workspace<PS, PT, PU, PV, B, N>,
 ) -> Result<Outcome, SolveError> {
     let Workspace { coeffs, signal, measurements: m } = ws;
-    let eps = start(cfg, m)?;
+    let ball = start::<B, N>(cfg, m)?;
     let mut complete = true;
     op.for_each_selected(|_, e| complete &= m.measured.get(e).copied().unwrap_or(false));
     if !complete || m.count() != PatchShape::<PS, PT, PU, PV, B, N>::PIXELS * op.phi.bands.len() {
@@ -193,10 +194,18 @@ pub fn solve_pinv<
         signal.copy_from_slice(coeffs);
         apply_in_place(&op.a, signal);
         op.subtract_measurements(m, signal, false);
-        let norm = libm::sqrtf(signal.iter().map(|r| r * r).sum());
-        if eps == 0.0 || norm > eps {
+        let r2: f32 = signal.iter().map(|r| r * r).sum();
+        // Each residual over its measurement's variance.
+        let mut w2 = 0.0f32;
+        if ball.is_weighted() {
+            op.for_each_selected(|i, e| {
+                let (r, y) = (signal.get(i).copied().unwrap_or(0.0), m.values.get(e).copied().unwrap_or(0.0));
+                w2 += r * r * ball.weight(y);
+            });
+        }
+        let norm = libm::sqrtf(r2);
+        if let Move::Scale(scale) = ball.move_for(r2, w2) {
             // S <- S - R' x_i A_i^+, R' = R, or R shrunk to the noise ball's surface.
-            let scale = if eps == 0.0 { 1.0 } else { 1.0 - eps / norm };
             apply_in_place(&op.a_pinv, signal);
             for (s, r) in coeffs.iter_mut().zip(signal.iter()) {
                 *s -= scale * r;

@@ -23,6 +23,7 @@
 //! a `Slice` on the stack (4 KiB), so the workspace does not grow and the slice stays
 //! in the L1 cache from the synthesis to the analysis.
 
+use crate::ball::{Ball, Move};
 use crate::dictionary::Dictionary;
 use crate::shape::PatchShape;
 use crate::transform::{Slice, flat, mode_pixel, mode_rows, mode_rows_add, slice};
@@ -37,10 +38,10 @@ pub const fn projection_macs<const PS: usize, const PT: usize, const PU: usize, 
     2 * pixels * B * (PS + PT + PU + PV) + 2 * B * measured
 }
 
-/// Moves the coefficients `coeffs` (of `dict`) onto the measurements `m`: exactly (`eps`
-/// 0), or onto the ball `||P D S - I|| <= eps` (a point inside it is left alone, one
-/// outside moves to its surface). `scratch` is clobbered. Returns the residual norm
-/// `||I - P D S||` before the move. This is the projection of every step of [`crate::solve`].
+/// Moves the coefficients `coeffs` (of `dict`) onto the measurements `m`: exactly, or onto
+/// the noise [`Ball`] (a point inside it is left alone, one outside moves to its surface).
+/// `scratch` is clobbered. Returns the residual norm `||I - P D S||` before the move. This
+/// is the projection of every step of [`crate::solve`].
 ///
 /// Kept out of line: inlined into the solver's step loop, the band step ran about twice
 /// as slow as in this function alone (`perf annotate` of `slf bench`), and a decode with
@@ -57,14 +58,15 @@ pub fn project_coefficients<
     coeffs: &mut [f32; N],
     scratch: &mut [f32; N],
     m: &Measurements<N>,
-    eps: f32,
+    ball: &Ball,
 ) -> f32 {
     const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
     let (d, t) = (&dict.d, &dict.t);
     let (fd, ft) = (dict.synthesis_folds(), dict.analysis_folds());
     let part_len = PT * PU * PV * B;
     mode_rows(&d.m1, fd[0], coeffs, scratch, part_len);
-    let mut r2 = 0.0f32;
+    let (mut r2, mut w2) = (0.0f32, 0.0f32);
+    let weighted = ball.is_weighted();
     let mut tmp: Slice<PT, PU, PV, B> = slice();
     let parts = scratch.chunks_exact_mut(part_len).zip(m.values.chunks_exact(part_len));
     for ((part, values), measured) in parts.zip(m.measured.chunks_exact(part_len)) {
@@ -72,17 +74,19 @@ pub fn project_coefficients<
         mode_rows(&d.m2, fd[1], part, tmp, PU * PV * B);
         mode_rows(&d.m3, fd[2], tmp, part, PV * B);
         mode_pixel(&d.m4, fd[3], part.as_chunks::<B>().0, tmp.as_chunks_mut::<B>().0);
-        r2 += band_step(&d.m5, tmp.as_chunks_mut::<B>().0, values, measured);
+        let fibres = tmp.as_chunks_mut::<B>().0;
+        if weighted {
+            let (r, w) = band_step::<B, true>(&d.m5, fibres, values, measured, ball);
+            (r2, w2) = (r2 + r, w2 + w);
+        } else {
+            r2 += band_step::<B, false>(&d.m5, fibres, values, measured, ball).0;
+        }
         mode_pixel(&t.m4, ft[3], tmp.as_chunks::<B>().0, part.as_chunks_mut::<B>().0);
         mode_rows(&t.m3, ft[2], part, tmp, PV * B);
         mode_rows(&t.m2, ft[1], tmp, part, PU * PV * B);
     }
     let norm = libm::sqrtf(r2);
-    let scale = if eps == 0.0 {
-        1.0
-    } else if norm > eps {
-        1.0 - eps / norm
-    } else {
+    let Move::Scale(scale) = ball.move_for(r2, w2) else {
         return norm; // inside the ball: no move
     };
     mode_rows_add(&t.m1, ft[0], scale, scratch, coeffs, part_len);
@@ -91,7 +95,9 @@ pub fn project_coefficients<
 
 /// The band step on a slice's pixels: `fibres` hold each pixel's band coefficients after
 /// the pixel modes' synthesis and become the correction's; `values` / `measured` are the
-/// slice's measurements in patch order. Returns the sum of squared residuals.
+/// slice's measurements in patch order. Returns the sum of squared residuals and, with
+/// `WEIGHTED`, of each over its measurement's variance ([`Ball::weight`]: one division per
+/// measurement, only in that mode).
 ///
 /// A pixel's measured bands are found from a bit mask of its flags ([`band_bits`]),
 /// lowest set bit first: scanning the flags one by one took a data-dependent branch per
@@ -101,9 +107,15 @@ pub fn project_coefficients<
 /// 3.1 us at three; criterion, paper patch); the bit mask (two multiplies a pixel instead
 /// of 128-bit arithmetic a band) took the projection from 5.98 to 5.75 us at one.
 #[inline(always)]
-fn band_step<const B: usize>(m5: &[[f32; B]; B], fibres: &mut [[f32; B]], values: &[f32], measured: &[bool]) -> f32 {
+fn band_step<const B: usize, const WEIGHTED: bool>(
+    m5: &[[f32; B]; B],
+    fibres: &mut [[f32; B]],
+    values: &[f32],
+    measured: &[bool],
+    ball: &Ball,
+) -> (f32, f32) {
     const { assert!(B <= 64, "a pixel's flags fit one mask (B <= MAX_BANDS)") };
-    let mut r2 = 0.0f32;
+    let (mut r2, mut w2) = (0.0f32, 0.0f32);
     for ((fibre, values), measured) in fibres.iter_mut().zip(values.as_chunks::<B>().0).zip(measured.as_chunks::<B>().0)
     {
         let mut correction = [0.0f32; B];
@@ -114,13 +126,16 @@ fn band_step<const B: usize>(m5: &[[f32; B]; B], fibres: &mut [[f32; B]], values
             let (Some(row), Some(&y)) = (m5.get(b), values.get(b)) else { break };
             let r = y - dot(row, fibre);
             r2 += r * r;
+            if WEIGHTED {
+                w2 += r * r * ball.weight(y);
+            }
             for (c, &w) in correction.iter_mut().zip(row) {
                 *c += r * w;
             }
         }
         *fibre = correction;
     }
-    r2
+    (r2, w2)
 }
 
 /// Up to 64 flags as a bit mask, bit `j` for flag `j` (any further flags are not read):

@@ -41,6 +41,13 @@ impl RawFormat {
             && self.max_valid >= 0.0
     }
 
+    /// The physical range of a value in normalised units: from no light (0) to the
+    /// brightest a pixel can measure (`max_valid`). A decoded value outside it is not a
+    /// radiance this sensor could have recorded, so the decoder clamps to it.
+    pub fn range(&self) -> (f32, f32) {
+        (0.0, ((self.max_valid - self.black) / (self.white - self.black)).max(0.0))
+    }
+
     /// A sample as a measurement in normalised units, or why it is not one.
     #[inline]
     pub fn classify(&self, raw: f32) -> Result<f32, Invalid> {

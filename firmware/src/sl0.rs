@@ -18,6 +18,8 @@
 //! measurement, normalised units) the projection is onto the ball `||A S - I|| <= eps`,
 //! `eps = noise * sqrt(m)` for `m` measurements, as SL0 does for noisy data: a point inside
 //! the ball is left alone, one outside is moved to its surface. It stops fitting the noise.
+//! With shot noise (`shot > 0`) each measurement's variance grows with its value and the
+//! ball is weighted accordingly ([`crate::ball`]).
 //!
 //! Every loop is bounded by [`Sl0Config::max_iterations`]; how a solve ended is in its
 //! [`Outcome`], never a hang.
@@ -25,6 +27,7 @@
 use core::fmt;
 
 use crate::ascent::ascend;
+use crate::ball::{Ball, Move};
 use crate::dictionary::Dictionary;
 use crate::projection::project_coefficients;
 use crate::transform::{analyze, synthesize};
@@ -44,9 +47,13 @@ pub struct Sl0Config {
     pub sigma_min: f32,
     /// Hard bound on steps (ascent + projection) per solve, >= 1.
     pub max_iterations: u32,
-    /// Noise standard deviation per measurement (normalised units), >= 0; 0 forces
-    /// equality with the measurements.
+    /// Noise standard deviation per measurement (normalised units), >= 0: read and
+    /// quantisation noise. With `shot` 0 too, the solution equals the measurements.
     pub noise: f32,
+    /// Shot noise: a measurement's variance per unit of its value (normalised units), >= 0;
+    /// `1 / electrons at white` for a sensor whose white level collects that many
+    /// electrons. A measurement `y` has variance `noise^2 + shot * max(y, 0)`.
+    pub shot: f32,
     /// Early stop: the solve ends once a whole sigma level moves the patch by less than
     /// this, as an RMS per value (normalised units), >= 0; 0 never stops early.
     pub tolerance: f32,
@@ -83,6 +90,7 @@ impl Sl0Config {
         sigma_min: 1e-3,
         max_iterations: 300,
         noise: 0.0,
+        shot: 0.0,
         tolerance: 0.0,
         warm_start: 1e-2,
         warm_sigma_f: 0.85,
@@ -113,6 +121,9 @@ impl Sl0Config {
         }
         if !(self.noise >= 0.0 && self.noise.is_finite()) {
             return bad("noise");
+        }
+        if !(self.shot >= 0.0 && self.shot.is_finite()) {
+            return bad("shot");
         }
         if !(self.tolerance >= 0.0 && self.tolerance.is_finite()) {
             return bad("tolerance");
@@ -232,42 +243,52 @@ pub(crate) fn max_abs(x: &[f32]) -> f32 {
     x.iter().fold(0.0f32, |m, v| m.max(v.abs()))
 }
 
-/// Moves `x` onto the measurements (exactly, or to the noise ball of radius `eps`);
-/// returns the residual norm before the move.
-fn project<const N: usize>(x: &mut [f32; N], m: &Measurements<N>, eps: f32) -> f32 {
-    let mut r2 = 0.0f32;
+/// Moves `x` onto the measurements (exactly, or to the noise ball); returns the residual
+/// norm before the move.
+fn project<const N: usize>(x: &mut [f32; N], m: &Measurements<N>, ball: &Ball) -> f32 {
+    let (mut r2, mut w2) = (0.0f32, 0.0f32);
     for ((x, &y), &k) in x.iter().zip(&m.values).zip(&m.measured) {
         if k {
             let r = y - x;
             r2 += r * r;
-        }
-    }
-    let norm = libm::sqrtf(r2);
-    if eps == 0.0 {
-        for ((x, &y), &k) in x.iter_mut().zip(&m.values).zip(&m.measured) {
-            if k {
-                *x = y;
-            }
-        }
-    } else if norm > eps {
-        let scale = 1.0 - eps / norm;
-        for ((x, &y), &k) in x.iter_mut().zip(&m.values).zip(&m.measured) {
-            if k {
-                *x += scale * (y - *x);
+            if ball.is_weighted() {
+                w2 += r * r * ball.weight(y);
             }
         }
     }
-    norm
+    match ball.move_for(r2, w2) {
+        Move::Scale(scale) if ball.is_exact() || scale == 1.0 => {
+            for ((x, &y), &k) in x.iter_mut().zip(&m.values).zip(&m.measured) {
+                if k {
+                    *x = y;
+                }
+            }
+        }
+        Move::Scale(scale) => {
+            for ((x, &y), &k) in x.iter_mut().zip(&m.values).zip(&m.measured) {
+                if k {
+                    *x += scale * (y - *x);
+                }
+            }
+        }
+        Move::Stay => {}
+    }
+    libm::sqrtf(r2)
 }
 
-/// The checks both projection paths start with; returns the noise-ball radius
-/// `eps = noise * sqrt(m)` (0 for exact projection).
-pub(crate) fn start<const N: usize>(cfg: &Sl0Config, m: &Measurements<N>) -> Result<f32, SolveError> {
+/// The checks both projection paths start with; returns the noise ball (exact projection
+/// without a noise description).
+pub(crate) fn start<const B: usize, const N: usize>(cfg: &Sl0Config, m: &Measurements<N>) -> Result<Ball, SolveError> {
     cfg.validate()?;
     if m.count == 0 {
         return Err(SolveError::NoMeasurements);
     }
-    Ok(cfg.noise * libm::sqrtf(m.count as f32))
+    if cfg.noise == 0.0 && cfg.shot == 0.0 {
+        return Ok(Ball::new(0.0, 0.0, m.count, 0));
+    }
+    // Pixels with at least one measured band (the band is the last axis).
+    let pixels = m.measured.as_chunks::<B>().0.iter().filter(|p| p.contains(&true)).count();
+    Ok(Ball::new(cfg.noise, cfg.shot, m.count, pixels as u32))
 }
 
 /// What one step (ascent + projection) reports to the schedule.
@@ -326,7 +347,7 @@ pub fn solve<const PS: usize, const PT: usize, const PU: usize, const PV: usize,
     cfg: &Sl0Config,
     ws: &mut Workspace<PS, PT, PU, PV, B, N>,
 ) -> Result<Outcome, SolveError> {
-    let eps = start(cfg, &ws.measurements)?;
+    let ball = start::<B, N>(cfg, &ws.measurements)?;
     if let Some(outcome) = short_path(cfg, ws) {
         return Ok(outcome);
     }
@@ -335,7 +356,7 @@ pub fn solve<const PS: usize, const PT: usize, const PU: usize, const PV: usize,
     for ((x, &y), &k) in signal.iter_mut().zip(&m.values).zip(&m.measured) {
         *x = if k { y } else { 0.0 };
     }
-    descend(dict, cfg, ws, eps, 1.0)
+    descend(dict, cfg, ws, &ball, 1.0)
 }
 
 /// The short path for a flat patch: if every band is measured and each band's
@@ -399,18 +420,18 @@ pub fn solve_warm<
     cfg: &Sl0Config,
     ws: &mut Workspace<PS, PT, PU, PV, B, N>,
 ) -> Result<Outcome, SolveError> {
-    let eps = start(cfg, &ws.measurements)?;
+    let ball = start::<B, N>(cfg, &ws.measurements)?;
     let warm = Sl0Config { sigma_f: cfg.warm_sigma_f, steps: cfg.warm_steps, ..*cfg };
-    descend(dict, &warm, ws, eps, cfg.warm_start)
+    descend(dict, &warm, ws, &ball, cfg.warm_start)
 }
 
 /// The schedule from the patch in `ws.signal`, from `sigma0 = scale * max |S|`, projecting
-/// onto the noise ball of radius `eps` (0: exactly).
+/// onto `ball`.
 fn descend<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
     dict: &Dictionary<PS, PT, PU, PV, B>,
     cfg: &Sl0Config,
     ws: &mut Workspace<PS, PT, PU, PV, B, N>,
-    eps: f32,
+    ball: &Ball,
     scale: f32,
 ) -> Result<Outcome, SolveError> {
     let Workspace { coeffs, signal, measurements: m } = ws;
@@ -419,17 +440,17 @@ fn descend<const PS: usize, const PT: usize, const PU: usize, const PV: usize, c
 
     let outcome = run_schedule(cfg, sigma0, N, |inv| {
         let step2 = ascend(coeffs, cfg.mu, inv);
-        let residual = project_coefficients(dict, coeffs, signal, m, eps);
+        let residual = project_coefficients(dict, coeffs, signal, m, ball);
         // From a point that meets the measurements, the step d moves the patch by D d on
         // the unmeasured values only (the projection puts the measured ones back), and D
         // is orthonormal: |moved|^2 = |d|^2 - residual^2, with no extra pass. With a noise
         // ball the projection may leave part of the step on measured values: |d| bounds it.
-        let moved2 = if eps == 0.0 { step2 - residual * residual } else { step2 };
+        let moved2 = if ball.is_exact() { step2 - residual * residual } else { step2 };
         Step { residual, moved: libm::sqrtf(moved2.max(0.0)) }
     });
 
     synthesize(dict, coeffs, signal);
-    project(signal, m, eps);
+    project(signal, m, ball);
     if signal.iter().any(|x| !x.is_finite()) {
         return Err(SolveError::NonFiniteResult);
     }

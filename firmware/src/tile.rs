@@ -422,7 +422,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     }
 
     /// Decodes every patch of `tile` with `model` (a dictionary or an ensemble), sending
-    /// each to `sink`.
+    /// each to `sink`, clamped to the sensor's physical range ([`RawFormat::range`]).
     ///
     /// # Errors
     /// [`TileError::Geometry`] before anything is read; [`TileError::Source`] or
@@ -451,6 +451,8 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                     let (flags, excluded) = self.read_patch(origin, source, ws).map_err(TileError::Source)?;
                     match model.decode(&self.config.sl0, ws) {
                         Ok(done) => {
+                            let (lo, hi) = self.config.raw.range();
+                            ws.clamp_patch(lo, hi);
                             let r = PatchReport {
                                 outcome: done.outcome,
                                 member: done.member,

@@ -147,6 +147,13 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
     pub fn patch(&self) -> &[f32; N] {
         &self.signal
     }
+
+    /// Limits the decoded patch to `[lo, hi]` (the sensor's physical range).
+    pub(crate) fn clamp_patch(&mut self, lo: f32, hi: f32) {
+        for x in self.signal.iter_mut() {
+            *x = x.max(lo).min(hi); // not `clamp`: it asserts `lo <= hi`, a panic site
+        }
+    }
 }
 
 impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize> Default

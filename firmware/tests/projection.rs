@@ -5,6 +5,7 @@ mod common;
 
 use common::*;
 use rand::Rng;
+use slf_firmware::ball::Ball;
 use slf_firmware::projection::project_coefficients;
 use slf_firmware::transform::analyze_preserving;
 use slf_firmware::{Dictionary, Measurements};
@@ -29,19 +30,30 @@ fn random_measurements<const B: usize, const N: usize>(seed: u64, per_pixel: usi
     (m, idx)
 }
 
-/// The projection in f64 with dense matrices: returns the projected coefficients and the
-/// residual norm before the move.
-fn dense_projection(k: &[f64], n: usize, s: &[f32], m_idx: &[usize], y: &[f32], eps: f64) -> (Vec<f64>, f64) {
+/// The projection in f64 with dense matrices onto the ball `sum r_i^2 / var_i <= m`,
+/// `var_i = noise^2 + shot * max(y_i, 0)` (both 0: exactly): returns the projected
+/// coefficients and the residual norm before the move.
+fn dense_projection(
+    k: &[f64],
+    n: usize,
+    s: &[f32],
+    m_idx: &[usize],
+    y: &[f32],
+    (noise, shot): (f64, f64),
+) -> (Vec<f64>, f64) {
     let x = dense_apply(k, n, s);
     let mut r = vec![0.0f64; n];
+    let mut white2 = 0.0;
     for &i in m_idx {
         r[i] = f64::from(y[i]) - x[i];
+        white2 += r[i] * r[i] / (noise * noise + shot * f64::from(y[i]).max(0.0));
     }
     let norm = r.iter().map(|v| v * v).sum::<f64>().sqrt();
-    let scale = if eps == 0.0 {
+    let m = m_idx.len() as f64;
+    let scale = if noise == 0.0 && shot == 0.0 {
         1.0
-    } else if norm > eps {
-        1.0 - eps / norm
+    } else if white2 > m {
+        1.0 - (m / white2).sqrt()
     } else {
         0.0
     };
@@ -51,6 +63,7 @@ fn dense_projection(k: &[f64], n: usize, s: &[f32], m_idx: &[usize], y: &[f32], 
 }
 
 fn check<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>() {
+    let mut inside = 0;
     for (dseed, dict) in [(0u64, Dictionary::<PS, PT, PU, PV, B>::dct()), (5, random_dictionary(5))] {
         let (k, n) = dense_kronecker(dict.synthesis());
         for (case, per_pixel) in [1usize, 3, B].into_iter().enumerate() {
@@ -58,21 +71,34 @@ fn check<const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             let y: Vec<f32> = (0..N).map(|i| m.get(i).unwrap_or(0.0)).collect();
             let mut r = rng(99 + case as u64);
             let s: Vec<f32> = (0..N).map(|_| r.random_range(-1.0f32..1.0)).collect();
-            let (_, norm0) = dense_projection(&k, n, &s, &idx, &y, 0.0);
-            // Exact, a ball the point lies outside of, and one it lies inside.
-            for eps in [0.0, 0.5 * norm0, 2.0 * norm0] {
+            let (_, norm0) = dense_projection(&k, n, &s, &idx, &y, (0.0, 0.0));
+            // The residual's RMS per measurement: a noise level of half of it puts the point
+            // outside the ball, twice it inside.
+            let rms = norm0 / (idx.len() as f64).sqrt();
+            // Exact; uniform balls the point lies outside of and inside of; weighted balls
+            // (shot noise: variance rising with the value in 0..1) outside and inside.
+            let balls = [
+                (0.0, 0.0),
+                (0.5 * rms, 0.0),
+                (2.0 * rms, 0.0),
+                (0.0, 0.25 * rms * rms),
+                (0.5 * rms, 16.0 * rms * rms),
+            ];
+            for (noise, shot) in balls {
                 let mut coeffs: Box<[f32; N]> = Box::new(s.clone().try_into().unwrap());
                 let mut scratch = Box::new([0.0f32; N]);
-                let residual = project_coefficients(&dict, &mut coeffs, &mut scratch, &m, eps as f32);
-                let (reference, norm) = dense_projection(&k, n, &s, &idx, &y, eps);
+                let ball = Ball::new(noise as f32, shot as f32, idx.len() as u32, 0); // radius^2 = m
+                let residual = project_coefficients(&dict, &mut coeffs, &mut scratch, &m, &ball);
+                let (reference, norm) = dense_projection(&k, n, &s, &idx, &y, (noise, shot));
                 let e = rel_err(&coeffs[..], &reference);
-                assert!(e <= 2e-6, "dict {dseed}, {per_pixel} per pixel, eps {eps}: rel err {e}");
+                assert!(e <= 2e-6, "dict {dseed}, {per_pixel} per pixel, noise {noise} shot {shot}: rel err {e}");
                 assert!((f64::from(residual) - norm).abs() <= 1e-5 * norm, "residual {residual} vs {norm}");
-                if eps > norm {
+                if reference.iter().zip(&s).all(|(a, &b)| *a == f64::from(b)) {
                     assert_eq!(&coeffs[..], &s[..], "inside the ball nothing moves");
+                    inside += 1;
                 }
                 // Exactly projected coefficients synthesise to the measurements.
-                if eps == 0.0 {
+                if noise == 0.0 && shot == 0.0 {
                     let x = dense_apply(&k, n, &coeffs[..]);
                     let worst = idx.iter().map(|&i| (x[i] - f64::from(y[i])).abs()).fold(0.0, f64::max);
                     assert!(worst <= 1e-5, "off the measurements by {worst}");
@@ -80,6 +106,9 @@ fn check<const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             }
         }
     }
+    // The uniform ball of twice the residual's RMS holds the point for each of the 2
+    // dictionaries x 3 cases; the half-RMS and weighted-outside ones never do.
+    assert!((6..=12).contains(&inside), "{inside} balls hold the point");
 }
 
 #[test]

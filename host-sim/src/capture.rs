@@ -253,6 +253,19 @@ impl Capture {
         RawFormat { black: d.black_level, white: d.white_level, max_valid: d.saturation_level - 0.5 }
     }
 
+    /// The sensor's noise in the decoder's normalised units, `(noise, shot)` as
+    /// [`Sl0Config`] takes them: a measurement `y` has variance `noise^2 + shot * max(y, 0)`.
+    /// Read noise and the quantisation of whole DN (`1/12` DN^2) make the floor; shot noise
+    /// is `1 / electrons at white` (a Poisson count's variance is its mean). `None` when
+    /// the capture does not describe its noise.
+    pub fn noise_model(&self) -> Option<(f32, f32)> {
+        let d = &self.description;
+        let n = d.noise?;
+        let range = f64::from(d.white_level - d.black_level);
+        let floor = (f64::from(n.read_noise_dn).powi(2) + 1.0 / 12.0) / (range * range);
+        Some((floor.sqrt() as f32, (1.0 / f64::from(n.full_well_electrons)) as f32))
+    }
+
     /// The firmware's tile decoder for this capture (the paper's 5 x 5 x 4 x 4 x 13 patch).
     ///
     /// # Errors

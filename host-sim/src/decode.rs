@@ -124,10 +124,23 @@ impl Window {
     }
 }
 
+/// Where the projection's noise ball comes from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum NoiseSource {
+    /// The capture's noise description ([`Capture::noise_model`]); exact projection if it
+    /// has none.
+    #[default]
+    Capture,
+    /// [`Sl0Config::noise`] and [`Sl0Config::shot`] as given (both 0: exact).
+    Config,
+}
+
 /// How to decode.
 #[derive(Clone, Copy, Debug)]
 pub struct DecodeOptions {
     pub sl0: Sl0Config,
+    /// Where the noise ball comes from.
+    pub noise: NoiseSource,
     /// Patches per tile (rows, cols): the unit of parallel work.
     pub tile_patches: (u16, u16),
     /// Show a progress bar once the run has taken a second.
@@ -142,7 +155,26 @@ pub struct DecodeOptions {
 
 impl Default for DecodeOptions {
     fn default() -> Self {
-        Self { sl0: Sl0Config::DEFAULT, tile_patches: (2, 2), progress: false, stride: (5, 5), window: Window::Uniform }
+        Self {
+            sl0: Sl0Config::DEFAULT,
+            noise: NoiseSource::Capture,
+            tile_patches: (2, 2),
+            progress: false,
+            stride: (5, 5),
+            window: Window::Uniform,
+        }
+    }
+}
+
+impl DecodeOptions {
+    /// The solver's config for `capture`: [`Self::sl0`] with the noise ball from
+    /// [`Self::noise`].
+    pub fn solver_config(&self, capture: &Capture) -> Sl0Config {
+        match (self.noise, capture.noise_model()) {
+            (NoiseSource::Config, _) => self.sl0,
+            (NoiseSource::Capture, Some((noise, shot))) => Sl0Config { noise, shot, ..self.sl0 },
+            (NoiseSource::Capture, None) => Sl0Config { noise: 0.0, shot: 0.0, ..self.sl0 },
+        }
     }
 }
 
@@ -259,7 +291,7 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
     let start = Instant::now();
     let d = &capture.description;
     ensure!(d.bands_nm.len() == 13, "the decoder's patch has 13 bands, the capture {}", d.bands_nm.len());
-    let decoder = capture.decoder(opts.sl0)?;
+    let decoder = capture.decoder(opts.solver_config(capture))?;
     let raw = capture.raw_frames()?;
     ensure!(
         (1..=5).contains(&opts.stride.0) && (1..=5).contains(&opts.stride.1),

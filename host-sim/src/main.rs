@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 use slf_host::camera::{CameraConfig, simulate};
 use slf_host::capture::{Capture, MaskDescription};
-use slf_host::decode::{Basis, DecodeOptions, decode_with, read_blob};
+use slf_host::decode::{Basis, DecodeOptions, NoiseSource, decode_with, read_blob};
 use slf_host::demosaic::Baseline;
 use slf_host::firmware::{ChoiceRule, DEFAULT_ENSEMBLE, MaskFamily, MemberChoice, Sl0Config};
 use slf_host::lightfield::{Dtype, read_npy, write_npy};
@@ -203,9 +203,18 @@ struct SolverArgs {
     /// Hard bound on SL0 steps per patch.
     #[arg(long, default_value_t = Sl0Config::DEFAULT.max_iterations)]
     max_iterations: u32,
-    /// Noise standard deviation per measurement (normalised units); 0 forces equality.
-    #[arg(long, default_value_t = 0.0)]
-    noise: f32,
+    /// Noise standard deviation per measurement (normalised units), instead of the
+    /// capture's noise description; 0 (with no --shot) forces equality.
+    #[arg(long, conflicts_with = "exact")]
+    noise: Option<f32>,
+    /// Shot noise: variance per unit of a measurement's value (normalised units, 1 /
+    /// electrons at white), instead of the capture's noise description.
+    #[arg(long, conflicts_with = "exact")]
+    shot: Option<f32>,
+    /// Exact projection: the decode equals the measurements, whatever noise the capture
+    /// describes. Without --exact, --noise or --shot the noise ball comes from the capture.
+    #[arg(long)]
+    exact: bool,
     /// Early stop: end a patch's solve once a sigma level moves it by less than this RMS
     /// per value (normalised units); 0 never stops early.
     #[arg(long, default_value_t = Sl0Config::DEFAULT.tolerance)]
@@ -227,6 +236,15 @@ struct SolverArgs {
 }
 
 impl SolverArgs {
+    /// Where the noise ball comes from: the capture unless told.
+    fn noise_source(&self) -> NoiseSource {
+        if self.exact || self.noise.is_some() || self.shot.is_some() {
+            NoiseSource::Config
+        } else {
+            NoiseSource::Capture
+        }
+    }
+
     fn config(&self) -> Result<Sl0Config> {
         let c = Sl0Config {
             sigma_f: self.sigma_f,
@@ -234,7 +252,8 @@ impl SolverArgs {
             mu: self.mu,
             sigma_min: self.sigma_min,
             max_iterations: self.max_iterations,
-            noise: self.noise,
+            noise: self.noise.unwrap_or(0.0),
+            shot: self.shot.unwrap_or(0.0),
             tolerance: self.tolerance,
             warm_start: self.warm_start,
             warm_sigma_f: self.warm_sigma_f,
@@ -620,6 +639,7 @@ fn run(cli: Cli) -> Result<()> {
             }
             let opts = DecodeOptions {
                 sl0: solver.config()?,
+                noise: solver.noise_source(),
                 progress: !quiet,
                 stride: (stride as u8, stride as u8),
                 window: window.window(),
@@ -661,6 +681,15 @@ fn run(cli: Cli) -> Result<()> {
                 std::fs::write(&path, csv).with_context(|| format!("cannot write {}", path.display()))?;
             }
             write_npy(&output, &lf, dtype)?;
+            let used = opts.solver_config(&cap);
+            let ball = match (opts.noise, used.noise > 0.0 || used.shot > 0.0) {
+                (_, false) => "exact projection".to_string(),
+                (NoiseSource::Capture, true) => {
+                    format!("the capture's noise (sd {:.2e} + shot {:.2e} per unit)", used.noise, used.shot)
+                }
+                (NoiseSource::Config, true) => format!("noise sd {:.2e} + shot {:.2e} per unit", used.noise, used.shot),
+            };
+            println!("projection: {ball}");
             println!(
                 "decoded {} patches ({} flagged, {} failed, {} tiles failed) in {:.2} s; wrote {}",
                 r.patches.decoded,

@@ -38,6 +38,15 @@ fn scene_simulate_decode_eval_round_trip() {
     assert!(p("cap/capture.json").exists() && p("cap/snapshot_2.png").exists());
     let out = stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("recon.npy")).arg("--quiet"));
     assert!(out.contains("decoded 64 patches (0 flagged, 0 failed, 0 tiles failed)"), "{out}");
+    // The capture's noise by default (2 DN read noise, 20,000 electrons at white); exact
+    // or a given noise on request, not both.
+    assert!(out.contains("projection: the capture's noise (sd 5.57e-4 + shot 5.00e-5 per unit)"), "{out}");
+    let exact = stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("x.npy")).args(["--exact", "-q"]));
+    assert!(exact.contains("projection: exact projection"), "{exact}");
+    let given = stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("x.npy")).args(["--noise", "1e-3", "-q"]));
+    assert!(given.contains("projection: noise sd 1.00e-3 + shot 0.00e0 per unit"), "{given}");
+    let e = failure(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("x.npy")).args(["--exact", "--noise", "1e-3"]));
+    assert!(e.contains("--exact") && e.contains("--noise"), "{e}");
     let out = stdout(slf().arg("eval").arg(p("truth.npy")).arg(p("recon.npy")));
     let psnr: f64 = out.split_whitespace().nth(1).unwrap().parse().unwrap();
     assert!(psnr > 30.0, "{out}");

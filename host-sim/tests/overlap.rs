@@ -4,8 +4,7 @@
 use slf_host::camera::{CameraConfig, simulate};
 use slf_host::decode::{Basis, DecodeOptions, TAPER, Window, decode_with};
 use slf_host::firmware::{
-    Dictionary, FrameSource, PaperShape, PaperWorkspace, PatchOrigin, PatchReport, PatchSink, Sl0Config, SolveError,
-    Tile,
+    Dictionary, FrameSource, PaperShape, PaperWorkspace, PatchOrigin, PatchReport, PatchSink, SolveError, Tile,
 };
 use slf_host::lightfield::LightField;
 
@@ -37,7 +36,8 @@ fn origins(total: usize, off: usize) -> Vec<usize> {
 
 fn reference(truth: &LightField, k: u8, stride: usize, window: Window) -> Vec<f32> {
     let capture = simulate(truth, &CameraConfig::pixel(3, k)).unwrap();
-    let decoder = capture.decoder(Sl0Config::DEFAULT).unwrap();
+    // The solver config `decode_with` uses: the capture's noise ball.
+    let decoder = capture.decoder(DecodeOptions::default().solver_config(&capture)).unwrap();
     let raw = capture.raw_frames().unwrap();
     let dct = Dictionary::dct();
     let mut ws = Box::new(PaperWorkspace::new());

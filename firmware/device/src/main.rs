@@ -129,7 +129,7 @@ mod device {
             mask,
             raw: RawFormat { black: BLACK, white: WHITE, max_valid: MAX_VALID },
             defects: DefectList::EMPTY,
-            sl0: Sl0Config::DEFAULT,
+            sl0: Sl0Config { noise: NOISE, shot: SHOT, ..Sl0Config::DEFAULT },
         };
         let Ok(decoder) = TileDecoder::<5, 5, 4, 4, 13, 5200>::new(config) else {
             hprintln!("error: decoder config rejected");
