@@ -38,7 +38,7 @@ fn mask(family: &str, k: u8) -> MaskDescription {
 fn scene_to_metrics_for_every_mask_family() {
     let truth = scene::named("depth").unwrap().render(SceneSize { views: (5, 5), rows: 40, cols: 40 });
     let dict = Dictionary::dct();
-    let floors = [("pixel", [21.0, 28.0]), ("lenslet", [13.0, 23.5]), ("kronecker", [5.5, 5.5])];
+    let floors = [("pixel", [21.0, 28.0]), ("lenslet", [13.0, 23.5]), ("kronecker", [10.0, 14.5])];
     let mut psnr_k3 = std::collections::HashMap::new();
     for (family, floor) in floors {
         for (i, k) in [1u8, 3].into_iter().enumerate() {
@@ -58,7 +58,9 @@ fn scene_to_metrics_for_every_mask_family() {
             }
         }
     }
-    assert!(psnr_k3["pixel"] >= psnr_k3["kronecker"] + 15.0, "{psnr_k3:?}");
+    // The kronecker mask's patches measure k bands each and are interpolated per pixel
+    // (measured 11.3 / 16.0 dB; 7.7 when SL0 solved them): still far below the pixel mask.
+    assert!(psnr_k3["pixel"] >= psnr_k3["kronecker"] + 10.0, "{psnr_k3:?}");
     assert!(psnr_k3["pixel"] > psnr_k3["lenslet"], "{psnr_k3:?}");
 }
 

@@ -21,10 +21,11 @@
 //! - **operators** ([`shape`], [`dct`], [`dictionary`], [`blob`], [`transform`]): the patch
 //!   geometry in the types, dictionaries (the 5D DCT and blobs in flash) and the separable
 //!   synthesis and analysis transforms.
-//! - **solver** ([`sl0`], [`ascent`], [`ball`], [`projection`], [`pinv`], [`choice`]): nD
-//!   SL0 with the orthonormal fast path, the noise ball a projection moves onto, the paper's
-//!   general pseudo-inverse path for kronecker masks, and the choice of an ensemble member
-//!   per patch (exhaustive or screened).
+//! - **solver** ([`sl0`], [`ascent`], [`ball`], [`projection`], [`pinv`], [`choice`],
+//!   [`interpolate`]): nD SL0 with the orthonormal fast path, the noise ball a projection
+//!   moves onto, the paper's general pseudo-inverse path for kronecker masks, the choice of
+//!   an ensemble member per patch (exhaustive or screened), and per-pixel spectral
+//!   interpolation for patches whose pixels all see the same bands.
 //! - **tile decoder** ([`tile`]): a rectangle of the raw frame, patch by patch, from a
 //!   [`TileSource`] to a [`PatchSink`], into a caller-owned [`Workspace`].
 //!
@@ -93,6 +94,7 @@ pub mod choice;
 pub mod dct;
 pub mod defects;
 pub mod dictionary;
+pub mod interpolate;
 pub mod mask;
 pub mod pinv;
 pub mod projection;

@@ -71,6 +71,10 @@ pub struct Sl0Config {
     /// each band's mean with no solve. Dark patches are flat (their spread is at most their
     /// brightness); with 0 only exactly flat patches (black, clipped) take it.
     pub flat: f32,
+    /// A patch whose measurements cover fewer than this many distinct bands (and at least
+    /// one) is decoded by per-pixel spectral interpolation ([`crate::interpolate`]) instead of SL0, and ends
+    /// as [`Ended::Interpolated`]; 0 solves every patch. Read by the tile decoder.
+    pub min_bands: u8,
 }
 
 impl Sl0Config {
@@ -96,6 +100,7 @@ impl Sl0Config {
         warm_sigma_f: 0.85,
         warm_steps: 1,
         flat: 0.0,
+        min_bands: 5,
     };
 
     /// Checks every field's range.
@@ -212,6 +217,9 @@ pub enum Ended {
     Converged,
     /// The patch was flat within [`Sl0Config::flat`]: decoded by the short path, no solve.
     Flat,
+    /// Too few bands measured: decoded by per-pixel spectral interpolation, no
+    /// solve ([`Sl0Config::min_bands`]).
+    Interpolated,
 }
 
 /// How a solve ended.
@@ -232,6 +240,11 @@ pub struct Outcome {
 }
 
 impl Outcome {
+    /// A patch decoded by interpolation: no step, no level.
+    pub const fn interpolated() -> Self {
+        Self { iterations: 0, levels: 0, sigma0: 0.0, residual: 0.0, ended: Ended::Interpolated }
+    }
+
     /// Whether the hard iteration bound stopped the solve.
     pub fn hit_bound(&self) -> bool {
         self.ended == Ended::IterationBound

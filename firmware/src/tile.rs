@@ -20,8 +20,9 @@
 use core::fmt;
 use core::num::NonZeroUsize;
 
-use crate::choice::PatchModel;
+use crate::choice::{ModelOutcome, PatchModel};
 use crate::defects::DefectList;
+use crate::interpolate::{bands_measured, interpolate_bands};
 use crate::log::log;
 use crate::mask::{LensletSize, Mask, MaskFamily};
 use crate::raw::{Invalid, RawFormat};
@@ -449,7 +450,17 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                         view_col,
                     };
                     let (flags, excluded) = self.read_patch(origin, source, ws).map_err(TileError::Source)?;
-                    match model.decode(&self.config.sl0, ws) {
+                    let cfg = &self.config.sl0;
+                    let bands = bands_measured::<B, N>(ws.measurements());
+                    // No band at all is no measurement: the model reports it.
+                    let decoded = if bands > 0 && bands < u32::from(cfg.min_bands) {
+                        let Workspace { signal, measurements, .. } = ws;
+                        interpolate_bands::<B, N>(measurements, signal);
+                        Ok(ModelOutcome { outcome: Outcome::interpolated(), member: None, solves: 0 })
+                    } else {
+                        model.decode(cfg, ws)
+                    };
+                    match decoded {
                         Ok(done) => {
                             let (lo, hi) = self.config.raw.range();
                             ws.clamp_patch(lo, hi);

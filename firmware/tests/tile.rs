@@ -91,7 +91,10 @@ fn config(mask: Mask<'static>) -> DecoderConfig<'static> {
         mask,
         raw: RawFormat::NORMALISED,
         defects: DefectList::EMPTY,
-        sl0: Sl0Config::DEFAULT,
+        // Every patch solved, so that each is the solver's (kronecker patches measure
+        // fewer than `min_bands` bands; interpolation is tested in `interpolate.rs` and
+        // the host's `baselines.rs`).
+        sl0: Sl0Config { min_bands: 0, ..Sl0Config::DEFAULT },
     }
 }
 
@@ -125,7 +128,7 @@ fn tile_decode_is_the_solver_on_the_cameras_measurements() {
             let mut ws = Box::new(PaperWorkspace::new());
             let (l0, v0) = ((origin.lenslet_row, origin.lenslet_col), (origin.view_row, origin.view_col));
             measure_window(&mask, (l0.0.into(), l0.1.into()), (v0.0.into(), v0.1.into()), &truth, &mut ws);
-            let out = solve(&dict, &Sl0Config::DEFAULT, &mut ws).unwrap();
+            let out = solve(&dict, &dec.config().sl0, &mut ws).unwrap();
             // The tile decoder clamps to the physical range: normalised samples, [0, 1].
             let clamped: Vec<f32> = ws.patch().iter().map(|x| x.clamp(0.0, 1.0)).collect();
             assert_eq!(&clamped[..], &patch[..], "{:?} {origin:?}", mask.family());

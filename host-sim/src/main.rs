@@ -233,6 +233,11 @@ struct SolverArgs {
     /// units) is decoded as each band's mean, with no solve; 0: exactly flat patches only.
     #[arg(long, default_value_t = Sl0Config::DEFAULT.flat)]
     flat: f32,
+    /// A patch whose measurements cover fewer distinct bands than this (a kronecker mask's
+    /// patch sees k, or up to 4k across mask blocks) is interpolated per pixel instead of
+    /// solved; 0 solves every patch (the paper's decode).
+    #[arg(long, default_value_t = Sl0Config::DEFAULT.min_bands)]
+    min_bands: u8,
 }
 
 impl SolverArgs {
@@ -259,6 +264,7 @@ impl SolverArgs {
             warm_sigma_f: self.warm_sigma_f,
             warm_steps: self.warm_steps,
             flat: self.flat,
+            min_bands: self.min_bands,
         };
         c.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
         Ok(c)
