@@ -46,7 +46,7 @@ fn scene_to_metrics_for_every_mask_family() {
             let dir = tempfile::tempdir().unwrap();
             simulate(&truth, &cam).unwrap().save(dir.path()).unwrap();
             let capture = Capture::load(dir.path()).unwrap();
-            let (recon, report) = decode(&capture, &dict, &DecodeOptions::default()).unwrap();
+            let (recon, report) = decode(&capture, &dict, &DecodeOptions::disjoint()).unwrap();
             assert_eq!((report.failed_tiles, report.patches.failed, report.uncovered), (0, 0, 0));
             assert_eq!(report.patches.decoded, 8 * 8 * 4, "every block in four angular windows");
             let m = evaluate(&truth, &recon).unwrap();

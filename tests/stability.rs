@@ -34,7 +34,7 @@ fn field(f: impl Fn(usize, usize, usize, usize, usize) -> f32) -> LightField {
 /// config, whatever noise the capture describes) and checks the invariants every case
 /// shares.
 fn checked(capture: &Capture, basis: &Basis, sl0: Sl0Config) -> (LightField, DecodeReport) {
-    checked_with(capture, basis, &DecodeOptions { sl0, noise: NoiseSource::Config, ..DecodeOptions::default() })
+    checked_with(capture, basis, &DecodeOptions { sl0, noise: NoiseSource::Config, ..DecodeOptions::disjoint() })
 }
 
 fn checked_with(capture: &Capture, basis: &Basis, opts: &DecodeOptions) -> (LightField, DecodeReport) {

@@ -22,7 +22,7 @@ use slf_firmware::{
 use crate::baseline::{Factors, analyze_5d, solve_5d};
 use crate::camera::{CameraConfig, simulate};
 use crate::capture::MaskDescription;
-use crate::decode::{Basis, DecodeOptions, decode, decode_with, patch_count};
+use crate::decode::{Basis, DecodeOptions, NoiseSource, Window, decode, decode_with, patch_count};
 use crate::demosaic::Baseline;
 use crate::lightfield::LightField;
 use crate::metrics::evaluate;
@@ -103,11 +103,28 @@ pub struct BenchOptions {
     pub masks: Vec<MaskFamily>,
 }
 
-fn settings(quick: bool) -> Vec<(String, Decoder, Sl0Config)> {
+/// The sweep's points: a name, a decoder, and how it decodes. The solver's settings are
+/// measured as the solver sees them: disjoint patches, the projection exactly as
+/// configured (exact unless the point sets a noise level); the decode's own defaults (the
+/// capture's noise model, overlapping patches) are points of their own.
+fn settings(quick: bool) -> Vec<(String, Decoder, DecodeOptions)> {
+    let solver = |sl0: Sl0Config| DecodeOptions {
+        sl0,
+        noise: NoiseSource::Config,
+        stride: (5, 5),
+        window: Window::Uniform,
+        ..DecodeOptions::default()
+    };
+    let decode = |stride: u8, window: Window, adaptive: Option<f32>| DecodeOptions {
+        stride: (stride, stride),
+        window,
+        adaptive,
+        ..DecodeOptions::default()
+    };
     let d = Sl0Config::DEFAULT;
     let dct = || Decoder::Basis(Basis::Dct);
     let ens = |choice| Decoder::Basis(Basis::Ensemble { blob: DEFAULT_ENSEMBLE.to_vec(), choice });
-    let mut s = vec![
+    let s = vec![
         ("DCT default".to_string(), dct(), d),
         ("DCT f64 reference".to_string(), Decoder::F64, d),
         ("DCT sigma_f 0.5".to_string(), dct(), Sl0Config { sigma_f: 0.5, ..d }),
@@ -115,21 +132,45 @@ fn settings(quick: bool) -> Vec<(String, Decoder, Sl0Config)> {
         ("DCT L 2".to_string(), dct(), Sl0Config { steps: 2, ..d }),
         ("DCT sigma_min 1e-2".to_string(), dct(), Sl0Config { sigma_min: 1e-2, ..d }),
         ("DCT sigma_min 3e-4".to_string(), dct(), Sl0Config { sigma_min: 3e-4, ..d }),
-        ("DCT noise-aware".to_string(), dct(), Sl0Config { noise: 2.0 / 3628.0, ..d }),
+        ("DCT read noise only (2 DN)".to_string(), dct(), Sl0Config { noise: 2.0 / 3628.0, ..d }),
         ("ensemble screened".to_string(), ens(MemberChoice::Screened(ChoiceRule::DEFAULT)), d),
     ];
+    let mut s: Vec<(String, Decoder, DecodeOptions)> = s.into_iter().map(|(n, dec, c)| (n, dec, solver(c))).collect();
     // What a user would pick instead of CS: the baselines, in every run.
-    s.extend(Baseline::ALL.map(|m| (m.name().to_string(), Decoder::Baseline(m), d)));
+    s.extend(Baseline::ALL.map(|m| (m.name().to_string(), Decoder::Baseline(m), solver(d))));
+    // The decode's defaults: the capture's noise model, then overlapping patches (the
+    // default stride 3 with the tapered window, and stride 2), and the adaptive rule.
+    let ens_screened = || ens(MemberChoice::Screened(ChoiceRule::DEFAULT));
+    s.push(("ensemble screened, noise model".to_string(), ens_screened(), decode(5, Window::Uniform, None)));
+    s.push((
+        "ensemble screened, noise model, stride 3 tapered (default)".to_string(),
+        ens_screened(),
+        decode(3, Window::Tapered, None),
+    ));
+    s.push((
+        "ensemble screened, noise model, stride 2 tapered".to_string(),
+        ens_screened(),
+        decode(2, Window::Tapered, None),
+    ));
+    if !quick {
+        s.push(("DCT, noise model, stride 3 tapered".to_string(), dct(), decode(3, Window::Tapered, None)));
+        s.push((
+            "ensemble screened, noise model, stride 3 adaptive 1.2".to_string(),
+            ens_screened(),
+            decode(3, Window::Tapered, Some(1.2)),
+        ));
+    }
+    let mut rest: Vec<(String, Decoder, Sl0Config)> = Vec::new();
     // Modelling only what a patch needs: the early stop, the flat short path, and the
     // ensemble's warm start (default 1e-2) against a cold second solve. The quick run keeps
     // one point of each.
     let (tolerances, flats, warms): (&[f32], &[f32], &[f32]) =
         if quick { (&[1e-3], &[4e-3], &[1.0]) } else { (&[1e-3, 3e-4], &[1e-3, 4e-3], &[1.0, 3e-3]) };
     for &tolerance in tolerances {
-        s.push((format!("DCT tolerance {tolerance:e}"), dct(), Sl0Config { tolerance, ..d }));
+        rest.push((format!("DCT tolerance {tolerance:e}"), dct(), Sl0Config { tolerance, ..d }));
     }
     for &flat in flats {
-        s.push((format!("DCT flat {flat:e}"), dct(), Sl0Config { flat, ..d }));
+        rest.push((format!("DCT flat {flat:e}"), dct(), Sl0Config { flat, ..d }));
     }
     let screened = || ens(MemberChoice::Screened(ChoiceRule::DEFAULT));
     // The warm solves on the main schedule (the default before they had their own).
@@ -142,35 +183,35 @@ fn settings(quick: bool) -> Vec<(String, Decoder, Sl0Config)> {
         };
         // A cold second solve is a first solve again: the main schedule too.
         let base = if warm_start == 1.0 { main_schedule } else { d };
-        s.push((name, screened(), Sl0Config { warm_start, ..base }));
+        rest.push((name, screened(), Sl0Config { warm_start, ..base }));
     }
-    s.push((format!("ensemble screened, warm sigma_f {} L {}", d.sigma_f, d.steps), screened(), main_schedule));
+    rest.push((format!("ensemble screened, warm sigma_f {} L {}", d.sigma_f, d.steps), screened(), main_schedule));
     // A DCT win solved again instead of averaged (the default before the mean).
-    s.push((
+    rest.push((
         "ensemble screened, DCT wins re-solved".to_string(),
         ens(MemberChoice::ScreenedResolve(ChoiceRule::DEFAULT)),
         d,
     ));
-    s.push((
+    rest.push((
         "ensemble screened, tolerance 1e-3, flat 4e-3".to_string(),
         screened(),
         Sl0Config { tolerance: 1e-3, flat: 4e-3, ..d },
     ));
     if !quick {
-        s.push(("ensemble exhaustive".to_string(), ens(MemberChoice::Exhaustive(ChoiceRule::DEFAULT)), d));
+        rest.push(("ensemble exhaustive".to_string(), ens(MemberChoice::Exhaustive(ChoiceRule::DEFAULT)), d));
     }
+    s.extend(rest.into_iter().map(|(n, dec, c)| (n, dec, solver(c))));
     s
 }
 
 fn run_decoder(
     capture: &crate::capture::Capture,
     dec: &Decoder,
-    sl0: Sl0Config,
+    opts: &DecodeOptions,
 ) -> Result<(LightField, crate::decode::DecodeReport)> {
-    let opts = DecodeOptions { sl0, ..DecodeOptions::default() };
     match dec {
-        Decoder::Basis(b) => decode_with(capture, b, &opts),
-        Decoder::F64 => decode(capture, &F64Dct::default(), &opts),
+        Decoder::Basis(b) => decode_with(capture, b, opts),
+        Decoder::F64 => decode(capture, &F64Dct::default(), opts),
         Decoder::Baseline(m) => {
             let (lf, _) = m.run(capture)?;
             let mut report = crate::decode::DecodeReport::default();
@@ -218,17 +259,17 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Point>> {
                 .iter()
                 .map(|t| simulate(t, &CameraConfig::pixel(7, k).with_mask(MaskDescription::seeded(family, 7, k))))
                 .collect::<Result<_>>()?;
-            for (name, dec, sl0) in &settings {
+            for (name, dec, opts) in &settings {
                 let family_name = format!("{family:?}").to_lowercase();
                 bar.set_message(format!("{family_name} k={k} {name}"));
                 let (mut p, mut s, mut a, mut t1, mut ta, mut solves, mut patches) =
                     (0.0, 0.0, 0.0, 0.0, 0.0, 0u64, 0u64);
                 for (truth, capture) in truths.iter().zip(&captures) {
                     let start = Instant::now();
-                    let (recon, report) = one.install(|| run_decoder(capture, dec, *sl0))?;
+                    let (recon, report) = one.install(|| run_decoder(capture, dec, opts))?;
                     t1 += start.elapsed().as_secs_f64();
                     let start = Instant::now();
-                    run_decoder(capture, dec, *sl0)?;
+                    run_decoder(capture, dec, opts)?;
                     ta += start.elapsed().as_secs_f64();
                     let m = evaluate(truth, &recon)?;
                     (p, s, a) = (p + m.psnr, s + m.ssim, a + m.sa);

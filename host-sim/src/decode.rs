@@ -135,6 +135,16 @@ pub enum NoiseSource {
     Config,
 }
 
+/// The default stride: 3 lenslets, with [`Window::Tapered`]. Chosen on the speed-against-
+/// error plot (`docs/results-real.md`, `docs/bench`): on three real scenes (HCI, 128 x 128)
+/// stride 3 tapered gains 1.2 / 1.4 / 2.1 dB over disjoint patches at pixel k = 1 / 3 and
+/// lenslet k = 3 for 3.8 times the patches, stride 2 another 0.2-0.4 dB for 8.2 times; on a
+/// smooth ramp the error's step across the disjoint grid's borders falls from 1.9 times the
+/// inside step to 1.0 (1.18 with the uniform window), so no grid shows. The seam-driven
+/// adaptive rule ([`DecodeOptions::adaptive`]) lands on the uniform strides' curve, not
+/// above it, so it is off by default.
+pub const DEFAULT_STRIDE: (u8, u8) = (3, 3);
+
 /// How to decode.
 #[derive(Clone, Copy, Debug)]
 pub struct DecodeOptions {
@@ -145,12 +155,18 @@ pub struct DecodeOptions {
     pub tile_patches: (u16, u16),
     /// Show a progress bar once the run has taken a second.
     pub progress: bool,
-    /// Lenslets between patch origins (rows, cols), each in 1..=5. 5 (the default) is the
-    /// grid of disjoint patches; smaller strides add patch grids shifted by multiples of
-    /// the stride, (5 / stride)^2 times the patches, averaged by [`Self::window`].
+    /// Lenslets between patch origins (rows, cols), each in 1..=5. 5 is the grid of
+    /// disjoint patches; smaller strides add patch grids shifted by multiples of the stride,
+    /// (5 / stride)^2 times the patches, averaged by [`Self::window`]. Default
+    /// [`DEFAULT_STRIDE`] with the tapered window.
     pub stride: (u8, u8),
     /// How overlapping patches are averaged.
     pub window: Window,
+    /// Decode a shifted patch only where the disjoint grid's first pass shows a seam there:
+    /// where the steps across the grid's borders inside the patch are more than this many
+    /// times the steps between the other lenslets ([`seam_score`]); `None` decodes every
+    /// shifted patch.
+    pub adaptive: Option<f32>,
 }
 
 impl Default for DecodeOptions {
@@ -160,13 +176,21 @@ impl Default for DecodeOptions {
             noise: NoiseSource::Capture,
             tile_patches: (2, 2),
             progress: false,
-            stride: (5, 5),
-            window: Window::Uniform,
+            stride: DEFAULT_STRIDE,
+            window: Window::Tapered,
+            adaptive: None,
         }
     }
 }
 
 impl DecodeOptions {
+    /// Disjoint patches (stride 5, the uniform window), otherwise the defaults: the grid
+    /// the firmware's tile decoder walks, one estimate per patch and angular window, as the
+    /// device decodes today.
+    pub fn disjoint() -> Self {
+        Self { stride: (5, 5), window: Window::Uniform, ..Self::default() }
+    }
+
     /// The solver's config for `capture`: [`Self::sl0`] with the noise ball from
     /// [`Self::noise`].
     pub fn solver_config(&self, capture: &Capture) -> Sl0Config {
@@ -298,45 +322,72 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
         "stride {:?}: each axis must be in 1..=5 lenslets",
         opts.stride
     );
-    let mut tiles: Vec<Tile> = decoder.tiles(opts.tile_patches).collect();
-    tiles.extend(shifted_tiles((d.lenslets[0], d.lenslets[1]), opts.stride, opts.tile_patches));
+    let base: Vec<Tile> = decoder.tiles(opts.tile_patches).collect();
     ensure!(
-        !tiles.is_empty(),
+        !base.is_empty(),
         "the sensor ({} x {} lenslets) is smaller than one 5 x 5 patch",
         d.lenslets[0],
         d.lenslets[1]
     );
+    let lenslets = (d.lenslets[0], d.lenslets[1]);
     let views = (d.views[0], d.views[1]);
+    let run = |tiles: &[Tile], progress: bool| -> Vec<(TileSums, Result<TileReport, String>)> {
+        let bar = ProgressBar::with_draw_target(Some(tiles.len() as u64), ProgressDrawTarget::hidden());
+        bar.set_style(
+            ProgressStyle::with_template("decoding {bar:40} {pos}/{len} tiles, {elapsed} elapsed, {eta} left")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        let shown = AtomicBool::new(false);
+        let out = tiles
+            .par_iter()
+            .map_init(
+                || Box::new(PaperWorkspace::new()),
+                |ws, &tile| {
+                    let mut sums = TileSums::new(tile, views, opts.window);
+                    let mut source = FrameSource::new(&raw);
+                    let r = decoder.decode_tile(model, tile, &mut source, &mut sums, ws).map_err(|e| e.to_string());
+                    bar.inc(1);
+                    if progress && start.elapsed().as_secs_f64() > 1.0 && !shown.swap(true, Ordering::Relaxed) {
+                        bar.set_draw_target(ProgressDrawTarget::stderr());
+                    }
+                    (sums, r)
+                },
+            )
+            .collect();
+        bar.finish_and_clear();
+        out
+    };
+    let mut results = run(&base, opts.progress);
+    let shifted = match opts.adaptive {
+        None => shifted_tiles(lenslets, opts.stride, opts.tile_patches),
+        Some(threshold) => {
+            let (first, _) = aggregate(&results, views, lenslets, base.len());
+            let seams = Seams::new(&first);
+            shifted_tiles(lenslets, opts.stride, (1, 1))
+                .into_iter()
+                .filter(|t| seams.score(t.lenslet_row as usize, t.lenslet_col as usize) > threshold)
+                .collect()
+        }
+    };
+    results.extend(run(&shifted, opts.progress));
+    let (lf, mut report) = aggregate(&results, views, lenslets, base.len() + shifted.len());
+    report.seconds = start.elapsed().as_secs_f64();
+    Ok((lf, report))
+}
 
-    let bar = ProgressBar::with_draw_target(Some(tiles.len() as u64), ProgressDrawTarget::hidden());
-    bar.set_style(
-        ProgressStyle::with_template("decoding {bar:40} {pos}/{len} tiles, {elapsed} elapsed, {eta} left")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    let shown = AtomicBool::new(false);
-    let results: Vec<(TileSums, Result<TileReport, String>)> = tiles
-        .par_iter()
-        .map_init(
-            || Box::new(PaperWorkspace::new()),
-            |ws, &tile| {
-                let mut sums = TileSums::new(tile, views, opts.window);
-                let mut source = FrameSource::new(&raw);
-                let r = decoder.decode_tile(model, tile, &mut source, &mut sums, ws).map_err(|e| e.to_string());
-                bar.inc(1);
-                if opts.progress && start.elapsed().as_secs_f64() > 1.0 && !shown.swap(true, Ordering::Relaxed) {
-                    bar.set_draw_target(ProgressDrawTarget::stderr());
-                }
-                (sums, r)
-            },
-        )
-        .collect();
-    bar.finish_and_clear();
-
-    let mut lf = LightField::zeros(views, d.lenslets[0], d.lenslets[1], 13);
+/// The light field and the report from every tile's sums: each value the weighted mean of
+/// the patch estimates that cover it.
+fn aggregate(
+    results: &[(TileSums, Result<TileReport, String>)],
+    views: (usize, usize),
+    lenslets: (usize, usize),
+    tiles: usize,
+) -> (LightField, DecodeReport) {
+    let mut lf = LightField::zeros(views, lenslets.0, lenslets.1, 13);
     let mut sum = vec![0.0f32; lf.data.len()];
     let mut weight = vec![0.0f32; lf.data.len()];
-    let mut report = DecodeReport { tiles: tiles.len(), ..DecodeReport::default() };
-    for (sums, r) in &results {
+    let mut report = DecodeReport { tiles, ..DecodeReport::default() };
+    for (sums, r) in results {
         match r {
             Ok(t) => {
                 report.patches.decoded += t.decoded;
@@ -371,6 +422,77 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
             report.uncovered += 1;
         }
     }
-    report.seconds = start.elapsed().as_secs_f64();
-    Ok((lf, report))
+    (lf, report)
+}
+
+/// Steps between neighbouring lenslets of a decoded light field (mean absolute difference
+/// over views and bands), to find where the disjoint grid's borders show.
+pub struct Seams {
+    /// Step between lenslet rows `y - 1` and `y` at column `x` (`y >= 1`), row-major.
+    down: Vec<f32>,
+    /// Step between lenslet columns `x - 1` and `x` at row `y` (`x >= 1`), row-major.
+    right: Vec<f32>,
+    cols: usize,
+    rows: usize,
+}
+
+impl Seams {
+    /// The steps of `lf`.
+    pub fn new(lf: &LightField) -> Self {
+        let (rows, cols) = (lf.rows, lf.cols);
+        let per = (lf.views.0 * lf.views.1 * lf.bands) as f32;
+        let step = |(y0, x0): (usize, usize), (y1, x1): (usize, usize)| {
+            let mut total = 0.0f32;
+            for u in 0..lf.views.0 {
+                for v in 0..lf.views.1 {
+                    let (a, b) = (lf.spectrum(u, v, y0, x0), lf.spectrum(u, v, y1, x1));
+                    total += a.iter().zip(b).map(|(p, q)| (p - q).abs()).sum::<f32>();
+                }
+            }
+            total / per
+        };
+        let mut down = vec![0.0; rows * cols];
+        let mut right = vec![0.0; rows * cols];
+        for y in 0..rows {
+            for x in 0..cols {
+                if y > 0 {
+                    down[y * cols + x] = step((y - 1, x), (y, x));
+                }
+                if x > 0 {
+                    right[y * cols + x] = step((y, x - 1), (y, x));
+                }
+            }
+        }
+        Self { down, right, cols, rows }
+    }
+
+    /// How much the disjoint grid's borders inside the patch at `(row, col)` stand out: the
+    /// mean step across them over the mean step between the patch's other lenslets (0 for
+    /// a patch that crosses no border).
+    pub fn score(&self, row: usize, col: usize) -> f32 {
+        let (mut seam, mut seams, mut inner, mut inners) = (0.0f32, 0u32, 0.0f32, 0u32);
+        for y in row..(row + 5).min(self.rows) {
+            for x in col..(col + 5).min(self.cols) {
+                let i = y * self.cols + x;
+                // Steps into (y, x) from above and from the left, inside the patch.
+                for (inside, at_border, step) in
+                    [(y > row, y % 5 == 0, self.down[i]), (x > col, x % 5 == 0, self.right[i])]
+                {
+                    if !inside {
+                        continue;
+                    }
+                    if at_border {
+                        (seam, seams) = (seam + step, seams + 1);
+                    } else {
+                        (inner, inners) = (inner + step, inners + 1);
+                    }
+                }
+            }
+        }
+        if seams == 0 {
+            return 0.0;
+        }
+        let inner = if inners > 0 { inner / inners as f32 } else { 0.0 };
+        (seam / seams as f32) / inner.max(1e-6)
+    }
 }

@@ -366,13 +366,18 @@ enum Command {
         /// Also write which ensemble member each patch used (CSV).
         #[arg(long)]
         member_map: Option<PathBuf>,
-        /// Lenslets between patch origins, 1..=5 (5: disjoint patches; smaller strides
-        /// decode (5 / stride)^2 times the patches and average them).
-        #[arg(long, default_value_t = 5, value_parser = ranged::<1, 5>)]
+        /// Lenslets between patch origins, 1..=5 (5: disjoint patches, which show their
+        /// grid; smaller strides decode (5 / stride)^2 times the patches and average them).
+        #[arg(long, default_value_t = 3, value_parser = ranged::<1, 5>)]
         stride: usize,
         /// How overlapping patches are averaged.
-        #[arg(long, value_enum, default_value_t = WindowArg::Uniform)]
+        #[arg(long, value_enum, default_value_t = WindowArg::Tapered)]
         window: WindowArg,
+        /// With a stride below 5: decode a shifted patch only where a first pass on the
+        /// disjoint grid shows a seam inside it, steps across the grid's borders more than
+        /// this many times those between its other lenslets.
+        #[arg(long)]
+        adaptive: Option<f32>,
         /// Stored dtype.
         #[arg(long, value_enum, default_value_t = Dtype::F32)]
         dtype: Dtype,
@@ -483,11 +488,11 @@ enum Command {
         #[arg(long)]
         blob: Option<PathBuf>,
         /// Also decode with overlapping patches at these strides (1..=4 lenslets), as
-        /// extra rows for the DCT and the ensemble.
-        #[arg(long, value_delimiter = ',', value_parser = ranged::<1, 4>)]
+        /// extra rows for the DCT and the ensemble (default: the decoder's default, 3).
+        #[arg(long, value_delimiter = ',', value_parser = ranged::<1, 4>, default_value = "3")]
         stride: Vec<usize>,
         /// How overlapping patches are averaged in those rows.
-        #[arg(long, value_enum, default_value_t = WindowArg::Uniform)]
+        #[arg(long, value_enum, default_value_t = WindowArg::Tapered)]
         window: WindowArg,
     },
     /// Write the capture the device binary decodes (frames as .npy and `capture.rs` constants).
@@ -622,7 +627,19 @@ fn run(cli: Cli) -> Result<()> {
             println!("wrote {} ({} snapshots)", output.display(), capture.frames.len());
             Ok(())
         }
-        Command::Decode { capture, output, method, solver, basis, member_map, stride, window, dtype, quiet } => {
+        Command::Decode {
+            capture,
+            output,
+            method,
+            solver,
+            basis,
+            member_map,
+            stride,
+            window,
+            adaptive,
+            dtype,
+            quiet,
+        } => {
             let cap = Capture::load(&capture)?;
             if method != Method::Cs {
                 anyhow::ensure!(member_map.is_none(), "--member-map needs --method cs (baselines use no ensemble)");
@@ -649,8 +666,12 @@ fn run(cli: Cli) -> Result<()> {
                 progress: !quiet,
                 stride: (stride as u8, stride as u8),
                 window: window.window(),
+                adaptive,
                 ..DecodeOptions::default()
             };
+            if let Some(a) = adaptive {
+                anyhow::ensure!(a.is_finite() && a >= 0.0, "--adaptive {a}: must be finite, at or above 0");
+            }
             let (lf, r) = decode_with(&cap, &basis.basis()?, &opts)?;
             let p = &r.patches;
             let all = p.decoded + p.failed;

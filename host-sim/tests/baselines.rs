@@ -116,7 +116,7 @@ fn patch_count_is_what_the_cs_decoder_decodes() {
         let (_, r) = slf_host::decode::decode_with(
             &cap,
             &slf_host::decode::Basis::Dct,
-            &slf_host::decode::DecodeOptions::default(),
+            &slf_host::decode::DecodeOptions::disjoint(),
         )
         .unwrap();
         let n = slf_host::decode::patch_count(&cap).unwrap();
@@ -183,11 +183,12 @@ fn kronecker_patches_with_too_few_bands_are_interpolated() {
         let cam = CameraConfig::pixel(3, k).noiseless().with_mask(MaskDescription::seeded(MaskFamily::Kronecker, 3, k));
         let cap = simulate(&truth, &cam).unwrap();
         let (interp, _) = interpolate(&cap).unwrap();
-        let (cs, report) = decode_with(&cap, &Basis::default_ensemble(), &DecodeOptions::default()).unwrap();
+        let (cs, report) = decode_with(&cap, &Basis::default_ensemble(), &DecodeOptions::disjoint()).unwrap();
         assert_eq!(report.solves, 0, "k {k}: a patch was solved");
         let worst = cs.data.iter().zip(&interp.data).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
         assert!(worst <= 1e-6, "k {k}: CS vs interpolation differ by {worst}");
-        let paper = DecodeOptions { sl0: Sl0Config { min_bands: 0, ..Sl0Config::DEFAULT }, ..DecodeOptions::default() };
+        let paper =
+            DecodeOptions { sl0: Sl0Config { min_bands: 0, ..Sl0Config::DEFAULT }, ..DecodeOptions::disjoint() };
         let (solved, report) = decode_with(&cap, &Basis::default_ensemble(), &paper).unwrap();
         assert!(report.solves > 0);
         let (p_solved, p_interp) = (evaluate(&truth, &solved).unwrap().psnr, evaluate(&truth, &interp).unwrap().psnr);

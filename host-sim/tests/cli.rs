@@ -37,7 +37,9 @@ fn scene_simulate_decode_eval_round_trip() {
     );
     assert!(p("cap/capture.json").exists() && p("cap/snapshot_2.png").exists());
     let out = stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("recon.npy")).arg("--quiet"));
-    assert!(out.contains("decoded 64 patches (0 flagged, 0 failed, 0 tiles failed)"), "{out}");
+    // 20 x 20 lenslets, four angular windows: 4 x 4 disjoint blocks and, at the default
+    // stride 3, 4 x 3 + 3 x 4 + 3 x 3 patches at shifted origins: (16 + 33) x 4.
+    assert!(out.contains("decoded 196 patches (0 flagged, 0 failed, 0 tiles failed)"), "{out}");
     // The capture's noise by default (2 DN read noise, 20,000 electrons at white); exact
     // or a given noise on request, not both.
     assert!(out.contains("projection: the capture's noise (sd 5.57e-4 + shot 5.00e-5 per unit)"), "{out}");
@@ -53,11 +55,11 @@ fn scene_simulate_decode_eval_round_trip() {
     assert!(out.contains("data range") && out.contains("SSIM") && out.contains("SA"), "{out}");
     // The DCT on request, and the member map of the (default) ensemble decode.
     let out = stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("dct.npy")).args(["--dictionary", "dct", "-q"]));
-    assert!(out.contains("decoded 64 patches"), "{out}");
+    assert!(out.contains("decoded 196 patches"), "{out}");
     stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("e.npy")).arg("--member-map").arg(p("map.csv")).arg("-q"));
     let map = std::fs::read_to_string(p("map.csv")).unwrap();
     assert_eq!(map.lines().next(), Some("lenslet_row,lenslet_col,view_row,view_col,member"));
-    assert_eq!(map.lines().count(), 1 + 64);
+    assert_eq!(map.lines().count(), 1 + 196);
     assert!(map.lines().skip(1).all(|l| l.rsplit(',').next().unwrap().parse::<u16>().unwrap() < 8));
     // A tiny training run writes a blob the decoder takes.
     let out = stdout(slf().arg("train").arg("-o").arg(p("e.slfd")).args([
@@ -186,13 +188,15 @@ fn nothing_decoded_is_a_failure_and_many_flagged_patches_a_warning() {
     let e = failure(
         slf().arg("decode").arg(p("cap")).arg("-o").arg(p("out.npy")).arg("-q").arg("--member-map").arg(p("m.csv")),
     );
-    assert!(e.contains("no patch decoded (36 failed"), "{e}");
+    // 12 x 12 lenslets, four angular windows: 3 x 3 disjoint blocks (with the edge strip)
+    // and, at the default stride 3, 2 + 2 + 1 patches at shifted origins: (9 + 5) x 4.
+    assert!(e.contains("no patch decoded (56 failed"), "{e}");
     assert!(!p("out.npy").exists() && !p("m.csv").exists(), "nothing written");
     // Half the pixels defective: every patch flagged, decoded, and a warning with the count.
     stdout(slf().arg("simulate").arg(p("lf.npy")).arg("-o").arg(p("cap2")).arg("--defects=0.5"));
     let out = slf().arg("decode").arg(p("cap2")).arg("-o").arg(p("out.npy")).arg("-q").assert().success();
     let err = String::from_utf8(out.get_output().stderr.clone()).unwrap();
-    assert!(err.contains("warning") && err.contains("36 were flagged"), "{err}");
+    assert!(err.contains("warning") && err.contains("56 were flagged"), "{err}");
     // No warning on a clean capture.
     stdout(slf().arg("simulate").arg(p("lf.npy")).arg("-o").arg(p("cap3")));
     let err = stderr_of_success(slf().arg("decode").arg(p("cap3")).arg("-o").arg(p("out3.npy")).arg("-q"));
@@ -366,9 +370,13 @@ fn evaluate_compares_every_method_per_scene_and_on_average() {
     stdout(slf().args(["scene", "texture", "--size", "15", "-o"]).arg(p("b.npy")));
     stdout(slf().arg("evaluate").arg(p("a.npy")).arg(p("b.npy")).arg("-o").arg(p("out")));
     let table = std::fs::read_to_string(p("out/table.md")).unwrap();
-    // 3 settings x (2 scenes + mean) x 5 methods, and a header of 2 lines.
-    assert_eq!(table.lines().count(), 2 + 3 * 3 * 5, "{table}");
-    for m in ["per-pixel interpolation", "neighbourhood demosaic", "PPID", "| DCT |", "ensemble screened"] {
+    // 3 settings x (2 scenes + mean) x 7 methods (3 baselines, DCT and ensemble on disjoint
+    // patches and at the default stride 3, tapered), and a header of 2 lines.
+    assert_eq!(table.lines().count(), 2 + 3 * 3 * 7, "{table}");
+    for m in ["per-pixel interpolation", "neighbourhood demosaic", "PPID", "| DCT |", "| ensemble screened |"] {
+        assert_eq!(table.matches(m).count(), 9, "{m}: {table}");
+    }
+    for m in ["| DCT, stride 3, tapered |", "| ensemble screened, stride 3, tapered |"] {
         assert_eq!(table.matches(m).count(), 9, "{m}: {table}");
     }
     assert!(p("out/a_dct.png").exists() && p("out/b_baseline-ppid-mihoubi-et-al-2017.png").exists());

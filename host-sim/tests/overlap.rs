@@ -104,8 +104,8 @@ fn overlapping_patches_average_as_every_patch_decoded_alone() {
 fn stride_five_is_todays_decode_and_bad_strides_are_refused() {
     let truth = common::small_smooth(5);
     let capture = simulate(&truth, &CameraConfig::pixel(4, 1)).unwrap();
-    let (a, ra) = decode_with(&capture, &Basis::Dct, &DecodeOptions::default()).unwrap();
-    let tapered = DecodeOptions { window: Window::Tapered, ..DecodeOptions::default() };
+    let (a, ra) = decode_with(&capture, &Basis::Dct, &DecodeOptions::disjoint()).unwrap();
+    let tapered = DecodeOptions { window: Window::Tapered, ..DecodeOptions::disjoint() };
     let (b, _) = decode_with(&capture, &Basis::Dct, &tapered).unwrap();
     // With disjoint patches (and the edge strips) a taper changes only where patches overlap.
     let differ = a.data.iter().zip(&b.data).filter(|(x, y)| x != y).count();
@@ -168,9 +168,49 @@ fn with_overlap_the_grid_is_gone_on_a_smooth_ramp() {
     assert!((truth_border - truth_inside).abs() < 1e-6);
     let (b5, i5) = decode(5, Window::Uniform);
     let (b2, i2) = decode(2, Window::Tapered);
+    let (b3, i3) = decode(3, Window::Uniform);
+    // The default: stride 3, tapered.
+    let defaults = DecodeOptions::default();
+    let (bd, id) = decode(defaults.stride.0, defaults.window);
     // Disjoint patches show the grid (measured: border steps 1.9 times the inside ones);
-    // with overlap the border steps are no larger than inside (measured 0.69 times;
-    // tolerance 10 %).
+    // with overlap the border steps are no larger than inside (measured 0.69 times at
+    // stride 2, 1.005 at the default; tolerance 10 %). Stride 3 with the uniform window
+    // leaves a trace (measured 1.18): lenslets covered by one patch and by two alternate.
     assert!(b5 > 1.2 * i5, "stride 5: border {b5:.5}, inside {i5:.5}");
     assert!(b2 <= 1.1 * i2, "stride 2: border {b2:.5}, inside {i2:.5}");
+    assert!(bd <= 1.1 * id, "default: border {bd:.5}, inside {id:.5}");
+    assert!(b3 > bd * (i3 / id), "stride 3 uniform {:.3} not above tapered {:.3}", b3 / i3, bd / id);
+}
+
+/// The adaptive rule: a shifted patch is decoded where the first pass shows a seam. With an
+/// infinite threshold none is (the decode is the disjoint one, same window); with 0 every
+/// one whose seams move at all (the full stride decode); the score is the seam's step over
+/// the inside steps, worked by hand on a light field with a known seam.
+#[test]
+fn adaptive_overlap_decodes_shifted_patches_only_at_seams() {
+    use slf_host::decode::Seams;
+    let truth = common::small_smooth(5);
+    let capture = simulate(&truth, &CameraConfig::pixel(4, 1)).unwrap();
+    let opts = |stride: u8, adaptive| DecodeOptions { stride: (stride, stride), adaptive, ..DecodeOptions::default() };
+    let (none, r_none) = decode_with(&capture, &Basis::Dct, &opts(3, Some(f32::INFINITY))).unwrap();
+    let (disjoint, r_disjoint) = decode_with(&capture, &Basis::Dct, &opts(5, None)).unwrap();
+    assert_eq!(none.data, disjoint.data);
+    assert_eq!(r_none.patches.decoded, r_disjoint.patches.decoded);
+    let (all, r_all) = decode_with(&capture, &Basis::Dct, &opts(3, Some(0.0))).unwrap();
+    let (full, r_full) = decode_with(&capture, &Basis::Dct, &opts(3, None)).unwrap();
+    assert_eq!(r_all.patches.decoded, r_full.patches.decoded);
+    let worst = all.data.iter().zip(&full.data).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+    assert!(worst <= 1e-6, "adaptive 0 vs every shifted patch: {worst}");
+    // Steps of 0.01 between lenslet columns, 0.05 across column 4|5, none between rows. A
+    // patch from column 3 crosses that seam once per row (steps into columns 4..7: 0.01,
+    // 0.05, 0.01, 0.01); its other steps are 3 of 0.01 per row and 4 of 0 per column, so
+    // 15 of 0.01 and 20 of 0 over its 5 rows and columns: mean 0.03 / 7. A patch from
+    // column 0 crosses no border.
+    let seam =
+        LightField::from_fn((2, 2), 10, 10, 13, |_, _, _, x, _| 0.01 * x as f32 + if x >= 5 { 0.04 } else { 0.0 });
+    let seams = Seams::new(&seam);
+    let s = seams.score(0, 3);
+    let want = 0.05 / (0.03 / 7.0);
+    assert!((s - want).abs() <= 1e-3 * want, "score {s} vs {want}");
+    assert_eq!(seams.score(0, 0), 0.0, "no border inside");
 }
