@@ -64,7 +64,7 @@ pub struct MaskSource {
     pub tile: Option<Vec<Vec<Vec<u8>>>>,
 }
 
-/// Sensor noise as simulated (informational; a decoder may use it for the noise floor).
+/// Sensor noise as simulated: the decoder's noise model by default ([`Capture::noise_model`]).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct NoiseDescription {

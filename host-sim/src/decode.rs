@@ -3,7 +3,10 @@
 //!
 //! Where a patch has fewer views than a lenslet, the decoder's overlapping angular windows
 //! each give an estimate of the shared views; so do the end-aligned edge tiles for the
-//! lenslets they share with the grid. Every estimate is averaged into the light field.
+//! lenslets they share with the grid, and (by default) the patch grids shifted by the
+//! stride ([`DEFAULT_STRIDE`], [`Window::Tapered`]). Every estimate is averaged into the
+//! light field with its window's weight. The solver's noise ball comes from the capture's
+//! noise description unless told otherwise ([`NoiseSource`]).
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -164,7 +167,7 @@ pub struct DecodeOptions {
     pub window: Window,
     /// Decode a shifted patch only where the disjoint grid's first pass shows a seam there:
     /// where the steps across the grid's borders inside the patch are more than this many
-    /// times the steps between the other lenslets ([`seam_score`]); `None` decodes every
+    /// times the steps between the other lenslets ([`Seams::score`]); `None` decodes every
     /// shifted patch.
     pub adaptive: Option<f32>,
 }
