@@ -12,7 +12,7 @@
 //! what its own measurements pin down, so only its second and later measurements show
 //! noise. A sixteenth of each pixel's first measurement ([`FIRST_SHARE`]) lets a one-shot
 //! decode shed some noise too. Measured on real scenes (HCI, 128 x 128, pixel mask; see
-//! `docs/results-real.md`): at one snapshot and the default sensor it costs 0.04-0.06 dB
+//! `docs/results-noise.md`): at one snapshot and the default sensor it costs 0.03-0.06 dB
 //! against the exact projection (a ball of `m / 4` cost 0.12-0.19 dB, one of `m` 0.3-0.75),
 //! and gains 0.2 dB at 1,000 electrons at white and 0.5 dB at 200; at three snapshots it
 //! gains 0.45-1.1 dB (a ball of `m`: 0.3-0.8).

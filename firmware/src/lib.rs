@@ -25,7 +25,7 @@
 //!   [`interpolate`]): nD SL0 with the orthonormal fast path, the noise ball a projection
 //!   moves onto, the paper's general pseudo-inverse path for kronecker masks, the choice of
 //!   an ensemble member per patch (exhaustive or screened), and per-pixel spectral
-//!   interpolation for patches whose pixels all see the same bands.
+//!   interpolation for patches that measure too few distinct bands.
 //! - **tile decoder** ([`tile`]): a rectangle of the raw frame, patch by patch, from a
 //!   [`TileSource`] to a [`PatchSink`], into a caller-owned [`Workspace`].
 //!

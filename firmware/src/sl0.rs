@@ -270,7 +270,8 @@ fn project<const N: usize>(x: &mut [f32; N], m: &Measurements<N>, ball: &Ball) -
         }
     }
     match ball.move_for(r2, w2) {
-        Move::Scale(scale) if ball.is_exact() || scale == 1.0 => {
+        // The exact projection (scale 1) puts the measured values back as they are.
+        Move::Scale(1.0) => {
             for ((x, &y), &k) in x.iter_mut().zip(&m.values).zip(&m.measured) {
                 if k {
                     *x = y;

@@ -440,6 +440,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             return Err(TileError::Geometry);
         }
         let mut report = TileReport::default();
+        let (lo, hi) = self.config.raw.range();
         for bs in 0..tile.lenslet_rows as usize / PS {
             for bt in 0..tile.lenslet_cols as usize / PT {
                 for (view_row, view_col) in self.windows() {
@@ -462,7 +463,6 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                     };
                     match decoded {
                         Ok(done) => {
-                            let (lo, hi) = self.config.raw.range();
                             ws.clamp_patch(lo, hi);
                             let r = PatchReport {
                                 outcome: done.outcome,

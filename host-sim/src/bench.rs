@@ -126,7 +126,8 @@ fn settings(quick: bool) -> Vec<(String, Decoder, DecodeOptions)> {
     let d = Sl0Config::DEFAULT;
     let dct = || Decoder::Basis(Basis::Dct);
     let ens = |choice| Decoder::Basis(Basis::Ensemble { blob: DEFAULT_ENSEMBLE.to_vec(), choice });
-    let s = vec![
+    let screened = || ens(MemberChoice::Screened(ChoiceRule::DEFAULT));
+    let mut s = vec![
         ("DCT default".to_string(), dct(), d),
         ("DCT f64 reference".to_string(), Decoder::F64, d),
         ("DCT sigma_f 0.5".to_string(), dct(), Sl0Config { sigma_f: 0.5, ..d }),
@@ -135,46 +136,23 @@ fn settings(quick: bool) -> Vec<(String, Decoder, DecodeOptions)> {
         ("DCT sigma_min 1e-2".to_string(), dct(), Sl0Config { sigma_min: 1e-2, ..d }),
         ("DCT sigma_min 3e-4".to_string(), dct(), Sl0Config { sigma_min: 3e-4, ..d }),
         ("DCT read noise only (2 DN)".to_string(), dct(), Sl0Config { noise: 2.0 / 3628.0, ..d }),
-        ("ensemble screened".to_string(), ens(MemberChoice::Screened(ChoiceRule::DEFAULT)), d),
+        ("ensemble screened".to_string(), screened(), d),
     ];
-    let mut s: Vec<(String, Decoder, DecodeOptions)> = s.into_iter().map(|(n, dec, c)| (n, dec, solver(c))).collect();
     // What a user would pick instead of CS: the baselines, in every run.
-    s.extend(Baseline::ALL.map(|m| (m.name().to_string(), Decoder::Baseline(m), solver(d))));
-    // The decode's defaults: the capture's noise model, then overlapping patches (the
-    // default stride 3 with the tapered window, and stride 2), and the adaptive rule.
-    let ens_screened = || ens(MemberChoice::Screened(ChoiceRule::DEFAULT));
-    s.push(("ensemble screened, noise model".to_string(), ens_screened(), decode(5, Window::Uniform, None)));
-    s.push((
-        "ensemble screened, noise model, stride 3 tapered (default)".to_string(),
-        ens_screened(),
-        decode(3, Window::Tapered, None),
-    ));
-    s.push((
-        "ensemble screened, noise model, stride 2 tapered".to_string(),
-        ens_screened(),
-        decode(2, Window::Tapered, None),
-    ));
-    if !quick {
-        s.push(("DCT, noise model, stride 3 tapered".to_string(), dct(), decode(3, Window::Tapered, None)));
-        s.push((
-            "ensemble screened, noise model, stride 3 adaptive 1.2".to_string(),
-            ens_screened(),
-            decode(3, Window::Tapered, Some(1.2)),
-        ));
-    }
-    let mut rest: Vec<(String, Decoder, Sl0Config)> = Vec::new();
+    s.extend(Baseline::ALL.map(|m| (m.name().to_string(), Decoder::Baseline(m), d)));
+    // Where the decode's own points go in the list.
+    let decode_points_at = s.len();
     // Modelling only what a patch needs: the early stop, the flat short path, and the
     // ensemble's warm start (default 1e-2) against a cold second solve. The quick run keeps
     // one point of each.
     let (tolerances, flats, warms): (&[f32], &[f32], &[f32]) =
         if quick { (&[1e-3], &[4e-3], &[1.0]) } else { (&[1e-3, 3e-4], &[1e-3, 4e-3], &[1.0, 3e-3]) };
     for &tolerance in tolerances {
-        rest.push((format!("DCT tolerance {tolerance:e}"), dct(), Sl0Config { tolerance, ..d }));
+        s.push((format!("DCT tolerance {tolerance:e}"), dct(), Sl0Config { tolerance, ..d }));
     }
     for &flat in flats {
-        rest.push((format!("DCT flat {flat:e}"), dct(), Sl0Config { flat, ..d }));
+        s.push((format!("DCT flat {flat:e}"), dct(), Sl0Config { flat, ..d }));
     }
-    let screened = || ens(MemberChoice::Screened(ChoiceRule::DEFAULT));
     // The warm solves on the main schedule (the default before they had their own).
     let main_schedule = Sl0Config { warm_sigma_f: d.sigma_f, warm_steps: d.steps, ..d };
     for &warm_start in warms {
@@ -185,25 +163,46 @@ fn settings(quick: bool) -> Vec<(String, Decoder, DecodeOptions)> {
         };
         // A cold second solve is a first solve again: the main schedule too.
         let base = if warm_start == 1.0 { main_schedule } else { d };
-        rest.push((name, screened(), Sl0Config { warm_start, ..base }));
+        s.push((name, screened(), Sl0Config { warm_start, ..base }));
     }
-    rest.push((format!("ensemble screened, warm sigma_f {} L {}", d.sigma_f, d.steps), screened(), main_schedule));
+    s.push((format!("ensemble screened, warm sigma_f {} L {}", d.sigma_f, d.steps), screened(), main_schedule));
     // A DCT win solved again instead of averaged (the default before the mean).
-    rest.push((
+    s.push((
         "ensemble screened, DCT wins re-solved".to_string(),
         ens(MemberChoice::ScreenedResolve(ChoiceRule::DEFAULT)),
         d,
     ));
-    rest.push((
+    s.push((
         "ensemble screened, tolerance 1e-3, flat 4e-3".to_string(),
         screened(),
         Sl0Config { tolerance: 1e-3, flat: 4e-3, ..d },
     ));
     if !quick {
-        rest.push(("ensemble exhaustive".to_string(), ens(MemberChoice::Exhaustive(ChoiceRule::DEFAULT)), d));
+        s.push(("ensemble exhaustive".to_string(), ens(MemberChoice::Exhaustive(ChoiceRule::DEFAULT)), d));
     }
-    s.extend(rest.into_iter().map(|(n, dec, c)| (n, dec, solver(c))));
-    s
+    let mut points: Vec<(String, Decoder, DecodeOptions)> =
+        s.into_iter().map(|(name, dec, sl0)| (name, dec, solver(sl0))).collect();
+    // The decode's defaults: the capture's noise model, then overlapping patches (the
+    // default stride 3 with the tapered window, and stride 2), and the adaptive rule.
+    let mut decode_points = vec![
+        ("ensemble screened, noise model".to_string(), screened(), decode(5, Window::Uniform, None)),
+        (
+            "ensemble screened, noise model, stride 3 tapered (default)".to_string(),
+            screened(),
+            decode(3, Window::Tapered, None),
+        ),
+        ("ensemble screened, noise model, stride 2 tapered".to_string(), screened(), decode(2, Window::Tapered, None)),
+    ];
+    if !quick {
+        decode_points.push(("DCT, noise model, stride 3 tapered".to_string(), dct(), decode(3, Window::Tapered, None)));
+        decode_points.push((
+            "ensemble screened, noise model, stride 3 adaptive 1.2".to_string(),
+            screened(),
+            decode(3, Window::Tapered, Some(1.2)),
+        ));
+    }
+    points.splice(decode_points_at..decode_points_at, decode_points);
+    points
 }
 
 fn run_decoder(

@@ -334,7 +334,7 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
     );
     let lenslets = (d.lenslets[0], d.lenslets[1]);
     let views = (d.views[0], d.views[1]);
-    let run = |tiles: &[Tile], progress: bool| -> Vec<(TileSums, Result<TileReport, String>)> {
+    let run = |tiles: &[Tile]| -> Vec<(TileSums, Result<TileReport, String>)> {
         let bar = ProgressBar::with_draw_target(Some(tiles.len() as u64), ProgressDrawTarget::hidden());
         bar.set_style(
             ProgressStyle::with_template("decoding {bar:40} {pos}/{len} tiles, {elapsed} elapsed, {eta} left")
@@ -350,7 +350,7 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
                     let mut source = FrameSource::new(&raw);
                     let r = decoder.decode_tile(model, tile, &mut source, &mut sums, ws).map_err(|e| e.to_string());
                     bar.inc(1);
-                    if progress && start.elapsed().as_secs_f64() > 1.0 && !shown.swap(true, Ordering::Relaxed) {
+                    if opts.progress && start.elapsed().as_secs_f64() > 1.0 && !shown.swap(true, Ordering::Relaxed) {
                         bar.set_draw_target(ProgressDrawTarget::stderr());
                     }
                     (sums, r)
@@ -360,20 +360,24 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
         bar.finish_and_clear();
         out
     };
-    let mut results = run(&base, opts.progress);
-    let shifted = match opts.adaptive {
-        None => shifted_tiles(lenslets, opts.stride, opts.tile_patches),
-        Some(threshold) => {
-            let (first, _) = aggregate(&results, views, lenslets, base.len());
-            let seams = Seams::new(&first);
-            shifted_tiles(lenslets, opts.stride, (1, 1))
-                .into_iter()
-                .filter(|t| seams.score(t.lenslet_row as usize, t.lenslet_col as usize) > threshold)
-                .collect()
-        }
-    };
-    results.extend(run(&shifted, opts.progress));
-    let (lf, mut report) = aggregate(&results, views, lenslets, base.len() + shifted.len());
+    // Every patch in one parallel pass; with the adaptive rule, the disjoint grid first and
+    // then the shifted patches its seams ask for.
+    let mut tiles = base;
+    if opts.adaptive.is_none() {
+        tiles.extend(shifted_tiles(lenslets, opts.stride, opts.tile_patches));
+    }
+    let mut results = run(&tiles);
+    if let Some(threshold) = opts.adaptive {
+        let (first, _) = aggregate(&results, views, lenslets, tiles.len());
+        let seams = Seams::new(&first);
+        let chosen: Vec<Tile> = shifted_tiles(lenslets, opts.stride, (1, 1))
+            .into_iter()
+            .filter(|t| seams.score(t.lenslet_row as usize, t.lenslet_col as usize) > threshold)
+            .collect();
+        results.extend(run(&chosen));
+        tiles.extend(chosen);
+    }
+    let (lf, mut report) = aggregate(&results, views, lenslets, tiles.len());
     report.seconds = start.elapsed().as_secs_f64();
     Ok((lf, report))
 }
