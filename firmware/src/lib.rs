@@ -28,6 +28,8 @@
 //!   interpolation for patches that measure too few distinct bands.
 //! - **tile decoder** ([`tile`]): a rectangle of the raw frame, patch by patch, from a
 //!   [`TileSource`] to a [`PatchSink`], into a caller-owned [`Workspace`].
+//! - **overlap** ([`overlap`]): patches at a stride below the patch size, averaged with a
+//!   [`Window`] into a caller-owned strip of lenslet rows, finished rows to a [`RowSink`].
 //!
 //! The device application sits on top of the tile decoder, in a crate of its own
 //! (`slf-device`, in `firmware/device/` of the repository), so that this library depends on
@@ -96,6 +98,7 @@ pub mod defects;
 pub mod dictionary;
 pub mod interpolate;
 pub mod mask;
+pub mod overlap;
 pub mod pinv;
 pub mod projection;
 pub mod raw;
@@ -116,6 +119,7 @@ pub use choice::{ChoiceRule, EnsembleModel, MemberChoice, ModelOutcome, PatchMod
 pub use defects::{DefectList, Pixel};
 pub use dictionary::{Dictionary, DictionaryError};
 pub use mask::{BandTile, LensletSize, Mask, MaskFamily, SensingError};
+pub use overlap::{Overlap, OverlapDecoder, OverlapError, OverlapReport, RowSink, Window};
 pub use prelude::{PAPER_N, PaperDecoder, PaperDictionary, PaperEnsemble, PaperEnsembleModel, PaperPatch, SetupError};
 pub use raw::{Frame, FrameSource, LeU16Frame, RawFormat, RawFrame};
 pub use shape::{FullViewShape, PaperShape, PatchShape};

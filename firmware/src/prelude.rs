@@ -17,6 +17,7 @@ pub use crate::choice::{ChoiceRule, EnsembleModel, MemberChoice, PatchModel};
 pub use crate::defects::{DefectList, Pixel};
 pub use crate::dictionary::{Dictionary, DictionaryError};
 pub use crate::mask::{BandTile, LensletSize, Mask, MaskFamily, SensingError};
+pub use crate::overlap::{Overlap, OverlapDecoder, OverlapError, OverlapReport, RowSink, Window};
 pub use crate::raw::{FrameSource, LeU16Frame, RawFormat, RawFrame};
 pub use crate::sl0::{Ended, Outcome, Sl0Config, SolveError};
 pub use crate::spi::{SpiFrameBuffer, SpiSourceError};
@@ -34,6 +35,9 @@ pub type PaperPatch = [f32; PAPER_N];
 
 /// The tile decoder for the paper's patch.
 pub type PaperDecoder<'a> = TileDecoder<'a, 5, 5, 4, 4, 13, PAPER_N>;
+
+/// The overlapped decoder for the paper's patch.
+pub type PaperOverlapDecoder<'a> = OverlapDecoder<'a, 5, 5, 4, 4, 13, PAPER_N>;
 
 /// A dictionary (one member, or the 5D DCT) of the paper's patch.
 pub type PaperDictionary = Dictionary<5, 5, 4, 4, 13>;

@@ -200,6 +200,8 @@ pub enum ConfigError {
     RawFormat,
     /// The solver config is out of range.
     Solver(SolveError),
+    /// An overlap stride outside `1..=` the patch's size.
+    Stride,
 }
 
 impl fmt::Display for ConfigError {
@@ -211,6 +213,7 @@ impl fmt::Display for ConfigError {
             Self::BlockMismatch => f.write_str("kronecker mask block differs from the patch's lenslets"),
             Self::RawFormat => f.write_str("raw format: need finite levels with white > black"),
             Self::Solver(e) => write!(f, "solver: {e}"),
+            Self::Stride => f.write_str("overlap stride must be in 1..=patch size per axis"),
         }
     }
 }

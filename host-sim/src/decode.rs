@@ -103,29 +103,9 @@ pub fn patch_count(capture: &Capture) -> Result<u64> {
     Ok(decoder.tiles((2, 2)).map(|t| u64::from(t.lenslet_rows / 5) * u64::from(t.lenslet_cols / 5) * windows).sum())
 }
 
-/// How overlapping patches are averaged where they meet.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Window {
-    /// Every value of a patch counts the same.
-    #[default]
-    Uniform,
-    /// A patch's lenslets weigh `TAPER` by their distance from its edge (1 at the rim, 3
-    /// in the centre, per axis, multiplied), so a value is taken mostly from the patches
-    /// it sits in the middle of, where a patch's model is best constrained.
-    Tapered,
-}
-
-/// Per-axis weight of a patch's lenslet in [`Window::Tapered`].
-pub const TAPER: [f32; 5] = [1.0, 2.0, 3.0, 2.0, 1.0];
-
-impl Window {
-    fn weight(self, s: usize, t: usize) -> f32 {
-        match self {
-            Window::Uniform => 1.0,
-            Window::Tapered => TAPER[s] * TAPER[t],
-        }
-    }
-}
+/// How overlapping patches are averaged where they meet: the firmware's window, so the
+/// host and the device weigh estimates alike.
+pub use slf_firmware::overlap::Window;
 
 /// Where the projection's noise ball comes from.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -293,7 +273,7 @@ impl PatchSink<5200> for TileSums {
         for (i, &x) in patch.iter().enumerate() {
             let [s, t, u, v, b] = PaperShape::coordinates(i);
             let j = self.at(s0 + s, t0 + t, o.view_row as usize + u, o.view_col as usize + v, b);
-            let w = self.window.weight(s, t);
+            let w = self.window.weight::<5, 5>(s, t);
             self.sum[j] += w * x;
             self.weight[j] += w;
         }

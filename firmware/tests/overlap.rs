@@ -1,0 +1,295 @@
+//! The overlapped decoder against the slow obvious reference: every patch position decoded
+//! on its own by the tile decoder, then averaged with the window's weights in f64 over a
+//! whole frame. The strip must give the same rows (to 1e-6) at every band width.
+
+mod common;
+
+use std::collections::HashMap;
+
+use slf_firmware::raw::ReadError;
+use slf_firmware::*;
+
+const L5: LensletSize = LensletSize { rows: 5, cols: 5 };
+/// 8 x 11 lenslets: neither a multiple of the patch, so edge strips and shifted grids meet.
+const SENSOR: SensorGeometry = SensorGeometry { lenslets: (8, 11), lenslet: L5 };
+const ROWS: usize = 8;
+const COLS: usize = 11;
+type Decoder<'a> = TileDecoder<'a, 5, 5, 4, 4, 13, 5200>;
+type Overlapped<'a> = OverlapDecoder<'a, 5, 5, 4, 4, 13, 5200>;
+
+/// A light field with texture at every lenslet, `[s][t][u][v][b]`.
+fn light_field() -> Vec<f32> {
+    let mut l = vec![0.0; ROWS * COLS * 25 * 13];
+    for (i, x) in l.iter_mut().enumerate() {
+        let b = i % 13;
+        let v = (i / 13) % 5;
+        let u = (i / 65) % 5;
+        let t = (i / 325) % COLS;
+        let s = i / (325 * COLS);
+        *x = 0.45
+            + 0.2 * ((s as f32) * 0.9 + (t as f32) * 0.6).sin()
+            + 0.15 * ((b as f32) * 0.5 + s as f32 * 0.3).cos()
+            + 0.02 * (u as f32 - 2.0) * (v as f32 - 2.0);
+    }
+    l
+}
+
+fn frames(mask: &Mask) -> Vec<Vec<f32>> {
+    let l = light_field();
+    let (rows, cols) = SENSOR.frame_size();
+    (0..mask.snapshots())
+        .map(|j| {
+            (0..rows * cols)
+                .map(|p| {
+                    let (row, col) = (p / cols, p % cols);
+                    let band = mask.band(j, row, col).unwrap() as usize;
+                    l[((((row / 5) * COLS + col / 5) * 5 + row % 5) * 5 + col % 5) * 13 + band]
+                })
+                .collect()
+        })
+        .collect()
+}
+
+fn decoder(mask: Mask<'static>) -> Decoder<'static> {
+    Decoder::new(DecoderConfig {
+        sensor: SENSOR,
+        mask,
+        raw: RawFormat::NORMALISED,
+        defects: DefectList::EMPTY,
+        sl0: Sl0Config::DEFAULT,
+    })
+    .unwrap()
+}
+
+/// Patch origins of the host's overlapped decode, written out: the tile grid with its edge
+/// strips, then each shifted grid's whole patches.
+fn origins(dec: &Decoder, stride: (usize, usize)) -> Vec<(usize, usize)> {
+    let mut o = Vec::new();
+    for tile in dec.tiles((1, 1)) {
+        o.push((tile.lenslet_row as usize, tile.lenslet_col as usize));
+    }
+    for dy in (0..5).step_by(stride.0) {
+        for dx in (0..5).step_by(stride.1) {
+            if (dy, dx) == (0, 0) {
+                continue;
+            }
+            let mut r = dy;
+            while r + 5 <= ROWS {
+                let mut c = dx;
+                while c + 5 <= COLS {
+                    o.push((r, c));
+                    c += 5;
+                }
+                r += 5;
+            }
+        }
+    }
+    o
+}
+
+struct Collect(Vec<(PatchOrigin, Vec<f32>)>);
+
+impl PatchSink<5200> for Collect {
+    type Error = ();
+    fn accept(&mut self, o: PatchOrigin, p: &[f32; 5200], _: &PatchReport) -> Result<(), ()> {
+        self.0.push((o, p.to_vec()));
+        Ok(())
+    }
+}
+
+/// The reference: each origin decoded alone, averaged in f64; `(s, t, u, v, b)` order.
+fn reference(dec: &Decoder, raw: &[RawFrame<f32>], stride: (usize, usize), window: Window) -> Vec<f64> {
+    let mut sum = vec![0.0f64; ROWS * COLS * 25 * 13];
+    let mut weight = vec![0.0f64; sum.len()];
+    let mut ws = Box::new(PaperWorkspace::new());
+    let mut cache: HashMap<(usize, usize), Collect> = HashMap::new();
+    for (r, c) in origins(dec, stride) {
+        let got = cache.entry((r, c)).or_insert_with(|| {
+            let mut sink = Collect(Vec::new());
+            let tile = Tile { lenslet_row: r as u16, lenslet_col: c as u16, lenslet_rows: 5, lenslet_cols: 5 };
+            dec.decode_tile(&Dictionary::dct(), tile, &mut FrameSource::new(raw), &mut sink, &mut ws).unwrap();
+            sink
+        });
+        for (o, p) in &got.0 {
+            for (i, &x) in p.iter().enumerate() {
+                let [s, t, u, v, b] = PaperShape::coordinates(i);
+                let w = f64::from(window.weight::<5, 5>(s, t));
+                let (row, col) = (o.lenslet_row as usize + s, o.lenslet_col as usize + t);
+                let (vu, vv) = (o.view_row as usize + u, o.view_col as usize + v);
+                let j = (((row * COLS + col) * 5 + vu) * 5 + vv) * 13 + b;
+                sum[j] += w * f64::from(x);
+                weight[j] += w;
+            }
+        }
+    }
+    sum.iter().zip(&weight).map(|(s, w)| if *w > 0.0 { s / w } else { 0.0 }).collect()
+}
+
+/// Rows from the strip, stitched into a frame; each row seen once per band.
+struct Rows {
+    frame: Vec<f32>,
+    seen: Vec<(u16, u16)>,
+    fail_at: Option<u16>,
+}
+
+impl RowSink for Rows {
+    type Error = u16;
+    fn row(&mut self, row: u16, first_col: u16, values: &[f32]) -> Result<(), u16> {
+        if self.fail_at == Some(row) {
+            return Err(row);
+        }
+        assert_eq!(values.len() % (25 * 13), 0);
+        let start = ((row as usize * COLS) + first_col as usize) * 325;
+        self.frame[start..start + values.len()].copy_from_slice(values);
+        self.seen.push((row, first_col));
+        Ok(())
+    }
+}
+
+fn rows() -> Rows {
+    Rows { frame: vec![f32::NAN; ROWS * COLS * 325], seen: Vec::new(), fail_at: None }
+}
+
+fn strip_decode<S: TileSource>(
+    dec: &Overlapped,
+    source: &mut S,
+    band: usize,
+    sink: &mut Rows,
+) -> Result<OverlapReport, OverlapError<u16>> {
+    let mut strip = vec![0.0f32; dec.strip_per_column() * band];
+    let mut ws = Box::new(PaperWorkspace::new());
+    dec.decode_frame(&Dictionary::dct(), source, &mut strip, sink, &mut ws)
+}
+
+fn worst(a: &[f32], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (f64::from(*x) - y).abs()).fold(0.0, f64::max)
+}
+
+#[test]
+fn the_strip_is_the_average_of_independent_patches_at_every_band_width() {
+    let mask = Mask::pixel(5, 2, 13, L5).unwrap();
+    let fr = frames(&mask);
+    let raw: Vec<RawFrame<f32>> = fr.iter().map(|f| RawFrame::new(f, 40, 55).unwrap()).collect();
+    let dec = decoder(mask);
+    for (stride, window, bands) in [
+        ((3, 3), Window::Tapered, &[COLS, 4, 1][..]),
+        ((2, 4), Window::Uniform, &[COLS][..]),
+        ((5, 5), Window::Uniform, &[COLS, 5][..]),
+    ] {
+        let want = reference(&dec, &raw, stride, window);
+        let od = Overlapped::new(dec, Overlap { stride: (stride.0 as u8, stride.1 as u8), window }).unwrap();
+        for &band in bands {
+            let mut sink = rows();
+            let r = strip_decode(&od, &mut FrameSource::new(&raw), band, &mut sink).unwrap();
+            let e = worst(&sink.frame, &want);
+            assert!(e < 1e-6, "stride {stride:?} {window:?} band {band}: max difference {e:e}");
+            assert_eq!(r.uncovered, 0);
+            assert_eq!(r.source_failures, 0);
+            assert_eq!(r.bands as usize, COLS.div_ceil(band));
+            assert_eq!((r.patches.decoded + r.patches.failed) as usize, od.patch_decodes(band));
+            // Every row of every band, in row order within a band.
+            assert_eq!(sink.seen.len(), ROWS * COLS.div_ceil(band));
+            for w in sink.seen.windows(2) {
+                assert!(w[1].1 > w[0].1 || (w[1].1 == w[0].1 && w[1].0 == w[0].0 + 1), "{w:?}");
+            }
+        }
+        // Four angular windows per position, each position decoded once at full width.
+        let positions = origins(&dec, stride).len();
+        assert_eq!(od.patch_decodes(COLS), positions * 4, "stride {stride:?}");
+    }
+}
+
+#[test]
+fn stride_five_is_the_disjoint_tile_decode() {
+    let mask = Mask::pixel(9, 3, 13, L5).unwrap();
+    let fr = frames(&mask);
+    let raw: Vec<RawFrame<f32>> = fr.iter().map(|f| RawFrame::new(f, 40, 55).unwrap()).collect();
+    let dec = decoder(mask);
+    let od = Overlapped::new(dec, Overlap { stride: (5, 5), window: Window::Uniform }).unwrap();
+    assert_eq!(od.patch_decodes(COLS), dec.tiles((1, 1)).count() * 4);
+    let mut sink = rows();
+    strip_decode(&od, &mut FrameSource::new(&raw), COLS, &mut sink).unwrap();
+    let want = reference(&dec, &raw, (5, 5), Window::Uniform);
+    assert!(worst(&sink.frame, &want) < 1e-6);
+}
+
+/// A source that fails on one pixel row.
+struct Flaky<'a> {
+    inner: FrameSource<'a, RawFrame<'a, f32>>,
+    bad_row: usize,
+}
+
+impl TileSource for Flaky<'_> {
+    type Error = ReadError;
+    fn read(&mut self, snapshot: usize, row: usize, col: usize, out: &mut [f32]) -> Result<(), ReadError> {
+        if row == self.bad_row {
+            return Err(ReadError::OutOfBounds { row: row as u32, col: col as u32 });
+        }
+        self.inner.read(snapshot, row, col, out)
+    }
+}
+
+#[test]
+fn a_failing_read_loses_only_its_patches() {
+    let mask = Mask::pixel(5, 2, 13, L5).unwrap();
+    let fr = frames(&mask);
+    let raw: Vec<RawFrame<f32>> = fr.iter().map(|f| RawFrame::new(f, 40, 55).unwrap()).collect();
+    let dec = decoder(mask);
+    let od = Overlapped::new(dec, Overlap::DEFAULT).unwrap();
+    // Pixel row 36 is lenslet row 7, view row 1: every window of the patches starting at
+    // lenslet row 3 reads it first thing. Those are 3 edge-strip patches and 3 shifted.
+    let mut sink = rows();
+    let mut src = Flaky { inner: FrameSource::new(&raw), bad_row: 36 };
+    let r = strip_decode(&od, &mut src, COLS, &mut sink).unwrap();
+    assert_eq!(r.source_failures, 6);
+    assert_eq!(r.patches.decoded as usize, od.patch_decodes(COLS) - 6 * 4);
+    // Rows 0..3 only see patches starting at row 0: as in the full decode.
+    let want = reference(&dec, &raw, (3, 3), Window::Tapered);
+    let top = 3 * COLS * 325;
+    assert!(worst(&sink.frame[..top], &want[..top]) < 1e-6);
+    // Rows 5..8 were only in failed patches: uncovered, sent as 0.
+    assert_eq!(r.uncovered as usize, 3 * COLS * 325);
+    assert!(sink.frame[5 * COLS * 325..].iter().all(|&x| x == 0.0));
+    assert!(sink.frame.iter().all(|x| x.is_finite()));
+}
+
+#[test]
+fn a_failing_sink_stops_the_decode_and_keeps_what_it_sent() {
+    let mask = Mask::pixel(5, 2, 13, L5).unwrap();
+    let fr = frames(&mask);
+    let raw: Vec<RawFrame<f32>> = fr.iter().map(|f| RawFrame::new(f, 40, 55).unwrap()).collect();
+    let od = Overlapped::new(decoder(mask), Overlap::DEFAULT).unwrap();
+    let mut sink = Rows { fail_at: Some(2), ..rows() };
+    let r = strip_decode(&od, &mut FrameSource::new(&raw), COLS, &mut sink);
+    assert_eq!(r, Err(OverlapError::Sink(2)));
+    assert_eq!(sink.seen, vec![(0, 0), (1, 0)]);
+}
+
+#[test]
+fn bad_strides_and_strips_are_refused() {
+    let mask = Mask::pixel(5, 2, 13, L5).unwrap();
+    let fr = frames(&mask);
+    let raw: Vec<RawFrame<f32>> = fr.iter().map(|f| RawFrame::new(f, 40, 55).unwrap()).collect();
+    let dec = decoder(mask);
+    for stride in [(0, 3), (3, 0), (6, 3), (3, 6)] {
+        let e = Overlapped::new(dec, Overlap { stride, window: Window::Tapered }).unwrap_err();
+        assert_eq!(e, ConfigError::Stride);
+    }
+    let od = Overlapped::new(dec, Overlap::DEFAULT).unwrap();
+    // Five rows of 25 views of 13 sums and a weight, per lenslet column.
+    assert_eq!(od.strip_per_column(), 5 * 25 * 14);
+    assert_eq!(od.strip_len(), 5 * 25 * 14 * COLS);
+    let mut strip = vec![0.0f32; od.strip_per_column() - 1];
+    let mut ws = Box::new(PaperWorkspace::new());
+    let mut sink = rows();
+    let r = od.decode_frame(&Dictionary::dct(), &mut FrameSource::new(&raw), &mut strip, &mut sink, &mut ws);
+    assert_eq!(r, Err(OverlapError::Strip));
+    assert!(sink.seen.is_empty());
+}
+
+#[test]
+fn tapered_weights_are_one_two_three_two_one() {
+    let w: Vec<f32> = (0..5).map(|s| Window::Tapered.weight::<5, 5>(s, 2)).collect();
+    assert_eq!(w, [3.0, 6.0, 9.0, 6.0, 3.0]);
+    assert_eq!(Window::Uniform.weight::<5, 5>(0, 4), 1.0);
+}
