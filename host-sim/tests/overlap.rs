@@ -67,11 +67,11 @@ fn reference(truth: &LightField, k: u8, stride: usize, window: Window) -> Vec<f3
                     for (o, patch) in &kept.0 {
                         for (i, &x) in patch.iter().enumerate() {
                             let [s, t, u, v, b] = PaperShape::coordinates(i);
+                            // The taper written out: 1, 2, 3, 2, 1 per axis.
+                            const TAPER: [f64; 5] = [1.0, 2.0, 3.0, 2.0, 1.0];
                             let w = match window {
                                 Window::Uniform => 1.0,
-                                Window::Tapered => {
-                                    f64::from([1.0, 2.0, 3.0, 2.0, 1.0][s] * [1.0, 2.0, 3.0, 2.0, 1.0][t])
-                                }
+                                Window::Tapered => TAPER[s] * TAPER[t],
                             };
                             let j = truth.index(o.view_row as usize + u, o.view_col as usize + v, r + s, c + t, b);
                             sum[j] += w * f64::from(x);
