@@ -293,3 +293,17 @@ fn tapered_weights_are_one_two_three_two_one() {
     assert_eq!(w, [3.0, 6.0, 9.0, 6.0, 3.0]);
     assert_eq!(Window::Uniform.weight::<5, 5>(0, 4), 1.0);
 }
+
+#[test]
+fn the_devices_overlapped_decode_fits_its_part() {
+    // The device binary (`firmware/device`) decodes its 5 x 10-lenslet capture through a
+    // strip of 5 lenslet columns: the workspace, the strip and 24 KiB for the stack
+    // (measured peak 17.5 KiB, `scripts/budgets.sh`) fit the part's 128 KiB; the full
+    // width (10 columns, one band) would not, which is why the strip is cut into bands.
+    let od = Overlapped::new(decoder(Mask::pixel(5, 2, 13, L5).unwrap()), Overlap::DEFAULT).unwrap();
+    let column = 4 * od.strip_per_column();
+    assert_eq!(column, 7_000);
+    let ws = core::mem::size_of::<PaperWorkspace>();
+    assert!(ws + 5 * column + 24 * 1024 <= 128 * 1024, "{ws} + 5 x {column}");
+    assert!(ws + 10 * column + 24 * 1024 > 128 * 1024);
+}

@@ -6,7 +6,9 @@
 //! and `firmware/device/capture.rs` (the constants the device decodes with).
 //! `slf device-check LOG` parses the device's semihosting output, decodes the same tiles on
 //! the host with the same firmware code and model, and fails when any patch differs by more
-//! than 1e-5 relative (to the patch's largest magnitude).
+//! than 1e-5 relative (to the patch's largest magnitude). The rows of the device's
+//! overlapped decode (its strip) are checked the same way against the host's default decode
+//! (stride 3, tapered window), relative to the light field's largest magnitude.
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -68,9 +70,24 @@ struct DevicePatch {
     values: Vec<f32>,
 }
 
-fn parse(log: &str) -> Result<(HashMap<PatchOrigin, DevicePatch>, usize)> {
+/// What the device printed: its patches, the rows of its overlapped decode by (lenslet
+/// row, first column), and the patch count of its `done` line.
+struct DeviceLog {
+    patches: HashMap<PatchOrigin, DevicePatch>,
+    rows: HashMap<(usize, usize), Vec<f32>>,
+    count: usize,
+}
+
+/// Which printed block the `data` lines belong to.
+enum Block {
+    Patch(PatchOrigin),
+    Row((usize, usize)),
+}
+
+fn parse(log: &str) -> Result<DeviceLog> {
     let mut patches = HashMap::new();
-    let mut current: Option<PatchOrigin> = None;
+    let mut rows: HashMap<(usize, usize), Vec<f32>> = HashMap::new();
+    let mut current: Option<Block> = None;
     let mut done = None;
     for (i, line) in log.lines().enumerate() {
         let w: Vec<&str> = line.split_whitespace().collect();
@@ -86,14 +103,24 @@ fn parse(log: &str) -> Result<(HashMap<PatchOrigin, DevicePatch>, usize)> {
                     view_col: n(4)? as u8,
                 };
                 patches.insert(o, DevicePatch { member: n(6)?, values: Vec::new() });
-                current = Some(o);
+                current = Some(Block::Patch(o));
+            }
+            Some("row") => {
+                ensure!(w.len() >= 3, "line {}: short row line", i + 1);
+                let n =
+                    |k: usize| w[k].parse::<usize>().with_context(|| format!("line {}: bad number {:?}", i + 1, w[k]));
+                let at = (n(1)?, n(2)?);
+                ensure!(rows.insert(at, Vec::new()).is_none(), "line {}: row {at:?} printed twice", i + 1);
+                current = Some(Block::Row(at));
             }
             Some("data") => {
-                let o = current.with_context(|| format!("line {}: data before any patch", i + 1))?;
-                let p = patches.get_mut(&o).context("patch")?;
+                let values = match current.as_ref().with_context(|| format!("line {}: data before any patch", i + 1))? {
+                    Block::Patch(o) => &mut patches.get_mut(o).context("patch")?.values,
+                    Block::Row(at) => rows.get_mut(at).context("row")?,
+                };
                 for h in &w[1..] {
                     let bits = u32::from_str_radix(h, 16).with_context(|| format!("line {}: bad hex {h:?}", i + 1))?;
-                    p.values.push(f32::from_bits(bits));
+                    values.push(f32::from_bits(bits));
                 }
             }
             Some("done") => {
@@ -103,7 +130,7 @@ fn parse(log: &str) -> Result<(HashMap<PatchOrigin, DevicePatch>, usize)> {
         }
     }
     let count = done.context("the device log has no `done` line: the run did not finish")?;
-    Ok((patches, count))
+    Ok(DeviceLog { patches, rows, count })
 }
 
 struct Collect(HashMap<PatchOrigin, (u16, Vec<f32>)>);
@@ -122,7 +149,7 @@ impl PatchSink<5200> for Collect {
 /// A malformed log, a missing or extra patch, or a difference above 1e-5 relative.
 pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
     let text = std::fs::read_to_string(log).with_context(|| format!("cannot read {}", log.display()))?;
-    let (device, count) = parse(&text)?;
+    let DeviceLog { patches: device, rows, count } = parse(&text)?;
     let capture = Capture::load(capture_dir)?;
     let ensemble = Ensemble::<5, 5, 4, 4, 13>::new(DEFAULT_ENSEMBLE).map_err(|e| anyhow::anyhow!("{e}"))?;
     let model = EnsembleModel::new(ensemble, MemberChoice::Screened(ChoiceRule::DEFAULT));
@@ -155,6 +182,49 @@ pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
     println!("device vs host: {} patches, largest relative difference {worst:.2e} (limit 1e-5)", host.0.len());
     if worst > 1e-5 {
         bail!("the device's patches differ from the host's by {worst:.2e} relative");
+    }
+    check_rows(&rows, &capture, &model)
+}
+
+/// The device's overlapped decode (strip rows) against the host's default decode.
+fn check_rows(
+    rows: &HashMap<(usize, usize), Vec<f32>>,
+    capture: &Capture,
+    model: &EnsembleModel<'_, 5, 5, 4, 4, 13>,
+) -> Result<()> {
+    let opts = crate::decode::DecodeOptions::default();
+    let (lf, _) = crate::decode::decode(capture, model, &opts)?;
+    let per_col = lf.views.0 * lf.views.1 * lf.bands;
+    let mut covered = vec![false; lf.rows * lf.cols];
+    let scale = lf.data.iter().fold(0.0f32, |m, x| m.max(x.abs())).max(f32::MIN_POSITIVE);
+    let mut worst = 0.0f64;
+    for (&(row, first), values) in rows {
+        ensure!(
+            row < lf.rows && values.len().is_multiple_of(per_col),
+            "device row {row} at column {first}: {} values",
+            values.len()
+        );
+        let cols = values.len() / per_col;
+        ensure!(first + cols <= lf.cols, "device row {row}: columns {first}..{} outside the sensor", first + cols);
+        for (i, x) in values.iter().enumerate() {
+            let (c, rest) = (i / per_col, i % per_col);
+            let (u, v, b) = (rest / (lf.views.1 * lf.bands), (rest / lf.bands) % lf.views.1, rest % lf.bands);
+            let h = lf.data[lf.index(u, v, row, first + c, b)];
+            worst = worst.max(f64::from((x - h).abs() / scale));
+            covered[row * lf.cols + first + c] = true;
+        }
+    }
+    let missing = covered.iter().filter(|&&c| !c).count();
+    ensure!(!rows.is_empty(), "the device printed no rows of its overlapped decode");
+    ensure!(missing == 0, "the device's overlapped decode left {missing} lenslets out");
+    println!(
+        "device strip vs host (stride {:?}, {:?}): {} rows, largest relative difference {worst:.2e} (limit 1e-5)",
+        opts.stride,
+        opts.window,
+        rows.len()
+    );
+    if worst > 1e-5 {
+        bail!("the device's overlapped rows differ from the host's by {worst:.2e} relative");
     }
     Ok(())
 }
