@@ -8,7 +8,7 @@
 //! - [`import`] brings real data in (views, hyperspectral cubes, other light fields) as
 //!   the camera's 13 bands.
 //! - [`scene`] renders synthetic spectral light fields ([`spectra`] holds measured and
-//!   synthetic spectra); [`lightfield`] reads and writes them as `.npy` ([`npy`] reads
+//!   synthetic spectra), [`realistic`] draws scenes that look like the world; [`lightfield`] reads and writes them as `.npy` ([`npy`] reads
 //!   any `.npy` with every size checked first).
 //! - [`camera`] turns a light field into raw frames with the firmware's masks, noise,
 //!   black level, quantisation, saturation and defects; [`capture`] is the folder format.
@@ -36,6 +36,7 @@ pub mod lightfield;
 pub mod metrics;
 pub mod npy;
 pub mod preview;
+pub mod realistic;
 pub mod report;
 pub mod scene;
 pub mod spectra;

@@ -99,6 +99,14 @@ enum Method {
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum GeneratorArg {
+    /// Slanted and curved surfaces, 1/f textures, measured spectra, five illuminants.
+    Realistic,
+    /// Fronto-parallel cards of chart colours and narrow bands under D65.
+    Toy,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
 enum WindowArg {
     /// Every value of a patch counts the same.
     Uniform,
@@ -289,7 +297,10 @@ enum Command {
     },
     /// Write a named test scene or a random training scene as a (U, V, H, W, B) .npy.
     Scene {
-        /// A name (smooth, texture, depth, saturated, dark) or `random`.
+        /// A name (test scenes: smooth, texture, depth, saturated, dark; realistic: outdoor,
+        /// tungsten, office, led), `random` (the training scenes of the shipped ensemble) or
+        /// `realistic` (slanted and curved surfaces, 1/f textures, measured spectra, five
+        /// illuminants), the last two drawn from --seed.
         name: String,
         /// Output .npy file.
         #[arg(short, long)]
@@ -439,6 +450,11 @@ enum Command {
         /// Learn every member (by default member 0 is the fixed 5D DCT).
         #[arg(long)]
         no_dct_member: bool,
+        /// Scene generator for the rendered training scenes: realistic (slanted and curved
+        /// surfaces, 1/f textures, measured spectra, five illuminants) or toy (the first
+        /// ensemble's cards of chart colours under D65).
+        #[arg(long, value_enum, default_value_t = GeneratorArg::Realistic)]
+        generator: GeneratorArg,
     },
     /// PSNR / SSIM / SA of every test scene x mask family x k, decoded with --dictionary
     /// (default: the shipped ensemble, screened); a markdown table.
@@ -575,11 +591,16 @@ fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Demo { out, scene, size, basis } => report::demo(&out, &scene, size, &basis.basis()?),
         Command::Scene { name, output, seed, size, views, dtype } => {
-            let s = if name == "random" {
-                scene::random(seed)
-            } else {
-                scene::named(&name)
-                    .with_context(|| format!("unknown scene {name:?}: one of {:?} or random", scene::NAMES))?
+            let s = match name.as_str() {
+                "random" => scene::random(seed),
+                "realistic" => slf_host::realistic::realistic(seed),
+                _ => slf_host::realistic::lookup(&name).with_context(|| {
+                    format!(
+                        "unknown scene {name:?}: one of {:?}, {:?}, random or realistic",
+                        scene::NAMES,
+                        slf_host::realistic::NAMES
+                    )
+                })?,
             };
             let size = SceneSize { views: (views, views), rows: size, cols: size };
             size.check().map_err(|e| anyhow::anyhow!("--size {} with --views {views}: {e}", size.rows))?;
@@ -786,6 +807,7 @@ fn run(cli: Cli) -> Result<()> {
             group,
             seed,
             no_dct_member,
+            generator,
         } => {
             let cfg = train::TrainConfig {
                 members,
@@ -797,7 +819,11 @@ fn run(cli: Cli) -> Result<()> {
                 progress: true,
             };
             let fields = if input.is_empty() {
-                train::training_fields(scenes, size, 1000 + seed)
+                let generator = match generator {
+                    GeneratorArg::Realistic => train::Generator::Realistic,
+                    GeneratorArg::Toy => train::Generator::Toy,
+                };
+                train::training_fields(scenes, size, 1000 + seed, generator)
             } else {
                 input.iter().map(|p| read_npy(p)).collect::<Result<Vec<_>, _>>()?
             };

@@ -1,18 +1,25 @@
-//! Synthetic spectral light fields: layered Lambertian surfaces.
+//! Synthetic spectral light fields: layered surfaces.
 //!
-//! A scene is a stack of fronto-parallel layers, far to near. Each has a shape, a disparity
-//! (pixels of shift per view step, -1.5..+1.5), a texture that mixes two reflectance spectra,
-//! and is lit by D65. View `(u, v)` sees the point `(y + d du, x + d dv)` of a layer of
-//! disparity `d`, with `(du, dv)` its offset from the central view; the nearest layer that
+//! A scene is a stack of layers. Each has a shape, a disparity (pixels of shift per view
+//! step, -1.5..+1.5 at its centre), a texture that mixes two reflectance spectra, and is lit
+//! by the scene's illuminant. View `(u, v)` sees the point `(y + d du, x + d dv)` of a layer
+//! of disparity `d`, with `(du, dv)` its offset from the central view; the nearest layer that
 //! covers that point wins, so occlusion is correct in every view. Each pixel averages 2 x 2
 //! samples, so edges are anti-aliased. Everything is seeded and deterministic.
+//!
+//! The five named test scenes ([`NAMES`]) and [`random`] use fronto-parallel Lambertian
+//! layers under D65, and stay as they are (they are the regression set and the shipped
+//! ensemble's training data). A layer can also be slanted and curved (its disparity varies
+//! over it, so the point a view sees is found by a fixed-point iteration), shaded by its
+//! surface normal, and carry a specular highlight that moves across views unlike its
+//! surface; `crate::realistic` builds scenes that use them.
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
 use crate::lightfield::LightField;
-use crate::spectra::{BANDS, COLORCHECKER, Spectrum, colorchecker, narrow_band, smooth_random, under_d65};
+use crate::spectra::{BANDS, COLORCHECKER, D65, Spectrum, colorchecker, narrow_band, smooth_random};
 
 /// The region a layer covers, in reference-view coordinates normalised to `[0, 1]`.
 #[derive(Clone, Debug, PartialEq)]
@@ -52,6 +59,17 @@ pub enum Texture {
     Fine {
         seed: u64,
     },
+    /// Detail at every scale: value noise summed over seven octaves from 64 pixels down to
+    /// one, each octave's amplitude `2^(1 - beta)` of the one before. An octave of value
+    /// noise spreads its variance over a frequency area that grows as `f^2`, so equal
+    /// amplitudes (`beta` = 1, equal energy per octave, as natural images have) give an
+    /// amplitude spectrum falling as `1 / f`, and in general `1 / f^beta`. Measured from 4 to
+    /// 32-pixel periods (`tests/scenes.rs`) the slope is about 0.3 steeper than `-beta`
+    /// (-1.29 at `beta` 1): value noise is smooth within its octave.
+    Pink {
+        seed: u64,
+        beta: f32,
+    },
 }
 
 fn hash01(seed: u64, ix: i64, iy: i64) -> f32 {
@@ -73,7 +91,8 @@ fn value_noise(seed: u64, y: f32, x: f32) -> f32 {
 }
 
 impl Texture {
-    fn weight(&self, y: f32, x: f32) -> f32 {
+    /// The weight of the second reflectance at pixel position `(y, x)`, in `[0, 1]`.
+    pub fn weight(&self, y: f32, x: f32) -> f32 {
         match *self {
             Texture::Flat => 0.0,
             Texture::Noise { cell, seed } => value_noise(seed, y / cell, x / cell),
@@ -82,28 +101,122 @@ impl Texture {
             }
             Texture::Checks { period } => ((y / period).floor() + (x / period).floor()).rem_euclid(2.0),
             Texture::Fine { seed } => value_noise(seed, y, x),
+            Texture::Pink { seed, beta } => {
+                let (mut sum, mut norm, mut amp, mut freq) = (0.0f32, 0.0f32, 1.0f32, 1.0 / 64.0f32);
+                for octave in 0..7u64 {
+                    sum += amp * (value_noise(seed.wrapping_add(octave), y * freq, x * freq) - 0.5);
+                    norm += amp;
+                    amp *= 2.0f32.powf(1.0 - beta);
+                    freq *= 2.0;
+                }
+                (0.5 + 1.6 * sum / norm).clamp(0.0, 1.0)
+            }
         }
     }
+}
+
+impl Shape {
+    /// The centre of the region, normalised (the frame's centre for `Everywhere`).
+    pub fn centre(&self) -> (f32, f32) {
+        match *self {
+            Shape::Everywhere => (0.5, 0.5),
+            Shape::Rect { y0, x0, y1, x1 } => ((y0 + y1) / 2.0, (x0 + x1) / 2.0),
+            Shape::Disc { cy, cx, .. } => (cy, cx),
+        }
+    }
+}
+
+/// A specular highlight: a white spot (the illuminant's spectrum) on a layer that moves
+/// `shift` pixels per view step relative to the layer's surface (a reflection seen at
+/// another depth than the surface), so it breaks the Lambertian model.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Highlight {
+    /// Centre, normalised, in the layer's coordinates at the central view.
+    pub cy: f32,
+    pub cx: f32,
+    /// Radius (standard deviation), normalised to the frame height.
+    pub radius: f32,
+    /// Peak radiance as a fraction of a white reflector's.
+    pub strength: f32,
+    /// Pixels per view step.
+    pub shift: f32,
 }
 
 /// One surface.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Layer {
-    /// Pixels of shift per view step (positive = nearer).
+    /// Pixels of shift per view step (positive = nearer), at the shape's centre.
     pub disparity: f32,
     pub shape: Shape,
     pub texture: Texture,
     /// The two reflectances the texture mixes.
     pub reflectance: [Spectrum; 2],
+    /// Change of disparity across the frame (rows, cols), per frame height / width: a
+    /// slanted plane. `(0, 0)`: fronto-parallel.
+    pub slope: (f32, f32),
+    /// Disparity added at normalised distance `r` from the shape's centre: `curvature r^2`
+    /// (negative: a dome, nearest in the middle).
+    pub curvature: f32,
+    /// How much of the radiance follows the surface normal's angle to the light (0: none,
+    /// 1: all of it, black where it faces away).
+    pub shading: f32,
+    pub highlight: Option<Highlight>,
 }
 
-/// A scene: layers (any order; rendered by disparity) and an exposure gain.
+impl Layer {
+    /// A fronto-parallel Lambertian layer.
+    pub fn flat(disparity: f32, shape: Shape, texture: Texture, reflectance: [Spectrum; 2]) -> Self {
+        Self {
+            disparity,
+            shape,
+            texture,
+            reflectance,
+            slope: (0.0, 0.0),
+            curvature: 0.0,
+            shading: 0.0,
+            highlight: None,
+        }
+    }
+
+    fn is_flat(&self) -> bool {
+        self.slope == (0.0, 0.0) && self.curvature == 0.0 && self.shading == 0.0 && self.highlight.is_none()
+    }
+
+    /// Disparity and its gradient (per normalised unit) at normalised `(y, x)`.
+    fn disparity_at(&self, y: f32, x: f32) -> (f32, f32, f32) {
+        let (cy, cx) = self.shape.centre();
+        let (dy, dx) = (y - cy, x - cx);
+        let d = self.disparity + self.slope.0 * dy + self.slope.1 * dx + self.curvature * (dy * dy + dx * dx);
+        (d, self.slope.0 + 2.0 * self.curvature * dy, self.slope.1 + 2.0 * self.curvature * dx)
+    }
+
+    /// The point `(y, x)` (pixels) of this layer that view offset `(du, dv)` sees at sample
+    /// `(py, px)`, and the disparity there: `y = py + d(y, x) du`, by fixed-point iteration
+    /// (the slopes are small against the frame, so it contracts fast).
+    fn hit(&self, py: f32, px: f32, du: f32, dv: f32, h: f32, w: f32) -> (f32, f32, f32) {
+        let (mut ly, mut lx) = (py, px);
+        let mut d = 0.0;
+        for _ in 0..5 {
+            d = self.disparity_at(ly / h, lx / w).0;
+            (ly, lx) = (py + d * du, px + d * dv);
+        }
+        (ly, lx, d)
+    }
+}
+
+/// Direction to the light for [`Layer::shading`] (unnormalised: up-left, towards the camera).
+const LIGHT: [f32; 3] = [-0.45, -0.35, 0.82];
+
+/// A scene: layers (any order; rendered by disparity), an illuminant and an exposure gain.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scene {
     pub name: String,
     pub layers: Vec<Layer>,
     /// Scales all radiance: 1 for a normal exposure, small for low light.
     pub gain: f32,
+    /// Relative spectral power of the light; radiance is reflectance times this over its
+    /// peak, so a white reflector is 1 in the light's brightest band.
+    pub illuminant: Spectrum,
 }
 
 /// The size of a rendered light field.
@@ -160,8 +273,14 @@ impl Scene {
         let mut lf = LightField::zeros(size.views, size.rows, size.cols, BANDS);
         let mut layers: Vec<&Layer> = self.layers.iter().collect();
         layers.sort_by(|a, b| b.disparity.total_cmp(&a.disparity)); // nearest first
-        let radiance: Vec<[Spectrum; 2]> =
-            layers.iter().map(|l| l.reflectance.map(|r| under_d65(&r).map(|x| x * self.gain))).collect();
+        let peak = self.illuminant.iter().fold(0.0f32, |m, &x| m.max(x));
+        let lit = |r: &Spectrum| -> Spectrum { core::array::from_fn(|b| r[b] * self.illuminant[b] / peak * self.gain) };
+        let radiance: Vec<[Spectrum; 2]> = layers.iter().map(|l| l.reflectance.map(|r| lit(&r))).collect();
+        let white = lit(&[1.0; BANDS]);
+        // Fronto-parallel Lambertian layers (the regression scenes) take the first hit in
+        // disparity order; other layers are all intersected and the nearest hit wins.
+        let all_flat = layers.iter().all(|l| l.is_flat());
+        let norm = (LIGHT[0] * LIGHT[0] + LIGHT[1] * LIGHT[1] + LIGHT[2] * LIGHT[2]).sqrt();
         let (cu, cv) = ((size.views.0 as f32 - 1.0) / 2.0, (size.views.1 as f32 - 1.0) / 2.0);
         let (h, w) = (size.rows as f32, size.cols as f32);
         // One spatial row of one view per task (rayon): rows are independent and contiguous.
@@ -174,15 +293,46 @@ impl Scene {
                 let mut acc = [0.0f32; BANDS];
                 for (sy, sx) in [(0.25, 0.25), (0.25, 0.75), (0.75, 0.25), (0.75, 0.75)] {
                     let (py, px) = (y as f32 + sy, x as f32 + sx);
-                    for (layer, rad) in layers.iter().zip(&radiance) {
-                        let (ly, lx) = (py + layer.disparity * du, px + layer.disparity * dv);
-                        if layer.shape.contains(ly / h, lx / w) {
-                            let t = layer.texture.weight(ly, lx);
-                            for (a, (r0, r1)) in acc.iter_mut().zip(rad[0].iter().zip(&rad[1])) {
-                                *a += 0.25 * (r0 + t * (r1 - r0));
+                    if all_flat {
+                        for (layer, rad) in layers.iter().zip(&radiance) {
+                            let (ly, lx) = (py + layer.disparity * du, px + layer.disparity * dv);
+                            if layer.shape.contains(ly / h, lx / w) {
+                                let t = layer.texture.weight(ly, lx);
+                                for (a, (r0, r1)) in acc.iter_mut().zip(rad[0].iter().zip(&rad[1])) {
+                                    *a += 0.25 * (r0 + t * (r1 - r0));
+                                }
+                                break;
                             }
-                            break;
                         }
+                        continue;
+                    }
+                    let mut best: Option<(usize, f32, f32, f32)> = None;
+                    for (i, layer) in layers.iter().enumerate() {
+                        let (ly, lx, d) = layer.hit(py, px, du, dv, h, w);
+                        if layer.shape.contains(ly / h, lx / w) && best.is_none_or(|b| d > b.3) {
+                            best = Some((i, ly, lx, d));
+                        }
+                    }
+                    let Some((i, ly, lx, _)) = best else { continue };
+                    let (layer, rad) = (layers[i], &radiance[i]);
+                    let t = layer.texture.weight(ly, lx);
+                    let shade = if layer.shading > 0.0 {
+                        let (_, gy, gx) = layer.disparity_at(ly / h, lx / w);
+                        // Depth falls as disparity rises: the normal leans against the gradient.
+                        let n = [gx, gy, 1.0];
+                        let nn = (n[0] * n[0] + n[1] * n[1] + 1.0).sqrt();
+                        let cos = (n[0] * LIGHT[0] + n[1] * LIGHT[1] + n[2] * LIGHT[2]) / (nn * norm);
+                        1.0 - layer.shading + layer.shading * cos.max(0.0)
+                    } else {
+                        1.0
+                    };
+                    let spec = layer.highlight.as_ref().map_or(0.0, |hl| {
+                        let (cy, cx) = (hl.cy * h + hl.shift * du, hl.cx * w + hl.shift * dv);
+                        let r = hl.radius * h;
+                        hl.strength * (-((ly - cy).powi(2) + (lx - cx).powi(2)) / (2.0 * r * r)).exp()
+                    });
+                    for (b, a) in acc.iter_mut().enumerate() {
+                        *a += 0.25 * (shade * (rad[0][b] + t * (rad[1][b] - rad[0][b])) + spec * white[b]);
                     }
                 }
                 px_out.copy_from_slice(&acc);
@@ -203,9 +353,10 @@ fn rect(y0: f32, x0: f32, y1: f32, x1: f32) -> Shape {
 /// The named test scenes, each of a distinct character.
 pub const NAMES: [&str; 5] = ["smooth", "texture", "depth", "saturated", "dark"];
 
-/// A named test scene (see [`NAMES`]); `None` for an unknown name.
+/// A named test scene (see [`NAMES`]); `None` for an unknown name (the realistic named
+/// scenes are in `crate::realistic`).
 pub fn named(name: &str) -> Option<Scene> {
-    let layer = |disparity, shape, texture, r0, r1| Layer { disparity, shape, texture, reflectance: [r0, r1] };
+    let layer = |disparity, shape, texture, r0, r1| Layer::flat(disparity, shape, texture, [r0, r1]);
     let layers = match name {
         // Broad gradients and soft noise: what compressed sensing finds easiest.
         "smooth" => vec![
@@ -282,7 +433,7 @@ pub fn named(name: &str) -> Option<Scene> {
         }
         _ => return None,
     };
-    Some(Scene { name: name.into(), layers, gain: 1.0 })
+    Some(Scene { name: name.into(), layers, gain: 1.0, illuminant: D65 })
 }
 
 /// A random training scene: a textured background and 2 to 5 shapes at distinct
@@ -322,7 +473,7 @@ pub fn random(seed: u64) -> Scene {
         };
         let tex = texture(&mut rng);
         let r = [spectrum(&mut rng), spectrum(&mut rng)];
-        layers.push(Layer { disparity: d, shape, texture: tex, reflectance: r });
+        layers.push(Layer::flat(d, shape, tex, r));
     }
-    Scene { name: format!("random-{seed}"), layers, gain: rng.random_range(0.5..1.0) }
+    Scene { name: format!("random-{seed}"), layers, gain: rng.random_range(0.5..1.0), illuminant: D65 }
 }

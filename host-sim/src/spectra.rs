@@ -1,17 +1,23 @@
 //! Spectra at slf's 13 bands: measured data, synthetic families, and illumination.
 //!
-//! Measured tables (ColorChecker reflectances, CIE 1931 observer, D65) are in
+//! Measured tables (ColorChecker reflectances, CIE 1931 observer, D65, every measured
+//! reflectance set colour-science ships, and illuminants A, FL2, FL11 and two LEDs) are in
 //! [`crate::spectra_data`], generated from colour-science by `scripts/gen_spectra.py`.
 
 use rand::Rng;
 
-pub use crate::spectra_data::{BAND_NM, CMF_1931, COLORCHECKER, D65};
+pub use crate::spectra_data::{BAND_NM, CMF_1931, COLORCHECKER, D65, ILLUMINANTS, MEASURED};
 
 /// Number of bands.
 pub const BANDS: usize = 13;
 
 /// A reflectance or radiance spectrum at the band centres.
 pub type Spectrum = [f32; BANDS];
+
+/// An illuminant of [`ILLUMINANTS`] by name ("D65", "A", "FL2", "FL11", "LED-B3", "LED-V1").
+pub fn illuminant(name: &str) -> Option<Spectrum> {
+    ILLUMINANTS.iter().find(|(n, _)| *n == name).map(|(_, s)| *s)
+}
 
 /// A ColorChecker patch's reflectance by its chart name ("dark skin", "blue sky", ..).
 pub fn colorchecker(name: &str) -> Option<Spectrum> {

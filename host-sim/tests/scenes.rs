@@ -28,15 +28,11 @@ fn two_cards() -> Scene {
     Scene {
         name: "cards".into(),
         layers: vec![
-            Layer { disparity: -1.0, shape: Shape::Everywhere, texture: Texture::Flat, reflectance: [white, white] },
-            Layer {
-                disparity: 1.0,
-                shape: Shape::Rect { y0: 0.4, x0: 0.4, y1: 0.6, x1: 0.6 },
-                texture: Texture::Flat,
-                reflectance: [red, red],
-            },
+            Layer::flat(-1.0, Shape::Everywhere, Texture::Flat, [white, white]),
+            Layer::flat(1.0, Shape::Rect { y0: 0.4, x0: 0.4, y1: 0.6, x1: 0.6 }, Texture::Flat, [red, red]),
         ],
         gain: 1.0,
+        illuminant: D65,
     }
 }
 
@@ -95,4 +91,156 @@ fn white_under_d65_is_white_in_srgb() {
     // The ColorChecker red is red.
     let rgb = linear_srgb(xyz(&under_d65(&colorchecker("red").unwrap())));
     assert!(rgb[0] > 3.0 * rgb[1] && rgb[0] > 3.0 * rgb[2], "{rgb:?}");
+}
+
+#[test]
+fn measured_sets_and_illuminants_are_as_published() {
+    use slf_host::spectra::{ILLUMINANTS, MEASURED, illuminant};
+    // Four colour checkers (24, 24, 24, 30), CIE TCS (14 + 15), NIST CQS (15), RAW to ACES (190).
+    assert_eq!(MEASURED.len(), 24 * 3 + 30 + 14 + 15 + 15 + 190);
+    let sets: std::collections::BTreeSet<&str> = MEASURED.iter().map(|m| m.0).collect();
+    assert_eq!(sets.len(), 8, "{sets:?}");
+    assert!(MEASURED.iter().all(|m| m.2.iter().all(|&x| (0.0..=1.0).contains(&x))));
+    // The BabelColor entries are the ColorChecker table the test scenes use.
+    for (name, r) in COLORCHECKER {
+        assert!(MEASURED.iter().any(|m| m.0 == "BabelColor Average" && m.1 == name && m.2 == r), "{name}");
+    }
+    for (name, p) in ILLUMINANTS {
+        assert_eq!(p.iter().fold(0.0f32, |m, &x| m.max(x)), 1.0, "{name}");
+    }
+    // A (a 2856 K black body) rises through the visible; FL11's terbium line (545 nm) is
+    // its peak; LED-B3's blue pump shows as a peak at 450 nm; D65 is flat to within 40 %.
+    let a = illuminant("A").unwrap();
+    assert!(a.windows(2).all(|w| w[1] > w[0]));
+    let fl11 = illuminant("FL11").unwrap();
+    assert_eq!(fl11.iter().position(|&x| x == 1.0), Some(6), "{fl11:?}");
+    let led = illuminant("LED-B3").unwrap();
+    assert!(led[2] > led[1] && led[2] > led[3]);
+    let d65 = illuminant("D65").unwrap();
+    assert!(d65.iter().all(|&x| x > 0.6));
+    assert!(illuminant("nope").is_none());
+}
+
+#[test]
+fn realistic_scenes_are_deterministic_distinct_and_in_range() {
+    use slf_host::realistic::{NAMES, lookup, realistic};
+    for name in NAMES {
+        let a = lookup(name).unwrap().render(SIZE);
+        assert_eq!(a, lookup(name).unwrap().render(SIZE), "{name}");
+        assert!(a.data.iter().all(|x| x.is_finite() && *x >= 0.0 && *x <= 1.0), "{name}: max {}", a.max());
+        assert!(a.max() > 0.1, "{name}");
+    }
+    assert_eq!(realistic(3).render(SIZE), realistic(3).render(SIZE));
+    assert_ne!(realistic(3).render(SIZE), realistic(4).render(SIZE));
+    // The test scenes are found by the same lookup, unchanged.
+    assert_eq!(lookup("depth").unwrap(), scene::named("depth").unwrap());
+    // Many draws: all in range, and they use more than one illuminant.
+    let lights: std::collections::BTreeSet<String> =
+        (0..12).map(|s| format!("{:?}", realistic(s).illuminant)).collect();
+    assert!(lights.len() >= 3, "{}", lights.len());
+}
+
+/// Phase (radians) of the DFT of `row` at `cycles` per row length.
+fn phase(row: &[f64], cycles: f64) -> f64 {
+    let n = row.len() as f64;
+    let (re, im) = row.iter().enumerate().fold((0.0, 0.0), |(re, im), (i, &x)| {
+        let a = std::f64::consts::TAU * cycles * i as f64 / n;
+        (re + x * a.cos(), im - x * a.sin())
+    });
+    im.atan2(re)
+}
+
+#[test]
+fn a_slanted_plane_has_continuous_disparity() {
+    // Vertical stripes of period 8 on a plane whose disparity runs from -0.5 at the top to
+    // +1.5 at the bottom. View (2, 4), two steps right, sees x + 2 d(y): its stripes sit
+    // 2 d(y) pixels left of the central view's, row by row.
+    let white = colorchecker("white 9.5 (.05 D)").unwrap();
+    let black = colorchecker("black 2 (1.5 D)").unwrap();
+    let plane = Layer {
+        slope: (2.0, 0.0),
+        ..Layer::flat(0.5, Shape::Everywhere, Texture::Stripes { period: 8.0, angle: 0.0 }, [black, white])
+    };
+    let s = Scene { name: "plane".into(), layers: vec![plane], gain: 1.0, illuminant: D65 };
+    let lf = s.render(SIZE);
+    for y in 0..40 {
+        let row = |v: usize| (0..40).map(|x| f64::from(lf.get(2, v, y, x, 6))).collect::<Vec<_>>();
+        let dphi = (phase(&row(4), 5.0) - phase(&row(2), 5.0) + 3.0 * std::f64::consts::PI)
+            .rem_euclid(std::f64::consts::TAU)
+            - std::f64::consts::PI;
+        // f4(x) = f2(x + s): the phase at frequency w advances by w s.
+        let shift = dphi * 8.0 / std::f64::consts::TAU;
+        let d = 0.5 + 2.0 * ((y as f64 + 0.5) / 40.0 - 0.5);
+        assert!((shift - 2.0 * d).abs() < 0.08, "row {y}: shift {shift:.3}, expected {:.3}", 2.0 * d);
+    }
+}
+
+#[test]
+fn a_highlight_moves_across_views_unlike_its_surface() {
+    use slf_host::scene::Highlight;
+    let grey = colorchecker("neutral 5 (.70 D)").unwrap();
+    let card = Layer {
+        highlight: Some(Highlight { cy: 0.5, cx: 0.5, radius: 0.05, strength: 0.5, shift: 1.5 }),
+        ..Layer::flat(0.0, Shape::Everywhere, Texture::Flat, [grey, grey])
+    };
+    let s = Scene { name: "card".into(), layers: vec![card], gain: 1.0, illuminant: D65 };
+    let lf = s.render(SIZE);
+    // The surface is at disparity 0 (the same in every view); the highlight's peak moves
+    // 1.5 pixels per view step: 3 pixels right in view (2, 4).
+    let peak = |v: usize| {
+        let row: Vec<f32> = (0..40).map(|x| lf.get(2, v, 20, x, 6)).collect();
+        let (w, c): (f64, f64) = row.iter().enumerate().fold((0.0, 0.0), |(w, c), (x, &r)| {
+            let e = f64::from(r - row[0]).max(0.0);
+            (w + e, c + e * (x as f64 + 0.5))
+        });
+        c / w
+    };
+    let (p2, p4) = (peak(2), peak(4));
+    assert!((p2 - 20.0).abs() < 0.1, "{p2}");
+    assert!((p4 - p2 - 3.0).abs() < 0.1, "{p2} {p4}");
+    assert_eq!(lf.get(2, 2, 2, 2, 6), lf.get(2, 4, 2, 2, 6), "away from it, the surface is the same");
+}
+
+/// Mean DFT magnitude of a Hann-windowed 64 x 64 window of `texture` on rings of radius
+/// `r` cycles per window.
+fn ring_amplitude(texture: &Texture, r: f64) -> f64 {
+    let n = 64usize;
+    let hann = |i: usize| 0.5 - 0.5 * (std::f64::consts::TAU * (i as f64 + 0.5) / n as f64).cos();
+    let mut total = 0.0;
+    let mut count = 0.0;
+    for (oy, ox) in [(0.0, 0.0), (300.0, 0.0), (0.0, 500.0), (700.0, 900.0)] {
+        let w: Vec<f64> = (0..n * n)
+            .map(|i| {
+                let (y, x) = (i / n, i % n);
+                f64::from(texture.weight(oy + y as f32, ox + x as f32)) * hann(y) * hann(x)
+            })
+            .collect();
+        for k in 0..16 {
+            let a = std::f64::consts::TAU * k as f64 / 16.0;
+            let (fy, fx) = (r * a.sin(), r * a.cos());
+            let (re, im) = w.iter().enumerate().fold((0.0, 0.0), |(re, im), (i, &v)| {
+                let ph = std::f64::consts::TAU * (fy * (i / n) as f64 + fx * (i % n) as f64) / n as f64;
+                (re + v * ph.cos(), im - v * ph.sin())
+            });
+            total += (re * re + im * im).sqrt();
+            count += 1.0;
+        }
+    }
+    total / count
+}
+
+#[test]
+fn pink_texture_falls_as_one_over_f() {
+    // Slope of log amplitude against log frequency from 2 to 16 cycles per 64 pixels
+    // (periods 32 to 4 pixels): -beta for a 1/f^beta field, within 0.35 (value noise is
+    // smooth within an octave, and a 64-pixel window holds few of the coarsest).
+    let slope = |beta: f32| {
+        let t = Texture::Pink { seed: 11, beta };
+        let (lo, hi) = (ring_amplitude(&t, 2.0), ring_amplitude(&t, 16.0));
+        (hi / lo).ln() / 8f64.ln()
+    };
+    let (s08, s10, s13) = (slope(0.8), slope(1.0), slope(1.3));
+    println!("slopes: beta 0.8 {s08:.2}, 1.0 {s10:.2}, 1.3 {s13:.2}");
+    assert!((s10 + 1.0).abs() < 0.35, "beta 1: slope {s10:.2}");
+    assert!(s13 < s10 && s10 < s08, "{s08:.2} {s10:.2} {s13:.2}");
 }

@@ -5,7 +5,7 @@ use slf_host::firmware::{ChoiceRule, DEFAULT_ENSEMBLE, Dictionary, Ensemble, Ens
 use slf_host::train::{self, TrainConfig};
 
 fn patches(seed: u64, scenes: usize, count: usize) -> Vec<f32> {
-    train::sample_patches(&train::training_fields(scenes, 24, seed), count, seed)
+    train::sample_patches(&train::training_fields(scenes, 24, seed, train::Generator::Toy), count, seed)
 }
 
 fn small() -> TrainConfig {

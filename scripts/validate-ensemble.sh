@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# Validation of ensemble candidates (issue 18): each blob, the 5D DCT and the demosaic
+# baseline decode the same captures of held-out light fields at pixel k = 1, pixel k = 3
+# and lenslet k = 3 (disjoint patches, the capture's noise model); prints PSNR per scene
+# and the mean, as a markdown table.
+#
+#   bash scripts/validate-ensemble.sh OUT_DIR "name=BLOB ..." LIGHT_FIELD.npy ...
+#
+# BLOB "dct" is the 5D DCT alone. The light fields are held out: never training data of
+# the candidates (the realistic named scenes use seeds below 1000; `slf train` renders
+# seeds from 1000 up). Real light fields (e.g. the HCI crops of scripts/real-eval.sh) are
+# for validation only: their licence forbids training what we ship.
+set -euo pipefail
+out=${1:?usage: validate-ensemble.sh OUT_DIR "name=BLOB ..." LF.npy ...}
+models=${2:?models}
+shift 2
+cd "$(dirname "$0")/.."
+cargo build --release -q -p slf-host
+slf=./target/release/slf
+mkdir -p "$out"
+settings="pixel:1 pixel:3 lenslet:3"
+header="| model |"
+rule="| --- |"
+for s in $settings; do
+  for lf in "$@"; do header="$header $(basename "$lf" .npy) ${s/:/ k=} |"; rule="$rule --- |"; done
+  header="$header mean ${s/:/ k=} |"; rule="$rule --- |"
+done
+echo "$header"
+echo "$rule"
+psnr() { "$slf" eval "$1" "$2" | awk '/PSNR/ { for (i = 1; i <= NF; i++) if ($i ~ /^[0-9.]+$/) { print $i; exit } }'; }
+for m in demosaic $models; do
+  name=${m%%=*}; blob=${m#*=}
+  row="| $name |"
+  for s in $settings; do
+    mask=${s%:*}; k=${s#*:}; sum=0; n=0
+    for lf in "$@"; do
+      base=$(basename "$lf" .npy)
+      cap="$out/cap-$base-$mask-$k"
+      [ -d "$cap" ] || "$slf" simulate "$lf" -o "$cap" --mask "$mask" -s "$k" --seed 3 > /dev/null
+      rec="$out/rec.npy"
+      case "$blob" in
+        demosaic) "$slf" decode "$cap" -o "$rec" --method demosaic > /dev/null ;;
+        dct) "$slf" decode "$cap" -o "$rec" --dictionary dct --stride 5 --window uniform > /dev/null ;;
+        *) "$slf" decode "$cap" -o "$rec" --blob "$blob" --stride 5 --window uniform > /dev/null ;;
+      esac
+      p=$(psnr "$lf" "$rec")
+      row="$row $p |"; sum=$(echo "$sum + $p" | bc -l); n=$((n + 1))
+    done
+    row="$row $(printf '%.2f' "$(echo "$sum / $n" | bc -l)") |"
+  done
+  echo "$row"
+done
