@@ -24,7 +24,6 @@ use core::fmt;
 
 use crate::choice::PatchModel;
 use crate::shape::PatchShape;
-use crate::sl0::SolveError;
 use crate::tile::{ConfigError, PatchOrigin, PatchReport, PatchSink, Tile, TileDecoder, TileReport, TileSource};
 use crate::workspace::Workspace;
 
@@ -133,6 +132,12 @@ fn on_grid(x: usize, total: usize, p: usize, offset: usize, edge: bool) -> bool 
     d.is_multiple_of(p) || (edge && x == last && !total.is_multiple_of(p))
 }
 
+/// Bands `(first, end)` of at most `band` (at least 1) lenslet columns across `cols`.
+fn bands(cols: usize, band: usize) -> impl Iterator<Item = (usize, usize)> {
+    let band = band.max(1);
+    (0..cols).step_by(band).map(move |c0| (c0, (c0 + band).min(cols)))
+}
+
 /// The tile decoder with patches at a stride: checked config, stateless.
 #[derive(Clone, Copy, Debug)]
 pub struct OverlapDecoder<
@@ -204,25 +209,25 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             .count()
     }
 
+    /// Columns of the grid's patches that start at lenslet row `r` and reach columns
+    /// `c0..c1`, a column once for each grid that starts a patch there.
+    fn starts(
+        &self,
+        r: usize,
+        c0: usize,
+        c1: usize,
+    ) -> impl Iterator<Item = usize> + use<'_, 'a, PS, PT, PU, PV, B, N> {
+        (c0.saturating_sub(PT - 1)..c1).flat_map(move |c| core::iter::repeat_n(c, self.starts_at(r, c)))
+    }
+
     /// Patch solves (angular windows included) a frame costs when the strip holds `band`
     /// lenslet columns: a patch straddling a band border is decoded for each band.
     pub fn patch_decodes(&self, band: usize) -> usize {
         let (rows, cols) = self.tiles.config().sensor.lenslets;
         let (rows, cols) = (rows as usize, cols as usize);
-        let band = band.clamp(1, cols.max(1));
-        let windows = self.tiles.windows().count();
-        let mut total = 0;
-        let mut c0 = 0;
-        while c0 < cols {
-            let c1 = (c0 + band).min(cols);
-            for r in 0..rows {
-                for c in c0.saturating_sub(PT - 1)..c1 {
-                    total += self.starts_at(r, c) * windows;
-                }
-            }
-            c0 = c1;
-        }
-        total
+        let positions: usize =
+            bands(cols, band).map(|(c0, c1)| (0..rows).map(|r| self.starts(r, c0, c1).count()).sum::<usize>()).sum();
+        positions * self.tiles.windows().count()
     }
 
     /// Decodes the whole frame with `model`, every patch position at this stride, and
@@ -252,9 +257,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         }
         let (vu, vv) = self.views();
         let mut report = OverlapReport::default();
-        let mut c0 = 0;
-        while c0 < cols {
-            let c1 = (c0 + band).min(cols);
+        for (c0, c1) in bands(cols, band) {
             report.bands += 1;
             let mut ring = Ring::<PS, PT, PU, PV, B, N> {
                 strip: &mut *strip,
@@ -271,22 +274,16 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                     ring.flush(next_row, sink, &mut report)?;
                     next_row += 1;
                 }
-                for c in c0.saturating_sub(PT - 1)..c1 {
-                    for _ in 0..self.starts_at(r, c) {
-                        let tile = Tile {
-                            lenslet_row: r as u16,
-                            lenslet_col: c as u16,
-                            lenslet_rows: PS as u16,
-                            lenslet_cols: PT as u16,
-                        };
-                        match self.tiles.decode_tile(model, tile, source, &mut ring, ws) {
-                            Ok(t) => {
-                                report.patches.decoded += t.decoded;
-                                report.patches.flagged += t.flagged;
-                                report.patches.failed += t.failed;
-                            }
-                            Err(_) => report.source_failures += 1,
-                        }
+                for c in self.starts(r, c0, c1) {
+                    let tile = Tile {
+                        lenslet_row: r as u16,
+                        lenslet_col: c as u16,
+                        lenslet_rows: PS as u16,
+                        lenslet_cols: PT as u16,
+                    };
+                    match self.tiles.decode_tile(model, tile, source, &mut ring, ws) {
+                        Ok(t) => report.patches.add(&t),
+                        Err(_) => report.source_failures += 1,
                     }
                 }
             }
@@ -294,7 +291,6 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                 ring.flush(next_row, sink, &mut report)?;
                 next_row += 1;
             }
-            c0 = c1;
         }
         Ok(report)
     }
@@ -345,9 +341,8 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
         };
         for (values, w) in sums.chunks_exact_mut(B).zip(weights.iter_mut()) {
             if *w > 0.0 {
-                let inv = *w;
                 for x in values.iter_mut() {
-                    *x /= inv;
+                    *x /= *w;
                 }
             } else {
                 report.uncovered += B as u32;
@@ -395,10 +390,6 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
                 }
             }
         }
-        Ok(())
-    }
-
-    fn reject(&mut self, _: PatchOrigin, _: SolveError) -> Result<(), Self::Error> {
         Ok(())
     }
 }

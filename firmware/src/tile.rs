@@ -177,7 +177,7 @@ pub struct TileReport {
 }
 
 impl TileReport {
-    fn add(&mut self, o: &Self) {
+    pub(crate) fn add(&mut self, o: &Self) {
         self.decoded += o.decoded;
         self.flagged += o.flagged;
         self.failed += o.failed;

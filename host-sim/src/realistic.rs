@@ -23,7 +23,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use crate::scene::{Highlight, Layer, Scene, Shape, Texture};
-use crate::spectra::{ILLUMINANTS, MEASURED, Spectrum, smooth_random};
+use crate::spectra::{ILLUMINANTS, MEASURED, Spectrum, illuminant, smooth_random};
 
 /// The realistic named scenes: (name, seed, illuminant).
 pub const SCENES: [(&str, u64, &str); 4] =
@@ -35,7 +35,7 @@ pub const NAMES: [&str; 4] = [SCENES[0].0, SCENES[1].0, SCENES[2].0, SCENES[3].0
 /// A realistic named scene ([`NAMES`]); `None` for another name.
 pub fn named(name: &str) -> Option<Scene> {
     let &(name, seed, light) = SCENES.iter().find(|s| s.0 == name)?;
-    let illuminant = ILLUMINANTS.iter().find(|l| l.0 == light)?.1;
+    let illuminant = illuminant(light)?;
     Some(Scene { name: name.into(), ..draw(seed, Some(illuminant)) })
 }
 

@@ -278,7 +278,9 @@ impl Scene {
         let radiance: Vec<[Spectrum; 2]> = layers.iter().map(|l| l.reflectance.map(|r| lit(&r))).collect();
         let white = lit(&[1.0; BANDS]);
         // Fronto-parallel Lambertian layers (the regression scenes) take the first hit in
-        // disparity order; other layers are all intersected and the nearest hit wins.
+        // disparity order; other layers are all intersected and the nearest hit wins. A
+        // flat layer's shade is 1 and its highlight 0, so the shared sum below gives the
+        // regression scenes the same bits as before layers could slant.
         let all_flat = layers.iter().all(|l| l.is_flat());
         let norm = (LIGHT[0] * LIGHT[0] + LIGHT[1] * LIGHT[1] + LIGHT[2] * LIGHT[2]).sqrt();
         let (cu, cv) = ((size.views.0 as f32 - 1.0) / 2.0, (size.views.1 as f32 - 1.0) / 2.0);
@@ -293,27 +295,23 @@ impl Scene {
                 let mut acc = [0.0f32; BANDS];
                 for (sy, sx) in [(0.25, 0.25), (0.25, 0.75), (0.75, 0.25), (0.75, 0.75)] {
                     let (py, px) = (y as f32 + sy, x as f32 + sx);
-                    if all_flat {
-                        for (layer, rad) in layers.iter().zip(&radiance) {
-                            let (ly, lx) = (py + layer.disparity * du, px + layer.disparity * dv);
-                            if layer.shape.contains(ly / h, lx / w) {
-                                let t = layer.texture.weight(ly, lx);
-                                for (a, (r0, r1)) in acc.iter_mut().zip(rad[0].iter().zip(&rad[1])) {
-                                    *a += 0.25 * (r0 + t * (r1 - r0));
-                                }
-                                break;
+                    let hit = if all_flat {
+                        // Sorted nearest first: the first layer that covers the point.
+                        layers.iter().enumerate().find_map(|(i, l)| {
+                            let (ly, lx) = (py + l.disparity * du, px + l.disparity * dv);
+                            l.shape.contains(ly / h, lx / w).then_some((i, ly, lx))
+                        })
+                    } else {
+                        let mut best: Option<(usize, f32, f32, f32)> = None;
+                        for (i, layer) in layers.iter().enumerate() {
+                            let (ly, lx, d) = layer.hit(py, px, du, dv, h, w);
+                            if layer.shape.contains(ly / h, lx / w) && best.is_none_or(|b| d > b.3) {
+                                best = Some((i, ly, lx, d));
                             }
                         }
-                        continue;
-                    }
-                    let mut best: Option<(usize, f32, f32, f32)> = None;
-                    for (i, layer) in layers.iter().enumerate() {
-                        let (ly, lx, d) = layer.hit(py, px, du, dv, h, w);
-                        if layer.shape.contains(ly / h, lx / w) && best.is_none_or(|b| d > b.3) {
-                            best = Some((i, ly, lx, d));
-                        }
-                    }
-                    let Some((i, ly, lx, _)) = best else { continue };
+                        best.map(|(i, ly, lx, _)| (i, ly, lx))
+                    };
+                    let Some((i, ly, lx)) = hit else { continue };
                     let (layer, rad) = (layers[i], &radiance[i]);
                     let t = layer.texture.weight(ly, lx);
                     let shade = if layer.shading > 0.0 {

@@ -62,6 +62,24 @@ mod device {
         file.get(10 + header..).unwrap_or(&[])
     }
 
+    /// Folds `values` into `checksum`, in order.
+    fn fold(checksum: &mut u32, values: &[f32]) {
+        for x in values {
+            *checksum = checksum.rotate_left(5) ^ x.to_bits();
+        }
+    }
+
+    /// Prints `values` as `data` lines of 13 f32 bit patterns (one pixel's bands each).
+    fn print_data(values: &[f32]) {
+        for chunk in values.chunks(13) {
+            hprint!("data");
+            for x in chunk {
+                hprint!(" {:08x}", x.to_bits());
+            }
+            hprintln!();
+        }
+    }
+
     /// Prints each accepted patch, folds it into a checksum.
     struct Print {
         checksum: u32,
@@ -73,9 +91,7 @@ mod device {
         type Error = core::convert::Infallible;
         fn accept(&mut self, o: PatchOrigin, p: &[f32; 5200], r: &PatchReport) -> Result<(), Self::Error> {
             self.patches += 1;
-            for x in p {
-                self.checksum = self.checksum.rotate_left(5) ^ x.to_bits();
-            }
+            fold(&mut self.checksum, p);
             if self.print {
                 hprintln!(
                     "patch {} {} {} {} member {} solves {} steps {}",
@@ -87,13 +103,7 @@ mod device {
                     r.solves,
                     r.outcome.iterations
                 );
-                for row in p.chunks(13) {
-                    hprint!("data");
-                    for x in row {
-                        hprint!(" {:08x}", x.to_bits());
-                    }
-                    hprintln!();
-                }
+                print_data(p);
             }
             Ok(())
         }
@@ -117,14 +127,8 @@ mod device {
         fn row(&mut self, row: u16, first_col: u16, values: &[f32]) -> Result<(), Self::Error> {
             self.rows += 1;
             hprintln!("row {} {} values {}", row, first_col, values.len());
-            for chunk in values.chunks(13) {
-                hprint!("data");
-                for x in chunk {
-                    self.checksum = self.checksum.rotate_left(5) ^ x.to_bits();
-                    hprint!(" {:08x}", x.to_bits());
-                }
-                hprintln!();
-            }
+            print_data(values);
+            fold(&mut self.checksum, values);
             Ok(())
         }
     }
