@@ -41,7 +41,10 @@ strip_cols = int(re.search(r"strip columns (\d+)", log).group(1))
 ov = re.search(r"overlap patches (\d+) bands (\d+) uncovered \d+ frame-patches (\d+)", log)
 ov_patches, ov_bands, frame_patches = (int(x) for x in ov.groups())
 t = len(tiles)
-assert len(wins) == 1 + 2 * t + 1, (len(wins), t)
+# Windows: the white balance's pass over the frame, one transform, the ensemble's tiles,
+# the DCT's tiles, the overlapped frame.
+assert len(wins) == 2 + 2 * t + 1, (len(wins), t)
+gains, wins = wins[0], wins[1:]
 patches = sum(tiles)
 ens = sum(wins[1:1 + t]) / patches
 dct = sum(wins[1 + t:1 + 2 * t]) / patches
@@ -59,6 +62,7 @@ print(f"| peak RAM for decoding a patch (static + stack, without the strip) | {r
 print(f"| strip of the overlapped decode ({strip_cols} lenslet columns) | {strip:,} B | |")
 print(f"| peak RAM for the overlapped frame (static + stack) | {frame_ram:,} B ({frame_ram / 1024:.1f} KiB) | 128 KiB (the part) |")
 print(f"| instructions per transform ({macs:,} multiply-adds) | {wins[0]:,} ({wins[0] / macs:.2f} per multiply-add) | |")
+print(f"| instructions for the white balance (one pass over the frame, every snapshot) | {gains:,} | |")
 print(f"| instructions per patch, 5D DCT | {dct:,.0f} | |")
 print(f"| instructions per patch, ensemble (8 members), screened | {ens:,.0f} | |")
 print(f"| instructions per frame, stride 3 tapered, screened ensemble ({ov_patches} patch solves in {ov_bands} bands; {frame_patches} with a full-width strip; disjoint: {patches}) | {frame:,} ({frame / patches:,.0f} per disjoint patch) | |")

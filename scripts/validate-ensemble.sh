@@ -1,14 +1,16 @@
 #!/usr/bin/env bash
-# Validation of ensemble candidates (issue 18): each blob, the 5D DCT and the demosaic
-# baseline decode the same captures of held-out light fields at pixel k = 1, pixel k = 3
-# and lenslet k = 3 (disjoint patches, the capture's noise model); prints PSNR per scene
-# and the mean, as a markdown table.
+# Validation of ensemble candidates (issue 18): each model decodes the same captures of
+# held-out light fields at pixel k = 1, pixel k = 3 and lenslet k = 3 (disjoint patches,
+# the capture's noise model); prints PSNR per scene and the mean, as a markdown table.
 #
 #   bash scripts/validate-ensemble.sh OUT_DIR "name=BLOB ..." LIGHT_FIELD.npy ...
 #
-# BLOB "dct" is the 5D DCT alone. The light fields are held out: never training data of
-# the candidates (the realistic named scenes use seeds below 1000; `slf train` renders
-# seeds from 1000 up). Real light fields (e.g. the HCI crops of scripts/real-eval.sh) are
+# BLOB is a blob file, or "dct" (the 5D DCT alone), or a baseline without compressed
+# sensing: "demosaic", "ppid", "interpolate" (`slf decode --method`). A CS model ending in
+# ":off" decodes without white balance (`--balance off`; the default balances each capture
+# by its grey world). The light fields are held out: never training data of the
+# candidates (the realistic named scenes use seeds below 1000; `slf train` renders seeds
+# from 1000 up). Real light fields (e.g. the HCI crops of scripts/real-eval.sh) are
 # for validation only: their licence forbids training what we ship.
 set -euo pipefail
 out=${1:?usage: validate-ensemble.sh OUT_DIR "name=BLOB ..." LF.npy ...}
@@ -28,8 +30,9 @@ done
 echo "$header"
 echo "$rule"
 psnr() { "$slf" eval "$1" "$2" | awk '/PSNR/ { for (i = 1; i <= NF; i++) if ($i ~ /^[0-9.]+$/) { print $i; exit } }'; }
-for m in demosaic $models; do
-  name=${m%%=*}; blob=${m#*=}
+for m in $models; do
+  name=${m%%=*}; blob=${m#*=}; extra=""
+  case "$blob" in *:off) blob=${blob%:off}; extra="--balance off" ;; esac
   row="| $name |"
   for s in $settings; do
     mask=${s%:*}; k=${s#*:}; sum=0; n=0
@@ -39,9 +42,9 @@ for m in demosaic $models; do
       [ -d "$cap" ] || "$slf" simulate "$lf" -o "$cap" --mask "$mask" -s "$k" --seed 3 > /dev/null
       rec="$out/rec.npy"
       case "$blob" in
-        demosaic) "$slf" decode "$cap" -o "$rec" --method demosaic > /dev/null ;;
-        dct) "$slf" decode "$cap" -o "$rec" --dictionary dct --stride 5 --window uniform > /dev/null ;;
-        *) "$slf" decode "$cap" -o "$rec" --blob "$blob" --stride 5 --window uniform > /dev/null ;;
+        demosaic|ppid|interpolate) "$slf" decode "$cap" -o "$rec" --method "$blob" > /dev/null ;;
+        dct) "$slf" decode "$cap" -o "$rec" --dictionary dct --stride 5 --window uniform $extra > /dev/null ;;
+        *) "$slf" decode "$cap" -o "$rec" --blob "$blob" --stride 5 --window uniform $extra > /dev/null ;;
       esac
       p=$(psnr "$lf" "$rec")
       row="$row $p |"; sum=$(echo "$sum + $p" | bc -l); n=$((n + 1))

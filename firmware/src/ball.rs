@@ -22,6 +22,11 @@
 //! factor. With equal variances (`shot` 0) that is the Euclidean projection onto a sphere;
 //! with unequal ones it is a point on the ellipsoid's surface (not the nearest, which needs
 //! a root search per step), found at the cost of one division per measurement.
+//!
+//! White-balanced values ([`crate::gains`]) are the sensor's divided by their band's gain
+//! `g`, so their variance is the sensor's over `g^2`: the ball weighs each residual by its
+//! band's gain ([`Ball::weight`]), and is weighted whenever any gain differs from 1, even
+//! without shot noise.
 
 /// The share of a pixel's first measurement in the ball's squared radius (see the module
 /// docs for how it was chosen).
@@ -36,6 +41,8 @@ pub struct Ball {
     shot: f32,
     /// `m - p + p * FIRST_SHARE`: the ball's squared radius in whitened units.
     radius2: f32,
+    /// The values are white-balanced with gains other than 1.
+    balanced: bool,
 }
 
 /// What a projection does with a residual of a given size.
@@ -53,7 +60,12 @@ impl Ball {
     /// projection.
     pub fn new(noise: f32, shot: f32, m: u32, p: u32) -> Self {
         let p = p.min(m);
-        Self { floor: noise * noise, shot, radius2: (m - p) as f32 + p as f32 * FIRST_SHARE }
+        Self { floor: noise * noise, shot, radius2: (m - p) as f32 + p as f32 * FIRST_SHARE, balanced: false }
+    }
+
+    /// The same ball for white-balanced values (`balanced`: some band's gain is not 1).
+    pub fn balanced(self, balanced: bool) -> Self {
+        Self { balanced, ..self }
     }
 
     /// Equality with the measurements.
@@ -65,16 +77,20 @@ impl Ball {
     /// Whether measurements differ in variance, so residuals are weighted one by one.
     #[inline(always)]
     pub fn is_weighted(&self) -> bool {
-        self.shot > 0.0
+        self.shot > 0.0 || (self.balanced && !self.is_exact())
     }
 
-    /// `1 / var` of a measurement of value `y` (weighted balls; at least the reciprocal of
-    /// the smallest normal `f32`, so a zero residual weighs 0, never NaN).
+    /// `1 / var` of a measurement of value `y` in a band of gain `gain` (weighted balls;
+    /// at least the reciprocal of the smallest normal `f32`, so a zero residual weighs 0,
+    /// never NaN). The sensor saw `y * gain`, of variance `floor + shot * max(y gain, 0)`;
+    /// divided by `gain` its variance is that over `gain^2`. With gain 1 this is bit for
+    /// bit the unbalanced weight.
     #[inline(always)]
-    pub fn weight(&self, y: f32) -> f32 {
+    pub fn weight(&self, y: f32, gain: f32) -> f32 {
         // Comparisons, not `f32::max`: on a Cortex-M4F that is a call to `fmaxf` (its NaN
         // rules), and this runs once per measurement per step.
-        let var = self.floor + self.shot * if y > 0.0 { y } else { 0.0 };
+        let seen = y * gain;
+        let var = (self.floor + self.shot * if seen > 0.0 { seen } else { 0.0 }) / (gain * gain);
         1.0 / if var > f32::MIN_POSITIVE { var } else { f32::MIN_POSITIVE }
     }
 

@@ -16,8 +16,9 @@
 //!
 //! - **raw frame** ([`raw`], [`defects`], [`spi`]): samples, which of them are
 //!   measurements, frames in memory or flash, and a frame buffer read over `embedded-hal` SPI.
-//! - **sensing** ([`mask`]): which band each pixel sees in each snapshot; the three mask
-//!   families `kronecker`, `lenslet`, `pixel`.
+//! - **sensing** ([`mask`], [`gains`]): which band each pixel sees in each snapshot; the
+//!   three mask families `kronecker`, `lenslet`, `pixel`; and the white balance, a gain per
+//!   band that the decode divides out of the measurements and multiplies back.
 //! - **operators** ([`shape`], [`dct`], [`dictionary`], [`blob`], [`transform`]): the patch
 //!   geometry in the types, dictionaries (the 5D DCT and blobs in flash) and the separable
 //!   synthesis and analysis transforms.
@@ -98,6 +99,7 @@ pub mod choice;
 pub mod dct;
 pub mod defects;
 pub mod dictionary;
+pub mod gains;
 pub mod interpolate;
 pub mod mask;
 pub mod overlap;

@@ -200,7 +200,7 @@ pub fn solve_pinv<
         if ball.is_weighted() {
             op.for_each_selected(|i, e| {
                 let (r, y) = (signal.get(i).copied().unwrap_or(0.0), m.values.get(e).copied().unwrap_or(0.0));
-                w2 += r * r * ball.weight(y);
+                w2 += r * r * ball.weight(y, m.gains.get(e % B).copied().unwrap_or(1.0));
             });
         }
         let norm = libm::sqrtf(r2);

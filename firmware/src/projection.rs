@@ -76,10 +76,10 @@ pub fn project_coefficients<
         mode_pixel(&d.m4, fd[3], part.as_chunks::<B>().0, tmp.as_chunks_mut::<B>().0);
         let fibres = tmp.as_chunks_mut::<B>().0;
         if weighted {
-            let (r, w) = band_step::<B, true>(&d.m5, fibres, values, measured, ball);
+            let (r, w) = band_step::<B, true>(&d.m5, fibres, values, measured, ball, &m.gains);
             (r2, w2) = (r2 + r, w2 + w);
         } else {
-            r2 += band_step::<B, false>(&d.m5, fibres, values, measured, ball).0;
+            r2 += band_step::<B, false>(&d.m5, fibres, values, measured, ball, &m.gains).0;
         }
         mode_pixel(&t.m4, ft[3], tmp.as_chunks::<B>().0, part.as_chunks_mut::<B>().0);
         mode_rows(&t.m3, ft[2], part, tmp, PV * B);
@@ -97,7 +97,7 @@ pub fn project_coefficients<
 /// the pixel modes' synthesis and become the correction's; `values` / `measured` are the
 /// slice's measurements in patch order. Returns the sum of squared residuals and, with
 /// `WEIGHTED`, of each over its measurement's variance ([`Ball::weight`]: one division per
-/// measurement, only in that mode).
+/// measurement, only in that mode, with the band's gain from `gains`).
 ///
 /// A pixel's measured bands are found from a bit mask of its flags ([`band_bits`]),
 /// lowest set bit first: scanning the flags one by one took a data-dependent branch per
@@ -113,6 +113,7 @@ fn band_step<const B: usize, const WEIGHTED: bool>(
     values: &[f32],
     measured: &[bool],
     ball: &Ball,
+    gains: &[f32],
 ) -> (f32, f32) {
     const { assert!(B <= 64, "a pixel's flags fit one mask (B <= MAX_BANDS)") };
     let (mut r2, mut w2) = (0.0f32, 0.0f32);
@@ -127,7 +128,7 @@ fn band_step<const B: usize, const WEIGHTED: bool>(
             let r = y - dot(row, fibre);
             r2 += r * r;
             if WEIGHTED {
-                w2 += r * r * ball.weight(y);
+                w2 += r * r * ball.weight(y, gains.get(b).copied().unwrap_or(1.0));
             }
             for (c, &w) in correction.iter_mut().zip(row) {
                 *c += r * w;

@@ -176,6 +176,8 @@ pub enum SolveError {
     PseudoInverse { mode: u8 },
     /// An ensemble member could not be read (not expected of a validated ensemble).
     NoSuchMember,
+    /// Band gains that are not finite and positive, or more than `MAX_BANDS` of them.
+    BadGains,
 }
 
 impl fmt::Display for SolveError {
@@ -195,6 +197,7 @@ impl fmt::Display for SolveError {
                 write!(f, "pseudo-inverse of mode {mode} did not converge")
             }
             Self::NoSuchMember => f.write_str("ensemble member could not be read"),
+            Self::BadGains => f.write_str("band gains must be finite and positive, at most MAX_BANDS"),
         }
     }
 }
@@ -258,14 +261,15 @@ pub(crate) fn max_abs(x: &[f32]) -> f32 {
 
 /// Moves `x` onto the measurements (exactly, or to the noise ball); returns the residual
 /// norm before the move.
-fn project<const N: usize>(x: &mut [f32; N], m: &Measurements<N>, ball: &Ball) -> f32 {
+fn project<const B: usize, const N: usize>(x: &mut [f32; N], m: &Measurements<N>, ball: &Ball) -> f32 {
     let (mut r2, mut w2) = (0.0f32, 0.0f32);
-    for ((x, &y), &k) in x.iter().zip(&m.values).zip(&m.measured) {
+    for (i, ((x, &y), &k)) in x.iter().zip(&m.values).zip(&m.measured).enumerate() {
         if k {
             let r = y - x;
             r2 += r * r;
             if ball.is_weighted() {
-                w2 += r * r * ball.weight(y);
+                // The band is the last axis.
+                w2 += r * r * ball.weight(y, m.gains.get(i % B).copied().unwrap_or(1.0));
             }
         }
     }
@@ -302,7 +306,7 @@ pub(crate) fn start<const B: usize, const N: usize>(cfg: &Sl0Config, m: &Measure
     }
     // Pixels with at least one measured band (the band is the last axis).
     let pixels = m.measured.as_chunks::<B>().0.iter().filter(|p| p.contains(&true)).count();
-    Ok(Ball::new(cfg.noise, cfg.shot, m.count, pixels as u32))
+    Ok(Ball::new(cfg.noise, cfg.shot, m.count, pixels as u32).balanced(m.balanced))
 }
 
 /// What one step (ascent + projection) reports to the schedule.
@@ -464,7 +468,7 @@ fn descend<const PS: usize, const PT: usize, const PU: usize, const PV: usize, c
     });
 
     synthesize(dict, coeffs, signal);
-    project(signal, m, ball);
+    project::<B, N>(signal, m, ball);
     if signal.iter().any(|x| !x.is_finite()) {
         return Err(SolveError::NonFiniteResult);
     }

@@ -202,6 +202,8 @@ pub enum ConfigError {
     Solver(SolveError),
     /// An overlap stride outside `1..=` the patch's size.
     Stride,
+    /// Band gains that are not finite and positive.
+    Gains,
 }
 
 impl fmt::Display for ConfigError {
@@ -214,6 +216,7 @@ impl fmt::Display for ConfigError {
             Self::RawFormat => f.write_str("raw format: need finite levels with white > black"),
             Self::Solver(e) => write!(f, "solver: {e}"),
             Self::Stride => f.write_str("overlap stride must be in 1..=patch size per axis"),
+            Self::Gains => f.write_str("band gains must be finite and positive"),
         }
     }
 }
@@ -268,7 +271,9 @@ pub struct DecoderConfig<'a> {
 }
 
 /// The tile decoder for patches of `PS x PT x PU x PV x B` (N values): a checked
-/// [`DecoderConfig`]. Stateless; all mutable state is in the caller's [`Workspace`].
+/// [`DecoderConfig`], and the capture's band gains (white balance, [`crate::gains`]; 1
+/// unless set by [`with_gains`](Self::with_gains)). Stateless; all mutable state is in the
+/// caller's [`Workspace`].
 #[derive(Clone, Copy, Debug)]
 pub struct TileDecoder<
     'a,
@@ -280,6 +285,7 @@ pub struct TileDecoder<
     const N: usize,
 > {
     config: DecoderConfig<'a>,
+    gains: [f32; B],
 }
 
 /// Origins of the angular windows along one axis: `ceil(views / patch)` windows of
@@ -331,12 +337,73 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             return Err(ConfigError::RawFormat);
         }
         sl0.validate().map_err(ConfigError::Solver)?;
-        Ok(Self { config })
+        Ok(Self { config, gains: [1.0; B] })
     }
 
     /// The checked config.
     pub fn config(&self) -> &DecoderConfig<'a> {
         &self.config
+    }
+
+    /// This decoder with band `b`'s measurements divided by `gains[b]` before the solve
+    /// and the decoded patch multiplied back (white balance, [`crate::gains`]); gains of 1
+    /// are the plain decode, bit for bit.
+    ///
+    /// # Errors
+    /// [`ConfigError::Gains`] for a gain that is not finite and positive.
+    pub fn with_gains(self, gains: &[f32; B]) -> Result<Self, ConfigError> {
+        if !crate::gains::valid(gains) {
+            return Err(ConfigError::Gains);
+        }
+        Ok(Self { gains: *gains, ..self })
+    }
+
+    /// The band gains the decode uses.
+    pub fn gains(&self) -> &[f32; B] {
+        &self.gains
+    }
+
+    /// Grey-world band gains of a frame: every valid sample of the sensor (defects and
+    /// invalid samples left out) summed per band ([`crate::gains::gains_from_sums`]).
+    /// Reads the frame once, one sensor row at a time in runs of up to 64 samples.
+    ///
+    /// # Errors
+    /// The source's error; nothing is estimated then.
+    pub fn estimate_gains<S: TileSource>(&self, source: &mut S) -> Result<[f32; B], S::Error> {
+        const RUN: usize = 64;
+        let c = &self.config;
+        let (rows, cols) = c.sensor.frame_size();
+        let mut sums = [0.0f32; B];
+        let mut counts = [0u32; B];
+        let mut run = [0.0f32; RUN];
+        for snapshot in 0..c.mask.snapshots() {
+            for row in 0..rows {
+                // Per row in f32, then added to the totals: a frame's sum in one f32 would
+                // lose the small bands' low digits.
+                let mut row_sums = [0.0f32; B];
+                for col0 in (0..cols).step_by(RUN) {
+                    let len = RUN.min(cols - col0);
+                    let Some(out) = run.get_mut(..len) else { break };
+                    source.read(snapshot, row, col0, out)?;
+                    for (dc, &raw) in out.iter().enumerate() {
+                        let col = col0 + dc;
+                        if c.defects.contains(row, col) {
+                            continue;
+                        }
+                        let Ok(y) = c.raw.classify(raw) else { continue };
+                        let band = c.mask.bands_at(row, col).get(snapshot).copied().unwrap_or(0) as usize;
+                        if let (Some(s), Some(n)) = (row_sums.get_mut(band), counts.get_mut(band)) {
+                            *s += y;
+                            *n += 1;
+                        }
+                    }
+                }
+                for (t, r) in sums.iter_mut().zip(&row_sums) {
+                    *t += r;
+                }
+            }
+        }
+        Ok(crate::gains::gains_from_sums(&sums, &counts))
     }
 
     /// Patch origins of one spatial block: every angular window.
@@ -389,6 +456,8 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let k = c.mask.snapshots();
         let m = ws.measurements_mut();
         m.clear();
+        // Checked finite and positive by `with_gains`; `B <= MAX_BANDS` by `PatchShape`.
+        let _ = m.set_gains(&self.gains);
         let mut flags = PatchFlags::default();
         let mut excluded = 0u16;
         let mut run = [[0.0f32; PV]; B];
@@ -409,8 +478,9 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                         }
                         for (band, r) in c.mask.bands_at(row, col).iter().zip(&run) {
                             let at = PatchShape::<PS, PT, PU, PV, B, N>::index(s, t, u, v, *band as usize);
+                            let gain = self.gains.get(*band as usize).copied().unwrap_or(1.0);
                             let ok = match c.raw.classify(r[v]) {
-                                Ok(y) => m.set(at, y).map_err(|_| Invalid::NonFinite),
+                                Ok(y) => m.set(at, y / gain).map_err(|_| Invalid::NonFinite),
                                 Err(e) => Err(e),
                             };
                             if let Err(e) = ok {
@@ -466,6 +536,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                     };
                     match decoded {
                         Ok(done) => {
+                            ws.unbalance_patch(&self.gains);
                             ws.clamp_patch(lo, hi);
                             let r = PatchReport {
                                 outcome: done.outcome,

@@ -5,7 +5,7 @@
 //! one flag per patch value: coefficients, signal, and the measurements. `new` is a
 //! `const fn`, so a device can place it in a `static`.
 
-use crate::shape::PatchShape;
+use crate::shape::{MAX_BANDS, PatchShape};
 use crate::sl0::SolveError;
 
 /// The measurements of one patch, dense in the patch layout: entry `i` is measured (with
@@ -15,17 +15,51 @@ use crate::sl0::SolveError;
 /// screened ensemble decode they hold the DCT's solution while the chosen member solves
 /// (see [`crate::MemberChoice::Screened`]): a solution that meets the measurements is known
 /// from its unmeasured entries alone, so it needs no buffer of its own.
+///
+/// Values may be white-balanced: band `b`'s values divided by a gain `g_b`
+/// ([`crate::gains`]), so that the decode works on spectra with the illuminant's tilt
+/// taken out. The gains travel with the values because the noise ball needs them: a value
+/// divided by `g_b` has its noise divided by `g_b` too ([`crate::ball::Ball::weight`]).
+/// Gains are 1 unless set, and [`clear`](Self::clear) keeps them (they are the unit of
+/// the values, not a measurement).
 #[derive(Clone, Debug)]
 pub struct Measurements<const N: usize> {
     pub(crate) values: [f32; N],
     pub(crate) measured: [bool; N],
     pub(crate) count: u32,
+    /// Gain of each band (the first `B` entries; 1 beyond them).
+    pub(crate) gains: [f32; MAX_BANDS],
+    /// Whether any gain differs from 1.
+    pub(crate) balanced: bool,
 }
 
 impl<const N: usize> Measurements<N> {
     /// Nothing measured.
     pub const fn new() -> Self {
-        Self { values: [0.0; N], measured: [false; N], count: 0 }
+        Self { values: [0.0; N], measured: [false; N], count: 0, gains: [1.0; MAX_BANDS], balanced: false }
+    }
+
+    /// Sets the gain of each band (`gains[b]` for band `b`; bands beyond `gains.len()` get
+    /// 1): the values set from now on are the sensor's divided by their band's gain.
+    ///
+    /// # Errors
+    /// [`SolveError::BadGains`] for more than [`MAX_BANDS`] gains or a gain that is not
+    /// finite and positive; the gains are left as they were.
+    pub fn set_gains(&mut self, gains: &[f32]) -> Result<(), SolveError> {
+        if gains.len() > MAX_BANDS || !gains.iter().all(|g| g.is_finite() && *g > 0.0) {
+            return Err(SolveError::BadGains);
+        }
+        self.gains = [1.0; MAX_BANDS];
+        for (o, g) in self.gains.iter_mut().zip(gains) {
+            *o = *g;
+        }
+        self.balanced = gains.iter().any(|&g| g != 1.0);
+        Ok(())
+    }
+
+    /// The gain of each band ([`MAX_BANDS`] entries; 1 for bands not set).
+    pub fn gains(&self) -> &[f32; MAX_BANDS] {
+        &self.gains
     }
 
     /// Forgets every measurement.
@@ -146,6 +180,19 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
     /// The decoded patch after a successful solve (layout of [`PatchShape::index`]).
     pub fn patch(&self) -> &[f32; N] {
         &self.signal
+    }
+
+    /// Multiplies each band of the decoded patch by its gain: a white-balanced decode back
+    /// in the sensor's units. Gains of 1 leave it as it is (and cost nothing).
+    pub(crate) fn unbalance_patch(&mut self, gains: &[f32; B]) {
+        if gains.iter().all(|&g| g == 1.0) {
+            return;
+        }
+        for pixel in self.signal.as_chunks_mut::<B>().0 {
+            for (x, g) in pixel.iter_mut().zip(gains) {
+                *x *= g;
+            }
+        }
     }
 
     /// Limits the decoded patch to `[lo, hi]` (the sensor's physical range).

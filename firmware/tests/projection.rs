@@ -31,8 +31,9 @@ fn random_measurements<const B: usize, const N: usize>(seed: u64, per_pixel: usi
 }
 
 /// The projection in f64 with dense matrices onto the ball `sum r_i^2 / var_i <= m`,
-/// `var_i = noise^2 + shot * max(y_i, 0)` (both 0: exactly): returns the projected
-/// coefficients and the residual norm before the move.
+/// `var_i = (noise^2 + shot * max(y_i g, 0)) / g^2` with `g` the gain of entry `i`'s band
+/// (white-balanced values; both 0: exactly): returns the projected coefficients and the
+/// residual norm before the move.
 fn dense_projection(
     k: &[f64],
     n: usize,
@@ -40,13 +41,15 @@ fn dense_projection(
     m_idx: &[usize],
     y: &[f32],
     (noise, shot): (f64, f64),
+    gains: &[f64],
 ) -> (Vec<f64>, f64) {
     let x = dense_apply(k, n, s);
     let mut r = vec![0.0f64; n];
     let mut white2 = 0.0;
     for &i in m_idx {
         r[i] = f64::from(y[i]) - x[i];
-        white2 += r[i] * r[i] / (noise * noise + shot * f64::from(y[i]).max(0.0));
+        let g = gains[i % gains.len()];
+        white2 += r[i] * r[i] * g * g / (noise * noise + shot * (f64::from(y[i]) * g).max(0.0));
     }
     let norm = r.iter().map(|v| v * v).sum::<f64>().sqrt();
     let m = m_idx.len() as f64;
@@ -71,34 +74,50 @@ fn check<const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             let y: Vec<f32> = (0..N).map(|i| m.get(i).unwrap_or(0.0)).collect();
             let mut r = rng(99 + case as u64);
             let s: Vec<f32> = (0..N).map(|_| r.random_range(-1.0f32..1.0)).collect();
-            let (_, norm0) = dense_projection(&k, n, &s, &idx, &y, (0.0, 0.0));
+            let ones = vec![1.0f64; B];
+            let (_, norm0) = dense_projection(&k, n, &s, &idx, &y, (0.0, 0.0), &ones);
+            // White balance: gains from 1/30 to 3 (a tungsten scene's spread), and values
+            // divided by them.
+            let gains: Vec<f32> = (0..B).map(|b| 3.0 / (1.0 + 89.0 * b as f32 / B as f32)).collect();
             // The residual's RMS per measurement: a noise level of half of it puts the point
             // outside the ball, twice it inside.
             let rms = norm0 / (idx.len() as f64).sqrt();
             // Exact; uniform balls the point lies outside of and inside of; weighted balls
             // (shot noise: variance rising with the value in 0..1) outside and inside.
+            // With gains: uniform noise and shot noise, the point outside.
             let balls = [
-                (0.0, 0.0),
-                (0.5 * rms, 0.0),
-                (2.0 * rms, 0.0),
-                (0.0, 0.25 * rms * rms),
-                (0.5 * rms, 16.0 * rms * rms),
+                (0.0, 0.0, false),
+                (0.5 * rms, 0.0, false),
+                (2.0 * rms, 0.0, false),
+                (0.0, 0.25 * rms * rms, false),
+                (0.5 * rms, 16.0 * rms * rms, false),
+                (0.0, 0.0, true),
+                (0.5 * rms, 0.0, true),
+                (0.5 * rms, 16.0 * rms * rms, true),
             ];
-            for (noise, shot) in balls {
+            for (noise, shot, balanced) in balls {
                 let mut coeffs: Box<[f32; N]> = Box::new(s.clone().try_into().unwrap());
                 let mut scratch = Box::new([0.0f32; N]);
-                let ball = Ball::new(noise as f32, shot as f32, idx.len() as u32, 0); // radius^2 = m
+                let mut m = m.clone();
+                let g64: Vec<f64> = if balanced {
+                    m.set_gains(&gains).unwrap();
+                    gains.iter().map(|&g| f64::from(g)).collect()
+                } else {
+                    ones.clone()
+                };
+                let ball = Ball::new(noise as f32, shot as f32, idx.len() as u32, 0).balanced(balanced); // radius^2 = m
                 let residual = project_coefficients(&dict, &mut coeffs, &mut scratch, &m, &ball);
-                let (reference, norm) = dense_projection(&k, n, &s, &idx, &y, (noise, shot));
+                let (reference, norm) = dense_projection(&k, n, &s, &idx, &y, (noise, shot), &g64);
                 let e = rel_err(&coeffs[..], &reference);
                 assert!(e <= 2e-6, "dict {dseed}, {per_pixel} per pixel, noise {noise} shot {shot}: rel err {e}");
                 assert!((f64::from(residual) - norm).abs() <= 1e-5 * norm, "residual {residual} vs {norm}");
                 if reference.iter().zip(&s).all(|(a, &b)| *a == f64::from(b)) {
                     assert_eq!(&coeffs[..], &s[..], "inside the ball nothing moves");
-                    inside += 1;
+                    inside += usize::from(!balanced);
                 }
                 // Exactly projected coefficients synthesise to the measurements.
                 if noise == 0.0 && shot == 0.0 {
+                    assert!(!ball.is_weighted(), "an exact ball weighs nothing, gains or not");
                     let x = dense_apply(&k, n, &coeffs[..]);
                     let worst = idx.iter().map(|&i| (x[i] - f64::from(y[i])).abs()).fold(0.0, f64::max);
                     assert!(worst <= 1e-5, "off the measurements by {worst}");

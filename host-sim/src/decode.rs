@@ -16,7 +16,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use slf_firmware::{
     Dictionary, FrameSource, PaperShape, PaperWorkspace, PatchModel, PatchOrigin, PatchReport, PatchSink, Sl0Config,
-    SolveError, Tile, TileReport,
+    SolveError, Tile, TileDecoder, TileReport,
 };
 
 use crate::capture::Capture;
@@ -128,6 +128,20 @@ pub enum NoiseSource {
 /// above it, so it is off by default.
 pub const DEFAULT_STRIDE: (u8, u8) = (3, 3);
 
+/// The white balance of a decode ([`slf_firmware::gains`]): each band's measurements divided
+/// by a gain before the solve and the decoded patch multiplied back.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum Balance {
+    /// Gains of 1: the plain decode.
+    Off,
+    /// Grey world: each band's mean over the capture's valid samples
+    /// ([`slf_firmware::TileDecoder::estimate_gains`]), as the device does it.
+    #[default]
+    GreyWorld,
+    /// These gains (e.g. from a white reference or a known illuminant).
+    Gains([f32; 13]),
+}
+
 /// How to decode.
 #[derive(Clone, Copy, Debug)]
 pub struct DecodeOptions {
@@ -150,6 +164,8 @@ pub struct DecodeOptions {
     /// times the steps between the other lenslets ([`Seams::score`]); `None` decodes every
     /// shifted patch.
     pub adaptive: Option<f32>,
+    /// The white balance.
+    pub balance: Balance,
 }
 
 impl Default for DecodeOptions {
@@ -162,6 +178,7 @@ impl Default for DecodeOptions {
             stride: DEFAULT_STRIDE,
             window: Window::Tapered,
             adaptive: None,
+            balance: Balance::default(),
         }
     }
 }
@@ -183,6 +200,27 @@ impl DecodeOptions {
             (NoiseSource::Capture, None) => Sl0Config { noise: 0.0, shot: 0.0, ..self.sl0 },
         }
     }
+}
+
+/// The firmware's tile decoder for `capture` as [`decode`] runs it: the solver config of
+/// [`DecodeOptions::solver_config`] and the band gains of [`DecodeOptions::balance`]
+/// (estimated from the frame for [`Balance::GreyWorld`], as the device does).
+///
+/// # Errors
+/// A capture the decoder cannot take, or gains that are not finite and positive.
+pub fn tile_decoder<'a>(capture: &'a Capture, opts: &DecodeOptions) -> Result<TileDecoder<'a, 5, 5, 4, 4, 13, 5200>> {
+    let decoder = capture.decoder(opts.solver_config(capture))?;
+    let gains = match opts.balance {
+        Balance::Off => [1.0; 13],
+        Balance::GreyWorld => {
+            let raw = capture.raw_frames()?;
+            decoder
+                .estimate_gains(&mut FrameSource::new(&raw))
+                .map_err(|e| anyhow!("{}: cannot read the frame for its white balance: {e:?}", capture.source()))?
+        }
+        Balance::Gains(g) => g,
+    };
+    decoder.with_gains(&gains).map_err(|e| anyhow!("gains {gains:?}: {e}"))
 }
 
 /// The tiles of the patch grids shifted by `(dy, dx)` lenslets for every multiple of the
@@ -233,6 +271,8 @@ pub struct DecodeReport {
     pub uncovered: usize,
     /// Wall time, seconds.
     pub seconds: f64,
+    /// The band gains the decode used (1 without white balance).
+    pub gains: [f32; 13],
 }
 
 /// Weighted sums of the patch estimates over one tile's lenslets, all views and bands.
@@ -298,7 +338,8 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
     let start = Instant::now();
     let d = &capture.description;
     ensure!(d.bands_nm.len() == 13, "the decoder's patch has 13 bands, the capture {}", d.bands_nm.len());
-    let decoder = capture.decoder(opts.solver_config(capture))?;
+    let decoder = tile_decoder(capture, opts)?;
+    let gains = *decoder.gains();
     let raw = capture.raw_frames()?;
     ensure!(
         (1..=5).contains(&opts.stride.0) && (1..=5).contains(&opts.stride.1),
@@ -359,6 +400,7 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
     }
     let (lf, mut report) = aggregate(&results, views, lenslets, tiles.len());
     report.seconds = start.elapsed().as_secs_f64();
+    report.gains = gains;
     Ok((lf, report))
 }
 

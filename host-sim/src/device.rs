@@ -76,6 +76,8 @@ struct DeviceLog {
     patches: HashMap<PatchOrigin, DevicePatch>,
     rows: HashMap<(usize, usize), Vec<f32>>,
     count: usize,
+    /// The white balance's band gains.
+    gains: Vec<f32>,
 }
 
 /// Which printed block the `data` lines belong to.
@@ -89,9 +91,16 @@ fn parse(log: &str) -> Result<DeviceLog> {
     let mut rows: HashMap<(usize, usize), Vec<f32>> = HashMap::new();
     let mut current: Option<Block> = None;
     let mut done = None;
+    let mut gains = Vec::new();
     for (i, line) in log.lines().enumerate() {
         let w: Vec<&str> = line.split_whitespace().collect();
         match w.first().copied() {
+            Some("gains") => {
+                for h in &w[1..] {
+                    let bits = u32::from_str_radix(h, 16).with_context(|| format!("line {}: bad hex {h:?}", i + 1))?;
+                    gains.push(f32::from_bits(bits));
+                }
+            }
             Some("patch") => {
                 ensure!(w.len() >= 7, "line {}: short patch line", i + 1);
                 let n =
@@ -130,7 +139,7 @@ fn parse(log: &str) -> Result<DeviceLog> {
         }
     }
     let count = done.context("the device log has no `done` line: the run did not finish")?;
-    Ok(DeviceLog { patches, rows, count })
+    Ok(DeviceLog { patches, rows, count, gains })
 }
 
 struct Collect(HashMap<PatchOrigin, (u16, Vec<f32>)>);
@@ -149,13 +158,20 @@ impl PatchSink<5200> for Collect {
 /// A malformed log, a missing or extra patch, or a difference above 1e-5 relative.
 pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
     let text = std::fs::read_to_string(log).with_context(|| format!("cannot read {}", log.display()))?;
-    let DeviceLog { patches: device, rows, count } = parse(&text)?;
+    let DeviceLog { patches: device, rows, count, gains } = parse(&text)?;
     let capture = Capture::load(capture_dir)?;
     let ensemble = Ensemble::<5, 5, 4, 4, 13>::new(DEFAULT_ENSEMBLE).map_err(|e| anyhow::anyhow!("{e}"))?;
     let model = EnsembleModel::new(ensemble, MemberChoice::Screened(ChoiceRule::DEFAULT));
     // The config the device takes from `capture.rs`: the capture's noise ball.
     let decoder = capture.decoder(crate::decode::DecodeOptions::default().solver_config(&capture))?;
     let raw = capture.raw_frames()?;
+    // The white balance, as the host's default decode estimates it.
+    let host_gains = decoder.estimate_gains(&mut FrameSource::new(&raw)).map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    ensure!(gains.len() == 13, "the device printed {} gains, not 13", gains.len());
+    let worst_gain = gains.iter().zip(&host_gains).map(|(a, b)| (a - b).abs() / b).fold(0.0f32, f32::max);
+    println!("device vs host: white balance gains differ by {worst_gain:.2e} relative (limit 1e-5)");
+    ensure!(worst_gain <= 1e-5, "the device's gains {gains:?} differ from the host's {host_gains:?}");
+    let decoder = decoder.with_gains(&host_gains).map_err(|e| anyhow::anyhow!("{e}"))?;
     let mut host = Collect(HashMap::new());
     let mut ws = Box::new(slf_firmware::PaperWorkspace::new());
     for tile in decoder.tiles((1, 1)) {

@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 use slf_host::camera::{CameraConfig, simulate};
 use slf_host::capture::{Capture, MaskDescription};
-use slf_host::decode::{Basis, DecodeOptions, NoiseSource, decode_with, read_blob};
+use slf_host::decode::{Balance, Basis, DecodeOptions, NoiseSource, decode_with, read_blob};
 use slf_host::demosaic::Baseline;
 use slf_host::firmware::{ChoiceRule, DEFAULT_ENSEMBLE, MaskFamily, MemberChoice, Sl0Config};
 use slf_host::lightfield::{Dtype, read_npy, write_npy};
@@ -279,6 +279,24 @@ impl SolverArgs {
     }
 }
 
+/// `--balance`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum BalanceArg {
+    /// Each band's mean over the frame (grey world).
+    Grey,
+    /// No white balance (gains of 1).
+    Off,
+}
+
+impl BalanceArg {
+    fn balance(self) -> Balance {
+        match self {
+            Self::Grey => Balance::GreyWorld,
+            Self::Off => Balance::Off,
+        }
+    }
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// Simulate a default scene with the pixel mask at k = 1 and k = 3, decode, report, preview.
@@ -389,6 +407,14 @@ enum Command {
         /// this many times those between its other lenslets.
         #[arg(long)]
         adaptive: Option<f32>,
+        /// White balance: each band divided by a gain before the solve and multiplied back
+        /// (grey: each band's mean over the frame, as the device does it).
+        #[arg(long, value_enum, default_value_t = BalanceArg::Grey)]
+        balance: BalanceArg,
+        /// The 13 band gains, comma-separated (e.g. from a white reference); replaces
+        /// --balance.
+        #[arg(long, value_delimiter = ',', num_args = 13)]
+        gains: Option<Vec<f32>>,
         /// Stored dtype.
         #[arg(long, value_enum, default_value_t = Dtype::F32)]
         dtype: Dtype,
@@ -455,6 +481,10 @@ enum Command {
         /// ensemble's cards of chart colours under D65).
         #[arg(long, value_enum, default_value_t = GeneratorArg::Realistic)]
         generator: GeneratorArg,
+        /// White balance of the training light fields, as the decoder balances a capture
+        /// (grey: each band divided by its mean over the light field).
+        #[arg(long, value_enum, default_value_t = BalanceArg::Grey)]
+        balance: BalanceArg,
     },
     /// PSNR / SSIM / SA of every test scene x mask family x k, decoded with --dictionary
     /// (default: the shipped ensemble, screened); a markdown table.
@@ -658,10 +688,24 @@ fn run(cli: Cli) -> Result<()> {
             stride,
             window,
             adaptive,
+            balance,
+            gains,
             dtype,
             quiet,
         } => {
             let cap = Capture::load(&capture)?;
+            let balance = match gains {
+                Some(g) => {
+                    let g: [f32; 13] =
+                        g.try_into().map_err(|g: Vec<f32>| anyhow::anyhow!("--gains: 13 values, got {}", g.len()))?;
+                    anyhow::ensure!(
+                        g.iter().all(|x| x.is_finite() && *x > 0.0),
+                        "--gains: every gain must be finite and positive"
+                    );
+                    Balance::Gains(g)
+                }
+                None => balance.balance(),
+            };
             if method != Method::Cs {
                 anyhow::ensure!(member_map.is_none(), "--member-map needs --method cs (baselines use no ensemble)");
                 let baseline = match method {
@@ -688,6 +732,7 @@ fn run(cli: Cli) -> Result<()> {
                 stride: (stride as u8, stride as u8),
                 window: window.window(),
                 adaptive,
+                balance,
                 ..DecodeOptions::default()
             };
             if let Some(a) = adaptive {
@@ -738,6 +783,12 @@ fn run(cli: Cli) -> Result<()> {
                 (NoiseSource::Config, true) => format!("noise sd {:.2e} + shot {:.2e} per unit", used.noise, used.shot),
             };
             println!("projection: {ball}");
+            let gains: Vec<String> = r.gains.iter().map(|g| format!("{g:.3}")).collect();
+            match balance {
+                Balance::Off => println!("white balance: off"),
+                Balance::GreyWorld => println!("white balance: grey world, gains {}", gains.join(" ")),
+                Balance::Gains(_) => println!("white balance: given gains {}", gains.join(" ")),
+            }
             println!(
                 "decoded {} patches ({} flagged, {} failed, {} tiles failed) in {:.2} s; wrote {}",
                 r.patches.decoded,
@@ -808,6 +859,7 @@ fn run(cli: Cli) -> Result<()> {
             seed,
             no_dct_member,
             generator,
+            balance,
         } => {
             let cfg = train::TrainConfig {
                 members,
@@ -826,6 +878,10 @@ fn run(cli: Cli) -> Result<()> {
                 train::training_fields(scenes, size, 1000 + seed, generator)
             } else {
                 input.iter().map(|p| read_npy(p)).collect::<Result<Vec<_>, _>>()?
+            };
+            let fields = match balance {
+                BalanceArg::Grey => fields.iter().map(train::white_balanced).collect(),
+                BalanceArg::Off => fields,
             };
             train::train_blob(&fields, patches, &cfg, &output)
         }

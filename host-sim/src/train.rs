@@ -357,6 +357,28 @@ pub fn train(patches: &[f32], cfg: &TrainConfig) -> (Vec<PaperDictionary>, Vec<I
     (members.iter().map(Member::dictionary).collect(), reports)
 }
 
+/// `lf` white-balanced as the decoder balances a capture: each band divided by its
+/// grey-world gain ([`slf_firmware::gains::gains_from_sums`] over every value), so that
+/// members learn the spectra the decoder sees, with the illuminant's tilt taken out.
+pub fn white_balanced(lf: &LightField) -> LightField {
+    let bands = lf.bands;
+    let mut sums = [0.0f64; 13];
+    let mut counts = [0u32; 13];
+    if bands != 13 {
+        return lf.clone();
+    }
+    for (i, &x) in lf.data.iter().enumerate() {
+        sums[i % 13] += f64::from(x);
+        counts[i % 13] += 1;
+    }
+    let gains = slf_firmware::gains::gains_from_sums(&sums.map(|s| s as f32), &counts);
+    let mut out = lf.clone();
+    for (i, x) in out.data.iter_mut().enumerate() {
+        *x /= gains[i % 13];
+    }
+    out
+}
+
 /// Which scene generator training renders.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Generator {

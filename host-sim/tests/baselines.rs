@@ -168,11 +168,12 @@ fn ppid_follows_a_brightness_edge() {
 /// one block, measures k < 5 bands and is interpolated per pixel, so the CS decode is the
 /// interpolation baseline (1e-6); with `min_bands` 0 SL0 solves every patch and lands
 /// well below it (measured: 4.7 against 14.7 dB at k = 1, 6.6 against 21.8 at k = 3). At stride 2 and k = 3 the
-/// patches across blocks (up to 12 bands) are solved.
+/// patches across blocks (up to 12 bands) are solved. Without white balance: the baseline
+/// interpolates the sensor's values, the balanced decode the balanced ones.
 #[test]
 fn kronecker_patches_with_too_few_bands_are_interpolated() {
     use slf_host::capture::MaskDescription;
-    use slf_host::decode::{Basis, DecodeOptions, decode_with};
+    use slf_host::decode::{Balance, Basis, DecodeOptions, decode_with};
     use slf_host::firmware::{MaskFamily, Sl0Config};
     let truth = LightField::from_fn((5, 5), 20, 15, 13, |u, v, y, x, b| {
         0.2 + 0.03 * b as f32
@@ -183,12 +184,12 @@ fn kronecker_patches_with_too_few_bands_are_interpolated() {
         let cam = CameraConfig::pixel(3, k).noiseless().with_mask(MaskDescription::seeded(MaskFamily::Kronecker, 3, k));
         let cap = simulate(&truth, &cam).unwrap();
         let (interp, _) = interpolate(&cap).unwrap();
-        let (cs, report) = decode_with(&cap, &Basis::default_ensemble(), &DecodeOptions::disjoint()).unwrap();
+        let plain = DecodeOptions { balance: Balance::Off, ..DecodeOptions::disjoint() };
+        let (cs, report) = decode_with(&cap, &Basis::default_ensemble(), &plain).unwrap();
         assert_eq!(report.solves, 0, "k {k}: a patch was solved");
         let worst = cs.data.iter().zip(&interp.data).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
         assert!(worst <= 1e-6, "k {k}: CS vs interpolation differ by {worst}");
-        let paper =
-            DecodeOptions { sl0: Sl0Config { min_bands: 0, ..Sl0Config::DEFAULT }, ..DecodeOptions::disjoint() };
+        let paper = DecodeOptions { sl0: Sl0Config { min_bands: 0, ..Sl0Config::DEFAULT }, ..plain };
         let (solved, report) = decode_with(&cap, &Basis::default_ensemble(), &paper).unwrap();
         assert!(report.solves > 0);
         let (p_solved, p_interp) = (evaluate(&truth, &solved).unwrap().psnr, evaluate(&truth, &interp).unwrap().psnr);

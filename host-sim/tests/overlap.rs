@@ -2,7 +2,7 @@
 //! (a one-patch tile each), then averaged with the window's weights in f64.
 
 use slf_host::camera::{CameraConfig, simulate};
-use slf_host::decode::{Basis, DecodeOptions, Window, decode_with};
+use slf_host::decode::{Basis, DecodeOptions, Window, decode_with, tile_decoder};
 use slf_host::firmware::{
     Dictionary, FrameSource, Overlap, OverlapDecoder, PaperShape, PaperWorkspace, PatchOrigin, PatchReport, PatchSink,
     RowSink, SolveError, Tile,
@@ -37,8 +37,9 @@ fn origins(total: usize, off: usize) -> Vec<usize> {
 
 fn reference(truth: &LightField, k: u8, stride: usize, window: Window) -> Vec<f32> {
     let capture = simulate(truth, &CameraConfig::pixel(3, k)).unwrap();
-    // The solver config `decode_with` uses: the capture's noise ball.
-    let decoder = capture.decoder(DecodeOptions::default().solver_config(&capture)).unwrap();
+    // The solver config `decode_with` uses: the capture's noise ball, and the white balance
+    // (the gains are the frame's; a patch decoded alone uses the same ones).
+    let decoder = tile_decoder(&capture, &DecodeOptions::default()).unwrap();
     let raw = capture.raw_frames().unwrap();
     let dct = Dictionary::dct();
     let mut ws = Box::new(PaperWorkspace::new());
@@ -103,7 +104,7 @@ fn overlapping_patches_average_as_every_patch_decoded_alone() {
         // The device's strip walks the same patches: the same light field, in bands of 4
         // lenslet columns (patches straddling a band border decoded twice).
         let overlap = Overlap { stride: (stride as u8, stride as u8), window };
-        let od = OverlapDecoder::new(capture.decoder(opts.solver_config(&capture)).unwrap(), overlap).unwrap();
+        let od = OverlapDecoder::new(tile_decoder(&capture, &opts).unwrap(), overlap).unwrap();
         let mut strip = vec![0.0f32; od.strip_per_column() * 4];
         let mut rows = Rows(LightField::zeros(truth.views, truth.rows, truth.cols, 13));
         let raw = capture.raw_frames().unwrap();

@@ -180,6 +180,19 @@ mod device {
             hprintln!("error: decoder config rejected");
             return debug::EXIT_FAILURE;
         };
+        // White balance (the host's default): one pass over the frame for each band's mean.
+        bench_begin(4);
+        let gains = decoder.estimate_gains(&mut FrameSource::new(&frames));
+        bench_end(4);
+        let Ok(decoder) = gains.map_err(|_| ()).and_then(|g| decoder.with_gains(&g).map_err(|_| ())) else {
+            hprintln!("error: the frame's white balance could not be estimated");
+            return debug::EXIT_FAILURE;
+        };
+        hprint!("gains");
+        for g in decoder.gains() {
+            hprint!(" {:08x}", g.to_bits());
+        }
+        hprintln!();
         let Some(model) = model() else {
             hprintln!("error: the shipped ensemble does not validate");
             return debug::EXIT_FAILURE;
