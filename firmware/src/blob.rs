@@ -25,9 +25,9 @@ use crate::dictionary::{Dictionary, DictionaryError, Factors, Matrix};
 
 /// The shipped default ensemble for the paper's patch (5 x 5 x 4 x 4 x 13): 8 members
 /// trained by `cargo run --release -p slf-host -- train -o firmware/dictionaries/ensemble8.slfd`
-/// (all defaults: 24 random training scenes of 60 x 60 lenslets, 6,000 patches, tau 100,
-/// 10 iterations, seed 1; member 0 is the fixed 5D DCT) on random scenes only, never the
-/// named test scenes.
+/// (all defaults: 48 realistic training scenes of 60 x 60 lenslets, white-balanced as the
+/// decoder balances a capture, 20,000 patches, tau 100, 10 iterations, seed 1; member 0 is
+/// the fixed 5D DCT) on rendered scenes only, never the named test scenes or real data.
 /// `Ensemble::<5, 5, 4, 4, 13>::new(DEFAULT_ENSEMBLE)` validates it.
 pub static DEFAULT_ENSEMBLE: &[u8] = include_bytes!("../dictionaries/ensemble8.slfd");
 

@@ -450,13 +450,13 @@ enum Command {
         #[arg(long, num_args = 1..)]
         input: Vec<PathBuf>,
         /// Random training scenes to render when no --input is given, 1..=1000.
-        #[arg(long, default_value_t = 24, value_parser = ranged::<1, 1000>)]
+        #[arg(long, default_value_t = 48, value_parser = ranged::<1, 1000>)]
         scenes: usize,
         /// Spatial size of each rendered training scene, 5..=1024.
         #[arg(long, default_value_t = 60, value_parser = ranged::<5, 1024>)]
         size: usize,
         /// Patches sampled for training, 1..=1000000.
-        #[arg(long, default_value_t = 6000, value_parser = ranged::<1, 1_000_000>)]
+        #[arg(long, default_value_t = 20_000, value_parser = ranged::<1, 1_000_000>)]
         patches: usize,
         /// Members K, 1..=256.
         #[arg(long, default_value_t = 8, value_parser = ranged::<1, 256>)]
