@@ -413,7 +413,7 @@ enum Command {
         balance: BalanceArg,
         /// The 13 band gains, comma-separated (e.g. from a white reference); replaces
         /// --balance.
-        #[arg(long, value_delimiter = ',', num_args = 13)]
+        #[arg(long, value_delimiter = ',', value_name = "G1,...,G13")]
         gains: Option<Vec<f32>>,
         /// Stored dtype.
         #[arg(long, value_enum, default_value_t = Dtype::F32)]
@@ -610,6 +610,10 @@ fn main() -> ExitCode {
     };
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
+        // The reader of our output went away (`| head`): it has what it wanted.
+        Err(e) if e.downcast_ref::<std::io::Error>().is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe) => {
+            ExitCode::SUCCESS
+        }
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::FAILURE
@@ -802,9 +806,13 @@ fn run(cli: Cli) -> Result<()> {
         }
         Command::Eval { truth, recon } => {
             let m = evaluate(&read_npy(&truth)?, &read_npy(&recon)?)?;
-            println!("PSNR {:.3} dB (data range {:.6} = max of ground truth)", m.psnr, m.data_range);
-            println!("SSIM {:.4}", m.ssim);
-            println!("SA   {:.3} deg", m.sa);
+            // Written, not `println!`: a reader that stops early (`slf eval A B | head -1`)
+            // closes the pipe, and `println!` panics on that.
+            use std::io::Write;
+            let mut out = std::io::stdout().lock();
+            writeln!(out, "PSNR {:.3} dB (data range {:.6} = max of ground truth)", m.psnr, m.data_range)?;
+            writeln!(out, "SSIM {:.4}", m.ssim)?;
+            writeln!(out, "SA   {:.3} deg", m.sa)?;
             Ok(())
         }
         Command::Baseline { patches, mask, snapshots } => baseline::compare_1d(patches, mask.family(), snapshots),

@@ -22,6 +22,13 @@ fn failure(cmd: &mut Command) -> String {
     err
 }
 
+/// Whether the default decode of `cap` reports its grey-world gains.
+fn out_default_has_gains(cap: &std::path::Path) -> bool {
+    let dir = tempfile::tempdir().unwrap();
+    let out = stdout(slf().arg("decode").arg(cap).arg("-o").arg(dir.path().join("x.npy")).arg("-q"));
+    out.contains("white balance: grey world, gains ")
+}
+
 #[test]
 fn scene_simulate_decode_eval_round_trip() {
     let dir = tempfile::tempdir().unwrap();
@@ -53,6 +60,27 @@ fn scene_simulate_decode_eval_round_trip() {
     let psnr: f64 = out.split_whitespace().nth(1).unwrap().parse().unwrap();
     assert!(psnr > 30.0, "{out}");
     assert!(out.contains("data range") && out.contains("SSIM") && out.contains("SA"), "{out}");
+    // A reader that closes the pipe before slf writes (`slf eval A B | head`) is no error.
+    let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("slf"))
+        .arg("eval")
+        .arg(p("truth.npy"))
+        .arg(p("recon.npy"))
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let done = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&done.stderr);
+    assert!(done.status.success() && !err.contains("panicked"), "{:?}: {err}", done.status);
+    // The white balance: grey world by default, off, or given gains (13 of them).
+    assert!(out_default_has_gains(&p("cap")), "no white balance line");
+    let off = stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("x.npy")).args(["--balance", "off", "-q"]));
+    assert!(off.contains("white balance: off"), "{off}");
+    let ones = vec!["1"; 13].join(",");
+    let given = stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("x.npy")).args(["--gains", &ones, "-q"]));
+    assert!(given.contains("white balance: given gains 1.000 1.000"), "{given}");
+    failure(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("x.npy")).args(["--gains", "1,2,3"]));
     // The DCT on request, and the member map of the (default) ensemble decode.
     let out = stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("dct.npy")).args(["--dictionary", "dct", "-q"]));
     assert!(out.contains("decoded 196 patches"), "{out}");
