@@ -365,42 +365,47 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
 
     /// Grey-world band gains of a frame: every valid sample of the sensor (defects and
     /// invalid samples left out) summed per band ([`crate::gains::gains_from_sums`]).
-    /// Reads the frame once, one sensor row at a time in runs of up to 64 samples.
+    /// Reads the frame once, one sensor row at a time in runs of up to 16 samples per
+    /// snapshot.
     ///
     /// # Errors
     /// The source's error; nothing is estimated then.
     pub fn estimate_gains<S: TileSource>(&self, source: &mut S) -> Result<[f32; B], S::Error> {
-        const RUN: usize = 64;
+        const RUN: usize = 16;
         let c = &self.config;
         let (rows, cols) = c.sensor.frame_size();
+        let k = c.mask.snapshots();
         let mut sums = [0.0f32; B];
         let mut counts = [0u32; B];
-        let mut run = [0.0f32; RUN];
-        for snapshot in 0..c.mask.snapshots() {
-            for row in 0..rows {
-                // Per row in f32, then added to the totals: a frame's sum in one f32 would
-                // lose the small bands' low digits.
-                let mut row_sums = [0.0f32; B];
-                for col0 in (0..cols).step_by(RUN) {
-                    let len = RUN.min(cols - col0);
+        // A pixel measures at most `B` distinct bands, so `k <= B` (checked by the mask).
+        let mut runs = [[0.0f32; RUN]; B];
+        for row in 0..rows {
+            // Per row in f32, then added to the totals: a frame's sum in one f32 would lose
+            // the small bands' low digits.
+            let mut row_sums = [0.0f32; B];
+            for col0 in (0..cols).step_by(RUN) {
+                let len = RUN.min(cols - col0);
+                for (j, run) in runs.iter_mut().enumerate().take(k) {
                     let Some(out) = run.get_mut(..len) else { break };
-                    source.read(snapshot, row, col0, out)?;
-                    for (dc, &raw) in out.iter().enumerate() {
-                        let col = col0 + dc;
-                        if c.defects.contains(row, col) {
-                            continue;
-                        }
-                        let Ok(y) = c.raw.classify(raw) else { continue };
-                        let band = c.mask.bands_at(row, col).get(snapshot).copied().unwrap_or(0) as usize;
-                        if let (Some(s), Some(n)) = (row_sums.get_mut(band), counts.get_mut(band)) {
+                    source.read(j, row, col0, out)?;
+                }
+                for dc in 0..len {
+                    let col = col0 + dc;
+                    if c.defects.contains(row, col) {
+                        continue;
+                    }
+                    // One band list per pixel, every snapshot's sample against it.
+                    for (band, run) in c.mask.bands_at(row, col).iter().zip(&runs) {
+                        let Ok(y) = c.raw.classify(run.get(dc).copied().unwrap_or(f32::NAN)) else { continue };
+                        if let (Some(s), Some(n)) = (row_sums.get_mut(*band as usize), counts.get_mut(*band as usize)) {
                             *s += y;
                             *n += 1;
                         }
                     }
                 }
-                for (t, r) in sums.iter_mut().zip(&row_sums) {
-                    *t += r;
-                }
+            }
+            for (t, r) in sums.iter_mut().zip(&row_sums) {
+                *t += r;
             }
         }
         Ok(crate::gains::gains_from_sums(&sums, &counts))

@@ -162,16 +162,15 @@ pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
     let capture = Capture::load(capture_dir)?;
     let ensemble = Ensemble::<5, 5, 4, 4, 13>::new(DEFAULT_ENSEMBLE).map_err(|e| anyhow::anyhow!("{e}"))?;
     let model = EnsembleModel::new(ensemble, MemberChoice::Screened(ChoiceRule::DEFAULT));
-    // The config the device takes from `capture.rs`: the capture's noise ball.
-    let decoder = capture.decoder(crate::decode::DecodeOptions::default().solver_config(&capture))?;
+    // The config the device takes from `capture.rs` (the capture's noise ball) and its white
+    // balance: the host's default.
+    let decoder = crate::decode::tile_decoder(&capture, &crate::decode::DecodeOptions::default())?;
     let raw = capture.raw_frames()?;
-    // The white balance, as the host's default decode estimates it.
-    let host_gains = decoder.estimate_gains(&mut FrameSource::new(&raw)).map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    let host_gains = *decoder.gains();
     ensure!(gains.len() == 13, "the device printed {} gains, not 13", gains.len());
     let worst_gain = gains.iter().zip(&host_gains).map(|(a, b)| (a - b).abs() / b).fold(0.0f32, f32::max);
     println!("device vs host: white balance gains differ by {worst_gain:.2e} relative (limit 1e-5)");
     ensure!(worst_gain <= 1e-5, "the device's gains {gains:?} differ from the host's {host_gains:?}");
-    let decoder = decoder.with_gains(&host_gains).map_err(|e| anyhow::anyhow!("{e}"))?;
     let mut host = Collect(HashMap::new());
     let mut ws = Box::new(slf_firmware::PaperWorkspace::new());
     for tile in decoder.tiles((1, 1)) {

@@ -703,7 +703,7 @@ fn run(cli: Cli) -> Result<()> {
                     let g: [f32; 13] =
                         g.try_into().map_err(|g: Vec<f32>| anyhow::anyhow!("--gains: 13 values, got {}", g.len()))?;
                     anyhow::ensure!(
-                        g.iter().all(|x| x.is_finite() && *x > 0.0),
+                        slf_host::firmware::gains::valid(&g),
                         "--gains: every gain must be finite and positive"
                     );
                     Balance::Gains(g)
