@@ -19,9 +19,10 @@
 //! - **sensing** ([`mask`], [`gains`]): which band each pixel sees in each snapshot; the
 //!   three mask families `kronecker`, `lenslet`, `pixel`; and the white balance, a gain per
 //!   band that the decode divides out of the measurements and multiplies back.
-//! - **operators** ([`shape`], [`dct`], [`dictionary`], [`blob`], [`transform`]): the patch
-//!   geometry in the types, dictionaries (the 5D DCT and blobs in flash) and the separable
-//!   synthesis and analysis transforms.
+//! - **operators** ([`shape`], [`disparity`], [`dct`], [`dictionary`], [`blob`],
+//!   [`transform`]): the patch geometry in the types, sheared patches that align the views
+//!   on a depth, dictionaries (the 5D DCT and blobs in flash) and the separable synthesis
+//!   and analysis transforms.
 //! - **solver** ([`sl0`], [`ascent`], [`ball`], [`projection`], [`pinv`], [`choice`],
 //!   [`interpolate`]): nD SL0 with the orthonormal fast path, the noise ball a projection
 //!   moves onto, the paper's general pseudo-inverse path for kronecker masks, the choice of
@@ -99,6 +100,7 @@ pub mod choice;
 pub mod dct;
 pub mod defects;
 pub mod dictionary;
+pub mod disparity;
 pub mod gains;
 pub mod interpolate;
 pub mod mask;
@@ -122,6 +124,7 @@ pub use blob::{DEFAULT_ENSEMBLE, Ensemble};
 pub use choice::{ChoiceRule, EnsembleModel, MemberChoice, ModelOutcome, PatchModel};
 pub use defects::{DefectList, Pixel};
 pub use dictionary::{Dictionary, DictionaryError};
+pub use disparity::DisparityRange;
 pub use mask::{BandTile, LensletSize, Mask, MaskFamily, SensingError};
 pub use overlap::{Overlap, OverlapDecoder, OverlapError, OverlapReport, RowSink, Window};
 pub use prelude::{PAPER_N, PaperDecoder, PaperDictionary, PaperEnsemble, PaperEnsembleModel, PaperPatch, SetupError};

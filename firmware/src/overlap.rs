@@ -94,6 +94,8 @@ pub struct OverlapReport {
     pub source_failures: u32,
     /// Values no decoded patch covered (sent as 0).
     pub uncovered: u32,
+    /// Values of a view no sheared patch covered, taken from the lenslet's other views.
+    pub filled: u32,
     /// Vertical bands the frame was decoded in.
     pub bands: u16,
 }
@@ -179,11 +181,24 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         (l.rows as usize, l.cols as usize)
     }
 
-    /// `f32`s of the strip per lenslet column: `PS` rows of every view's `B` sums and one
-    /// weight.
+    /// Lenslets a sheared patch reaches beyond its rectangle (rows, cols): the halo of
+    /// the tile decoder's disparity range ([`crate::disparity`]; 0 when it is off).
+    fn halo(&self) -> (usize, usize) {
+        let (u, v) = self.views();
+        let range = self.tiles.disparities();
+        (range.halo(u), range.halo(v))
+    }
+
+    /// Lenslet rows the ring keeps: a patch's `PS` and its halo above and below.
+    fn ring_rows(&self) -> usize {
+        PS + 2 * self.halo().0
+    }
+
+    /// `f32`s of the strip per lenslet column: `PS` rows (and the rows a sheared patch
+    /// reaches beyond them) of every view's `B` sums and one weight.
     pub fn strip_per_column(&self) -> usize {
         let (u, v) = self.views();
-        PS * u * v * (B + 1)
+        self.ring_rows() * u * v * (B + 1)
     }
 
     /// `f32`s of a strip that decodes the whole sensor width in one band.
@@ -217,7 +232,8 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         c0: usize,
         c1: usize,
     ) -> impl Iterator<Item = usize> + use<'_, 'a, PS, PT, PU, PV, B, N> {
-        (c0.saturating_sub(PT - 1)..c1).flat_map(move |c| core::iter::repeat_n(c, self.starts_at(r, c)))
+        let h = self.halo().1;
+        (c0.saturating_sub(PT - 1 + h)..c1 + h).flat_map(move |c| core::iter::repeat_n(c, self.starts_at(r, c)))
     }
 
     /// Patch solves (angular windows included) a frame costs when the strip holds `band`
@@ -256,6 +272,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             return Err(OverlapError::Strip);
         }
         let (vu, vv) = self.views();
+        let halo = self.halo().0;
         let mut report = OverlapReport::default();
         for (c0, c1) in bands(cols, band) {
             report.bands += 1;
@@ -263,14 +280,16 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                 strip: &mut *strip,
                 first_col: c0,
                 cols: c1 - c0,
+                rows: self.ring_rows(),
+                frame_rows: rows,
                 views: (vu, vv),
                 window: self.overlap.window,
             };
             ring.clear();
             let mut next_row = 0;
             for r in 0..rows {
-                // Rows above `r` are finished: no later patch reaches them.
-                while next_row < r {
+                // Rows above `r - halo` are finished: no later patch reaches them.
+                while next_row + halo < r {
                     ring.flush(next_row, sink, &mut report)?;
                     next_row += 1;
                 }
@@ -296,12 +315,17 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     }
 }
 
-/// The strip during one band: `PS` slots of `cols` lenslets, each slot the sums
-/// `(col, u, v, b)` and then the weights `(col, u, v)`; lenslet row `y` is in slot `y % PS`.
+/// The strip during one band: `rows` slots of `cols` lenslets, each slot the sums
+/// `(col, u, v, b)` and then the weights `(col, u, v)`; lenslet row `y` is in slot
+/// `y % rows`.
 struct Ring<'s, const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize> {
     strip: &'s mut [f32],
     first_col: usize,
     cols: usize,
+    /// Slots: `PS` and the shear's halo above and below.
+    rows: usize,
+    /// Lenslet rows of the sensor: a sheared value beyond them is dropped.
+    frame_rows: usize,
     views: (usize, usize),
     window: Window,
 }
@@ -314,21 +338,23 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
     }
 
     fn clear(&mut self) {
-        let n = PS * self.slot_len();
+        let n = self.rows * self.slot_len();
         if let Some(s) = self.strip.get_mut(..n) {
             s.fill(0.0);
         }
     }
 
-    /// Slot `y % PS` split into its sums and weights.
+    /// Slot `y % rows` split into its sums and weights.
     fn slot(&mut self, y: usize) -> Option<(&mut [f32], &mut [f32])> {
         let len = self.slot_len();
         let sums = self.cols * self.views.0 * self.views.1 * B;
-        let start = (y % PS) * len;
+        let start = (y % self.rows.max(1)) * len;
         self.strip.get_mut(start..start + len).map(|s| s.split_at_mut(sums.min(len)))
     }
 
-    /// Divides row `y` by its weights, sends it, and clears its slot.
+    /// Divides row `y` by its weights, sends it, and clears its slot. A view of a lenslet
+    /// that no patch covered (sheared patches can leave one at the frame's edge or between
+    /// blocks sheared apart) takes the mean of the lenslet's covered views.
     fn flush<K: RowSink>(
         &mut self,
         y: usize,
@@ -336,18 +362,36 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
         report: &mut OverlapReport,
     ) -> Result<(), OverlapError<K::Error>> {
         let first_col = self.first_col as u16;
+        let views = self.views.0 * self.views.1;
         let Some((sums, weights)) = self.slot(y) else {
             return Ok(());
         };
-        for (values, w) in sums.chunks_exact_mut(B).zip(weights.iter_mut()) {
-            if *w > 0.0 {
-                for x in values.iter_mut() {
-                    *x /= *w;
+        for (lenslet, lw) in sums.chunks_exact_mut(views * B).zip(weights.chunks_exact_mut(views)) {
+            let mut mean = [0.0f32; B];
+            let mut covered = 0u32;
+            for (values, w) in lenslet.chunks_exact_mut(B).zip(lw.iter()) {
+                if *w > 0.0 {
+                    for (x, m) in values.iter_mut().zip(mean.iter_mut()) {
+                        *x /= *w;
+                        *m += *x;
+                    }
+                    covered += 1;
                 }
-            } else {
-                report.uncovered += B as u32;
             }
-            *w = 0.0;
+            if covered == 0 {
+                report.uncovered += (views * B) as u32;
+            } else if covered < views as u32 {
+                for m in mean.iter_mut() {
+                    *m /= covered as f32;
+                }
+                for (values, w) in lenslet.chunks_exact_mut(B).zip(lw.iter()) {
+                    if *w <= 0.0 {
+                        values.copy_from_slice(&mean);
+                        report.filled += B as u32;
+                    }
+                }
+            }
+            lw.fill(0.0);
         }
         let sent = sink.row(y as u16, first_col, sums).map_err(OverlapError::Sink);
         sums.fill(0.0);
@@ -362,19 +406,25 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
 
     fn accept(&mut self, o: PatchOrigin, patch: &[f32; N], _: &PatchReport) -> Result<(), Self::Error> {
         let (vu, vv) = self.views;
-        let (first, cols, window) = (self.first_col, self.cols, self.window);
+        let (first, cols, window, frame_rows) = (self.first_col, self.cols, self.window, self.frame_rows);
         for s in 0..PS {
-            let Some((sums, weights)) = self.slot(o.lenslet_row as usize + s) else {
-                continue;
-            };
-            for t in 0..PT {
-                let col = o.lenslet_col as usize + t;
-                let Some(c) = col.checked_sub(first).filter(|&c| c < cols) else {
-                    continue;
-                };
-                let w = window.weight::<PS, PT>(s, t);
-                for u in 0..PU {
+            for u in 0..PU {
+                for t in 0..PT {
+                    let w = window.weight::<PS, PT>(s, t);
                     for v in 0..PV {
+                        // The pixel the value was read from (sheared patches: shifted per view).
+                        let (row, col) = o.lenslet(s, t, u, v, (vu, vv));
+                        let Some(c) =
+                            usize::try_from(col).ok().and_then(|c| c.checked_sub(first)).filter(|&c| c < cols)
+                        else {
+                            continue;
+                        };
+                        let Some(row) = usize::try_from(row).ok().filter(|&r| r < frame_rows) else {
+                            continue;
+                        };
+                        let Some((sums, weights)) = self.slot(row) else {
+                            continue;
+                        };
                         let at = (c * vu + o.view_row as usize + u) * vv + o.view_col as usize + v;
                         let i = PatchShape::<PS, PT, PU, PV, B, N>::pixel_index(s, t, u, v);
                         let (Some(dst), Some(src), Some(wt)) =

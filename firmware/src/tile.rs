@@ -22,6 +22,7 @@ use core::num::NonZeroUsize;
 
 use crate::choice::{ModelOutcome, PatchModel};
 use crate::defects::DefectList;
+use crate::disparity::{Best, Consistency, DisparityRange, shift};
 use crate::interpolate::{bands_measured, interpolate_bands};
 use crate::log::log;
 use crate::mask::{LensletSize, Mask, MaskFamily};
@@ -91,7 +92,8 @@ pub struct Tile {
     pub lenslet_cols: u16,
 }
 
-/// Where a patch sits: its first lenslet and its angular window's first view.
+/// Where a patch sits: its first lenslet, its angular window's first view, and the
+/// disparity it was sheared to ([`crate::disparity`]; 0: unsheared).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct PatchOrigin {
@@ -99,6 +101,22 @@ pub struct PatchOrigin {
     pub lenslet_col: u16,
     pub view_row: u8,
     pub view_col: u8,
+    pub disparity: i8,
+}
+
+impl PatchOrigin {
+    /// The sensor lenslet (row, col) whose pixel holds the patch's value at lenslet
+    /// `(s, t)`, view `(u, v)` of its window, for lenslets of `views` (rows, cols) views:
+    /// the patch's own lenslet shifted by the shear. May lie outside the sensor (a
+    /// sheared patch reaches beyond its rectangle; such values were not measured and a
+    /// sink drops them).
+    #[inline]
+    pub fn lenslet(&self, s: usize, t: usize, u: usize, v: usize, views: (usize, usize)) -> (isize, isize) {
+        let d = self.disparity;
+        let du = crate::disparity::shift(d, self.view_row as usize + u, views.0);
+        let dv = crate::disparity::shift(d, self.view_col as usize + v, views.1);
+        ((self.lenslet_row as usize + s) as isize + du, (self.lenslet_col as usize + t) as isize + dv)
+    }
 }
 
 /// Why samples of a patch were left out, as bits.
@@ -286,6 +304,7 @@ pub struct TileDecoder<
 > {
     config: DecoderConfig<'a>,
     gains: [f32; B],
+    disparities: DisparityRange,
 }
 
 /// Origins of the angular windows along one axis: `ceil(views / patch)` windows of
@@ -337,7 +356,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             return Err(ConfigError::RawFormat);
         }
         sl0.validate().map_err(ConfigError::Solver)?;
-        Ok(Self { config, gains: [1.0; B] })
+        Ok(Self { config, gains: [1.0; B], disparities: DisparityRange::OFF })
     }
 
     /// The checked config.
@@ -361,6 +380,20 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     /// The band gains the decode uses.
     pub fn gains(&self) -> &[f32; B] {
         &self.gains
+    }
+
+    /// This decoder with each spatial block sheared to the disparity of `range` its
+    /// measurements agree with best ([`crate::disparity`]): the block's patches read, and
+    /// report in [`PatchOrigin::disparity`], sheared pixels. A sink must place a patch's
+    /// values with [`PatchOrigin::lenslet`] (the [`crate::OverlapDecoder`]'s does).
+    /// [`DisparityRange::OFF`] is the unsheared decode, bit for bit.
+    pub fn with_disparities(self, range: DisparityRange) -> Self {
+        Self { disparities: range, ..self }
+    }
+
+    /// The candidate disparities the decode searches.
+    pub fn disparities(&self) -> DisparityRange {
+        self.disparities
     }
 
     /// Grey-world band gains of a frame: every valid sample of the sensor (defects and
@@ -449,7 +482,9 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     }
 
     /// Reads the patch at `origin` into the workspace's measurements; returns the flags
-    /// and the number of samples left out.
+    /// and the number of samples left out. A sheared patch (`origin.disparity != 0`)
+    /// reads each view from its shifted lenslet ([`PatchOrigin::lenslet`]), one sample
+    /// at a time; pixels the shear puts outside the sensor are not measurements.
     fn read_patch<S: TileSource>(
         &self,
         origin: PatchOrigin,
@@ -458,6 +493,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     ) -> Result<(PatchFlags, u16), S::Error> {
         let c = &self.config;
         let (lu, lv) = (c.sensor.lenslet.rows as usize, c.sensor.lenslet.cols as usize);
+        let (nr, nc) = (c.sensor.lenslets.0 as isize, c.sensor.lenslets.1 as isize);
         let k = c.mask.snapshots();
         let m = ws.measurements_mut();
         m.clear();
@@ -468,36 +504,129 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let mut run = [[0.0f32; PV]; B];
         for s in 0..PS {
             for u in 0..PU {
-                let row = (origin.lenslet_row as usize + s) * lu + origin.view_row as usize + u;
                 for t in 0..PT {
-                    let col0 = (origin.lenslet_col as usize + t) * lv + origin.view_col as usize;
-                    for (j, r) in run.iter_mut().enumerate().take(k) {
-                        source.read(j, row, col0, r)?;
-                    }
-                    for v in 0..PV {
-                        let col = col0 + v;
-                        if c.defects.contains(row, col) {
-                            flags.insert(PatchFlags::DEFECTIVE);
-                            excluded += k as u16;
-                            continue;
+                    if origin.disparity == 0 {
+                        // One run of the lenslet's view row per snapshot.
+                        let row = (origin.lenslet_row as usize + s) * lu + origin.view_row as usize + u;
+                        let col0 = (origin.lenslet_col as usize + t) * lv + origin.view_col as usize;
+                        for (j, r) in run.iter_mut().enumerate().take(k) {
+                            source.read(j, row, col0, r)?;
                         }
-                        for (band, r) in c.mask.bands_at(row, col).iter().zip(&run) {
-                            let at = PatchShape::<PS, PT, PU, PV, B, N>::index(s, t, u, v, *band as usize);
-                            let gain = self.gains.get(*band as usize).copied().unwrap_or(1.0);
-                            let ok = match c.raw.classify(r[v]) {
-                                Ok(y) => m.set(at, y / gain).map_err(|_| Invalid::NonFinite),
-                                Err(e) => Err(e),
-                            };
-                            if let Err(e) = ok {
-                                flags.insert(e.into());
-                                excluded += 1;
+                        for v in 0..PV {
+                            let at = PatchShape::<PS, PT, PU, PV, B, N>::pixel_index(s, t, u, v);
+                            self.put_pixel(
+                                m,
+                                at,
+                                row,
+                                col0 + v,
+                                |j| run.get(j).map(|r| r[v]),
+                                &mut flags,
+                                &mut excluded,
+                            );
+                        }
+                    } else {
+                        for v in 0..PV {
+                            let (lr, lc) = origin.lenslet(s, t, u, v, (lu, lv));
+                            if !(0..nr).contains(&lr) || !(0..nc).contains(&lc) {
+                                continue;
                             }
+                            let row = lr as usize * lu + origin.view_row as usize + u;
+                            let col = lc as usize * lv + origin.view_col as usize + v;
+                            for (j, r) in run.iter_mut().enumerate().take(k) {
+                                source.read(j, row, col, &mut r[..1])?;
+                            }
+                            let at = PatchShape::<PS, PT, PU, PV, B, N>::pixel_index(s, t, u, v);
+                            self.put_pixel(m, at, row, col, |j| run.get(j).map(|r| r[0]), &mut flags, &mut excluded);
                         }
                     }
                 }
             }
         }
         Ok((flags, excluded))
+    }
+
+    /// Sensor pixel `(row, col)`'s samples (`sample(j)` of snapshot `j`) as measurements
+    /// of the patch's pixel whose first band is at `at`, each divided by its band's gain;
+    /// a defective pixel or an invalid sample is left out and flagged.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn put_pixel(
+        &self,
+        m: &mut crate::workspace::Measurements<N>,
+        at: usize,
+        row: usize,
+        col: usize,
+        sample: impl Fn(usize) -> Option<f32>,
+        flags: &mut PatchFlags,
+        excluded: &mut u16,
+    ) {
+        let c = &self.config;
+        if c.defects.contains(row, col) {
+            flags.insert(PatchFlags::DEFECTIVE);
+            *excluded += c.mask.snapshots() as u16;
+            return;
+        }
+        for (j, band) in c.mask.bands_at(row, col).iter().enumerate() {
+            let gain = self.gains.get(*band as usize).copied().unwrap_or(1.0);
+            let ok = match c.raw.classify(sample(j).unwrap_or(f32::NAN)) {
+                Ok(y) => m.set(at + *band as usize, y / gain).map_err(|_| Invalid::NonFinite),
+                Err(e) => Err(e),
+            };
+            if let Err(e) = ok {
+                flags.insert(e.into());
+                *excluded += 1;
+            }
+        }
+    }
+
+    /// The disparity of `range` whose shear best aligns the views of the `PS x PT` block
+    /// at lenslet `(row, col)`: every view of each of its lenslets (not only a window's),
+    /// scored by [`Consistency`]. 0 when the range is off (nothing is read).
+    ///
+    /// # Errors
+    /// The source's error.
+    pub fn choose_disparity<S: TileSource>(&self, row: usize, col: usize, source: &mut S) -> Result<i8, S::Error> {
+        if self.disparities.is_off() {
+            return Ok(0);
+        }
+        let c = &self.config;
+        let (lu, lv) = (c.sensor.lenslet.rows as usize, c.sensor.lenslet.cols as usize);
+        let (nr, nc) = (c.sensor.lenslets.0 as isize, c.sensor.lenslets.1 as isize);
+        let k = c.mask.snapshots();
+        let mut best = Best::default();
+        let mut one = [[0.0f32; 1]; B];
+        for d in self.disparities.candidates() {
+            let mut score = Consistency::new();
+            for s in 0..PS {
+                for t in 0..PT {
+                    for u in 0..lu {
+                        let lr = (row + s) as isize + shift(d, u, lu);
+                        for v in 0..lv {
+                            let lc = (col + t) as isize + shift(d, v, lv);
+                            if !(0..nr).contains(&lr) || !(0..nc).contains(&lc) {
+                                continue;
+                            }
+                            let (r, cc) = (lr as usize * lu + u, lc as usize * lv + v);
+                            if c.defects.contains(r, cc) {
+                                continue;
+                            }
+                            for (j, o) in one.iter_mut().enumerate().take(k) {
+                                source.read(j, r, cc, o)?;
+                            }
+                            for (band, o) in c.mask.bands_at(r, cc).iter().zip(&one) {
+                                if let Ok(y) = c.raw.classify(o[0]) {
+                                    let gain = self.gains.get(*band as usize).copied().unwrap_or(1.0);
+                                    score.add(*band as usize, y / gain);
+                                }
+                            }
+                        }
+                    }
+                    score.end_point();
+                }
+            }
+            best.offer(d, &score);
+        }
+        Ok(best.disparity())
     }
 
     /// Decodes every patch of `tile` with `model` (a dictionary or an ensemble), sending
@@ -521,13 +650,10 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let (lo, hi) = self.config.raw.range();
         for bs in 0..tile.lenslet_rows as usize / PS {
             for bt in 0..tile.lenslet_cols as usize / PT {
+                let (row, col) = (tile.lenslet_row + (bs * PS) as u16, tile.lenslet_col + (bt * PT) as u16);
+                let disparity = self.choose_disparity(row as usize, col as usize, source).map_err(TileError::Source)?;
                 for (view_row, view_col) in self.windows() {
-                    let origin = PatchOrigin {
-                        lenslet_row: tile.lenslet_row + (bs * PS) as u16,
-                        lenslet_col: tile.lenslet_col + (bt * PT) as u16,
-                        view_row,
-                        view_col,
-                    };
+                    let origin = PatchOrigin { lenslet_row: row, lenslet_col: col, view_row, view_col, disparity };
                     let (flags, excluded) = self.read_patch(origin, source, ws).map_err(TileError::Source)?;
                     let cfg = &self.config.sl0;
                     let bands = bands_measured::<B, N>(ws.measurements());

@@ -15,8 +15,8 @@ use anyhow::{Result, anyhow, ensure};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use slf_firmware::{
-    Dictionary, FrameSource, PaperShape, PaperWorkspace, PatchModel, PatchOrigin, PatchReport, PatchSink, Sl0Config,
-    SolveError, Tile, TileDecoder, TileReport,
+    Dictionary, DisparityRange, FrameSource, PaperShape, PaperWorkspace, PatchModel, PatchOrigin, PatchReport,
+    PatchSink, Sl0Config, SolveError, Tile, TileDecoder, TileReport,
 };
 
 use crate::capture::Capture;
@@ -166,6 +166,9 @@ pub struct DecodeOptions {
     pub adaptive: Option<f32>,
     /// The white balance.
     pub balance: Balance,
+    /// The disparities each spatial block may be sheared to ([`slf_firmware::disparity`]);
+    /// off (only 0) by default.
+    pub disparities: DisparityRange,
 }
 
 impl Default for DecodeOptions {
@@ -179,6 +182,7 @@ impl Default for DecodeOptions {
             window: Window::Tapered,
             adaptive: None,
             balance: Balance::default(),
+            disparities: DisparityRange::OFF,
         }
     }
 }
@@ -220,7 +224,8 @@ pub fn tile_decoder<'a>(capture: &'a Capture, opts: &DecodeOptions) -> Result<Ti
         }
         Balance::Gains(g) => g,
     };
-    decoder.with_gains(&gains).map_err(|e| anyhow!("gains {gains:?}: {e}"))
+    let decoder = decoder.with_gains(&gains).map_err(|e| anyhow!("gains {gains:?}: {e}"))?;
+    Ok(decoder.with_disparities(opts.disparities))
 }
 
 /// The tiles of the patch grids shifted by `(dy, dx)` lenslets for every multiple of the
@@ -269,33 +274,59 @@ pub struct DecodeReport {
     pub member_map: Vec<(PatchOrigin, u16)>,
     /// Light-field values no decoded patch covered (left at 0).
     pub uncovered: usize,
+    /// Values of a view no (sheared) patch covered, taken from the lenslet's other views.
+    pub filled: usize,
+    /// The disparity each spatial block was sheared to, by its first patch's origin
+    /// (empty when the decode searched no disparity).
+    pub disparity_map: Vec<(PatchOrigin, i8)>,
     /// Wall time, seconds.
     pub seconds: f64,
     /// The band gains the decode used (1 without white balance).
     pub gains: [f32; 13],
 }
 
-/// Weighted sums of the patch estimates over one tile's lenslets, all views and bands.
+/// Weighted sums of the patch estimates over one tile's lenslets and the halo a sheared
+/// patch reaches beyond them (`halo` lenslets on every side), all views and bands.
 struct TileSums {
     tile: Tile,
     views: (usize, usize),
     window: Window,
+    halo: usize,
     sum: Vec<f32>,
     weight: Vec<f32>,
     steps: u64,
     solves: u64,
     members: Vec<(PatchOrigin, u16)>,
+    disparities: Vec<(PatchOrigin, i8)>,
 }
 
 impl TileSums {
-    fn new(tile: Tile, views: (usize, usize), window: Window) -> Self {
-        let n = tile.lenslet_rows as usize * tile.lenslet_cols as usize * views.0 * views.1 * 13;
-        Self { tile, views, window, sum: vec![0.0; n], weight: vec![0.0; n], steps: 0, solves: 0, members: Vec::new() }
+    fn new(tile: Tile, views: (usize, usize), window: Window, halo: usize) -> Self {
+        let (rows, cols) = (tile.lenslet_rows as usize + 2 * halo, tile.lenslet_cols as usize + 2 * halo);
+        let n = rows * cols * views.0 * views.1 * 13;
+        let (sum, weight) = (vec![0.0; n], vec![0.0; n]);
+        Self {
+            tile,
+            views,
+            window,
+            halo,
+            sum,
+            weight,
+            steps: 0,
+            solves: 0,
+            members: Vec::new(),
+            disparities: Vec::new(),
+        }
     }
 
-    /// Index in the tile's `(s, t, u, v, b)` buffer.
+    /// Lenslet rows and columns of the buffer.
+    fn extent(&self) -> (usize, usize) {
+        (self.tile.lenslet_rows as usize + 2 * self.halo, self.tile.lenslet_cols as usize + 2 * self.halo)
+    }
+
+    /// Index in the buffer's `(s, t, u, v, b)` order, `(s, t)` counted from the halo's corner.
     fn at(&self, s: usize, t: usize, u: usize, v: usize, b: usize) -> usize {
-        (((s * self.tile.lenslet_cols as usize + t) * self.views.0 + u) * self.views.1 + v) * 13 + b
+        (((s * self.extent().1 + t) * self.views.0 + u) * self.views.1 + v) * 13 + b
     }
 }
 
@@ -308,11 +339,22 @@ impl PatchSink<5200> for TileSums {
         if let Some(m) = report.member {
             self.members.push((o, m));
         }
-        let (s0, t0) =
-            ((o.lenslet_row - self.tile.lenslet_row) as usize, (o.lenslet_col - self.tile.lenslet_col) as usize);
+        if (o.view_row, o.view_col) == (0, 0) && self.halo > 0 {
+            self.disparities.push((o, o.disparity));
+        }
+        // The halo's corner, in sensor lenslets.
+        let (r0, c0) =
+            (self.tile.lenslet_row as isize - self.halo as isize, self.tile.lenslet_col as isize - self.halo as isize);
+        let (rows, cols) = self.extent();
         for (i, &x) in patch.iter().enumerate() {
             let [s, t, u, v, b] = PaperShape::coordinates(i);
-            let j = self.at(s0 + s, t0 + t, o.view_row as usize + u, o.view_col as usize + v, b);
+            // The pixel the value was read from (sheared patches: shifted per view).
+            let (r, c) = o.lenslet(s, t, u, v, self.views);
+            let (Ok(r), Ok(c)) = (usize::try_from(r - r0), usize::try_from(c - c0)) else { continue };
+            if r >= rows || c >= cols {
+                continue;
+            }
+            let j = self.at(r, c, o.view_row as usize + u, o.view_col as usize + v, b);
             let w = self.window.weight::<5, 5>(s, t);
             self.sum[j] += w * x;
             self.weight[j] += w;
@@ -355,6 +397,7 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
     );
     let lenslets = (d.lenslets[0], d.lenslets[1]);
     let views = (d.views[0], d.views[1]);
+    let halo = opts.disparities.halo(views.0.max(views.1));
     let run = |tiles: &[Tile]| -> Vec<(TileSums, Result<TileReport, String>)> {
         let bar = ProgressBar::with_draw_target(Some(tiles.len() as u64), ProgressDrawTarget::hidden());
         bar.set_style(
@@ -367,7 +410,7 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
             .map_init(
                 || Box::new(PaperWorkspace::new()),
                 |ws, &tile| {
-                    let mut sums = TileSums::new(tile, views, opts.window);
+                    let mut sums = TileSums::new(tile, views, opts.window, halo);
                     let mut source = FrameSource::new(&raw);
                     let r = decoder.decode_tile(model, tile, &mut source, &mut sums, ws).map_err(|e| e.to_string());
                     bar.inc(1);
@@ -428,13 +471,24 @@ fn aggregate(
         report.steps += sums.steps;
         report.solves += sums.solves;
         report.member_map.extend_from_slice(&sums.members);
+        report.disparity_map.extend_from_slice(&sums.disparities);
         let tile = sums.tile;
-        for s in 0..tile.lenslet_rows as usize {
-            for t in 0..tile.lenslet_cols as usize {
+        let (rows, cols) = sums.extent();
+        for s in 0..rows {
+            for t in 0..cols {
+                let (Some(r), Some(c)) = (
+                    (tile.lenslet_row as usize + s).checked_sub(sums.halo),
+                    (tile.lenslet_col as usize + t).checked_sub(sums.halo),
+                ) else {
+                    continue;
+                };
+                if r >= lenslets.0 || c >= lenslets.1 {
+                    continue;
+                }
                 for u in 0..views.0 {
                     for v in 0..views.1 {
                         let src = sums.at(s, t, u, v, 0);
-                        let dst = lf.index(u, v, tile.lenslet_row as usize + s, tile.lenslet_col as usize + t, 0);
+                        let dst = lf.index(u, v, r, c, 0);
                         for b in 0..13 {
                             sum[dst + b] += sums.sum[src + b];
                             weight[dst + b] += sums.weight[src + b];
@@ -447,11 +501,58 @@ fn aggregate(
     for ((x, &s), &w) in lf.data.iter_mut().zip(&sum).zip(&weight) {
         if w > 0.0 {
             *x = s / w;
-        } else {
-            report.uncovered += 1;
+        }
+    }
+    // A view of a lenslet no (sheared) patch covered takes the mean of the lenslet's
+    // covered views, as the firmware's overlap ring does; a lenslet with none stays 0.
+    for r in 0..lenslets.0 {
+        for c in 0..lenslets.1 {
+            for b in 0..13 {
+                let (mut mean, mut covered) = (0.0f32, 0u32);
+                for u in 0..views.0 {
+                    for v in 0..views.1 {
+                        let i = lf.index(u, v, r, c, b);
+                        if weight[i] > 0.0 {
+                            mean += lf.data[i];
+                            covered += 1;
+                        }
+                    }
+                }
+                for u in 0..views.0 {
+                    for v in 0..views.1 {
+                        let i = lf.index(u, v, r, c, b);
+                        if weight[i] > 0.0 {
+                            continue;
+                        }
+                        if covered > 0 {
+                            lf.data[i] = mean / covered as f32;
+                            report.filled += 1;
+                        } else {
+                            report.uncovered += 1;
+                        }
+                    }
+                }
+            }
         }
     }
     (lf, report)
+}
+
+/// The disparity per lenslet (row-major, `rows x cols`) from a decode's
+/// [`DecodeReport::disparity_map`]: the mean of the chosen disparities of the 5 x 5 blocks
+/// that cover the lenslet (overlapping blocks at a stride below 5), NaN where none does.
+pub fn disparity_per_lenslet(blocks: &[(PatchOrigin, i8)], rows: usize, cols: usize) -> Vec<f32> {
+    let mut sum = vec![0.0f32; rows * cols];
+    let mut count = vec![0u32; rows * cols];
+    for (o, d) in blocks {
+        for r in o.lenslet_row as usize..(o.lenslet_row as usize + 5).min(rows) {
+            for c in o.lenslet_col as usize..(o.lenslet_col as usize + 5).min(cols) {
+                sum[r * cols + c] += f32::from(*d);
+                count[r * cols + c] += 1;
+            }
+        }
+    }
+    sum.iter().zip(&count).map(|(&s, &n)| if n > 0 { s / n as f32 } else { f32::NAN }).collect()
 }
 
 /// Steps between neighbouring lenslets of a decoded light field (mean absolute difference

@@ -38,6 +38,17 @@ fn positive(s: &str) -> Result<f32, String> {
 }
 
 /// A finite number at or above zero, for clap.
+/// `MIN:MAX`, integer disparities around 0 (e.g. `-1:1`), within the decoder's limit.
+fn disparity_range(s: &str) -> Result<slf_host::firmware::DisparityRange, String> {
+    let bad = || {
+        let m = slf_host::firmware::disparity::MAX_DISPARITY;
+        format!("{s:?}: want MIN:MAX, integers with -{m} <= MIN <= 0 <= MAX <= {m} (e.g. -1:1)")
+    };
+    let (a, b) = s.split_once(':').ok_or_else(bad)?;
+    let (a, b) = (a.trim().parse::<i8>().map_err(|_| bad())?, b.trim().parse::<i8>().map_err(|_| bad())?);
+    slf_host::firmware::DisparityRange::new(a, b).ok_or_else(bad)
+}
+
 fn non_negative(s: &str) -> Result<f32, String> {
     match s.parse::<f32>() {
         Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
@@ -415,6 +426,15 @@ enum Command {
         /// --balance.
         #[arg(long, value_delimiter = ',', value_name = "G1,...,G13")]
         gains: Option<Vec<f32>>,
+        /// Integer disparities (pixels per view step) each 5 x 5-lenslet block may be
+        /// sheared to before decoding, MIN:MAX (0:0: unsheared); chosen per block by how
+        /// well the views' same-band samples agree.
+        #[arg(long, value_parser = disparity_range, value_name = "MIN:MAX", allow_hyphen_values = true)]
+        disparities: Option<slf_host::firmware::DisparityRange>,
+        /// Also write the chosen disparity per lenslet (.npy, lenslet rows x cols, f32: the
+        /// mean over the blocks that cover it); needs --disparities.
+        #[arg(long)]
+        disparity_map: Option<PathBuf>,
         /// Stored dtype.
         #[arg(long, value_enum, default_value_t = Dtype::F32)]
         dtype: Dtype,
@@ -694,6 +714,8 @@ fn run(cli: Cli) -> Result<()> {
             adaptive,
             balance,
             gains,
+            disparities,
+            disparity_map,
             dtype,
             quiet,
         } => {
@@ -737,8 +759,13 @@ fn run(cli: Cli) -> Result<()> {
                 window: window.window(),
                 adaptive,
                 balance,
+                disparities: disparities.unwrap_or_default(),
                 ..DecodeOptions::default()
             };
+            anyhow::ensure!(
+                disparity_map.is_none() || !opts.disparities.is_off(),
+                "--disparity-map needs --disparities (e.g. -1:1): without it every block is at 0"
+            );
             if let Some(a) = adaptive {
                 anyhow::ensure!(a.is_finite() && a >= 0.0, "--adaptive {a}: must be finite, at or above 0");
             }
@@ -776,6 +803,12 @@ fn run(cli: Cli) -> Result<()> {
                     );
                 }
                 std::fs::write(&path, csv).with_context(|| format!("cannot write {}", path.display()))?;
+            }
+            if let Some(path) = disparity_map {
+                let (rows, cols) = (cap.description.lenslets[0], cap.description.lenslets[1]);
+                let map = slf_host::decode::disparity_per_lenslet(&r.disparity_map, rows, cols);
+                slf_host::lightfield::write_npy_f32_2d(&path, &map, rows, cols)
+                    .with_context(|| format!("cannot write {}", path.display()))?;
             }
             write_npy(&output, &lf, dtype)?;
             let used = opts.solver_config(&cap);
