@@ -26,6 +26,12 @@ use crate::shape::MAX_BANDS;
 /// `d` reaches `d (U - 1) / 2` lenslets beyond the patch, and sinks keep that halo.
 pub const MAX_DISPARITY: i8 = 3;
 
+/// The weight, relative to a sheared patch's, of an unsheared fallback estimate
+/// ([`crate::tile::PatchReport::fallback`]): small enough to change a value a sheared patch
+/// reached by about a thousandth of the two estimates' difference, and the whole value
+/// where none did.
+pub const FALLBACK_WEIGHT: f32 = 1e-3;
+
 /// The candidate disparities of a decode: the integers `min..=max`. Config: immutable.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]

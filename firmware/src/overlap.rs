@@ -404,13 +404,14 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
 {
     type Error = core::convert::Infallible;
 
-    fn accept(&mut self, o: PatchOrigin, patch: &[f32; N], _: &PatchReport) -> Result<(), Self::Error> {
+    fn accept(&mut self, o: PatchOrigin, patch: &[f32; N], r: &PatchReport) -> Result<(), Self::Error> {
+        let scale = if r.fallback { crate::disparity::FALLBACK_WEIGHT } else { 1.0 };
         let (vu, vv) = self.views;
         let (first, cols, window, frame_rows) = (self.first_col, self.cols, self.window, self.frame_rows);
         for s in 0..PS {
             for u in 0..PU {
                 for t in 0..PT {
-                    let w = window.weight::<PS, PT>(s, t);
+                    let w = scale * window.weight::<PS, PT>(s, t);
                     for v in 0..PV {
                         // The pixel the value was read from (sheared patches: shifted per view).
                         let (row, col) = o.lenslet(s, t, u, v, (vu, vv));

@@ -180,6 +180,10 @@ pub struct PatchReport {
     pub measured: u16,
     /// Samples left out.
     pub excluded: u16,
+    /// An unsheared estimate of a block that was decoded sheared at the frame's edge: it
+    /// is only there for the views no sheared patch reached, and a sink weighs it by
+    /// [`crate::disparity::FALLBACK_WEIGHT`].
+    pub fallback: bool,
 }
 
 /// Counts for one tile or frame.
@@ -647,53 +651,91 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             return Err(TileError::Geometry);
         }
         let mut report = TileReport::default();
-        let (lo, hi) = self.config.raw.range();
         for bs in 0..tile.lenslet_rows as usize / PS {
             for bt in 0..tile.lenslet_cols as usize / PT {
                 let (row, col) = (tile.lenslet_row + (bs * PS) as u16, tile.lenslet_col + (bt * PT) as u16);
                 let disparity = self.choose_disparity(row as usize, col as usize, source).map_err(TileError::Source)?;
                 for (view_row, view_col) in self.windows() {
                     let origin = PatchOrigin { lenslet_row: row, lenslet_col: col, view_row, view_col, disparity };
-                    let (flags, excluded) = self.read_patch(origin, source, ws).map_err(TileError::Source)?;
-                    let cfg = &self.config.sl0;
-                    let bands = bands_measured::<B, N>(ws.measurements());
-                    // No band at all is no measurement: the model reports it.
-                    let decoded = if bands > 0 && bands < u32::from(cfg.min_bands) {
-                        let Workspace { signal, measurements, .. } = ws;
-                        interpolate_bands::<B, N>(measurements, signal);
-                        Ok(ModelOutcome { outcome: Outcome::interpolated(), member: None, solves: 0 })
-                    } else {
-                        model.decode(cfg, ws)
-                    };
-                    match decoded {
-                        Ok(done) => {
-                            ws.unbalance_patch(&self.gains);
-                            ws.clamp_patch(lo, hi);
-                            let r = PatchReport {
-                                outcome: done.outcome,
-                                member: done.member,
-                                solves: done.solves,
-                                flags,
-                                measured: ws.measurements().count() as u16,
-                                excluded,
-                            };
-                            if !flags.is_empty() {
-                                report.flagged += 1;
-                                log!(warn, "patch flagged: {} samples left out", excluded);
-                            }
-                            report.decoded += 1;
-                            sink.accept(origin, ws.patch(), &r).map_err(TileError::Sink)?;
-                        }
-                        Err(e) => {
-                            report.failed += 1;
-                            log!(warn, "patch not decoded: {}", e);
-                            sink.reject(origin, e).map_err(TileError::Sink)?;
-                        }
+                    self.decode_patch(model, origin, false, source, sink, ws, &mut report)?;
+                }
+                // A block sheared at the frame's edge leaves some views of the edge's
+                // lenslets to no patch (their points lie outside the other views): an
+                // unsheared decode of the block fills them, weighed so little that it
+                // changes nothing a sheared patch reached.
+                if disparity != 0 && self.near_edge(row as usize, col as usize, disparity) {
+                    for (view_row, view_col) in self.windows() {
+                        let origin =
+                            PatchOrigin { lenslet_row: row, lenslet_col: col, view_row, view_col, disparity: 0 };
+                        self.decode_patch(model, origin, true, source, sink, ws, &mut report)?;
                     }
                 }
             }
         }
         Ok(report)
+    }
+
+    /// Whether a block at lenslet `(row, col)` sheared to `d` reaches past the sensor's edge.
+    fn near_edge(&self, row: usize, col: usize, d: i8) -> bool {
+        let c = &self.config;
+        let (lu, lv) = (c.sensor.lenslet.rows as usize, c.sensor.lenslet.cols as usize);
+        let (rows, cols) = (c.sensor.lenslets.0 as usize, c.sensor.lenslets.1 as usize);
+        let range = DisparityRange::new(d.min(0), d.max(0)).unwrap_or(DisparityRange::OFF);
+        let (hr, hc) = (range.halo(lu), range.halo(lv));
+        row < hr || col < hc || row + PS + hr > rows || col + PT + hc > cols
+    }
+
+    /// Reads, decodes and sends the patch at `origin` (a fallback: see
+    /// [`PatchReport::fallback`]), counting it in `report`.
+    #[allow(clippy::too_many_arguments)]
+    fn decode_patch<M: PatchModel<PS, PT, PU, PV, B, N>, S: TileSource, K: PatchSink<N>>(
+        &self,
+        model: &M,
+        origin: PatchOrigin,
+        fallback: bool,
+        source: &mut S,
+        sink: &mut K,
+        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+        report: &mut TileReport,
+    ) -> Result<(), TileError<S::Error, K::Error>> {
+        let (lo, hi) = self.config.raw.range();
+        let (flags, excluded) = self.read_patch(origin, source, ws).map_err(TileError::Source)?;
+        let cfg = &self.config.sl0;
+        let bands = bands_measured::<B, N>(ws.measurements());
+        // No band at all is no measurement: the model reports it.
+        let decoded = if bands > 0 && bands < u32::from(cfg.min_bands) {
+            let Workspace { signal, measurements, .. } = ws;
+            interpolate_bands::<B, N>(measurements, signal);
+            Ok(ModelOutcome { outcome: Outcome::interpolated(), member: None, solves: 0 })
+        } else {
+            model.decode(cfg, ws)
+        };
+        match decoded {
+            Ok(done) => {
+                ws.unbalance_patch(&self.gains);
+                ws.clamp_patch(lo, hi);
+                let r = PatchReport {
+                    outcome: done.outcome,
+                    member: done.member,
+                    solves: done.solves,
+                    flags,
+                    measured: ws.measurements().count() as u16,
+                    excluded,
+                    fallback,
+                };
+                if !flags.is_empty() {
+                    report.flagged += 1;
+                    log!(warn, "patch flagged: {} samples left out", excluded);
+                }
+                report.decoded += 1;
+                sink.accept(origin, ws.patch(), &r).map_err(TileError::Sink)
+            }
+            Err(e) => {
+                report.failed += 1;
+                log!(warn, "patch not decoded: {}", e);
+                sink.reject(origin, e).map_err(TileError::Sink)
+            }
+        }
     }
 
     /// Decodes every tile of the sensor (see [`tiles`](Self::tiles)); a tile that fails

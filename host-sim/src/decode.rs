@@ -339,9 +339,10 @@ impl PatchSink<5200> for TileSums {
         if let Some(m) = report.member {
             self.members.push((o, m));
         }
-        if (o.view_row, o.view_col) == (0, 0) && self.halo > 0 {
+        if (o.view_row, o.view_col) == (0, 0) && self.halo > 0 && !report.fallback {
             self.disparities.push((o, o.disparity));
         }
+        let scale = if report.fallback { slf_firmware::disparity::FALLBACK_WEIGHT } else { 1.0 };
         // The halo's corner, in sensor lenslets.
         let (r0, c0) =
             (self.tile.lenslet_row as isize - self.halo as isize, self.tile.lenslet_col as isize - self.halo as isize);
@@ -355,7 +356,7 @@ impl PatchSink<5200> for TileSums {
                 continue;
             }
             let j = self.at(r, c, o.view_row as usize + u, o.view_col as usize + v, b);
-            let w = self.window.weight::<5, 5>(s, t);
+            let w = scale * self.window.weight::<5, 5>(s, t);
             self.sum[j] += w * x;
             self.weight[j] += w;
         }

@@ -826,6 +826,18 @@ fn run(cli: Cli) -> Result<()> {
                 Balance::GreyWorld => println!("white balance: grey world, gains {}", gains.join(" ")),
                 Balance::Gains(_) => println!("white balance: given gains {}", gains.join(" ")),
             }
+            if !opts.disparities.is_off() {
+                let mut counts = std::collections::BTreeMap::<i8, usize>::new();
+                for (_, d) in &r.disparity_map {
+                    *counts.entry(*d).or_default() += 1;
+                }
+                let counts: Vec<String> = counts.iter().map(|(d, n)| format!("{d:+}: {n}")).collect();
+                println!(
+                    "disparity: blocks per disparity {}; {} values of views no sheared patch reached, from their lenslet's other views",
+                    counts.join(", "),
+                    r.filled
+                );
+            }
             println!(
                 "decoded {} patches ({} flagged, {} failed, {} tiles failed) in {:.2} s; wrote {}",
                 r.patches.decoded,
