@@ -485,11 +485,16 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             && tile.lenslet_col as u32 + tile.lenslet_cols as u32 <= cols as u32
     }
 
-    /// Reads the patch at `origin` into the workspace's measurements; returns the flags
-    /// and the number of samples left out. A sheared patch (`origin.disparity != 0`)
-    /// reads each view from its shifted lenslet ([`PatchOrigin::lenslet`]), one sample
-    /// at a time; pixels the shear puts outside the sensor are not measurements.
-    fn read_patch<S: TileSource>(
+    /// Reads the patch at `origin` into the workspace's measurements (each divided by its
+    /// band's gain), as a decode does before it solves; returns the flags and the number of
+    /// samples left out. A sheared patch (`origin.disparity != 0`) reads each view from its
+    /// shifted lenslet ([`PatchOrigin::lenslet`]), one sample at a time; pixels the shear
+    /// puts outside the sensor are not measurements. `origin` is not checked against the
+    /// sensor: a pixel outside it is a read the source refuses.
+    ///
+    /// # Errors
+    /// The source's error.
+    pub fn read_patch<S: TileSource>(
         &self,
         origin: PatchOrigin,
         source: &mut S,

@@ -1,0 +1,66 @@
+#!/usr/bin/env bash
+# The tables of docs/results-depth.md (issue 19): sheared decoding (`slf decode
+# --disparities`) against the decode before it and the baselines, on the realistic set
+# (three real light fields and slf's four realistic named scenes) and on slf's five
+# synthetic test scenes, at pixel k = 1, pixel k = 3 and lenslet k = 3, at the default
+# stride (3, tapered) and the capture's noise model. Per setting: PSNR per scene, then the
+# means of PSNR / SSIM / SA and the decode's wall time summed over the scenes (one run, so
+# the times compare; the machine is shared, so only their ratios mean anything).
+#
+#   bash scripts/results-depth.sh OUT_DIR > tables.md
+#
+# The real light fields are scripts/real-eval.sh's 128 x 128 crops, in $SLF_REAL (default
+# /tmp/hci/real); their licence allows evaluation only.
+set -euo pipefail
+out=${1:?usage: results-depth.sh OUT_DIR}
+cd "$(dirname "$0")/.."
+cargo build --release -q -p slf-host
+slf=${SLF_BIN:-./target/release/slf}
+hci=${SLF_REAL:-/tmp/hci/real}
+mkdir -p "$out/lf"
+for n in outdoor tungsten office led; do
+  [ -f "$out/lf/$n.npy" ] || "$slf" scene "$n" --size 64 -o "$out/lf/$n.npy" > /dev/null
+done
+for n in smooth texture depth saturated dark; do
+  [ -f "$out/lf/$n.npy" ] || "$slf" scene "$n" --size 40 -o "$out/lf/$n.npy" > /dev/null
+done
+# name=decode arguments (commas for spaces)
+models="demosaic=--method,demosaic ppid=--method,ppid dct=--dictionary,dct dct+depth=--dictionary,dct,--disparities=-1:1 ensemble=--stride,3 ensemble+depth=--disparities=-1:1 ensemble+depth2=--disparities=-2:2"
+table() {
+  local dir=$1
+  shift
+  local header="| model | setting |" rule="| --- | --- |"
+  for lf in "$@"; do header="$header $(basename "$lf" .npy) |"; rule="$rule --- |"; done
+  echo "$header mean PSNR | mean SSIM | mean SA | seconds |"
+  echo "$rule --- | --- | --- | --- |"
+  for s in pixel:1 pixel:3 lenslet:3; do
+    mask=${s%:*}; k=${s#*:}
+    for m in $models; do
+      name=${m%%=*}; args=${m#*=}; args=${args//,/ }
+      row="| $name | $mask k=$k |"; sp=0; ss=0; sa=0; secs=0; n=0
+      for lf in "$@"; do
+        base=$(basename "$lf" .npy)
+        cap="$dir/cap-$base-$mask-$k"
+        [ -d "$cap" ] || "$slf" simulate "$lf" -o "$cap" --mask "$mask" -s "$k" --seed 3 > /dev/null
+        rec="$dir/rec.npy"
+        # shellcheck disable=SC2086
+        t=$("$slf" decode "$cap" -o "$rec" --quiet $args | awk '/ in [0-9.]+ s/ { for (i = 1; i < NF; i++) if ($i == "in") print $(i + 1) }')
+        read -r p q a < <("$slf" eval "$lf" "$rec" | awk '/^PSNR/ { p = $2 } /^SSIM/ { q = $2 } /^SA/ { a = $2 } END { print p, q, a }')
+        row="$row $p |"
+        sp=$(echo "$sp + $p" | bc -l); ss=$(echo "$ss + $q" | bc -l); sa=$(echo "$sa + $a" | bc -l)
+        secs=$(echo "$secs + ${t:-0}" | bc -l); n=$((n + 1))
+      done
+      printf '%s %.2f | %.4f | %.2f | %.1f |\n' "$row" "$(echo "$sp / $n" | bc -l)" "$(echo "$ss / $n" | bc -l)" \
+        "$(echo "$sa / $n" | bc -l)" "$secs"
+    done
+  done
+}
+echo "## Realistic set"
+echo
+table "$out/real" "$hci/antinous_128.npy" "$hci/dino_128.npy" "$hci/cotton_128.npy" "$out/lf/outdoor.npy" \
+  "$out/lf/tungsten.npy" "$out/lf/office.npy" "$out/lf/led.npy"
+echo
+echo "## Synthetic test scenes"
+echo
+table "$out/syn" "$out/lf/smooth.npy" "$out/lf/texture.npy" "$out/lf/depth.npy" "$out/lf/saturated.npy" \
+  "$out/lf/dark.npy"
