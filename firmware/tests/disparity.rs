@@ -32,21 +32,21 @@ fn small_decoder(mask: Mask<'static>) -> Small<'static> {
     .unwrap()
 }
 
-/// The sensor lenslet of patch lenslet `(s, t)`, view `(u, v)` of the window at `(vr, vc)`,
+/// The sensor lenslet of patch lenslet `(s, t)`, view `(u, v)` of the window at `window`,
 /// sheared to `d`, from the definition: view `w` of a lenslet of 3 views is shifted by
 /// `-d (w - 1)` lenslets.
 fn sheared(
     origin: (isize, isize),
-    s: usize,
-    t: usize,
-    vr: usize,
-    vc: usize,
-    u: usize,
-    v: usize,
+    (s, t): (usize, usize),
+    window: (usize, usize),
+    (u, v): (usize, usize),
     d: i8,
 ) -> (isize, isize) {
     let d = d as isize;
-    (origin.0 + s as isize - d * ((vr + u) as isize - 1), origin.1 + t as isize - d * ((vc + v) as isize - 1))
+    (
+        origin.0 + s as isize - d * ((window.0 + u) as isize - 1),
+        origin.1 + t as isize - d * ((window.1 + v) as isize - 1),
+    )
 }
 
 #[test]
@@ -72,7 +72,7 @@ fn sheared_operator_matches_dense_gather_times_basis() {
             for t in 0..3 {
                 for u in 0..2 {
                     for v in 0..2 {
-                        let (lr, lc) = sheared(origin, s, t, window.0, window.1, u, v, d);
+                        let (lr, lc) = sheared(origin, (s, t), window, (u, v), d);
                         if lr < 0 || lc < 0 || lr >= 10 || lc >= 11 {
                             continue;
                         }
