@@ -284,6 +284,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                 frame_rows: rows,
                 views: (vu, vv),
                 window: self.overlap.window,
+                range: self.tiles.config().raw.range(),
             };
             ring.clear();
             let mut next_row = 0;
@@ -328,6 +329,9 @@ struct Ring<'s, const PS: usize, const PT: usize, const PU: usize, const PV: usi
     frame_rows: usize,
     views: (usize, usize),
     window: Window,
+    /// The sensor's physical range: a mean of estimates inside it stays inside it, and
+    /// the clamp takes off what rounding adds.
+    range: (f32, f32),
 }
 
 impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
@@ -363,6 +367,7 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
     ) -> Result<(), OverlapError<K::Error>> {
         let first_col = self.first_col as u16;
         let views = self.views.0 * self.views.1;
+        let (lo, hi) = self.range;
         let Some((sums, weights)) = self.slot(y) else {
             return Ok(());
         };
@@ -372,7 +377,7 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
             for (values, w) in lenslet.chunks_exact_mut(B).zip(lw.iter()) {
                 if *w > 0.0 {
                     for (x, m) in values.iter_mut().zip(mean.iter_mut()) {
-                        *x /= *w;
+                        *x = (*x / *w).clamp(lo, hi);
                         *m += *x;
                     }
                     covered += 1;
@@ -382,7 +387,7 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
                 report.uncovered += (views * B) as u32;
             } else if covered < views as u32 {
                 for m in mean.iter_mut() {
-                    *m /= covered as f32;
+                    *m = (*m / covered as f32).clamp(lo, hi);
                 }
                 for (values, w) in lenslet.chunks_exact_mut(B).zip(lw.iter()) {
                     if *w <= 0.0 {

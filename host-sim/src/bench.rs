@@ -15,8 +15,8 @@ use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use plotters::prelude::*;
 use slf_firmware::{
-    ChoiceRule, DEFAULT_ENSEMBLE, Dictionary, Ended, MaskFamily, MemberChoice, ModelOutcome, Outcome, PatchModel,
-    Sl0Config, SolveError, Workspace,
+    ChoiceRule, DEFAULT_ENSEMBLE, Dictionary, DisparityRange, Ended, MaskFamily, MemberChoice, ModelOutcome, Outcome,
+    PatchModel, Sl0Config, SolveError, Workspace,
 };
 
 use crate::baseline::{Factors, analyze_5d, solve_5d};
@@ -115,13 +115,19 @@ fn settings(quick: bool) -> Vec<(String, Decoder, DecodeOptions)> {
         noise: NoiseSource::Config,
         stride: (5, 5),
         window: Window::Uniform,
+        disparities: DisparityRange::OFF,
         ..DecodeOptions::default()
     };
-    let decode = |stride: u8, window: Window, adaptive: Option<f32>| DecodeOptions {
+    let unsheared = |stride: u8, window: Window, adaptive: Option<f32>| DecodeOptions {
         stride: (stride, stride),
         window,
         adaptive,
+        disparities: DisparityRange::OFF,
         ..DecodeOptions::default()
+    };
+    let decode = |stride: u8, window: Window, adaptive: Option<f32>| DecodeOptions {
+        disparities: DisparityRange::DEFAULT,
+        ..unsheared(stride, window, adaptive)
     };
     let d = Sl0Config::DEFAULT;
     let dct = || Decoder::Basis(Basis::Dct);
@@ -185,20 +191,43 @@ fn settings(quick: bool) -> Vec<(String, Decoder, DecodeOptions)> {
     // The decode's defaults: the capture's noise model, then overlapping patches (the
     // default stride 3 with the tapered window, and stride 2), and the adaptive rule.
     let mut decode_points = vec![
-        ("ensemble screened, noise model".to_string(), screened(), decode(5, Window::Uniform, None)),
+        ("ensemble screened, noise model".to_string(), screened(), unsheared(5, Window::Uniform, None)),
         (
-            "ensemble screened, noise model, stride 3 tapered (default)".to_string(),
+            "ensemble screened, noise model, stride 3 tapered, unsheared".to_string(),
+            screened(),
+            unsheared(3, Window::Tapered, None),
+        ),
+        (
+            "ensemble screened, noise model, stride 3 tapered, disparities -1:1 (default)".to_string(),
             screened(),
             decode(3, Window::Tapered, None),
         ),
-        ("ensemble screened, noise model, stride 2 tapered".to_string(), screened(), decode(2, Window::Tapered, None)),
+        (
+            "ensemble screened, noise model, stride 2 tapered, disparities -1:1".to_string(),
+            screened(),
+            decode(2, Window::Tapered, None),
+        ),
     ];
     if !quick {
-        decode_points.push(("DCT, noise model, stride 3 tapered".to_string(), dct(), decode(3, Window::Tapered, None)));
         decode_points.push((
-            "ensemble screened, noise model, stride 3 adaptive 1.2".to_string(),
+            "ensemble screened, noise model, stride 2 tapered, unsheared".to_string(),
             screened(),
-            decode(3, Window::Tapered, Some(1.2)),
+            unsheared(2, Window::Tapered, None),
+        ));
+        decode_points.push((
+            "DCT, noise model, stride 3 tapered, unsheared".to_string(),
+            dct(),
+            unsheared(3, Window::Tapered, None),
+        ));
+        decode_points.push((
+            "DCT, noise model, stride 3 tapered, disparities -1:1".to_string(),
+            dct(),
+            decode(3, Window::Tapered, None),
+        ));
+        decode_points.push((
+            "ensemble screened, noise model, stride 3 adaptive 1.2, unsheared".to_string(),
+            screened(),
+            unsheared(3, Window::Tapered, Some(1.2)),
         ));
     }
     points.splice(decode_points_at..decode_points_at, decode_points);

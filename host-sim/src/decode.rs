@@ -166,8 +166,9 @@ pub struct DecodeOptions {
     pub adaptive: Option<f32>,
     /// The white balance.
     pub balance: Balance,
-    /// The disparities each spatial block may be sheared to ([`slf_firmware::disparity`]);
-    /// off (only 0) by default.
+    /// The disparities each spatial block may be sheared to ([`slf_firmware::disparity`]):
+    /// [`DisparityRange::DEFAULT`] (-1..=1) unless told otherwise; [`DisparityRange::OFF`]
+    /// decodes every patch unsheared.
     pub disparities: DisparityRange,
 }
 
@@ -182,17 +183,17 @@ impl Default for DecodeOptions {
             window: Window::Tapered,
             adaptive: None,
             balance: Balance::default(),
-            disparities: DisparityRange::OFF,
+            disparities: DisparityRange::DEFAULT,
         }
     }
 }
 
 impl DecodeOptions {
-    /// Disjoint patches (stride 5, the uniform window), otherwise the defaults: the grid
-    /// the firmware's tile decoder walks, one estimate per patch and angular window, as the
-    /// device decodes today.
+    /// Disjoint patches (stride 5, the uniform window), unsheared, otherwise the defaults:
+    /// the grid the firmware's tile decoder walks, one estimate per patch and angular
+    /// window, as the device decodes its tiles.
     pub fn disjoint() -> Self {
-        Self { stride: (5, 5), window: Window::Uniform, ..Self::default() }
+        Self { stride: (5, 5), window: Window::Uniform, disparities: DisparityRange::OFF, ..Self::default() }
     }
 
     /// The solver's config for `capture`: [`Self::sl0`] with the noise ball from
@@ -398,6 +399,7 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
     );
     let lenslets = (d.lenslets[0], d.lenslets[1]);
     let views = (d.views[0], d.views[1]);
+    let range = decoder.config().raw.range();
     let halo = opts.disparities.halo(views.0.max(views.1));
     let run = |tiles: &[Tile]| -> Vec<(TileSums, Result<TileReport, String>)> {
         let bar = ProgressBar::with_draw_target(Some(tiles.len() as u64), ProgressDrawTarget::hidden());
@@ -433,7 +435,7 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
     }
     let mut results = run(&tiles);
     if let Some(threshold) = opts.adaptive {
-        let (first, _) = aggregate(&results, views, lenslets, tiles.len());
+        let (first, _) = aggregate(&results, views, lenslets, tiles.len(), range);
         let seams = Seams::new(&first);
         let chosen: Vec<Tile> = shifted_tiles(lenslets, opts.stride, (1, 1))
             .into_iter()
@@ -442,7 +444,7 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
         results.extend(run(&chosen));
         tiles.extend(chosen);
     }
-    let (lf, mut report) = aggregate(&results, views, lenslets, tiles.len());
+    let (lf, mut report) = aggregate(&results, views, lenslets, tiles.len(), range);
     report.seconds = start.elapsed().as_secs_f64();
     report.gains = gains;
     Ok((lf, report))
@@ -455,6 +457,7 @@ fn aggregate(
     views: (usize, usize),
     lenslets: (usize, usize),
     tiles: usize,
+    (lo, hi): (f32, f32),
 ) -> (LightField, DecodeReport) {
     let mut lf = LightField::zeros(views, lenslets.0, lenslets.1, 13);
     let mut sum = vec![0.0f32; lf.data.len()];
@@ -499,9 +502,11 @@ fn aggregate(
             }
         }
     }
+    // Each value the weighted mean of estimates in the sensor's range [lo, hi]: the clamp
+    // takes off only what rounding adds (the firmware's overlap ring does the same).
     for ((x, &s), &w) in lf.data.iter_mut().zip(&sum).zip(&weight) {
         if w > 0.0 {
-            *x = s / w;
+            *x = (s / w).clamp(lo, hi);
         }
     }
     // A view of a lenslet no (sheared) patch covered takes the mean of the lenslet's
@@ -526,7 +531,7 @@ fn aggregate(
                             continue;
                         }
                         if covered > 0 {
-                            lf.data[i] = mean / covered as f32;
+                            lf.data[i] = (mean / covered as f32).clamp(lo, hi);
                             report.filled += 1;
                         } else {
                             report.uncovered += 1;

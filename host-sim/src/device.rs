@@ -164,8 +164,11 @@ pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
     let ensemble = Ensemble::<5, 5, 4, 4, 13>::new(DEFAULT_ENSEMBLE).map_err(|e| anyhow::anyhow!("{e}"))?;
     let model = EnsembleModel::new(ensemble, MemberChoice::Screened(ChoiceRule::DEFAULT));
     // The config the device takes from `capture.rs` (the capture's noise ball) and its white
-    // balance: the host's default.
-    let decoder = crate::decode::tile_decoder(&capture, &crate::decode::DecodeOptions::default())?;
+    // balance: the host's default. The device's tiles are its per-patch benchmark, unsheared;
+    // its overlapped frame shears (checked in `check_rows`).
+    let unsheared =
+        crate::decode::DecodeOptions { disparities: slf_firmware::DisparityRange::OFF, ..Default::default() };
+    let decoder = crate::decode::tile_decoder(&capture, &unsheared)?;
     let raw = capture.raw_frames()?;
     let host_gains = *decoder.gains();
     ensure!(gains.len() == 13, "the device printed {} gains, not 13", gains.len());

@@ -403,7 +403,8 @@ enum Command {
         solver: SolverArgs,
         #[command(flatten)]
         basis: BasisArgs,
-        /// Also write which ensemble member each patch used (CSV).
+        /// Also write which ensemble member each patch used (CSV: the patch's origin, the
+        /// disparity it was sheared to, the member).
         #[arg(long)]
         member_map: Option<PathBuf>,
         /// Lenslets between patch origins, 1..=5 (5: disjoint patches, which show their
@@ -427,12 +428,12 @@ enum Command {
         #[arg(long, value_delimiter = ',', value_name = "G1,...,G13")]
         gains: Option<Vec<f32>>,
         /// Integer disparities (pixels per view step) each 5 x 5-lenslet block may be
-        /// sheared to before decoding, MIN:MAX (0:0: unsheared); chosen per block by how
-        /// well the views' same-band samples agree.
+        /// sheared to before decoding, MIN:MAX (default -1:1; 0:0 decodes unsheared); chosen
+        /// per block by how well the views' same-band samples agree.
         #[arg(long, value_parser = disparity_range, value_name = "MIN:MAX", allow_hyphen_values = true)]
         disparities: Option<slf_host::firmware::DisparityRange>,
         /// Also write the chosen disparity per lenslet (.npy, lenslet rows x cols, f32: the
-        /// mean over the blocks that cover it); needs --disparities.
+        /// mean over the blocks that cover it); not with --disparities 0:0.
         #[arg(long)]
         disparity_map: Option<PathBuf>,
         /// Stored dtype.
@@ -759,12 +760,12 @@ fn run(cli: Cli) -> Result<()> {
                 window: window.window(),
                 adaptive,
                 balance,
-                disparities: disparities.unwrap_or_default(),
+                disparities: disparities.unwrap_or(slf_host::firmware::DisparityRange::DEFAULT),
                 ..DecodeOptions::default()
             };
             anyhow::ensure!(
                 disparity_map.is_none() || !opts.disparities.is_off(),
-                "--disparity-map needs --disparities (e.g. -1:1): without it every block is at 0"
+                "--disparity-map needs disparities to search: with --disparities 0:0 every block is at 0"
             );
             if let Some(a) = adaptive {
                 anyhow::ensure!(a.is_finite() && a >= 0.0, "--adaptive {a}: must be finite, at or above 0");
@@ -792,14 +793,14 @@ fn run(cli: Cli) -> Result<()> {
             }
             if let Some(path) = member_map {
                 let mut csv = String::from(
-                    "lenslet_row,lenslet_col,view_row,view_col,member
+                    "lenslet_row,lenslet_col,view_row,view_col,disparity,member
 ",
                 );
                 for (o, m) in &r.member_map {
                     csv += &format!(
-                        "{},{},{},{},{m}
+                        "{},{},{},{},{},{m}
 ",
-                        o.lenslet_row, o.lenslet_col, o.view_row, o.view_col
+                        o.lenslet_row, o.lenslet_col, o.view_row, o.view_col, o.disparity
                     );
                 }
                 std::fs::write(&path, csv).with_context(|| format!("cannot write {}", path.display()))?;

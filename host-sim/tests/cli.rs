@@ -43,9 +43,14 @@ fn scene_simulate_decode_eval_round_trip() {
             .args(["--mask", "pixel", "-s", "3", "--format", "png"]),
     );
     assert!(p("cap/capture.json").exists() && p("cap/snapshot_2.png").exists());
-    let out = stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("recon.npy")).arg("--quiet"));
+    let out = stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("recon.npy")).args([
+        "--quiet",
+        "--disparities",
+        "0:0",
+    ]));
     // 20 x 20 lenslets, four angular windows: 4 x 4 disjoint blocks and, at the default
-    // stride 3, 4 x 3 + 3 x 4 + 3 x 3 patches at shifted origins: (16 + 33) x 4.
+    // stride 3, 4 x 3 + 3 x 4 + 3 x 3 patches at shifted origins: (16 + 33) x 4 (unsheared:
+    // a block sheared at the frame's edge adds its unsheared fallback).
     assert!(out.contains("decoded 196 patches (0 flagged, 0 failed, 0 tiles failed)"), "{out}");
     // The capture's noise by default (2 DN read noise, 20,000 electrons at white); exact
     // or a given noise on request, not both.
@@ -82,12 +87,26 @@ fn scene_simulate_decode_eval_round_trip() {
     assert!(given.contains("white balance: given gains 1.000 1.000"), "{given}");
     failure(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("x.npy")).args(["--gains", "1,2,3"]));
     // The DCT on request, and the member map of the (default) ensemble decode.
-    let out = stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("dct.npy")).args(["--dictionary", "dct", "-q"]));
+    let out = stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("dct.npy")).args([
+        "--dictionary",
+        "dct",
+        "-q",
+        "--disparities=0:0",
+    ]));
     assert!(out.contains("decoded 196 patches"), "{out}");
     stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("e.npy")).arg("--member-map").arg(p("map.csv")).arg("-q"));
     let map = std::fs::read_to_string(p("map.csv")).unwrap();
-    assert_eq!(map.lines().next(), Some("lenslet_row,lenslet_col,view_row,view_col,member"));
-    assert_eq!(map.lines().count(), 1 + 196);
+    assert_eq!(map.lines().next(), Some("lenslet_row,lenslet_col,view_row,view_col,disparity,member"));
+    // Every patch (with the default disparity search, the 196 of the grid and the unsheared
+    // fallbacks of the blocks sheared at the frame's edge), the grid's each once.
+    let grid: std::collections::HashSet<String> =
+        map.lines().skip(1).map(|l| l.split(',').take(4).collect::<Vec<_>>().join(",")).collect();
+    assert!(
+        grid.len() == 196 && map.lines().count() > 196,
+        "{} patches, {} origins",
+        map.lines().count() - 1,
+        grid.len()
+    );
     assert!(map.lines().skip(1).all(|l| l.rsplit(',').next().unwrap().parse::<u16>().unwrap() < 8));
     // A tiny training run writes a blob the decoder takes.
     let out = stdout(slf().arg("train").arg("-o").arg(p("e.slfd")).args([
@@ -222,7 +241,14 @@ fn nothing_decoded_is_a_failure_and_many_flagged_patches_a_warning() {
     assert!(!p("out.npy").exists() && !p("m.csv").exists(), "nothing written");
     // Half the pixels defective: every patch flagged, decoded, and a warning with the count.
     stdout(slf().arg("simulate").arg(p("lf.npy")).arg("-o").arg(p("cap2")).arg("--defects=0.5"));
-    let out = slf().arg("decode").arg(p("cap2")).arg("-o").arg(p("out.npy")).arg("-q").assert().success();
+    let out = slf()
+        .arg("decode")
+        .arg(p("cap2"))
+        .arg("-o")
+        .arg(p("out.npy"))
+        .args(["-q", "--disparities", "0:0"])
+        .assert()
+        .success();
     let err = String::from_utf8(out.get_output().stderr.clone()).unwrap();
     assert!(err.contains("warning") && err.contains("56 were flagged"), "{err}");
     // No warning on a clean capture.

@@ -4,8 +4,8 @@
 use slf_host::camera::{CameraConfig, simulate};
 use slf_host::decode::{Basis, DecodeOptions, Window, decode_with, tile_decoder};
 use slf_host::firmware::{
-    Dictionary, FrameSource, Overlap, OverlapDecoder, PaperShape, PaperWorkspace, PatchOrigin, PatchReport, PatchSink,
-    RowSink, SolveError, Tile,
+    Dictionary, DisparityRange, FrameSource, Overlap, OverlapDecoder, PaperShape, PaperWorkspace, PatchOrigin,
+    PatchReport, PatchSink, RowSink, SolveError, Tile,
 };
 use slf_host::lightfield::LightField;
 
@@ -35,11 +35,17 @@ fn origins(total: usize, off: usize) -> Vec<usize> {
     v
 }
 
+/// The default decode without the disparity search: every patch at its own rectangle (the
+/// sheared decode is checked in `tests/depth.rs`).
+fn unsheared() -> DecodeOptions {
+    DecodeOptions { disparities: DisparityRange::OFF, ..DecodeOptions::default() }
+}
+
 fn reference(truth: &LightField, k: u8, stride: usize, window: Window) -> Vec<f32> {
     let capture = simulate(truth, &CameraConfig::pixel(3, k)).unwrap();
     // The solver config `decode_with` uses: the capture's noise ball, and the white balance
     // (the gains are the frame's; a patch decoded alone uses the same ones).
-    let decoder = tile_decoder(&capture, &DecodeOptions::default()).unwrap();
+    let decoder = tile_decoder(&capture, &unsheared()).unwrap();
     let raw = capture.raw_frames().unwrap();
     let dct = Dictionary::dct();
     let mut ws = Box::new(PaperWorkspace::new());
@@ -95,7 +101,7 @@ fn overlapping_patches_average_as_every_patch_decoded_alone() {
         [(5, Window::Uniform, 1), (2, Window::Uniform, 1), (3, Window::Tapered, 3), (1, Window::Tapered, 1)]
     {
         let capture = simulate(&truth, &CameraConfig::pixel(3, k)).unwrap();
-        let opts = DecodeOptions { stride: (stride as u8, stride as u8), window, ..DecodeOptions::default() };
+        let opts = DecodeOptions { stride: (stride as u8, stride as u8), window, ..unsheared() };
         let (fast, report) = decode_with(&capture, &Basis::Dct, &opts).unwrap();
         assert_eq!(report.uncovered, 0);
         let slow = reference(&truth, k, stride, window);
@@ -143,7 +149,7 @@ fn stride_five_is_todays_decode_and_bad_strides_are_refused() {
     // With disjoint patches (and the edge strips) a taper changes only where patches overlap.
     let differ = a.data.iter().zip(&b.data).filter(|(x, y)| x != y).count();
     assert!(differ > 0 && differ < a.data.len() / 2, "{differ}");
-    let three = DecodeOptions { stride: (3, 3), ..DecodeOptions::default() };
+    let three = DecodeOptions { stride: (3, 3), ..unsheared() };
     let (_, r3) = decode_with(&capture, &Basis::Dct, &three).unwrap();
     // 12 x 12 lenslets, 4 angular windows: rows and columns {0, 5, 7} give 9 patches a
     // window; stride 3 adds the grids at offsets (0, 3), (3, 0), (3, 3): 2 + 2 + 1.

@@ -39,9 +39,9 @@ mod device {
     use defmt_semihosting as _;
     use panic_semihosting as _;
     use slf_firmware::{
-        ChoiceRule, DEFAULT_ENSEMBLE, DecoderConfig, DefectList, Dictionary, Ensemble, EnsembleModel, FrameSource,
-        LeU16Frame, LensletSize, Mask, MemberChoice, Overlap, OverlapDecoder, PaperShape, PaperWorkspace, PatchModel,
-        PatchOrigin, PatchReport, PatchSink, RawFormat, RowSink, SensorGeometry, Sl0Config, TileDecoder,
+        ChoiceRule, DEFAULT_ENSEMBLE, DecoderConfig, DefectList, Dictionary, DisparityRange, Ensemble, EnsembleModel,
+        FrameSource, LeU16Frame, LensletSize, Mask, MemberChoice, Overlap, OverlapDecoder, PaperShape, PaperWorkspace,
+        PatchModel, PatchOrigin, PatchReport, PatchSink, RawFormat, RowSink, SensorGeometry, Sl0Config, TileDecoder,
     };
 
     use super::{bench_begin, bench_end};
@@ -109,12 +109,14 @@ mod device {
         }
     }
 
-    /// Lenslet columns of the overlapped decode's strip: the ring of 5 lenslet rows x 25
-    /// views x (13 sums + 1 weight) f32 is 7,000 B a column, so the capture's 10 columns
-    /// are decoded as two bands of 5 (35,000 B), the most that fits beside the workspace
-    /// and the stack in the emulated part's 128 KiB (see README, "Overlap on the device").
-    const STRIP_COLUMNS: usize = 5;
-    const STRIP_LEN: usize = STRIP_COLUMNS * 5 * 25 * 14;
+    /// Lenslet columns of the overlapped decode's strip: with the default disparities
+    /// (-1..=1, sheared patches reach 2 lenslet rows beyond their own) the ring is 9 lenslet
+    /// rows x 25 views x (13 sums + 1 weight) f32, 12,600 B a column, so the capture's 10
+    /// columns are decoded as four bands of at most 3 (37,800 B), the most that fits beside
+    /// the workspace and the stack in the emulated part's 128 KiB (see README, "Overlap on
+    /// the device").
+    const STRIP_COLUMNS: usize = 3;
+    const STRIP_LEN: usize = STRIP_COLUMNS * 9 * 25 * 14;
 
     /// Prints each finished row of the overlapped decode, folds it into a checksum.
     struct PrintRows {
@@ -243,11 +245,17 @@ mod device {
         let Some(strip) = cortex_m::singleton!(: [f32; STRIP_LEN] = [0.0; STRIP_LEN]) else {
             return debug::EXIT_FAILURE;
         };
-        let Ok(overlapped) = OverlapDecoder::new(decoder, Overlap::DEFAULT) else {
+        // Window 5 (after the frame): the disparity choice of one block, alone.
+        let depth = decoder.with_disparities(DisparityRange::DEFAULT);
+        let Ok(overlapped) = OverlapDecoder::new(depth, Overlap::DEFAULT) else {
             return debug::EXIT_FAILURE;
         };
+        if overlapped.strip_per_column() * STRIP_COLUMNS != STRIP_LEN {
+            hprintln!("error: the strip is not {} columns of the ring", STRIP_COLUMNS);
+            return debug::EXIT_FAILURE;
+        }
         let mut rows = PrintRows { checksum: 0, rows: 0 };
-        hprintln!("overlap stride 3 tapered strip columns {}", STRIP_COLUMNS);
+        hprintln!("overlap stride 3 tapered disparities -1..1 strip columns {}", STRIP_COLUMNS);
         bench_begin(3);
         let r = overlapped.decode_frame(&model, &mut FrameSource::new(&frames), strip, &mut rows, ws);
         bench_end(3);
@@ -264,6 +272,10 @@ mod device {
             }
             Err(_) => failed += 1,
         }
+        bench_begin(5);
+        let chosen = depth.choose_disparity(2, 3, &mut FrameSource::new(&frames));
+        bench_end(5);
+        hprintln!("disparity of block 2 3: {}", chosen.unwrap_or(i8::MIN));
         let stack = crate::stack::peak();
         hprintln!("strip bytes {}", core::mem::size_of::<[f32; STRIP_LEN]>());
         hprintln!("disjoint stack peak bytes {}", disjoint_stack);
