@@ -18,7 +18,9 @@
 //! differ least is the block's depth. With a per-pixel one-hot mask the 25 views of a
 //! point see about two samples per band, so a 5 x 5-lenslet block compares a few hundred
 //! pairs per candidate. Fractional disparities rounded to the nearest pixel measured no
-//! better than the integers (`docs/results-depth.md`), so candidates are integers.
+//! better than the integers (`docs/results-depth.md`), so candidates are integers. (Exact
+//! fractional shears, where a measurement interpolates several patch values, measured far
+//! better on a slow reference; they need a projection that is not a selection.)
 
 use crate::shape::MAX_BANDS;
 
