@@ -330,7 +330,8 @@ struct Ring<'s, const PS: usize, const PT: usize, const PU: usize, const PV: usi
     views: (usize, usize),
     window: Window,
     /// The sensor's physical range: a mean of estimates inside it stays inside it, and
-    /// the clamp takes off what rounding adds.
+    /// the clamp takes off what rounding adds (`max` then `min`: `f32::clamp` asserts its
+    /// bounds, a panic path).
     range: (f32, f32),
 }
 
@@ -371,13 +372,14 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
         let Some((sums, weights)) = self.slot(y) else {
             return Ok(());
         };
-        for (lenslet, lw) in sums.chunks_exact_mut(views * B).zip(weights.chunks_exact_mut(views)) {
+        // (`max(1)`: a chunk size of 0 is a panic path; the views are at least 1.)
+        for (lenslet, lw) in sums.chunks_exact_mut((views * B).max(1)).zip(weights.chunks_exact_mut(views.max(1))) {
             let mut mean = [0.0f32; B];
             let mut covered = 0u32;
             for (values, w) in lenslet.chunks_exact_mut(B).zip(lw.iter()) {
                 if *w > 0.0 {
                     for (x, m) in values.iter_mut().zip(mean.iter_mut()) {
-                        *x = (*x / *w).clamp(lo, hi);
+                        *x = (*x / *w).max(lo).min(hi);
                         *m += *x;
                     }
                     covered += 1;
@@ -387,7 +389,7 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
                 report.uncovered += (views * B) as u32;
             } else if covered < views as u32 {
                 for m in mean.iter_mut() {
-                    *m = (*m / covered as f32).clamp(lo, hi);
+                    *m = (*m / covered as f32).max(lo).min(hi);
                 }
                 for (values, w) in lenslet.chunks_exact_mut(B).zip(lw.iter()) {
                     if *w <= 0.0 {
