@@ -201,6 +201,9 @@ fn run_decode(c: &DecodeCase, ws: &mut PaperWorkspace) -> Result<(), TestCaseErr
         sl0,
     };
     let Ok(decoder) = PaperDecoder::new(config) else { return Ok(()) };
+    // Sheared blocks too: a disparity range of 0..=3 either way, from the seed's top bits.
+    let reach = ((c.seed >> 61) % 4) as i8;
+    let decoder = decoder.with_disparities(DisparityRange::new(-reach, reach).unwrap_or(DisparityRange::OFF));
     // Frames: the drawn values repeated over the sensor (a frame of the wrong size is
     // refused by `RawFrame::new`, also checked).
     let (rows, cols) = config.sensor.frame_size();
