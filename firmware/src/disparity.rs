@@ -79,7 +79,7 @@ impl DisparityRange {
     }
 
     /// The candidates, 0 first and then by growing magnitude (negative first on a tie),
-    /// the order [`Consistency::best`] prefers on equal scores.
+    /// the order [`Best`] prefers on equal scores.
     pub fn candidates(&self) -> impl Iterator<Item = i8> + use<> {
         let (min, max) = (self.min, self.max);
         (0..=MAX_DISPARITY).flat_map(move |m| [-m, m]).filter(move |&d| d >= min && d <= max).enumerate().filter_map(
