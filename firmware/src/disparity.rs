@@ -91,8 +91,7 @@ impl DisparityRange {
     /// The lenslets a shear reaches beyond the patch on either side, for lenslets of
     /// `views` views along an axis: `max |d| * max |u - uc|`.
     pub const fn halo(&self, views: usize) -> usize {
-        let m = if -self.min > self.max { -self.min } else { self.max };
-        m as usize * (views.saturating_sub(1) - (views.saturating_sub(1)) / 2)
+        reach(if -self.min > self.max { self.min } else { self.max }, views)
     }
 }
 
@@ -100,6 +99,12 @@ impl Default for DisparityRange {
     fn default() -> Self {
         Self::OFF
     }
+}
+
+/// The lenslets a shear to `d` reaches beyond the patch on either side, for lenslets of
+/// `views` views along an axis: `|d| * max |u - uc|`.
+pub const fn reach(d: i8, views: usize) -> usize {
+    d.unsigned_abs() as usize * (views.saturating_sub(1) - views.saturating_sub(1) / 2)
 }
 
 /// Lenslets by which view `view` of a lenslet with `views` views (along one axis) is

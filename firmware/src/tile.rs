@@ -22,7 +22,7 @@ use core::num::NonZeroUsize;
 
 use crate::choice::{ModelOutcome, PatchModel};
 use crate::defects::DefectList;
-use crate::disparity::{Best, Consistency, DisparityRange, shift};
+use crate::disparity::{Best, Consistency, DisparityRange, reach, shift};
 use crate::interpolate::{bands_measured, interpolate_bands};
 use crate::log::log;
 use crate::mask::{LensletSize, Mask, MaskFamily};
@@ -502,7 +502,6 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     ) -> Result<(PatchFlags, u16), S::Error> {
         let c = &self.config;
         let (lu, lv) = (c.sensor.lenslet.rows as usize, c.sensor.lenslet.cols as usize);
-        let (nr, nc) = (c.sensor.lenslets.0 as isize, c.sensor.lenslets.1 as isize);
         let k = c.mask.snapshots();
         let m = ws.measurements_mut();
         m.clear();
@@ -535,12 +534,11 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                         }
                     } else {
                         for v in 0..PV {
-                            let (lr, lc) = origin.lenslet(s, t, u, v, (lu, lv));
-                            if !(0..nr).contains(&lr) || !(0..nc).contains(&lc) {
+                            let (vr, vc) = (origin.view_row as usize + u, origin.view_col as usize + v);
+                            let Some((row, col)) = self.sensor_pixel(origin.lenslet(s, t, u, v, (lu, lv)), vr, vc)
+                            else {
                                 continue;
-                            }
-                            let row = lr as usize * lu + origin.view_row as usize + u;
-                            let col = lc as usize * lv + origin.view_col as usize + v;
+                            };
                             for (j, r) in run.iter_mut().enumerate().take(k) {
                                 source.read(j, row, col, &mut r[..1])?;
                             }
@@ -552,6 +550,24 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             }
         }
         Ok((flags, excluded))
+    }
+
+    /// The sensor pixel `(row, col)` of view `(u, v)` of lenslet `(lr, lc)` (a shear can
+    /// put the lenslet outside the sensor: then `None`).
+    #[inline(always)]
+    fn sensor_pixel(&self, (lr, lc): (isize, isize), u: usize, v: usize) -> Option<(usize, usize)> {
+        let c = &self.config;
+        let lr = usize::try_from(lr).ok().filter(|&r| r < usize::from(c.sensor.lenslets.0))?;
+        let lc = usize::try_from(lc).ok().filter(|&c0| c0 < usize::from(c.sensor.lenslets.1))?;
+        Some((lr * usize::from(c.sensor.lenslet.rows) + u, lc * usize::from(c.sensor.lenslet.cols) + v))
+    }
+
+    /// A raw sample through `band` as a measurement: normalised and divided by the band's
+    /// gain, or why it is not one.
+    #[inline(always)]
+    fn balanced(&self, band: u8, raw: f32) -> Result<f32, Invalid> {
+        let gain = self.gains.get(band as usize).copied().unwrap_or(1.0);
+        self.config.raw.classify(raw).map(|y| y / gain)
     }
 
     /// Sensor pixel `(row, col)`'s samples (`sample(j)` of snapshot `j`) as measurements
@@ -576,9 +592,8 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             return;
         }
         for (j, band) in c.mask.bands_at(row, col).iter().enumerate() {
-            let gain = self.gains.get(*band as usize).copied().unwrap_or(1.0);
-            let ok = match c.raw.classify(sample(j).unwrap_or(f32::NAN)) {
-                Ok(y) => m.set(at + *band as usize, y / gain).map_err(|_| Invalid::NonFinite),
+            let ok = match self.balanced(*band, sample(j).unwrap_or(f32::NAN)) {
+                Ok(y) => m.set(at + *band as usize, y).map_err(|_| Invalid::NonFinite),
                 Err(e) => Err(e),
             };
             if let Err(e) = ok {
@@ -600,7 +615,6 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         }
         let c = &self.config;
         let (lu, lv) = (c.sensor.lenslet.rows as usize, c.sensor.lenslet.cols as usize);
-        let (nr, nc) = (c.sensor.lenslets.0 as isize, c.sensor.lenslets.1 as isize);
         let k = c.mask.snapshots();
         let mut best = Best::default();
         let mut one = [[0.0f32; 1]; B];
@@ -612,10 +626,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                         let lr = (row + s) as isize + shift(d, u, lu);
                         for v in 0..lv {
                             let lc = (col + t) as isize + shift(d, v, lv);
-                            if !(0..nr).contains(&lr) || !(0..nc).contains(&lc) {
-                                continue;
-                            }
-                            let (r, cc) = (lr as usize * lu + u, lc as usize * lv + v);
+                            let Some((r, cc)) = self.sensor_pixel((lr, lc), u, v) else { continue };
                             if c.defects.contains(r, cc) {
                                 continue;
                             }
@@ -623,9 +634,8 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                                 source.read(j, r, cc, o)?;
                             }
                             for (band, o) in c.mask.bands_at(r, cc).iter().zip(&one) {
-                                if let Ok(y) = c.raw.classify(o[0]) {
-                                    let gain = self.gains.get(*band as usize).copied().unwrap_or(1.0);
-                                    score.add(*band as usize, y / gain);
+                                if let Ok(y) = self.balanced(*band, o[0]) {
+                                    score.add(*band as usize, y);
                                 }
                             }
                         }
@@ -685,8 +695,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let c = &self.config;
         let (lu, lv) = (c.sensor.lenslet.rows as usize, c.sensor.lenslet.cols as usize);
         let (rows, cols) = (c.sensor.lenslets.0 as usize, c.sensor.lenslets.1 as usize);
-        let range = DisparityRange::new(d.min(0), d.max(0)).unwrap_or(DisparityRange::OFF);
-        let (hr, hc) = (range.halo(lu), range.halo(lv));
+        let (hr, hc) = (reach(d, lu), reach(d, lv));
         row < hr || col < hc || row + PS + hr > rows || col + PT + hc > cols
     }
 

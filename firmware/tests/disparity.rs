@@ -294,17 +294,28 @@ fn a_range_that_chooses_zero_everywhere_is_the_unsheared_decode_bit_for_bit() {
     // The overlap decoder keeps a halo of rows for sheared patches; with every block at
     // 0 its rows are the unsheared ones, bit for bit.
     let rows_of = |dec: Decoder<'static>| {
-        let od = OverlapDecoder::new(dec, Overlap::DEFAULT).unwrap();
-        let mut strip = vec![0.0f32; od.strip_len()];
-        let mut out = Rows(Vec::new());
-        let mut ws = Box::new(PaperWorkspace::new());
-        let r = od.decode_frame(&dct, &mut FrameSource::new(&raw), &mut strip, &mut out, &mut ws).unwrap();
+        let (rows, r) = overlap_rows(dec, &raw, 19);
         assert_eq!((r.uncovered, r.filled), (0, 0));
-        out.0
+        rows
     };
     let (x, y) = (rows_of(plain), rows_of(searched));
     assert_eq!(x.len(), 17);
     assert_eq!(x, y);
+}
+
+/// The rows of an overlapped decode (stride 3, tapered) of `raw` with the DCT, through a
+/// strip of `columns` lenslet columns, and its report.
+fn overlap_rows(
+    dec: Decoder<'static>,
+    raw: &[RawFrame<f32>],
+    columns: usize,
+) -> (Vec<(u16, u16, Vec<f32>)>, OverlapReport) {
+    let od = OverlapDecoder::new(dec, Overlap::DEFAULT).unwrap();
+    let mut strip = vec![0.0f32; od.strip_per_column() * columns];
+    let mut out = Rows(Vec::new());
+    let mut ws = Box::new(PaperWorkspace::new());
+    let r = od.decode_frame(&Dictionary::dct(), &mut FrameSource::new(raw), &mut strip, &mut out, &mut ws).unwrap();
+    (out.0, r)
 }
 
 struct Rows(Vec<(u16, u16, Vec<f32>)>);
@@ -324,17 +335,12 @@ fn a_sheared_plane_decodes_better() {
     let frames = plane(&mask, 1, 6);
     let raw: Vec<RawFrame<f32>> = frames.iter().map(|f| RawFrame::new(f, rows, cols).unwrap()).collect();
     let truth = scene(1, 6);
-    let dct = Dictionary::dct();
     let decode = |dec: Decoder<'static>| {
-        let od = OverlapDecoder::new(dec, Overlap::DEFAULT).unwrap();
-        let mut strip = vec![0.0f32; od.strip_per_column() * 7];
-        let mut out = Rows(Vec::new());
-        let mut ws = Box::new(PaperWorkspace::new());
-        let r = od.decode_frame(&dct, &mut FrameSource::new(&raw), &mut strip, &mut out, &mut ws).unwrap();
+        let (out, r) = overlap_rows(dec, &raw, 7);
         assert_eq!(r.uncovered, 0);
         // Mean squared error over the sensor.
         let mut err = 0.0f64;
-        for (row, c0, values) in &out.0 {
+        for (row, c0, values) in &out {
             for (i, x) in values.chunks(13).enumerate() {
                 let (c, u, v) = (*c0 as usize + i / 25, (i / 5) % 5, i % 5);
                 let p = (*row as usize * 5 + u) * cols + c * 5 + v;

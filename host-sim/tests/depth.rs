@@ -6,11 +6,14 @@
 use assert_cmd::Command;
 use slf_host::camera::{CameraConfig, simulate};
 use slf_host::decode::{Basis, DecodeOptions, decode_with, disparity_per_lenslet, tile_decoder};
-use slf_host::firmware::{Dictionary, DisparityRange, FrameSource, Overlap, OverlapDecoder, PaperWorkspace, RowSink};
+use slf_host::firmware::{Dictionary, DisparityRange, FrameSource, Overlap, OverlapDecoder, PaperWorkspace};
 use slf_host::lightfield::{Dtype, LightField, write_npy};
 use slf_host::metrics::psnr;
 use slf_host::scene::{Layer, Scene, SceneSize, Shape, Texture};
 use slf_host::spectra::{D65, colorchecker};
+
+mod common;
+use common::Rows;
 
 /// Fronto-parallel textured planes: `(disparity, shape)`, the first behind the others.
 fn planes(planes: &[(f32, Shape)], size: usize) -> LightField {
@@ -93,22 +96,6 @@ fn two_planes_each_get_their_own_disparity() {
         }
     }
     assert!(inside >= 1 && outside >= 20, "{inside} blocks on the square, {outside} on the background");
-}
-
-/// A light field filled from the strip's rows.
-struct Rows(LightField);
-
-impl RowSink for Rows {
-    type Error = core::convert::Infallible;
-    fn row(&mut self, row: u16, first_col: u16, values: &[f32]) -> Result<(), Self::Error> {
-        let (vu, vv) = self.0.views;
-        for (i, x) in values.chunks(13).enumerate() {
-            let (c, u, v) = (i / (vu * vv), (i / vv) % vu, i % vv);
-            let at = self.0.index(u, v, row as usize, first_col as usize + c, 0);
-            self.0.data[at..at + 13].copy_from_slice(x);
-        }
-        Ok(())
-    }
 }
 
 #[test]

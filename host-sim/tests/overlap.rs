@@ -5,11 +5,12 @@ use slf_host::camera::{CameraConfig, simulate};
 use slf_host::decode::{Basis, DecodeOptions, Window, decode_with, tile_decoder};
 use slf_host::firmware::{
     Dictionary, DisparityRange, FrameSource, Overlap, OverlapDecoder, PaperShape, PaperWorkspace, PatchOrigin,
-    PatchReport, PatchSink, RowSink, SolveError, Tile,
+    PatchReport, PatchSink, SolveError, Tile,
 };
 use slf_host::lightfield::LightField;
 
 mod common;
+use common::Rows;
 
 /// Keeps the patches a one-patch tile sends (one per angular window).
 struct Kept(Vec<(PatchOrigin, Vec<f32>)>);
@@ -120,22 +121,6 @@ fn overlapping_patches_average_as_every_patch_decoded_alone() {
         assert_eq!((r.bands, r.uncovered), (3, 0));
         let worst = fast.data.iter().zip(&rows.0.data).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
         assert!(worst <= 1e-6, "strip, stride {stride}, {window:?}, k = {k}: off by {worst}");
-    }
-}
-
-/// A light field filled from the strip's rows.
-struct Rows(LightField);
-
-impl RowSink for Rows {
-    type Error = core::convert::Infallible;
-    fn row(&mut self, row: u16, first_col: u16, values: &[f32]) -> Result<(), Self::Error> {
-        let (vu, vv) = self.0.views;
-        for (i, x) in values.chunks(13).enumerate() {
-            let (c, u, v) = (i / (vu * vv), (i / vv) % vu, i % vv);
-            let at = self.0.index(u, v, row as usize, first_col as usize + c, 0);
-            self.0.data[at..at + 13].copy_from_slice(x);
-        }
-        Ok(())
     }
 }
 

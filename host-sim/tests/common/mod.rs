@@ -1,6 +1,7 @@
 //! Helpers shared by the host's tests: hand-made `.npy` files and a small test scene.
 #![allow(dead_code)] // each test binary uses a part
 
+use slf_host::firmware::RowSink;
 use slf_host::lightfield::LightField;
 use slf_host::scene::{SceneSize, named};
 
@@ -23,4 +24,20 @@ pub fn small_smooth(views: usize) -> LightField {
     named("smooth")
         .map(|s| s.render(SceneSize { views: (views, views), rows: 12, cols: 12 }))
         .unwrap_or_else(|| unreachable!("smooth is a named scene"))
+}
+
+/// A light field filled from an overlapped decode's strip rows (13 bands).
+pub struct Rows(pub LightField);
+
+impl RowSink for Rows {
+    type Error = core::convert::Infallible;
+    fn row(&mut self, row: u16, first_col: u16, values: &[f32]) -> Result<(), Self::Error> {
+        let (vu, vv) = self.0.views;
+        for (i, x) in values.chunks(13).enumerate() {
+            let (c, u, v) = (i / (vu * vv), (i / vv) % vu, i % vv);
+            let at = self.0.index(u, v, row as usize, first_col as usize + c, 0);
+            self.0.data[at..at + 13].copy_from_slice(x);
+        }
+        Ok(())
+    }
 }
