@@ -83,6 +83,30 @@ fn sl0(a: &DMatrix<f64>, y: &DVector<f64>, cfg: &Sl0Config) -> DVector<f64> {
     s
 }
 
+/// An orthonormal `n x n` operator that shifts a signal by `g` samples (`x[s] = z(s + g)`):
+/// the polar factor (`U V^T` of the SVD) of `z`'s DCT-II interpolant evaluated at `s + g`
+/// (`polar`), or the band-limited periodic (DFT) interpolant, which is orthogonal for odd
+/// `n` (`!polar`).
+fn orthonormal_shift(n: usize, g: f64, polar: bool) -> Vec<Vec<f64>> {
+    use std::f64::consts::PI;
+    let m = if polar {
+        let c = dct(n);
+        let a = |k: usize| if k == 0 { (1.0 / n as f64).sqrt() } else { (2.0 / n as f64).sqrt() };
+        let e = DMatrix::from_fn(n, n, |s, j| {
+            (0..n).map(|k| a(k) * (PI * (s as f64 + g + 0.5) * k as f64 / n as f64).cos() * c[k][j]).sum::<f64>()
+        });
+        let svd = e.svd(true, true);
+        svd.u.expect("u") * svd.v_t.expect("v_t")
+    } else {
+        let h = (n as i64 - 1) / 2;
+        DMatrix::from_fn(n, n, |s, j| {
+            let q = s as f64 + g - j as f64;
+            (-h..=h).map(|k| (2.0 * PI * k as f64 * q / n as f64).cos()).sum::<f64>() / n as f64
+        })
+    };
+    (0..n).map(|r| (0..n).map(|c| m[(r, c)]).collect()).collect()
+}
+
 /// Bilinear weights of a patch position `(qs, qt)` in `[0, 4]^2` over the 5 x 5 grid.
 fn bilinear(qs: f64, qt: f64) -> Vec<((usize, usize), f64)> {
     let (s0, t0) = ((qs.floor() as usize).min(3), (qt.floor() as usize).min(3));
@@ -120,8 +144,20 @@ fn main() -> Result<()> {
     let cfg = Sl0Config::DEFAULT;
     // The window of views 0..4 x 0..4 of the 5 x 5 lenslet: view offsets from the centre.
     let du = |u: usize| u as f64 - 2.0;
-    let names = ["integer n", "integer n + 1", "n + 0.5 rounded", "n + 0.5 exact"];
-    let mut err = [0.0f64; 4];
+    let names = [
+        "integer n",
+        "integer n + 1",
+        "n + 0.5 rounded",
+        "n + 0.5 exact",
+        "n + 0.5 orthonormal shift (polar of the DCT interpolant)",
+        "n + 0.5 orthonormal shift (periodic DFT interpolant)",
+    ];
+    // The orthonormal variants read each view at the integer part `floor(shift)` of its
+    // shift (a selection) and model the rest, 0 or 0.5, in the dictionary: `A = P H K`,
+    // `H` per view the orthonormal shift by `-(shift - floor(shift))`.
+    let half = [orthonormal_shift(5, -0.5, true), orthonormal_shift(5, -0.5, false)];
+    let identity: Vec<Vec<f64>> = (0..5).map(|r| (0..5).map(|c| f64::from(u8::from(r == c))).collect()).collect();
+    let mut err = [0.0f64; 6];
     let (mut count, mut blocks) = (0usize, 0usize);
     // Blocks in an order that spreads the first ones over the frame (every 3rd position).
     let positions: Vec<(usize, usize)> =
@@ -143,7 +179,7 @@ fn main() -> Result<()> {
             }
             blocks += 1;
             // Each variant: the shift of view u (lenslets), and whether to interpolate.
-            let shifts: [Box<dyn Fn(usize) -> f64>; 4] = [
+            let shifts: [Box<dyn Fn(usize) -> f64>; 6] = [
                 Box::new(move |u| -n * du(u)),
                 Box::new(move |u| -(n + 1.0) * du(u)),
                 Box::new(move |u| {
@@ -151,7 +187,10 @@ fn main() -> Result<()> {
                     x.signum() * (x.abs() + 0.5).floor()
                 }),
                 Box::new(move |u| -(n + 0.5) * du(u)),
+                Box::new(move |u| (-(n + 0.5) * du(u)).floor()),
+                Box::new(move |u| (-(n + 0.5) * du(u)).floor()),
             ];
+            let fractional = |u: usize| -(n + 0.5) * du(u) - (-(n + 0.5) * du(u)).floor() > 0.25;
             // The sensor pixels near the block, and where each variant puts them in its patch.
             // Row `y` in view row `u` (or column `x` in view column `w`, from `bx`).
             let pos = |v: usize, y: usize, u: usize| y as f64 - by as f64 - shifts[v](u);
@@ -163,14 +202,24 @@ fn main() -> Result<()> {
                 for x in bx.saturating_sub(6)..(bx + 11).min(cols) {
                     for u in 0..4 {
                         for w in 0..4 {
-                            if (0..4).all(|v| inside(pos(v, y, u)) && inside(pos_c(v, x, w))) {
+                            if (0..6).all(|v| inside(pos(v, y, u)) && inside(pos_c(v, x, w))) {
                                 pixels.push((y, x, u, w));
                             }
                         }
                     }
                 }
             }
-            for v in 0..4 {
+            for v in 0..6 {
+                // The view's orthonormal shift along s and t (orthonormal variants only).
+                let h = |u: usize| if v >= 4 && fractional(u) { &half[v - 4] } else { &identity };
+                let weights_of = |qs: f64, qt: f64, u: usize, w: usize| -> Vec<((usize, usize), f64)> {
+                    if v < 4 {
+                        return bilinear(qs, qt);
+                    }
+                    let (q, r) = (qs.round() as usize, qt.round() as usize);
+                    let (hs, ht) = (h(u), h(w));
+                    (0..5).flat_map(|a| (0..5).map(move |b| ((a, b), hs[q][a] * ht[r][b]))).collect()
+                };
                 // Measurement rows: a sensor pixel's one band, as weights over patch entries.
                 let mut rows_a: Vec<Vec<(usize, f64)>> = Vec::new();
                 let mut ys = Vec::new();
@@ -187,7 +236,7 @@ fn main() -> Result<()> {
                                 source.read(0, row, col, &mut sample).map_err(|e| anyhow::anyhow!("{e:?}"))?;
                                 let b = usize::from(mask.band(0, row, col).context("band")?);
                                 let Ok(value) = raw_format.classify(sample[0]) else { continue };
-                                let weights = bilinear(qs, qt)
+                                let weights = weights_of(qs, qt, u, w)
                                     .into_iter()
                                     .map(|((s, t), wt)| ((((s * 5 + t) * 4 + u) * 4 + w) * 13 + b, wt))
                                     .collect();
@@ -212,7 +261,7 @@ fn main() -> Result<()> {
                 let mut est = Vec::with_capacity(pixels.len() * 13);
                 for &(y, x, u, w) in &pixels {
                     for b in 0..13 {
-                        let value: f64 = bilinear(pos(v, y, u), pos_c(v, x, w))
+                        let value: f64 = weights_of(pos(v, y, u), pos_c(v, x, w), u, w)
                             .iter()
                             .map(|&((ps, pt), wt)| wt * patch[(((ps * 5 + pt) * 4 + u) * 4 + w) * 13 + b])
                             .sum();
