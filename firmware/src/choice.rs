@@ -318,6 +318,9 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let solved = solve_warm(&member, cfg, ws).map(|outcome| (outcome, self.score(&member, rule, ws)));
         let (outcome, member_score) = solved.inspect_err(|_| ws.measurements.drop_stash())?;
         let dct_wins = dct_score < DCT_MARGIN * member_score;
+        // The stash keeps the DCT's solution in the unmeasured entries only, which is all
+        // of it for selections; interpolating measurements re-solve instead.
+        let resolve = resolve || !ws.measurements.half.is_none();
         if dct_wins && !resolve {
             // Both meet the measurements (the member's to its noise ball: the measured
             // entries stay the member's), and so does their mean, each weighted by the

@@ -103,6 +103,7 @@ pub mod dct;
 pub mod defects;
 pub mod dictionary;
 pub mod disparity;
+pub mod fractional;
 pub mod gains;
 pub mod interpolate;
 pub mod mask;

@@ -421,7 +421,9 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
                     let w = scale * window.weight::<PS, PT>(s, t);
                     for v in 0..PV {
                         // The pixel the value was read from (sheared patches: shifted per view).
-                        let (row, col) = o.lenslet(s, t, u, v, (vu, vv));
+                        let Some((row, col)) = o.lenslet::<PS, PT>(s, t, u, v, (vu, vv)) else {
+                            continue;
+                        };
                         let Some(c) =
                             usize::try_from(col).ok().and_then(|c| c.checked_sub(first)).filter(|&c| c < cols)
                         else {

@@ -144,7 +144,7 @@ fn band_step<const B: usize, const WEIGHTED: bool>(
 /// the bytes of a `u64` (each 0 or 1) and gathered into one byte by a multiply whose
 /// partial products never overlap (byte `i` lands on bit `56 + i`).
 #[inline(always)]
-fn band_bits(flags: &[bool]) -> u64 {
+pub(crate) fn band_bits(flags: &[bool]) -> u64 {
     const GATHER: u64 = 0x0102_0408_1020_4080;
     let mut bits = 0u64;
     for (i, eight) in flags.chunks(8).enumerate().take(8) {
@@ -160,7 +160,7 @@ fn band_bits(flags: &[bool]) -> u64 {
 /// `sum a[j] b[j]` as eight running sums added pairwise: a chain of `B / 8 + 3` additions
 /// instead of `B`, so the pixels' band steps overlap.
 #[inline(always)]
-fn dot<const B: usize>(a: &[f32; B], b: &[f32; B]) -> f32 {
+pub(crate) fn dot<const B: usize>(a: &[f32; B], b: &[f32; B]) -> f32 {
     let mut acc = [0.0f32; 8];
     for (j, (x, y)) in a.iter().zip(b).enumerate() {
         acc[j % 8] += x * y;

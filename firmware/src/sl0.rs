@@ -29,6 +29,7 @@ use core::fmt;
 use crate::ascent::ascend;
 use crate::ball::{Ball, Move};
 use crate::dictionary::Dictionary;
+use crate::fractional::project_fractional;
 use crate::projection::project_coefficients;
 use crate::transform::{analyze, synthesize};
 use crate::workspace::{Measurements, Workspace};
@@ -366,6 +367,15 @@ pub fn solve<const PS: usize, const PT: usize, const PU: usize, const PV: usize,
     ws: &mut Workspace<PS, PT, PU, PV, B, N>,
 ) -> Result<Outcome, SolveError> {
     let ball = start::<B, N>(cfg, &ws.measurements)?;
+    if !ws.measurements.half.is_none() {
+        // Interpolating measurements: the minimum-norm start `M^+ I` is the exact
+        // projection of zero.
+        let Workspace { coeffs, signal, measurements: m } = ws;
+        coeffs.fill(0.0);
+        project_fractional(dict, coeffs, signal, m, &Ball::new(0.0, 0.0, m.count, 0));
+        synthesize(dict, coeffs, signal);
+        return descend(dict, cfg, ws, &ball, 1.0);
+    }
     if let Some(outcome) = short_path(cfg, ws) {
         return Ok(outcome);
     }
@@ -456,19 +466,29 @@ fn descend<const PS: usize, const PT: usize, const PU: usize, const PV: usize, c
     analyze(dict, signal, coeffs);
     let sigma0 = scale * max_abs(coeffs);
 
+    let selection = m.half.is_none();
     let outcome = run_schedule(cfg, sigma0, N, |inv| {
         let step2 = ascend(coeffs, cfg.mu, inv);
-        let residual = project_coefficients(dict, coeffs, signal, m, ball);
+        let residual = if selection {
+            project_coefficients(dict, coeffs, signal, m, ball)
+        } else {
+            project_fractional(dict, coeffs, signal, m, ball)
+        };
         // From a point that meets the measurements, the step d moves the patch by D d on
         // the unmeasured values only (the projection puts the measured ones back), and D
         // is orthonormal: |moved|^2 = |d|^2 - residual^2, with no extra pass. With a noise
-        // ball the projection may leave part of the step on measured values: |d| bounds it.
-        let moved2 = if ball.is_exact() { step2 - residual * residual } else { step2 };
+        // ball, or measurements that interpolate (their residual is not the step's part
+        // the projection removes), |d| bounds it.
+        let moved2 = if ball.is_exact() && selection { step2 - residual * residual } else { step2 };
         Step { residual, moved: libm::sqrtf(moved2.max(0.0)) }
     });
 
     synthesize(dict, coeffs, signal);
-    project::<B, N>(signal, m, ball);
+    if selection {
+        // Rounding of the transforms aside the patch meets the measurements; put them back
+        // exactly (interpolating ones: the last step's projection is the last word).
+        project::<B, N>(signal, m, ball);
+    }
     if signal.iter().any(|x| !x.is_finite()) {
         return Err(SolveError::NonFiniteResult);
     }

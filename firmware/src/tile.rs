@@ -22,7 +22,8 @@ use core::num::NonZeroUsize;
 
 use crate::choice::{ModelOutcome, PatchModel};
 use crate::defects::DefectList;
-use crate::disparity::{Best, Consistency, DisparityRange, reach, shift};
+use crate::disparity::{Best, Consistency, Disparity, DisparityRange, HalfViews, is_half, reach, rounded_shift, shift};
+use crate::fractional::{MAX_GRID, to_sensor};
 use crate::interpolate::{bands_measured, interpolate_bands};
 use crate::log::log;
 use crate::mask::{LensletSize, Mask, MaskFamily};
@@ -93,7 +94,7 @@ pub struct Tile {
 }
 
 /// Where a patch sits: its first lenslet, its angular window's first view, and the
-/// disparity it was sheared to ([`crate::disparity`]; 0: unsheared).
+/// disparity it was sheared to ([`crate::disparity`]; zero: unsheared).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct PatchOrigin {
@@ -101,21 +102,35 @@ pub struct PatchOrigin {
     pub lenslet_col: u16,
     pub view_row: u8,
     pub view_col: u8,
-    pub disparity: i8,
+    pub disparity: Disparity,
 }
 
 impl PatchOrigin {
-    /// The sensor lenslet (row, col) whose pixel holds the patch's value at lenslet
-    /// `(s, t)`, view `(u, v)` of its window, for lenslets of `views` (rows, cols) views:
-    /// the patch's own lenslet shifted by the shear. May lie outside the sensor (a
-    /// sheared patch reaches beyond its rectangle; such values were not measured and a
-    /// sink drops them).
+    /// The sensor lenslet (row, col) whose pixel the patch's grid position `(s, t)` of
+    /// view `(u, v)` of its window names, for `PS x PT`-lenslet patches and lenslets of
+    /// `views` (rows, cols) views: the patch's own lenslet shifted by the shear. For a view
+    /// half a lenslet off the grid ([`crate::disparity::is_half`]) that pixel lies between
+    /// positions `s` and `s + 1`, and the last position names none (`None`). May lie
+    /// outside the sensor (a sheared patch reaches beyond its rectangle; such values were
+    /// not measured and a sink drops them). A sink puts the patch's value at `(s, t, u, v)`
+    /// there: a decoded half-pixel patch is handed over at its pixels
+    /// ([`crate::fractional::to_sensor`]).
     #[inline]
-    pub fn lenslet(&self, s: usize, t: usize, u: usize, v: usize, views: (usize, usize)) -> (isize, isize) {
+    pub fn lenslet<const PS: usize, const PT: usize>(
+        &self,
+        s: usize,
+        t: usize,
+        u: usize,
+        v: usize,
+        views: (usize, usize),
+    ) -> Option<(isize, isize)> {
         let d = self.disparity;
-        let du = crate::disparity::shift(d, self.view_row as usize + u, views.0);
-        let dv = crate::disparity::shift(d, self.view_col as usize + v, views.1);
-        ((self.lenslet_row as usize + s) as isize + du, (self.lenslet_col as usize + t) as isize + dv)
+        let (vr, vc) = (self.view_row as usize + u, self.view_col as usize + v);
+        if (is_half(d, vr, views.0) && s + 1 >= PS) || (is_half(d, vc, views.1) && t + 1 >= PT) {
+            return None;
+        }
+        let (du, dv) = (shift(d, vr, views.0), shift(d, vc, views.1));
+        Some(((self.lenslet_row as usize + s) as isize + du, (self.lenslet_col as usize + t) as isize + dv))
     }
 }
 
@@ -390,9 +405,12 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     /// measurements agree with best ([`crate::disparity`]): the block's patches read, and
     /// report in [`PatchOrigin::disparity`], sheared pixels. A sink must place a patch's
     /// values with [`PatchOrigin::lenslet`] (the [`crate::OverlapDecoder`]'s does).
-    /// [`DisparityRange::OFF`] is the unsheared decode, bit for bit.
+    /// [`DisparityRange::OFF`] is the unsheared decode, bit for bit. Half-pixel
+    /// candidates are kept only for patches of at most [`MAX_GRID`] lenslets, and not on a
+    /// kronecker mask (whose general path is for selections).
     pub fn with_disparities(self, range: DisparityRange) -> Self {
-        Self { disparities: range, ..self }
+        let halves = range.has_halves() && PS * PT <= MAX_GRID && self.config.mask.family() != MaskFamily::Kronecker;
+        Self { disparities: range.with_halves(halves), ..self }
     }
 
     /// The candidate disparities the decode searches.
@@ -510,10 +528,12 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let mut flags = PatchFlags::default();
         let mut excluded = 0u16;
         let mut run = [[0.0f32; PV]; B];
+        let half = HalfViews::of(origin.disparity, (origin.view_row as usize, origin.view_col as usize), (lu, lv));
+        m.set_half_views(half);
         for s in 0..PS {
             for u in 0..PU {
                 for t in 0..PT {
-                    if origin.disparity == 0 {
+                    if origin.disparity == Disparity::ZERO {
                         // One run of the lenslet's view row per snapshot.
                         let row = (origin.lenslet_row as usize + s) * lu + origin.view_row as usize + u;
                         let col0 = (origin.lenslet_col as usize + t) * lv + origin.view_col as usize;
@@ -535,7 +555,9 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                     } else {
                         for v in 0..PV {
                             let (vr, vc) = (origin.view_row as usize + u, origin.view_col as usize + v);
-                            let Some((row, col)) = self.sensor_pixel(origin.lenslet(s, t, u, v, (lu, lv)), vr, vc)
+                            let Some((row, col)) = origin
+                                .lenslet::<PS, PT>(s, t, u, v, (lu, lv))
+                                .and_then(|l| self.sensor_pixel(l, vr, vc))
                             else {
                                 continue;
                             };
@@ -609,9 +631,14 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     ///
     /// # Errors
     /// The source's error.
-    pub fn choose_disparity<S: TileSource>(&self, row: usize, col: usize, source: &mut S) -> Result<i8, S::Error> {
+    pub fn choose_disparity<S: TileSource>(
+        &self,
+        row: usize,
+        col: usize,
+        source: &mut S,
+    ) -> Result<Disparity, S::Error> {
         if self.disparities.is_off() {
-            return Ok(0);
+            return Ok(Disparity::ZERO);
         }
         let c = &self.config;
         let (lu, lv) = (c.sensor.lenslet.rows as usize, c.sensor.lenslet.cols as usize);
@@ -623,9 +650,9 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             for s in 0..PS {
                 for t in 0..PT {
                     for u in 0..lu {
-                        let lr = (row + s) as isize + shift(d, u, lu);
+                        let lr = (row + s) as isize + rounded_shift(d, u, lu);
                         for v in 0..lv {
-                            let lc = (col + t) as isize + shift(d, v, lv);
+                            let lc = (col + t) as isize + rounded_shift(d, v, lv);
                             let Some((r, cc)) = self.sensor_pixel((lr, lc), u, v) else { continue };
                             if c.defects.contains(r, cc) {
                                 continue;
@@ -678,10 +705,15 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                 // lenslets to no patch (their points lie outside the other views): an
                 // unsheared decode of the block fills them, weighed so little that it
                 // changes nothing a sheared patch reached.
-                if disparity != 0 && self.near_edge(row as usize, col as usize, disparity) {
+                if disparity != Disparity::ZERO && self.near_edge(row as usize, col as usize, disparity) {
                     for (view_row, view_col) in self.windows() {
-                        let origin =
-                            PatchOrigin { lenslet_row: row, lenslet_col: col, view_row, view_col, disparity: 0 };
+                        let origin = PatchOrigin {
+                            lenslet_row: row,
+                            lenslet_col: col,
+                            view_row,
+                            view_col,
+                            disparity: Disparity::ZERO,
+                        };
                         self.decode_patch(model, origin, true, source, sink, ws, &mut report)?;
                     }
                 }
@@ -691,7 +723,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     }
 
     /// Whether a block at lenslet `(row, col)` sheared to `d` reaches past the sensor's edge.
-    fn near_edge(&self, row: usize, col: usize, d: i8) -> bool {
+    fn near_edge(&self, row: usize, col: usize, d: Disparity) -> bool {
         let c = &self.config;
         let (lu, lv) = (c.sensor.lenslet.rows as usize, c.sensor.lenslet.cols as usize);
         let (rows, cols) = (c.sensor.lenslets.0 as usize, c.sensor.lenslets.1 as usize);
@@ -726,6 +758,10 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         };
         match decoded {
             Ok(done) => {
+                let half = ws.measurements().half_views();
+                if !half.is_none() {
+                    to_sensor::<PS, PT, PU, PV, B, N>(half, &mut ws.signal);
+                }
                 ws.unbalance_patch(&self.gains);
                 ws.clamp_patch(lo, hi);
                 let r = PatchReport {

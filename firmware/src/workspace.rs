@@ -5,6 +5,7 @@
 //! one flag per patch value: coefficients, signal, and the measurements. `new` is a
 //! `const fn`, so a device can place it in a `static`.
 
+use crate::disparity::HalfViews;
 use crate::shape::{MAX_BANDS, PatchShape};
 use crate::sl0::SolveError;
 
@@ -31,12 +32,36 @@ pub struct Measurements<const N: usize> {
     pub(crate) gains: [f32; MAX_BANDS],
     /// Whether any gain differs from 1.
     pub(crate) balanced: bool,
+    /// The views whose measurements interpolate the patch (a half-pixel shear,
+    /// [`crate::disparity`]); none: every measurement is one value.
+    pub(crate) half: HalfViews,
 }
 
 impl<const N: usize> Measurements<N> {
     /// Nothing measured.
     pub const fn new() -> Self {
-        Self { values: [0.0; N], measured: [false; N], count: 0, gains: [1.0; MAX_BANDS], balanced: false }
+        Self {
+            values: [0.0; N],
+            measured: [false; N],
+            count: 0,
+            gains: [1.0; MAX_BANDS],
+            balanced: false,
+            half: HalfViews::NONE,
+        }
+    }
+
+    /// Makes the measurements of `half`'s views interpolations of the patch: entry
+    /// `(s, t, u, v, b)` of a view whose row `u` is half measures the mean of the patch's
+    /// `(s, ..)` and `(s + 1, ..)` (and likewise along `t` for a half column `v`); the last
+    /// grid position of a half axis is then no measurement, and is ignored if set.
+    /// [`clear`](Self::clear) puts every view back on the grid.
+    pub fn set_half_views(&mut self, half: HalfViews) {
+        self.half = half;
+    }
+
+    /// The views whose measurements interpolate the patch.
+    pub fn half_views(&self) -> HalfViews {
+        self.half
     }
 
     /// Sets the gain of each band (`gains[b]` for band `b`; bands beyond `gains.len()` get
@@ -67,6 +92,7 @@ impl<const N: usize> Measurements<N> {
         self.values.fill(0.0);
         self.measured.fill(false);
         self.count = 0;
+        self.half = HalfViews::NONE;
     }
 
     /// Records that patch entry `index` measured `value` (normalised units).

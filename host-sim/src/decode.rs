@@ -14,6 +14,7 @@ use std::time::Instant;
 use anyhow::{Result, anyhow, ensure};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
+use slf_firmware::disparity::Disparity;
 use slf_firmware::{
     Dictionary, DisparityRange, FrameSource, PaperShape, PaperWorkspace, PatchModel, PatchOrigin, PatchReport,
     PatchSink, Sl0Config, SolveError, Tile, TileDecoder, TileReport,
@@ -279,7 +280,7 @@ pub struct DecodeReport {
     pub filled: usize,
     /// The disparity each spatial block was sheared to, by its first patch's origin
     /// (empty when the decode searched no disparity).
-    pub disparity_map: Vec<(PatchOrigin, i8)>,
+    pub disparity_map: Vec<(PatchOrigin, Disparity)>,
     /// Wall time, seconds.
     pub seconds: f64,
     /// The band gains the decode used (1 without white balance).
@@ -298,7 +299,7 @@ struct TileSums {
     steps: u64,
     solves: u64,
     members: Vec<(PatchOrigin, u16)>,
-    disparities: Vec<(PatchOrigin, i8)>,
+    disparities: Vec<(PatchOrigin, Disparity)>,
 }
 
 impl TileSums {
@@ -351,7 +352,7 @@ impl PatchSink<5200> for TileSums {
         for (i, &x) in patch.iter().enumerate() {
             let [s, t, u, v, b] = PaperShape::coordinates(i);
             // The pixel the value was read from (sheared patches: shifted per view).
-            let (r, c) = o.lenslet(s, t, u, v, self.views);
+            let Some((r, c)) = o.lenslet::<5, 5>(s, t, u, v, self.views) else { continue };
             let (Ok(r), Ok(c)) = (usize::try_from(r - r0), usize::try_from(c - c0)) else { continue };
             if r >= rows || c >= cols {
                 continue;
@@ -547,13 +548,13 @@ fn aggregate(
 /// The disparity per lenslet (row-major, `rows x cols`) from a decode's
 /// [`DecodeReport::disparity_map`]: the mean of the chosen disparities of the 5 x 5 blocks
 /// that cover the lenslet (overlapping blocks at a stride below 5), NaN where none does.
-pub fn disparity_per_lenslet(blocks: &[(PatchOrigin, i8)], rows: usize, cols: usize) -> Vec<f32> {
+pub fn disparity_per_lenslet(blocks: &[(PatchOrigin, Disparity)], rows: usize, cols: usize) -> Vec<f32> {
     let mut sum = vec![0.0f32; rows * cols];
     let mut count = vec![0u32; rows * cols];
     for (o, d) in blocks {
         for r in o.lenslet_row as usize..(o.lenslet_row as usize + 5).min(rows) {
             for c in o.lenslet_col as usize..(o.lenslet_col as usize + 5).min(cols) {
-                sum[r * cols + c] += f32::from(*d);
+                sum[r * cols + c] += d.as_f32();
                 count[r * cols + c] += 1;
             }
         }

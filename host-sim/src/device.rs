@@ -110,7 +110,7 @@ fn parse(log: &str) -> Result<DeviceLog> {
                     lenslet_col: n(2)?,
                     view_row: n(3)? as u8,
                     view_col: n(4)? as u8,
-                    disparity: 0,
+                    disparity: slf_firmware::disparity::Disparity::ZERO,
                 };
                 patches.insert(o, DevicePatch { member: n(6)?, values: Vec::new() });
                 current = Some(Block::Patch(o));

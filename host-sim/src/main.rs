@@ -38,15 +38,26 @@ fn positive(s: &str) -> Result<f32, String> {
 }
 
 /// A finite number at or above zero, for clap.
-/// `MIN:MAX`, integer disparities around 0 (e.g. `-1:1`), within the decoder's limit.
+/// `MIN:MAX[:STEP]`, integer disparities around 0 (e.g. `-1:1`) within the decoder's
+/// limit, in steps of 1 (the default) or 0.5.
 fn disparity_range(s: &str) -> Result<slf_host::firmware::DisparityRange, String> {
     let bad = || {
         let m = slf_host::firmware::disparity::MAX_DISPARITY;
-        format!("{s:?}: want MIN:MAX, integers with -{m} <= MIN <= 0 <= MAX <= {m} (e.g. -1:1)")
+        format!(
+            "{s:?}: want MIN:MAX[:STEP], integers with -{m} <= MIN <= 0 <= MAX <= {m} and a step of 1 or 0.5 (e.g. -1:1:0.5)"
+        )
     };
-    let (a, b) = s.split_once(':').ok_or_else(bad)?;
+    let mut parts = s.split(':');
+    let (Some(a), Some(b), step, None) = (parts.next(), parts.next(), parts.next(), parts.next()) else {
+        return Err(bad());
+    };
     let (a, b) = (a.trim().parse::<i8>().map_err(|_| bad())?, b.trim().parse::<i8>().map_err(|_| bad())?);
-    slf_host::firmware::DisparityRange::new(a, b).ok_or_else(bad)
+    let halves = match step.map(str::trim) {
+        None | Some("1") => false,
+        Some("0.5") | Some(".5") => true,
+        Some(_) => return Err(bad()),
+    };
+    slf_host::firmware::DisparityRange::new(a, b).map(|r| r.with_halves(halves)).ok_or_else(bad)
 }
 
 fn non_negative(s: &str) -> Result<f32, String> {
@@ -427,10 +438,11 @@ enum Command {
         /// --balance.
         #[arg(long, value_delimiter = ',', value_name = "G1,...,G13")]
         gains: Option<Vec<f32>>,
-        /// Integer disparities (pixels per view step) each 5 x 5-lenslet block may be
-        /// sheared to before decoding, MIN:MAX (default -1:1; 0:0 decodes unsheared); chosen
+        /// Disparities (pixels per view step) each 5 x 5-lenslet block may be sheared to
+        /// before decoding, MIN:MAX[:STEP] (default -1:1; 0:0 decodes unsheared; a STEP of
+        /// 0.5 adds the half-pixel shears, whose measurements interpolate the patch); chosen
         /// per block by how well the views' same-band samples agree.
-        #[arg(long, value_parser = disparity_range, value_name = "MIN:MAX", allow_hyphen_values = true)]
+        #[arg(long, value_parser = disparity_range, value_name = "MIN:MAX[:STEP]", allow_hyphen_values = true)]
         disparities: Option<slf_host::firmware::DisparityRange>,
         /// Also write the chosen disparity per lenslet (.npy, lenslet rows x cols, f32: the
         /// mean over the blocks that cover it); not with --disparities 0:0.
@@ -828,11 +840,14 @@ fn run(cli: Cli) -> Result<()> {
                 Balance::Gains(_) => println!("white balance: given gains {}", gains.join(" ")),
             }
             if !opts.disparities.is_off() {
-                let mut counts = std::collections::BTreeMap::<i8, usize>::new();
+                let mut counts = std::collections::BTreeMap::<slf_host::firmware::disparity::Disparity, usize>::new();
                 for (_, d) in &r.disparity_map {
                     *counts.entry(*d).or_default() += 1;
                 }
-                let counts: Vec<String> = counts.iter().map(|(d, n)| format!("{d:+}: {n}")).collect();
+                let counts: Vec<String> = counts
+                    .iter()
+                    .map(|(d, n)| format!("{}{d}: {n}", if d.in_halves() > 0 { "+" } else { "" }))
+                    .collect();
                 println!(
                     "disparity: blocks per disparity {}; {} values of views no sheared patch reached, from their lenslet's other views",
                     counts.join(", "),
