@@ -8,7 +8,7 @@ mod common;
 
 use common::*;
 use rand::Rng;
-use slf_firmware::disparity::{Consistency, MAX_DISPARITY};
+use slf_firmware::disparity::{Consistency, Disparity, MAX_DISPARITY};
 use slf_firmware::*;
 
 // A small patch (3 x 3 lenslets x 2 x 2 views x 4 bands) on lenslets of 3 x 3 views, so the
@@ -95,7 +95,7 @@ fn sheared_operator_matches_dense_gather_times_basis() {
             lenslet_col: origin.1 as u16,
             view_row: window.0 as u8,
             view_col: window.1 as u8,
-            disparity: d,
+            disparity: Disparity::pixels(d),
         };
         let (flags, excluded) = dec.read_patch(o, &mut FrameSource::new(&raw), &mut ws).unwrap();
         assert!(flags.is_empty() && excluded == 0);
@@ -126,7 +126,8 @@ fn sheared_operator_and_its_adjoint_agree() {
         (0..2).map(|_| (0..rows * cols).map(|_| 10.0 + r.random_range(0.0f32..1.0)).collect()).collect();
     let raw: Vec<RawFrame<f32>> = frames.iter().map(|f| RawFrame::new(f, rows, cols).unwrap()).collect();
     for d in [-2i8, -1, 1, 2] {
-        let o = PatchOrigin { lenslet_row: 4, lenslet_col: 4, view_row: 1, view_col: 0, disparity: d };
+        let o =
+            PatchOrigin { lenslet_row: 4, lenslet_col: 4, view_row: 1, view_col: 0, disparity: Disparity::pixels(d) };
         let mut ws = Box::new(Workspace::<3, 3, 2, 2, 4, 144>::new());
         dec.read_patch(o, &mut FrameSource::new(&raw), &mut ws).unwrap();
         let m = ws.measurements();
@@ -189,8 +190,12 @@ fn ranges_are_checked_and_searched_nearest_zero_first() {
     assert_eq!(DisparityRange::new(-MAX_DISPARITY - 1, 0), None);
     assert_eq!(DisparityRange::new(0, MAX_DISPARITY + 1), None);
     let r = DisparityRange::new(-2, 1).unwrap();
-    assert_eq!(r.candidates().collect::<Vec<_>>(), [0, -1, 1, -2]);
-    assert_eq!(DisparityRange::OFF.candidates().collect::<Vec<_>>(), [0]);
+    let halves = |r: DisparityRange| r.candidates().map(|d| d.in_halves()).collect::<Vec<_>>();
+    assert_eq!(halves(r), [0, -2, 2, -4]);
+    assert_eq!(halves(DisparityRange::OFF), [0]);
+    // With halves: every half pixel between the ends, nearest zero first.
+    assert_eq!(halves(r.with_halves(true)), [0, -1, 1, -2, 2, -3, -4]);
+    assert_eq!(halves(DisparityRange::OFF.with_halves(true)), [0]);
     // Lenslets of 5 views: view 0 or 4 is 2 from the centre, so d = 2 reaches 4 lenslets.
     assert_eq!((r.halo(5), r.halo(4), r.halo(3), DisparityRange::OFF.halo(5)), (4, 4, 2, 0));
 }
@@ -266,7 +271,7 @@ fn the_known_disparity_of_a_plane_is_chosen_off_the_edges() {
                 // Off the edges: the shear's halo (2 |d|) inside the sensor.
                 let h = 2 * d.unsigned_abs() as usize;
                 if r0 >= h && c0 >= h && r0 + 5 + h <= 17 && c0 + 5 + h <= 19 {
-                    assert_eq!(i32::from(got), d, "seed {seed}, k {k}: block ({r0}, {c0})");
+                    assert_eq!(i32::from(got.in_halves()), 2 * d, "seed {seed}, k {k}: block ({r0}, {c0})");
                 }
             }
         }
@@ -288,7 +293,7 @@ fn a_range_that_chooses_zero_everywhere_is_the_unsheared_decode_bit_for_bit() {
     plain.decode_frame(&dct, (2, 2), &mut FrameSource::new(&raw), &mut a, &mut ws);
     searched.decode_frame(&dct, (2, 2), &mut FrameSource::new(&raw), &mut b, &mut ws);
     assert!(!a.0.is_empty());
-    assert!(b.0.iter().all(|(o, _, f)| o.disparity == 0 && !f), "a block was sheared or had a fallback");
+    assert!(b.0.iter().all(|(o, _, f)| o.disparity == Disparity::ZERO && !f), "a block was sheared or had a fallback");
     assert_eq!(a.0, b.0);
 
     // The overlap decoder keeps a halo of rows for sheared patches; with every block at

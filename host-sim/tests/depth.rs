@@ -6,6 +6,7 @@
 use assert_cmd::Command;
 use slf_host::camera::{CameraConfig, simulate};
 use slf_host::decode::{Basis, DecodeOptions, decode_with, disparity_per_lenslet, tile_decoder};
+use slf_host::firmware::disparity::Disparity;
 use slf_host::firmware::{Dictionary, DisparityRange, FrameSource, Overlap, OverlapDecoder, PaperWorkspace};
 use slf_host::lightfield::{Dtype, LightField, write_npy};
 use slf_host::metrics::psnr;
@@ -52,7 +53,7 @@ fn the_disparity_of_a_plane_is_chosen_everywhere_off_the_edges() {
         for (o, got) in &report.disparity_map {
             let (r, c) = (usize::from(o.lenslet_row), usize::from(o.lenslet_col));
             if r >= h && c >= h && r + 5 + h <= 30 && c + 5 + h <= 30 {
-                assert_eq!(*got, d, "k {k}: block at ({r}, {c})");
+                assert_eq!(*got, Disparity::pixels(d), "k {k}: block at ({r}, {c})");
                 checked += 1;
             }
         }
@@ -88,10 +89,10 @@ fn two_planes_each_get_their_own_disparity() {
             continue;
         }
         if within(r) && within(c) {
-            assert_eq!(*got, 1, "block ({r}, {c}) on the square");
+            assert_eq!(*got, Disparity::pixels(1), "block ({r}, {c}) on the square");
             inside += 1;
         } else if clear(r) || clear(c) {
-            assert_eq!(*got, -1, "block ({r}, {c}) on the background");
+            assert_eq!(*got, Disparity::pixels(-1), "block ({r}, {c}) on the background");
             outside += 1;
         }
     }
@@ -107,7 +108,7 @@ fn the_device_ring_decodes_sheared_patches_as_the_host_does() {
     let capture = simulate(&truth, &CameraConfig::pixel(5, 1)).unwrap();
     let opts = DecodeOptions { disparities: range(-1, 1), ..DecodeOptions::default() };
     let (host, report) = decode_with(&capture, &Basis::Dct, &opts).unwrap();
-    let sheared = report.disparity_map.iter().filter(|(_, d)| *d != 0).count();
+    let sheared = report.disparity_map.iter().filter(|(_, d)| *d != Disparity::ZERO).count();
     assert!(sheared > 10, "{sheared} sheared blocks");
     let od = OverlapDecoder::new(tile_decoder(&capture, &opts).unwrap(), Overlap::DEFAULT).unwrap();
     let mut strip = vec![0.0f32; od.strip_per_column() * 6];

@@ -275,7 +275,7 @@ mod device {
         bench_begin(5);
         let chosen = depth.choose_disparity(2, 3, &mut FrameSource::new(&frames));
         bench_end(5);
-        hprintln!("disparity of block 2 3: {}", chosen.unwrap_or(i8::MIN));
+        hprintln!("disparity of block 2 3 (half pixels): {}", chosen.map_or(i8::MIN, |d| d.in_halves()));
         let stack = crate::stack::peak();
         hprintln!("strip bytes {}", core::mem::size_of::<[f32; STRIP_LEN]>());
         hprintln!("disjoint stack peak bytes {}", disjoint_stack);
