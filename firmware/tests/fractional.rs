@@ -104,6 +104,8 @@ fn half_pixel_read_and_projection_match_the_dense_definition() {
         (2, 2, -1, (4, 3), (1, 1)),
         (3, 3, 3, (3, 4), (1, 0)),
         (4, 1, -3, (4, 4), (0, 1)),
+        // Every band at every pixel: a whole view's 9 positions are one block (the large factor).
+        (5, 4, 1, (3, 4), (1, 1)),
     ] {
         let mask = Mask::pixel(seed, k, 4, L3).unwrap();
         let dec = small_decoder(mask);

@@ -201,9 +201,12 @@ fn run_decode(c: &DecodeCase, ws: &mut PaperWorkspace) -> Result<(), TestCaseErr
         sl0,
     };
     let Ok(decoder) = PaperDecoder::new(config) else { return Ok(()) };
-    // Sheared blocks too: a disparity range of 0..=3 either way, from the seed's top bits.
+    // Sheared blocks too: a disparity range of 0..=3 either way, with or without the
+    // half-pixel shears, from the seed's top bits.
     let reach = ((c.seed >> 61) % 4) as i8;
-    let decoder = decoder.with_disparities(DisparityRange::new(-reach, reach).unwrap_or(DisparityRange::OFF));
+    let halves = (c.seed >> 60) & 1 == 1;
+    let range = DisparityRange::new(-reach, reach).unwrap_or(DisparityRange::OFF).with_halves(halves);
+    let decoder = decoder.with_disparities(range);
     // Frames: the drawn values repeated over the sensor (a frame of the wrong size is
     // refused by `RawFrame::new`, also checked).
     let (rows, cols) = config.sensor.frame_size();
