@@ -133,7 +133,7 @@ fn the_command_line_writes_the_disparity_map_and_refuses_bad_ranges() {
         .arg(p("cap"))
         .arg("-o")
         .arg(p("x.npy"))
-        .args(["--dictionary", "dct", "--disparities", "-1:1", "--disparity-map"])
+        .args(["--dictionary", "dct", "--disparities", "-1:1:0.5", "--disparity-map"])
         .arg(p("map.npy"))
         .arg("-q")
         .assert()
@@ -146,10 +146,14 @@ fn the_command_line_writes_the_disparity_map_and_refuses_bad_ranges() {
     let map = std::fs::read(p("map.npy")).unwrap();
     let header = String::from_utf8_lossy(&map[..128]);
     assert!(header.contains("(20, 20") && header.contains("<f4"), "{header}");
+    // The plane is at disparity 1: blocks off the edges choose it among the halves.
+    assert!(out.contains("+1: "), "{out}");
     for (args, want) in [
         (vec!["--disparities", "1:2"], "MIN:MAX"),
         (vec!["--disparities", "-9:1"], "MIN:MAX"),
         (vec!["--disparities", "x"], "MIN:MAX"),
+        (vec!["--disparities", "-1:1:0.3"], "STEP"),
+        (vec!["--disparities", "-1:1:0.5:1"], "STEP"),
         (vec!["--disparities", "0:0", "--disparity-map", "m.npy"], "needs disparities"),
     ] {
         let o = slf().arg("decode").arg(p("cap")).arg("-o").arg(p("y.npy")).args(&args).assert().failure();
