@@ -23,9 +23,10 @@
 //!   [`transform`]): the patch geometry in the types, sheared patches that align the views
 //!   on a depth, dictionaries (the 5D DCT and blobs in flash) and the separable synthesis
 //!   and analysis transforms.
-//! - **solver** ([`sl0`], [`ascent`], [`ball`], [`projection`], [`pinv`], [`choice`],
-//!   [`interpolate`]): nD SL0 with the orthonormal fast path, the noise ball a projection
-//!   moves onto, the paper's general pseudo-inverse path for kronecker masks, the choice of
+//! - **solver** ([`sl0`], [`ascent`], [`ball`], [`projection`], [`fractional`], [`pinv`],
+//!   [`choice`], [`interpolate`]): nD SL0 with the orthonormal fast path, the noise ball a
+//!   projection moves onto, the projection of half-pixel sheared patches (whose measurements
+//!   interpolate them), the paper's general pseudo-inverse path for kronecker masks, the choice of
 //!   an ensemble member per patch (exhaustive or screened), and per-pixel spectral
 //!   interpolation for patches that measure too few distinct bands.
 //! - **tile decoder** ([`tile`]): a rectangle of the raw frame, patch by patch, from a
