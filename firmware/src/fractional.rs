@@ -19,11 +19,11 @@
 //! costs one copy of the patch per direction and the band values of every pixel of a
 //! view a band is measured in: measured, about 1.5 times the fast path's projection.
 
-use crate::ball::{Ball, Move};
+use crate::ball::Ball;
 use crate::dictionary::Dictionary;
-use crate::projection::{band_bits, dot};
+use crate::projection::{apply_move, band_bits, dot, slice_analysis, slice_synthesis};
 use crate::shape::PatchShape;
-use crate::transform::{Slice, flat, mode_pixel, mode_rows, mode_rows_add, slice};
+use crate::transform::{Slice, flat, mode_rows, slice};
 use crate::workspace::Measurements;
 
 /// The largest view grid (`PS * PT`) a half-pixel patch may have: one band's system of a
@@ -50,43 +50,29 @@ pub fn project_fractional<
     ball: &Ball,
 ) -> f32 {
     const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
-    let (d, t) = (&dict.d, &dict.t);
-    let (fd, ft) = (dict.synthesis_folds(), dict.analysis_folds());
     let part_len = PT * PU * PV * B;
-    // The pixel modes' synthesis, every slice back in place: each pixel's band coefficients.
-    mode_rows(&d.m1, fd[0], coeffs, scratch, part_len);
+    // The pixel modes' synthesis (the fast path's), every slice back in place: each
+    // pixel's band coefficients.
+    mode_rows(&dict.d.m1, dict.synthesis_folds()[0], coeffs, scratch, part_len);
     let mut tmp: Slice<PT, PU, PV, B> = slice();
     for part in scratch.chunks_exact_mut(part_len) {
         let tmp = flat(&mut tmp);
-        mode_rows(&d.m2, fd[1], part, tmp, PU * PV * B);
-        mode_rows(&d.m3, fd[2], tmp, part, PV * B);
-        mode_pixel(&d.m4, fd[3], part.as_chunks::<B>().0, tmp.as_chunks_mut::<B>().0);
-        for (p, x) in part.iter_mut().zip(tmp.iter()) {
-            *p = *x;
-        }
+        slice_synthesis(dict, part, tmp);
+        part.copy_from_slice(tmp);
     }
     let (mut r2, mut w2) = (0.0f32, 0.0f32);
     for u in 0..PU {
         for v in 0..PV {
-            let (r, w) = view_step::<PS, PT, PU, PV, B, N>(&d.m5, scratch, m, ball, (u, v));
+            let (r, w) = view_step::<PS, PT, PU, PV, B, N>(&dict.d.m5, scratch, m, ball, (u, v));
             (r2, w2) = (r2 + r, w2 + w);
         }
     }
     for part in scratch.chunks_exact_mut(part_len) {
         let tmp = flat(&mut tmp);
-        mode_pixel(&t.m4, ft[3], part.as_chunks::<B>().0, tmp.as_chunks_mut::<B>().0);
-        mode_rows(&t.m3, ft[2], tmp, part, PV * B);
-        mode_rows(&t.m2, ft[1], part, tmp, PU * PV * B);
-        for (p, x) in part.iter_mut().zip(tmp.iter()) {
-            *p = *x;
-        }
+        tmp.copy_from_slice(part);
+        slice_analysis(dict, tmp, part);
     }
-    let norm = libm::sqrtf(r2);
-    let Move::Scale(scale) = ball.move_for(r2, w2) else {
-        return norm; // inside the ball: no move
-    };
-    mode_rows_add(&t.m1, ft[0], scale, scratch, coeffs, part_len);
-    norm
+    apply_move(dict, ball, (r2, w2), scratch, coeffs)
 }
 
 /// The band step of view `(u, v)`: its pixels' band coefficients in `fibres` become the

@@ -61,35 +61,73 @@ pub fn project_coefficients<
     ball: &Ball,
 ) -> f32 {
     const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
-    let (d, t) = (&dict.d, &dict.t);
-    let (fd, ft) = (dict.synthesis_folds(), dict.analysis_folds());
     let part_len = PT * PU * PV * B;
-    mode_rows(&d.m1, fd[0], coeffs, scratch, part_len);
+    mode_rows(&dict.d.m1, dict.synthesis_folds()[0], coeffs, scratch, part_len);
     let (mut r2, mut w2) = (0.0f32, 0.0f32);
     let weighted = ball.is_weighted();
     let mut tmp: Slice<PT, PU, PV, B> = slice();
     let parts = scratch.chunks_exact_mut(part_len).zip(m.values.chunks_exact(part_len));
     for ((part, values), measured) in parts.zip(m.measured.chunks_exact(part_len)) {
         let tmp = flat(&mut tmp);
-        mode_rows(&d.m2, fd[1], part, tmp, PU * PV * B);
-        mode_rows(&d.m3, fd[2], tmp, part, PV * B);
-        mode_pixel(&d.m4, fd[3], part.as_chunks::<B>().0, tmp.as_chunks_mut::<B>().0);
+        slice_synthesis(dict, part, tmp);
         let fibres = tmp.as_chunks_mut::<B>().0;
         if weighted {
-            let (r, w) = band_step::<B, true>(&d.m5, fibres, values, measured, ball, &m.gains);
+            let (r, w) = band_step::<B, true>(&dict.d.m5, fibres, values, measured, ball, &m.gains);
             (r2, w2) = (r2 + r, w2 + w);
         } else {
-            r2 += band_step::<B, false>(&d.m5, fibres, values, measured, ball, &m.gains).0;
+            r2 += band_step::<B, false>(&dict.d.m5, fibres, values, measured, ball, &m.gains).0;
         }
-        mode_pixel(&t.m4, ft[3], tmp.as_chunks::<B>().0, part.as_chunks_mut::<B>().0);
-        mode_rows(&t.m3, ft[2], part, tmp, PV * B);
-        mode_rows(&t.m2, ft[1], tmp, part, PU * PV * B);
+        slice_analysis(dict, tmp, part);
     }
+    apply_move(dict, ball, (r2, w2), scratch, coeffs)
+}
+
+/// The synthesis of one spatial slice over the pixel modes after the first: `part` (its
+/// first mode already synthesised) to each pixel's band coefficients in `fibres`; `part`
+/// is clobbered. Shared by both projections ([`crate::fractional`]).
+#[inline(always)]
+pub(crate) fn slice_synthesis<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
+    dict: &Dictionary<PS, PT, PU, PV, B>,
+    part: &mut [f32],
+    fibres: &mut [f32],
+) {
+    let (d, fd) = (&dict.d, dict.synthesis_folds());
+    mode_rows(&d.m2, fd[1], part, fibres, PU * PV * B);
+    mode_rows(&d.m3, fd[2], fibres, part, PV * B);
+    mode_pixel(&d.m4, fd[3], part.as_chunks::<B>().0, fibres.as_chunks_mut::<B>().0);
+}
+
+/// The inverse of [`slice_synthesis`]: a slice's corrections as band coefficients in
+/// `fibres` analysed over the pixel modes after the first into `part`; `fibres` is
+/// clobbered.
+#[inline(always)]
+pub(crate) fn slice_analysis<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
+    dict: &Dictionary<PS, PT, PU, PV, B>,
+    fibres: &mut [f32],
+    part: &mut [f32],
+) {
+    let (t, ft) = (&dict.t, dict.analysis_folds());
+    mode_pixel(&t.m4, ft[3], fibres.as_chunks::<B>().0, part.as_chunks_mut::<B>().0);
+    mode_rows(&t.m3, ft[2], part, fibres, PV * B);
+    mode_rows(&t.m2, ft[1], fibres, part, PU * PV * B);
+}
+
+/// The end of a projection: the ball's move for squared residual norms `(r2, w2)` (plain,
+/// weighted), and the correction in `scratch` (all but the first mode analysed) added to
+/// `coeffs` at that scale through the first mode's analysis. Returns the residual norm.
+#[inline(always)]
+pub(crate) fn apply_move<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
+    dict: &Dictionary<PS, PT, PU, PV, B>,
+    ball: &Ball,
+    (r2, w2): (f32, f32),
+    scratch: &[f32],
+    coeffs: &mut [f32],
+) -> f32 {
     let norm = libm::sqrtf(r2);
     let Move::Scale(scale) = ball.move_for(r2, w2) else {
         return norm; // inside the ball: no move
     };
-    mode_rows_add(&t.m1, ft[0], scale, scratch, coeffs, part_len);
+    mode_rows_add(&dict.t.m1, dict.analysis_folds()[0], scale, scratch, coeffs, PT * PU * PV * B);
     norm
 }
 

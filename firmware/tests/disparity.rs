@@ -11,27 +11,6 @@ use rand::Rng;
 use slf_firmware::disparity::{Consistency, Disparity, MAX_DISPARITY};
 use slf_firmware::*;
 
-// A small patch (3 x 3 lenslets x 2 x 2 views x 4 bands) on lenslets of 3 x 3 views, so the
-// dense 144 x 144 basis is cheap.
-const L3: LensletSize = LensletSize { rows: 3, cols: 3 };
-const SMALL: SensorGeometry = SensorGeometry { lenslets: (10, 11), lenslet: L3 };
-type Small<'a> = TileDecoder<'a, 3, 3, 2, 2, 4, 144>;
-type SmallShape = PatchShape<3, 3, 2, 2, 4, 144>;
-
-/// Raw samples `x + 10` read back as `x` (any sign), up to f32 rounding near 10.
-const OFFSET: RawFormat = RawFormat { black: 10.0, white: 11.0, max_valid: 1e6 };
-
-fn small_decoder(mask: Mask<'static>) -> Small<'static> {
-    Small::new(DecoderConfig {
-        sensor: SMALL,
-        mask,
-        raw: OFFSET,
-        defects: DefectList::EMPTY,
-        sl0: Sl0Config { min_bands: 0, ..Sl0Config::DEFAULT },
-    })
-    .unwrap()
-}
-
 /// The sensor lenslet of patch lenslet `(s, t)`, view `(u, v)` of the window at `window`,
 /// sheared to `d`, from the definition: view `w` of a lenslet of 3 views is shifted by
 /// `-d (w - 1)` lenslets.

@@ -15,27 +15,6 @@ use slf_firmware::disparity::{Disparity, HalfViews};
 use slf_firmware::fractional::{project_fractional, to_sensor};
 use slf_firmware::*;
 
-// A small patch (3 x 3 lenslets x 2 x 2 views x 4 bands) on lenslets of 3 x 3 views
-// (centre view 1), so the dense 144 x 144 basis is cheap.
-const L3: LensletSize = LensletSize { rows: 3, cols: 3 };
-const SMALL: SensorGeometry = SensorGeometry { lenslets: (10, 11), lenslet: L3 };
-type Small<'a> = TileDecoder<'a, 3, 3, 2, 2, 4, 144>;
-type SmallShape = PatchShape<3, 3, 2, 2, 4, 144>;
-
-/// Raw samples `x + 10` read back as `x` (any sign), up to f32 rounding near 10.
-const OFFSET: RawFormat = RawFormat { black: 10.0, white: 11.0, max_valid: 1e6 };
-
-fn small_decoder(mask: Mask<'static>) -> Small<'static> {
-    Small::new(DecoderConfig {
-        sensor: SMALL,
-        mask,
-        raw: OFFSET,
-        defects: DefectList::EMPTY,
-        sl0: Sl0Config { min_bands: 0, ..Sl0Config::DEFAULT },
-    })
-    .unwrap()
-}
-
 /// One measurement of a patch, from the definition: the grid entries it averages.
 struct Row {
     /// Patch entry where the read stores it (its first grid position).

@@ -187,3 +187,25 @@ pub fn measure_window<
         }
     }
 }
+
+/// The sheared-patch tests' small sensor: patches of 3 x 3 lenslets x 2 x 2 views x 4
+/// bands on lenslets of 3 x 3 views (centre view 1), so a dense 144 x 144 basis is cheap.
+pub const L3: slf_firmware::LensletSize = slf_firmware::LensletSize { rows: 3, cols: 3 };
+pub const SMALL: slf_firmware::SensorGeometry = slf_firmware::SensorGeometry { lenslets: (10, 11), lenslet: L3 };
+pub type Small<'a> = slf_firmware::TileDecoder<'a, 3, 3, 2, 2, 4, 144>;
+pub type SmallShape = PatchShape<3, 3, 2, 2, 4, 144>;
+
+/// Raw samples `x + 10` read back as `x` (any sign), up to f32 rounding near 10.
+pub const OFFSET: slf_firmware::RawFormat = slf_firmware::RawFormat { black: 10.0, white: 11.0, max_valid: 1e6 };
+
+/// The small sensor's decoder (every patch solved: `min_bands` 0).
+pub fn small_decoder(mask: Mask<'static>) -> Small<'static> {
+    Small::new(slf_firmware::DecoderConfig {
+        sensor: SMALL,
+        mask,
+        raw: OFFSET,
+        defects: slf_firmware::DefectList::EMPTY,
+        sl0: slf_firmware::Sl0Config { min_bands: 0, ..slf_firmware::Sl0Config::DEFAULT },
+    })
+    .unwrap()
+}
