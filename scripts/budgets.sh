@@ -2,7 +2,7 @@
 # Measures the device budgets on qemu's emulated Cortex-M4F and prints a markdown table:
 # flash (.text + .rodata), static RAM (.data + .bss), peak stack (painted), the Workspace,
 # instructions per transform multiply-add and per patch (5D DCT, shipped ensemble with
-# screened choice) and per overlapped frame (stride 3, tapered, through the strip),
+# screened choice; the DCT sheared to whole and half-pixel disparities) and per overlapped frame (stride 3, tapered, through the strip),
 # counted by the qemu plugin scripts/wincount/wincount.c between the device binary's
 # bench_begin / bench_end markers. The 96 KiB decode budget is for one patch (workspace +
 # stack); the overlapped frame adds the strip, and must fit the part's 128 KiB.
@@ -42,28 +42,36 @@ ov = re.search(r"overlap patches (\d+) bands (\d+) uncovered \d+ frame-patches (
 ov_patches, ov_bands, frame_patches = (int(x) for x in ov.groups())
 t = len(tiles)
 # Windows: the white balance's pass over the frame, one transform, the ensemble's tiles,
-# the DCT's tiles, the overlapped frame, the disparity choice of one block.
-assert len(wins) == 2 + 2 * t + 2, (len(wins), t)
-gains, choose, wins = wins[0], wins[-1], wins[1:-1]
+# the DCT's tiles, the overlapped frame, the disparity choice of one block, then each of
+# the DCT tiles' patches solved sheared to disparity 1, and to 1/2.
 patches = sum(tiles)
+assert len(wins) == 2 + 2 * t + 2 + 2 * patches, (len(wins), t, patches)
+gains, wins = wins[0], wins[1:]
 ens = sum(wins[1:1 + t]) / patches
 dct = sum(wins[1 + t:1 + 2 * t]) / patches
-frame = wins[1 + 2 * t]
+frame, choose = wins[1 + 2 * t], wins[2 + 2 * t]
+dct_whole = sum(wins[3 + 2 * t:3 + 2 * t + patches]) / patches
+dct_half = sum(wins[3 + 2 * t + patches:]) / patches
+sheared_stack = int(re.search(r"^sheared stack peak bytes (\d+)", log, re.M).group(1))
+steps = re.search(r"^sheared dct steps whole (\d+) half (\d+)", log, re.M)
+steps_whole, steps_half = (int(x) / patches for x in steps.groups())
 # The per-patch budget: everything but the overlapped decode's strip, with the stack of
 # the disjoint decode; the overlapped frame: everything.
-flash, ram = text + rodata + data, data + bss - strip + disjoint_stack
+flash, ram = text + rodata + data, data + bss - strip + max(disjoint_stack, sheared_stack)
 frame_ram = data + bss + stack
 print("| budget | measured | limit |\n| --- | --- | --- |")
 print(f"| flash (.text + .rodata + .data) | {flash:,} B ({flash / 1024:.1f} KiB) | 256 KiB |")
 print(f"| static RAM (.data + .bss) | {data + bss:,} B | |")
 print(f"| of which the Workspace | {ws:,} B | |")
 print(f"| peak stack (painted) | {stack:,} B | |")
+print(f"| peak stack of a disjoint decode / of sheared solves (whole and half-pixel) | {disjoint_stack:,} / {sheared_stack:,} B | |")
 print(f"| peak RAM for decoding a patch (static + stack, without the strip) | {ram:,} B ({ram / 1024:.1f} KiB) | 96 KiB |")
 print(f"| strip of the overlapped decode ({strip_cols} lenslet columns) | {strip:,} B | |")
 print(f"| peak RAM for the overlapped frame (static + stack) | {frame_ram:,} B ({frame_ram / 1024:.1f} KiB) | 128 KiB (the part) |")
 print(f"| instructions per transform ({macs:,} multiply-adds) | {wins[0]:,} ({wins[0] / macs:.2f} per multiply-add) | |")
 print(f"| instructions for the white balance (one pass over the frame, every snapshot) | {gains:,} | |")
 print(f"| instructions per patch, 5D DCT | {dct:,.0f} | |")
+print(f"| instructions per patch, 5D DCT sheared to disparity 1 ({steps_whole:.0f} steps) / 1/2 ({steps_half:.0f} steps) | {dct_whole:,.0f} / {dct_half:,.0f} | |")
 print(f"| instructions per patch, ensemble (8 members), screened | {ens:,.0f} | |")
 print(f"| instructions to choose one block's disparity (-1..1: 3 candidates x 625 pixels x k samples) | {choose:,} | |")
 print(f"| instructions per frame, stride 3 tapered, disparities -1..1, screened ensemble ({ov_patches} patch solves in {ov_bands} bands; {frame_patches} with a full-width strip; disjoint: {patches}) | {frame:,} ({frame / patches:,.0f} per disjoint patch) | |")

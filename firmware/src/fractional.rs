@@ -9,9 +9,10 @@
 //! per view and band: a dense system of the band's measured grid positions in that view
 //! (at most `PS * PT`, a few for one-hot masks). Its entries are products of one factor
 //! per axis: 1 on a whole axis at the same position, 1/2 on a half axis at the same
-//! position and 1/4 at neighbouring ones, 0 otherwise. Each step solves every block by
-//! Cholesky on the stack; the blocks depend on the mask only, but keeping their factors
-//! would cost RAM a patch does not have.
+//! position and 1/4 at neighbouring ones, 0 otherwise. Most blocks of a one-hot mask are
+//! diagonal (a band's positions in a view are rarely neighbours), a division each; the
+//! rest are factored as `L D L^T` on the stack at every step. The blocks depend on the
+//! mask only, but keeping their factors would cost RAM a patch does not have.
 //!
 //! The pixel modes' synthesis and analysis are the fast path's; what differs is that a
 //! view's grid spans every spatial slice, so the synthesis of all slices is finished
@@ -79,10 +80,12 @@ pub fn project_fractional<
 /// correction's `M^T (M M^T)^-1 r`, band by measured band. Returns the sums of squared
 /// residuals, plain and (weighted balls) over their variances.
 ///
-/// A measurement's model value is the dot products of its two to four pixels with the
-/// band's row of `D5`, and a pixel's correction goes back through the rows of the bands it
-/// was corrected in only: with one measurement per pixel that is about 1,000 multiply-adds
-/// a view each way, where every pixel's every measured band took 4,000.
+/// One pass over the view's grid positions sums each measurement's two to four pixels
+/// (a model value is `D5`'s band row against that sum, one dot product however many pixels
+/// it interpolates) and files its residual under its band. Each band's block is solved,
+/// then the view's pixels are rebuilt from the corrections alone: a measurement adds its
+/// `weight * z` times its band's row of `D5` to the pixels it read, about 1,000
+/// multiply-adds a view each way at one measurement per pixel.
 #[inline(never)]
 fn view_step<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
     m5: &[[f32; B]; B],
@@ -94,94 +97,79 @@ fn view_step<const PS: usize, const PT: usize, const PU: usize, const PV: usize,
     let (hs, ht) = (usize::from(m.half.row(u)), usize::from(m.half.col(v)));
     let fibres = scratch.as_chunks_mut::<B>().0;
     let pixel = |s: usize, t: usize| ((s * PT + t) * PU + u) * PV + v;
-    // The bands measured anywhere in the view.
-    let mut bands = 0u64;
-    for s in 0..PS {
-        for t in 0..PT {
-            let at = pixel(s, t) * B;
-            if let Some(flags) = m.measured.get(at..at + B) {
-                bands |= band_bits(flags);
-            }
-        }
-    }
-    let mut correction = [[0.0f32; B]; MAX_GRID];
-    let mut touched = [0u64; MAX_GRID];
-    let weight = if hs + ht == 0 {
-        1.0
-    } else if hs + ht == 1 {
-        0.5
-    } else {
-        0.25
-    };
+    // The diagonal of M M^T: a measurement's own overlap.
+    let weight = overlap(hs, 0) * overlap(ht, 0);
+    // Per band: its measured grid positions (`s * PT + t`) and their residuals.
+    let mut count = [0usize; B];
+    let mut at = [[0u8; MAX_GRID]; B];
+    let mut r = [[0.0f32; MAX_GRID]; B];
     let (mut r2, mut w2) = (0.0f32, 0.0f32);
-    let mut bits = bands;
-    while bits != 0 {
-        let b = bits.trailing_zeros() as usize;
-        bits &= bits - 1;
-        let Some(row) = m5.get(b) else { continue };
-        // The band's measured grid positions and their residuals.
-        let mut at = [(0usize, 0usize); MAX_GRID];
-        let mut r = [0.0f32; MAX_GRID];
-        let mut n = 0usize;
-        for s in 0..PS - hs {
-            for t in 0..PT - ht {
-                let i = pixel(s, t) * B + b;
-                let (Some(true), Some(&y)) = (m.measured.get(i).copied(), m.values.get(i)) else { continue };
-                let mut model = 0.0f32;
-                for a in 0..=hs {
-                    for c in 0..=ht {
-                        if let Some(f) = fibres.get(pixel(s + a, t + c)) {
-                            model += dot(row, f);
+    let weighted = ball.is_weighted();
+    for s in 0..PS - hs {
+        for t in 0..PT - ht {
+            let base = pixel(s, t) * B;
+            let (Some(flags), Some(ys)) = (m.measured.get(base..base + B), m.values.get(base..base + B)) else {
+                continue;
+            };
+            let mut bits = band_bits(flags);
+            if bits == 0 {
+                continue;
+            }
+            // The values this position's measurements interpolate, summed.
+            let mut sum = [0.0f32; B];
+            for a in 0..=hs {
+                for c in 0..=ht {
+                    if let Some(f) = fibres.get(pixel(s + a, t + c)) {
+                        for (o, &x) in sum.iter_mut().zip(f) {
+                            *o += x;
                         }
                     }
                 }
-                let res = y - weight * model;
-                r2 += res * res;
-                if ball.is_weighted() {
-                    w2 += res * res * ball.weight(y, m.gains.get(b).copied().unwrap_or(1.0));
-                }
-                if let (Some(p), Some(q)) = (at.get_mut(n), r.get_mut(n)) {
-                    (*p, *q) = ((s, t), res);
-                    n += 1;
-                }
             }
-        }
-        let at = at.get(..n).unwrap_or(&[]);
-        if n <= SMALL_BLOCK {
-            solve_block::<SMALL_BLOCK>(at, &mut r, (hs, ht));
-        } else {
-            solve_block::<MAX_GRID>(at, &mut r, (hs, ht));
-        }
-        for (&(s, t), &z) in at.iter().zip(&r) {
-            for a in 0..=hs {
-                for c in 0..=ht {
-                    let p = (s + a) * PT + t + c;
-                    if let (Some(o), Some(k)) = (correction.get_mut(p).and_then(|x| x.get_mut(b)), touched.get_mut(p)) {
-                        *o += weight * z;
-                        *k |= 1 << b;
-                    }
-                }
-            }
-        }
-    }
-    // Back to band coefficients: each pixel's correction in the bands it was corrected in.
-    for s in 0..PS {
-        for t in 0..PT {
-            let p = s * PT + t;
-            let (Some(f), Some(c), Some(&k)) = (fibres.get_mut(pixel(s, t)), correction.get(p), touched.get(p)) else {
-                continue;
-            };
-            let mut out = [0.0f32; B];
-            let mut bits = k;
             while bits != 0 {
                 let b = bits.trailing_zeros() as usize;
                 bits &= bits - 1;
-                let (Some(row), Some(&z)) = (m5.get(b), c.get(b)) else { continue };
-                for (o, &w) in out.iter_mut().zip(row) {
-                    *o += z * w;
+                let (Some(row), Some(&y), Some(n)) = (m5.get(b), ys.get(b), count.get_mut(b)) else { continue };
+                let res = y - weight * dot(row, &sum);
+                r2 += res * res;
+                if weighted {
+                    w2 += res * res * ball.weight(y, m.gains.get(b).copied().unwrap_or(1.0));
+                }
+                let (Some(p), Some(q), Ok(pos)) = (
+                    at.get_mut(b).and_then(|x| x.get_mut(*n)),
+                    r.get_mut(b).and_then(|x| x.get_mut(*n)),
+                    u8::try_from(s * PT + t),
+                ) else {
+                    continue;
+                };
+                (*p, *q) = (pos, res);
+                *n += 1;
+            }
+        }
+    }
+    // The view's pixels become the correction, built from each band's solved block.
+    for s in 0..PS {
+        for t in 0..PT {
+            if let Some(f) = fibres.get_mut(pixel(s, t)) {
+                *f = [0.0; B];
+            }
+        }
+    }
+    for (b, ((&n, at), r)) in count.iter().zip(&at).zip(&mut r).enumerate() {
+        let (Some(at), Some(row)) = (at.get(..n), m5.get(b)) else { continue };
+        solve_block(at, r, (hs, ht), PT);
+        for (&p, &z) in at.iter().zip(r.iter()) {
+            let (s, t) = (usize::from(p) / PT, usize::from(p) % PT);
+            let z = weight * z;
+            for a in 0..=hs {
+                for c in 0..=ht {
+                    if let Some(f) = fibres.get_mut(pixel(s + a, t + c)) {
+                        for (o, &w) in f.iter_mut().zip(row) {
+                            *o += z * w;
+                        }
+                    }
                 }
             }
-            *f = out;
         }
     }
     (r2, w2)
@@ -205,53 +193,77 @@ fn overlap(half: usize, delta: usize) -> f32 {
 }
 
 /// Solves `G z = r` in place for one view and band's measurements at grid positions `at`
-/// (`G = M M^T`, [`overlap`] per axis; at most `L` of them), by Cholesky in an `L x L`
-/// square on the stack. A pivot that is not
-/// positive (it cannot be for distinct positions; rounding could only make one tiny)
-/// zeroes its unknown instead of dividing by it.
-#[allow(clippy::needless_range_loop)] // Cholesky reads best with its indices
-fn solve_block<const L: usize>(at: &[(usize, usize)], r: &mut [f32; MAX_GRID], (hs, ht): (usize, usize)) {
-    let n = at.len().min(L).min(MAX_GRID);
-    if n == 1 {
-        r[0] /= overlap(hs, 0) * overlap(ht, 0);
-        return;
+/// (`s * pt + t`; `G = M M^T`, [`overlap`] per axis). Measurements that share no value
+/// leave `G` diagonal, a division each: always on a whole view, and in most blocks of a
+/// one-hot mask, whose band's positions are rarely neighbours. Otherwise by Cholesky.
+fn solve_block(at: &[u8], r: &mut [f32; MAX_GRID], (hs, ht): (usize, usize), pt: usize) {
+    let split = |p: u8| (usize::from(p) / pt, usize::from(p) % pt);
+    let shares = |i: usize, j: usize| {
+        let ((si, ti), (sj, tj)) = (split(at.get(i).copied().unwrap_or(0)), split(at.get(j).copied().unwrap_or(0)));
+        si.abs_diff(sj) <= hs && ti.abs_diff(tj) <= ht
+    };
+    let n = at.len().min(MAX_GRID);
+    if (1..n).all(|i| (0..i).all(|j| !shares(i, j))) {
+        let weight = overlap(hs, 0) * overlap(ht, 0);
+        for x in r.iter_mut().take(n) {
+            *x /= weight;
+        }
+    } else if n <= SMALL_BLOCK {
+        cholesky::<SMALL_BLOCK>(at, r, (hs, ht), pt);
+    } else {
+        cholesky::<MAX_GRID>(at, r, (hs, ht), pt);
     }
-    // Lower triangle of G, overwritten by its Cholesky factor L.
+}
+
+/// [`solve_block`] by an `L D L^T` factorisation (Cholesky without square roots: one
+/// division per pivot, where the square roots' latency took a third of the band step) in
+/// an `L x L` square on the stack. A pivot that is not positive (it cannot be for distinct
+/// positions; rounding could only make one tiny) zeroes its unknown instead of dividing by
+/// it.
+#[allow(clippy::needless_range_loop)] // the factorisation reads best with its indices
+fn cholesky<const L: usize>(at: &[u8], r: &mut [f32; MAX_GRID], (hs, ht): (usize, usize), pt: usize) {
+    let n = at.len().min(L).min(MAX_GRID);
+    let split = |p: u8| (usize::from(p) / pt, usize::from(p) % pt);
+    // Lower triangle of G, overwritten by the unit lower factor L; D and 1 / D apart.
     let mut l = [[0.0f32; L]; L];
-    for (i, &(si, ti)) in at.iter().enumerate().take(n) {
-        for (j, &(sj, tj)) in at.iter().enumerate().take(i + 1) {
+    let (mut d, mut inv) = ([0.0f32; L], [0.0f32; L]);
+    for (i, &pi) in at.iter().enumerate().take(n) {
+        let (si, ti) = split(pi);
+        for (j, &pj) in at.iter().enumerate().take(i + 1) {
+            let (sj, tj) = split(pj);
             l[i][j] = overlap(hs, si.abs_diff(sj)) * overlap(ht, ti.abs_diff(tj));
         }
     }
     for j in 0..n {
-        let mut d = l[j][j];
+        let mut pivot = l[j][j];
         for k in 0..j {
-            d -= l[j][k] * l[j][k];
+            pivot -= l[j][k] * l[j][k] * d[k];
         }
-        let pivot = if d > f32::MIN_POSITIVE { libm::sqrtf(d) } else { 0.0 };
-        l[j][j] = pivot;
+        if pivot > f32::MIN_POSITIVE {
+            (d[j], inv[j]) = (pivot, 1.0 / pivot);
+        }
         for i in j + 1..n {
             let mut x = l[i][j];
             for k in 0..j {
-                x -= l[i][k] * l[j][k];
+                x -= l[i][k] * l[j][k] * d[k];
             }
-            l[i][j] = if pivot > 0.0 { x / pivot } else { 0.0 };
+            l[i][j] = x * inv[j];
         }
     }
-    // L y = r, then L^T z = y.
+    // L y = r, then D L^T z = y.
     for i in 0..n {
         let mut x = r[i];
         for k in 0..i {
             x -= l[i][k] * r[k];
         }
-        r[i] = if l[i][i] > 0.0 { x / l[i][i] } else { 0.0 };
+        r[i] = x;
     }
     for i in (0..n).rev() {
-        let mut x = r[i];
+        let mut x = r[i] * inv[i];
         for k in i + 1..n {
             x -= l[k][i] * r[k];
         }
-        r[i] = if l[i][i] > 0.0 { x / l[i][i] } else { 0.0 };
+        r[i] = if inv[i] > 0.0 { x } else { 0.0 };
     }
 }
 

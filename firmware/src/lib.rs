@@ -128,7 +128,7 @@ pub use blob::{DEFAULT_ENSEMBLE, Ensemble};
 pub use choice::{ChoiceRule, EnsembleModel, MemberChoice, ModelOutcome, PatchModel};
 pub use defects::{DefectList, Pixel};
 pub use dictionary::{Dictionary, DictionaryError};
-pub use disparity::DisparityRange;
+pub use disparity::{Disparity, DisparityRange};
 pub use mask::{BandTile, LensletSize, Mask, MaskFamily, SensingError};
 pub use overlap::{Overlap, OverlapDecoder, OverlapError, OverlapReport, RowSink, Window};
 pub use prelude::{PAPER_N, PaperDecoder, PaperDictionary, PaperEnsemble, PaperEnsembleModel, PaperPatch, SetupError};

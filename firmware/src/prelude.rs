@@ -16,7 +16,7 @@ pub use crate::blob::{DEFAULT_ENSEMBLE, Ensemble};
 pub use crate::choice::{ChoiceRule, EnsembleModel, MemberChoice, PatchModel};
 pub use crate::defects::{DefectList, Pixel};
 pub use crate::dictionary::{Dictionary, DictionaryError};
-pub use crate::disparity::DisparityRange;
+pub use crate::disparity::{Disparity, DisparityRange};
 pub use crate::mask::{BandTile, LensletSize, Mask, MaskFamily, SensingError};
 pub use crate::overlap::{Overlap, OverlapDecoder, OverlapError, OverlapReport, RowSink, Window};
 pub use crate::raw::{FrameSource, LeU16Frame, RawFormat, RawFrame};

@@ -2,6 +2,7 @@
 //! pixels found from the definition (each pixel's fractional grid position), the
 //! interpolating operator and its projection against a dense f64 reference
 //! (`S - A^T (A A^T)^-1 (A S - y)` with `A = M K`, `M` written from the definition), the
+//! full-size blocks (every entry measured on a 5 x 5 grid) against the same reference, the
 //! noise ball's move as a fraction of the exact one, a solve that meets its measurements,
 //! and the chosen disparity of a plane at a half-pixel disparity.
 
@@ -150,6 +151,59 @@ fn half_pixel_read_and_projection_match_the_dense_definition() {
         // `M`'s adjoint, which the match above shows. After it, A S = y.
         let after = DVector::from_iterator(n, coeffs.iter().map(|&v| f64::from(v)));
         assert!((&a * after - &y).norm() < 1e-4, "case {seed}: projected patch misses its measurements");
+    }
+}
+
+/// Every entry of every view measured on a 5 x 5 grid, one view of each kind (whole,
+/// half row, half column, both): blocks of 25 diagonal, of 20 in chains, and of 16 coupled
+/// in two dimensions, the sizes past the small factor, with some entries left out so
+/// blocks of every size between occur. Against the dense f64 projection, from the
+/// definition (a half axis averages grid positions `s` and `s + 1`).
+#[test]
+fn full_blocks_project_like_the_dense_definition() {
+    type Grid = PatchShape<5, 5, 2, 2, 2, 200>;
+    let dict = random_dictionary::<5, 5, 2, 2, 2>(41);
+    let (kd, n) = dense_kronecker(dict.synthesis());
+    let half = HalfViews { rows: 0b10, cols: 0b10 };
+    for (case, keep) in [(0, 1.0f32), (1, 0.6), (2, 0.3)] {
+        let mut r = rng(50 + case);
+        let mut m = Measurements::<200>::new();
+        let mut rows: Vec<Vec<(usize, f64)>> = Vec::new();
+        let mut y = Vec::new();
+        for u in 0..2 {
+            for v in 0..2 {
+                let (hs, ht) = (usize::from(half.row(u)), usize::from(half.col(v)));
+                for s in 0..5 - hs {
+                    for t in 0..5 - ht {
+                        for b in 0..2 {
+                            if r.random_range(0.0f32..1.0) >= keep {
+                                continue;
+                            }
+                            let w = 1.0 / ((1 + hs) * (1 + ht)) as f64;
+                            let taps = (0..=hs)
+                                .flat_map(|a| (0..=ht).map(move |c| (Grid::index(s + a, t + c, u, v, b), w)))
+                                .collect();
+                            let value = r.random_range(-1.0f32..1.0);
+                            m.set(Grid::index(s, t, u, v, b), value).unwrap();
+                            rows.push(taps);
+                            y.push(f64::from(value));
+                        }
+                    }
+                }
+            }
+        }
+        m.set_half_views(half);
+        let a = DMatrix::<f64>::from_fn(rows.len(), n, |i, j| rows[i].iter().map(|&(e, w)| w * kd[e * n + j]).sum());
+        let s0: [f32; 200] = core::array::from_fn(|_| r.random_range(-1.0f32..1.0));
+        let s = DVector::from_iterator(n, s0.iter().map(|&v| f64::from(v)));
+        let y = DVector::from_vec(y);
+        let chol = (&a * a.transpose()).cholesky().expect("A A^T positive definite");
+        let want = &s - a.transpose() * chol.solve(&(&a * &s - &y));
+        let mut coeffs = s0;
+        let mut scratch = [0.0f32; 200];
+        project_fractional(&dict, &mut coeffs, &mut scratch, &m, &Ball::new(0.0, 0.0, m.count() as u32, 0));
+        let err = coeffs.iter().zip(want.iter()).map(|(&g, w)| (f64::from(g) - w).abs()).fold(0.0, f64::max);
+        assert!(err < 2e-5, "case {case}: projection differs from the dense one by {err}");
     }
 }
 

@@ -7,7 +7,8 @@
 //! decodes the same tiles with the 5D DCT, and last the whole frame with overlapping
 //! patches (stride 3, tapered window) through a strip of lenslet rows, printing each
 //! finished row. `bench_begin` / `bench_end` bracket one synthesis, then each ensemble
-//! tile, then each DCT tile, then the overlapped frame, so the qemu plugin
+//! tile, then each DCT tile, then the overlapped frame, then one block's disparity
+//! choice, then the DCT tiles sheared to whole and to half-pixel disparities, so the qemu plugin
 //! `scripts/wincount/wincount.c` counts instructions per transform and per patch. The
 //! stack is painted at start and scanned at the end for its peak depth.
 //!
@@ -39,9 +40,10 @@ mod device {
     use defmt_semihosting as _;
     use panic_semihosting as _;
     use slf_firmware::{
-        ChoiceRule, DEFAULT_ENSEMBLE, DecoderConfig, DefectList, Dictionary, DisparityRange, Ensemble, EnsembleModel,
-        FrameSource, LeU16Frame, LensletSize, Mask, MemberChoice, Overlap, OverlapDecoder, PaperShape, PaperWorkspace,
-        PatchModel, PatchOrigin, PatchReport, PatchSink, RawFormat, RowSink, SensorGeometry, Sl0Config, TileDecoder,
+        ChoiceRule, DEFAULT_ENSEMBLE, DecoderConfig, DefectList, Dictionary, Disparity, DisparityRange, Ensemble,
+        EnsembleModel, FrameSource, LeU16Frame, LensletSize, Mask, MemberChoice, Overlap, OverlapDecoder, PaperShape,
+        PaperWorkspace, PatchModel, PatchOrigin, PatchReport, PatchSink, RawFormat, RowSink, SensorGeometry, Sl0Config,
+        TileDecoder,
     };
 
     use super::{bench_begin, bench_end};
@@ -277,6 +279,39 @@ mod device {
         bench_end(5);
         hprintln!("disparity of block 2 3 (half pixels): {}", chosen.map_or(i8::MIN, |d| d.in_halves()));
         let stack = crate::stack::peak();
+
+        // Windows 6 and 7: the DCT tiles' patches again, each read sheared to disparity 1
+        // (whole pixels, selections) and to 1/2 (interpolating measurements) and solved,
+        // without the choice or edge fallbacks of a sheared tile decode, so the two
+        // compare solve for solve. The stack is painted anew: its peak is theirs.
+        crate::stack::paint();
+        let halves = decoder.with_disparities(DisparityRange::DEFAULT.with_halves(true));
+        let mut steps = [0u32; 2];
+        for (i, d) in [Disparity::pixels(1), Disparity::halves(1)].into_iter().enumerate() {
+            for tile in decoder.tiles((1, 1)) {
+                for (view_row, view_col) in decoder.windows() {
+                    let origin = PatchOrigin {
+                        lenslet_row: tile.lenslet_row,
+                        lenslet_col: tile.lenslet_col,
+                        view_row,
+                        view_col,
+                        disparity: d,
+                    };
+                    bench_begin(6 + i as u32);
+                    let r = halves
+                        .read_patch(origin, &mut FrameSource::new(&frames), ws)
+                        .map_err(|_| ())
+                        .and_then(|_| dct.decode(&decoder.config().sl0, ws).map_err(|_| ()));
+                    bench_end(6 + i as u32);
+                    match r {
+                        Ok(o) => steps[i] += o.outcome.iterations,
+                        Err(()) => failed += 1,
+                    }
+                }
+            }
+        }
+        hprintln!("sheared dct steps whole {} half {}", steps[0], steps[1]);
+        hprintln!("sheared stack peak bytes {}", crate::stack::peak());
         hprintln!("strip bytes {}", core::mem::size_of::<[f32; STRIP_LEN]>());
         hprintln!("disjoint stack peak bytes {}", disjoint_stack);
         hprintln!("workspace bytes {}", core::mem::size_of::<PaperWorkspace>());
