@@ -8,6 +8,7 @@
 # the times compare; the machine is shared, so only their ratios mean anything).
 #
 #   bash scripts/results-depth.sh OUT_DIR > tables.md
+#   SLF_MODELS="ensemble ensemble+halves" bash scripts/results-depth.sh OUT_DIR  # some rows
 #
 # The real light fields are scripts/real-eval.sh's 128 x 128 crops, in $SLF_REAL (default
 # /tmp/hci/real); their licence allows evaluation only.
@@ -24,8 +25,15 @@ done
 for n in smooth texture depth saturated dark; do
   [ -f "$out/lf/$n.npy" ] || "$slf" scene "$n" --size 40 -o "$out/lf/$n.npy" > /dev/null
 done
-# name=decode arguments (commas for spaces)
-models="demosaic=--method,demosaic ppid=--method,ppid dct=--dictionary,dct dct+depth=--dictionary,dct,--disparities=-1:1 ensemble=--stride,3 ensemble+depth=--disparities=-1:1 ensemble+depth2=--disparities=-2:2"
+# name=decode arguments (commas for spaces); SLF_MODELS picks some of them by name.
+all="demosaic=--method,demosaic ppid=--method,ppid dct=--dictionary,dct,--disparities=0:0
+dct+depth=--dictionary,dct,--disparities=-1:1 dct+halves=--dictionary,dct,--disparities=-1:1:0.5
+ensemble=--disparities=0:0 ensemble+depth=--disparities=-1:1 ensemble+depth2=--disparities=-2:2
+ensemble+halves=--disparities=-1:1:0.5"
+models=""
+for m in $all; do
+  case " ${SLF_MODELS:-${m%%=*}} " in *" ${m%%=*} "*) models="$models $m" ;; esac
+done
 table() {
   local dir=$1
   shift

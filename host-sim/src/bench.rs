@@ -115,20 +115,21 @@ fn settings(quick: bool) -> Vec<(String, Decoder, DecodeOptions)> {
         noise: NoiseSource::Config,
         stride: (5, 5),
         window: Window::Uniform,
-        disparities: DisparityRange::OFF,
+        disparities: Some(DisparityRange::OFF),
         ..DecodeOptions::default()
     };
     let unsheared = |stride: u8, window: Window, adaptive: Option<f32>| DecodeOptions {
         stride: (stride, stride),
         window,
         adaptive,
-        disparities: DisparityRange::OFF,
+        disparities: Some(DisparityRange::OFF),
         ..DecodeOptions::default()
     };
     let decode = |stride: u8, window: Window, adaptive: Option<f32>| DecodeOptions {
-        disparities: DisparityRange::DEFAULT,
+        disparities: Some(DisparityRange::DEFAULT),
         ..unsheared(stride, window, adaptive)
     };
+    let halves = DisparityRange::DEFAULT.with_halves(true);
     let d = Sl0Config::DEFAULT;
     let dct = || Decoder::Basis(Basis::Dct);
     let ens = |choice| Decoder::Basis(Basis::Ensemble { blob: DEFAULT_ENSEMBLE.to_vec(), choice });
@@ -223,6 +224,16 @@ fn settings(quick: bool) -> Vec<(String, Decoder, DecodeOptions)> {
             "DCT, noise model, stride 3 tapered, disparities -1:1".to_string(),
             dct(),
             decode(3, Window::Tapered, None),
+        ));
+        decode_points.push((
+            "DCT, noise model, stride 3 tapered, disparities -1:1:0.5".to_string(),
+            dct(),
+            DecodeOptions { disparities: Some(halves), ..decode(3, Window::Tapered, None) },
+        ));
+        decode_points.push((
+            "ensemble screened, noise model, stride 3 tapered, disparities -1:1:0.5".to_string(),
+            screened(),
+            DecodeOptions { disparities: Some(halves), ..decode(3, Window::Tapered, None) },
         ));
         decode_points.push((
             "ensemble screened, noise model, stride 3 adaptive 1.2, unsheared".to_string(),

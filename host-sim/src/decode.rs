@@ -167,10 +167,11 @@ pub struct DecodeOptions {
     pub adaptive: Option<f32>,
     /// The white balance.
     pub balance: Balance,
-    /// The disparities each spatial block may be sheared to ([`slf_firmware::disparity`]):
-    /// [`DisparityRange::DEFAULT`] (-1..=1) unless told otherwise; [`DisparityRange::OFF`]
-    /// decodes every patch unsheared.
-    pub disparities: DisparityRange,
+    /// The disparities each spatial block may be sheared to ([`slf_firmware::disparity`]);
+    /// `None` (the default): the capture's, [`DisparityRange::for_snapshots`] (-1..=1, in
+    /// half pixels for a single snapshot); [`DisparityRange::OFF`] decodes every patch
+    /// unsheared.
+    pub disparities: Option<DisparityRange>,
 }
 
 impl Default for DecodeOptions {
@@ -184,7 +185,7 @@ impl Default for DecodeOptions {
             window: Window::Tapered,
             adaptive: None,
             balance: Balance::default(),
-            disparities: DisparityRange::DEFAULT,
+            disparities: None,
         }
     }
 }
@@ -194,7 +195,14 @@ impl DecodeOptions {
     /// the grid the firmware's tile decoder walks, one estimate per patch and angular
     /// window, as the device decodes its tiles.
     pub fn disjoint() -> Self {
-        Self { stride: (5, 5), window: Window::Uniform, disparities: DisparityRange::OFF, ..Self::default() }
+        Self { stride: (5, 5), window: Window::Uniform, disparities: Some(DisparityRange::OFF), ..Self::default() }
+    }
+
+    /// The disparities a decode of `capture` searches: [`Self::disparities`], or the
+    /// capture's default.
+    pub fn disparities_for(&self, capture: &Capture) -> DisparityRange {
+        let snapshots = u8::try_from(capture.description.frames.len()).unwrap_or(u8::MAX);
+        self.disparities.unwrap_or(DisparityRange::for_snapshots(snapshots))
     }
 
     /// The solver's config for `capture`: [`Self::sl0`] with the noise ball from
@@ -227,7 +235,7 @@ pub fn tile_decoder<'a>(capture: &'a Capture, opts: &DecodeOptions) -> Result<Ti
         Balance::Gains(g) => g,
     };
     let decoder = decoder.with_gains(&gains).map_err(|e| anyhow!("gains {gains:?}: {e}"))?;
-    Ok(decoder.with_disparities(opts.disparities))
+    Ok(decoder.with_disparities(opts.disparities_for(capture)))
 }
 
 /// The tiles of the patch grids shifted by `(dy, dx)` lenslets for every multiple of the
@@ -401,7 +409,7 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
     let lenslets = (d.lenslets[0], d.lenslets[1]);
     let views = (d.views[0], d.views[1]);
     let range = decoder.config().raw.range();
-    let halo = opts.disparities.halo(views.0.max(views.1));
+    let halo = decoder.disparities().halo(views.0.max(views.1));
     let run = |tiles: &[Tile]| -> Vec<(TileSums, Result<TileReport, String>)> {
         let bar = ProgressBar::with_draw_target(Some(tiles.len() as u64), ProgressDrawTarget::hidden());
         bar.set_style(

@@ -167,7 +167,7 @@ pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
     // balance: the host's default. The device's tiles are its per-patch benchmark, unsheared;
     // its overlapped frame shears (checked in `check_rows`).
     let unsheared =
-        crate::decode::DecodeOptions { disparities: slf_firmware::DisparityRange::OFF, ..Default::default() };
+        crate::decode::DecodeOptions { disparities: Some(slf_firmware::DisparityRange::OFF), ..Default::default() };
     let decoder = crate::decode::tile_decoder(&capture, &unsheared)?;
     let raw = capture.raw_frames()?;
     let host_gains = *decoder.gains();

@@ -439,9 +439,10 @@ enum Command {
         #[arg(long, value_delimiter = ',', value_name = "G1,...,G13")]
         gains: Option<Vec<f32>>,
         /// Disparities (pixels per view step) each 5 x 5-lenslet block may be sheared to
-        /// before decoding, MIN:MAX[:STEP] (default -1:1; 0:0 decodes unsheared; a STEP of
-        /// 0.5 adds the half-pixel shears, whose measurements interpolate the patch); chosen
-        /// per block by how well the views' same-band samples agree.
+        /// before decoding, MIN:MAX[:STEP] (default -1:1:0.5 for a single snapshot, -1:1 for
+        /// more; 0:0 decodes unsheared; a STEP of 0.5 adds the half-pixel shears, whose
+        /// measurements interpolate the patch); chosen per block by how well the views'
+        /// same-band samples agree.
         #[arg(long, value_parser = disparity_range, value_name = "MIN:MAX[:STEP]", allow_hyphen_values = true)]
         disparities: Option<slf_host::firmware::DisparityRange>,
         /// Also write the chosen disparity per lenslet (.npy, lenslet rows x cols, f32: the
@@ -772,11 +773,11 @@ fn run(cli: Cli) -> Result<()> {
                 window: window.window(),
                 adaptive,
                 balance,
-                disparities: disparities.unwrap_or(slf_host::firmware::DisparityRange::DEFAULT),
+                disparities,
                 ..DecodeOptions::default()
             };
             anyhow::ensure!(
-                disparity_map.is_none() || !opts.disparities.is_off(),
+                disparity_map.is_none() || !opts.disparities_for(&cap).is_off(),
                 "--disparity-map needs disparities to search: with --disparities 0:0 every block is at 0"
             );
             if let Some(a) = adaptive {
@@ -839,7 +840,7 @@ fn run(cli: Cli) -> Result<()> {
                 Balance::GreyWorld => println!("white balance: grey world, gains {}", gains.join(" ")),
                 Balance::Gains(_) => println!("white balance: given gains {}", gains.join(" ")),
             }
-            if !opts.disparities.is_off() {
+            if !opts.disparities_for(&cap).is_off() {
                 let mut counts = std::collections::BTreeMap::<slf_host::firmware::disparity::Disparity, usize>::new();
                 for (_, d) in &r.disparity_map {
                     *counts.entry(*d).or_default() += 1;

@@ -35,8 +35,8 @@ fn planes(planes: &[(f32, Shape)], size: usize) -> LightField {
     scene.render(SceneSize { views: (5, 5), rows: size, cols: size })
 }
 
-fn range(min: i8, max: i8) -> DisparityRange {
-    DisparityRange::new(min, max).unwrap()
+fn range(min: i8, max: i8) -> Option<DisparityRange> {
+    Some(DisparityRange::new(min, max).unwrap())
 }
 
 #[test]
@@ -61,7 +61,7 @@ fn the_disparity_of_a_plane_is_chosen_everywhere_off_the_edges() {
         // The map per lenslet: the plane's disparity wherever only such blocks cover it.
         let map = disparity_per_lenslet(&report.disparity_map, 30, 30);
         assert_eq!(map[15 * 30 + 15], f32::from(d));
-        let unsheared = DecodeOptions { disparities: DisparityRange::OFF, ..DecodeOptions::default() };
+        let unsheared = DecodeOptions { disparities: Some(DisparityRange::OFF), ..DecodeOptions::default() };
         let (plain, _) = decode_with(&capture, &Basis::Dct, &unsheared).unwrap();
         let (a, b) = (psnr(&truth.data, &plain.data, 1.0), psnr(&truth.data, &sheared.data, 1.0));
         assert!(b > a + 1.0, "d {d}, k {k}: sheared {b:.2} dB against unsheared {a:.2}");
@@ -159,5 +159,17 @@ fn the_command_line_writes_the_disparity_map_and_refuses_bad_ranges() {
         let o = slf().arg("decode").arg(p("cap")).arg("-o").arg(p("y.npy")).args(&args).assert().failure();
         let err = String::from_utf8(o.get_output().stderr.clone()).unwrap();
         assert!(err.contains(want) && !err.contains("panicked"), "{args:?}: {err}");
+    }
+}
+
+#[test]
+fn the_default_search_is_in_half_pixels_for_a_single_snapshot_only() {
+    let truth = planes(&[(0.5, Shape::Everywhere)], 10);
+    for (k, halves) in [(1u8, true), (2, false), (3, false)] {
+        let capture = simulate(&truth, &CameraConfig::pixel(3, k)).unwrap();
+        let default = DecodeOptions::default().disparities_for(&capture);
+        assert_eq!((default.min(), default.max(), default.has_halves()), (-1, 1, halves), "k = {k}");
+        let given = DecodeOptions { disparities: range(0, 0), ..DecodeOptions::default() };
+        assert!(given.disparities_for(&capture).is_off(), "k = {k}: a given range is kept");
     }
 }

@@ -39,7 +39,7 @@ fn origins(total: usize, off: usize) -> Vec<usize> {
 /// The default decode without the disparity search: every patch at its own rectangle (the
 /// sheared decode is checked in `tests/depth.rs`).
 fn unsheared() -> DecodeOptions {
-    DecodeOptions { disparities: DisparityRange::OFF, ..DecodeOptions::default() }
+    DecodeOptions { disparities: Some(DisparityRange::OFF), ..DecodeOptions::default() }
 }
 
 fn reference(truth: &LightField, k: u8, stride: usize, window: Window) -> Vec<f32> {
