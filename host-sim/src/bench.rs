@@ -199,7 +199,7 @@ fn settings(quick: bool) -> Vec<(String, Decoder, DecodeOptions)> {
             unsheared(3, Window::Tapered, None),
         ),
         (
-            "ensemble screened, noise model, stride 3 tapered, disparities -1:1 (default)".to_string(),
+            "ensemble screened, noise model, stride 3 tapered, disparities -1:1 (default for k > 1)".to_string(),
             screened(),
             decode(3, Window::Tapered, None),
         ),
@@ -231,7 +231,7 @@ fn settings(quick: bool) -> Vec<(String, Decoder, DecodeOptions)> {
             DecodeOptions { disparities: Some(halves), ..decode(3, Window::Tapered, None) },
         ));
         decode_points.push((
-            "ensemble screened, noise model, stride 3 tapered, disparities -1:1:0.5".to_string(),
+            "ensemble screened, noise model, stride 3 tapered, disparities -1:1:0.5 (default for k = 1)".to_string(),
             screened(),
             DecodeOptions { disparities: Some(halves), ..decode(3, Window::Tapered, None) },
         ));

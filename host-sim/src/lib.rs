@@ -18,7 +18,7 @@
 //!   method) evaluate it.
 //!
 //! [`evaluation`] runs every method a user could pick (baselines, DCT, ensemble) on light
-//! fields they bring. [`report`] holds the tables of `slf demo`, `sweep` and `compare`, [`bench`] the speed
+//! fields they bring. [`report`] holds the tables of `slf demo`, `sweep` and `compare`, [`mod@bench`] the speed
 //! against error sweep; the `slf` command (`src/main.rs`) parses arguments and calls them.
 
 pub use slf_firmware as firmware;
