@@ -248,7 +248,8 @@ mod device {
             return debug::EXIT_FAILURE;
         };
         // Window 5 (after the frame): the disparity choice of one block, alone.
-        let depth = decoder.with_disparities(DisparityRange::DEFAULT);
+        // The host's default search for the capture (whole disparities at k > 1).
+        let depth = decoder.with_disparities(DisparityRange::for_snapshots(SNAPSHOTS));
         let Ok(overlapped) = OverlapDecoder::new(depth, Overlap::DEFAULT) else {
             return debug::EXIT_FAILURE;
         };
