@@ -159,7 +159,7 @@ fn view_step<const PS: usize, const PT: usize, const PU: usize, const PV: usize,
         let (Some(at), Some(row)) = (at.get(..n), m5.get(b)) else { continue };
         solve_block(at, r, (hs, ht), PT);
         for (&p, &z) in at.iter().zip(r.iter()) {
-            let (s, t) = (usize::from(p) / PT, usize::from(p) % PT);
+            let (s, t) = grid_position(p, PT);
             let z = weight * z;
             for a in 0..=hs {
                 for c in 0..=ht {
@@ -192,14 +192,20 @@ fn overlap(half: usize, delta: usize) -> f32 {
     }
 }
 
+/// A grid position `s * pt + t` as `(s, t)`.
+#[inline(always)]
+fn grid_position(p: u8, pt: usize) -> (usize, usize) {
+    (usize::from(p) / pt, usize::from(p) % pt)
+}
+
 /// Solves `G z = r` in place for one view and band's measurements at grid positions `at`
 /// (`s * pt + t`; `G = M M^T`, [`overlap`] per axis). Measurements that share no value
 /// leave `G` diagonal, a division each: always on a whole view, and in most blocks of a
-/// one-hot mask, whose band's positions are rarely neighbours. Otherwise by Cholesky.
+/// one-hot mask, whose band's positions are rarely neighbours. Otherwise by [`cholesky`].
 fn solve_block(at: &[u8], r: &mut [f32; MAX_GRID], (hs, ht): (usize, usize), pt: usize) {
-    let split = |p: u8| (usize::from(p) / pt, usize::from(p) % pt);
+    let position = |i: usize| grid_position(at.get(i).copied().unwrap_or(0), pt);
     let shares = |i: usize, j: usize| {
-        let ((si, ti), (sj, tj)) = (split(at.get(i).copied().unwrap_or(0)), split(at.get(j).copied().unwrap_or(0)));
+        let ((si, ti), (sj, tj)) = (position(i), position(j));
         si.abs_diff(sj) <= hs && ti.abs_diff(tj) <= ht
     };
     let n = at.len().min(MAX_GRID);
@@ -223,14 +229,13 @@ fn solve_block(at: &[u8], r: &mut [f32; MAX_GRID], (hs, ht): (usize, usize), pt:
 #[allow(clippy::needless_range_loop)] // the factorisation reads best with its indices
 fn cholesky<const L: usize>(at: &[u8], r: &mut [f32; MAX_GRID], (hs, ht): (usize, usize), pt: usize) {
     let n = at.len().min(L).min(MAX_GRID);
-    let split = |p: u8| (usize::from(p) / pt, usize::from(p) % pt);
     // Lower triangle of G, overwritten by the unit lower factor L; D and 1 / D apart.
     let mut l = [[0.0f32; L]; L];
     let (mut d, mut inv) = ([0.0f32; L], [0.0f32; L]);
     for (i, &pi) in at.iter().enumerate().take(n) {
-        let (si, ti) = split(pi);
+        let (si, ti) = grid_position(pi, pt);
         for (j, &pj) in at.iter().enumerate().take(i + 1) {
-            let (sj, tj) = split(pj);
+            let (sj, tj) = grid_position(pj, pt);
             l[i][j] = overlap(hs, si.abs_diff(sj)) * overlap(ht, ti.abs_diff(tj));
         }
     }
