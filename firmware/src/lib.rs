@@ -12,27 +12,33 @@
 //!
 //! # Layers
 //!
-//! From the sensor to decoded patches, one module each:
+//! From the sensor to decoded patches, one folder each; a layer uses only the layers
+//! before it (the repository's `tests/layers.rs` checks every `crate::` path):
 //!
-//! - **raw frame** ([`raw`], [`defects`], [`spi`]): samples, which of them are
-//!   measurements, frames in memory or flash, and a frame buffer read over `embedded-hal` SPI.
-//! - **sensing** ([`mask`], [`gains`]): which band each pixel sees in each snapshot; the
-//!   three mask families `kronecker`, `lenslet`, `pixel`; and the white balance, a gain per
-//!   band that the decode divides out of the measurements and multiplies back.
-//! - **operators** ([`shape`], [`disparity`], [`dct`], [`dictionary`], [`blob`],
-//!   [`transform`]): the patch geometry in the types, sheared patches that align the views
-//!   on a depth, dictionaries (the 5D DCT and blobs in flash) and the separable synthesis
-//!   and analysis transforms.
-//! - **solver** ([`sl0`], [`ascent`], [`ball`], [`projection`], [`fractional`], [`pinv`],
-//!   [`choice`], [`interpolate`]): nD SL0 with the orthonormal fast path, the noise ball a
-//!   projection moves onto, the projection of half-pixel sheared patches (whose measurements
-//!   interpolate them), the paper's general pseudo-inverse path for kronecker masks, the choice of
-//!   an ensemble member per patch (exhaustive or screened), and per-pixel spectral
-//!   interpolation for patches that measure too few distinct bands.
-//! - **tile decoder** ([`tile`]): a rectangle of the raw frame, patch by patch, from a
-//!   [`TileSource`] to a [`PatchSink`], into a caller-owned [`Workspace`].
-//! - **overlap** ([`overlap`]): patches at a stride below the patch size, averaged with a
-//!   [`Window`] into a caller-owned strip of lenslet rows, finished rows to a [`RowSink`].
+//! - **sensor** ([`sensor`]: [`raw`], [`source`](sensor::source), [`defects`], [`spi`],
+//!   [`mask`], [`gains`]): samples, which of them are measurements, frames in memory or
+//!   flash, a frame buffer read over `embedded-hal` SPI, the [`TileSource`] trait they all
+//!   implement; which band each pixel sees in each snapshot (the three mask families
+//!   `kronecker`, `lenslet`, `pixel`); and the white balance, a gain per band that the decode
+//!   divides out of the measurements and multiplies back.
+//! - **operators** ([`operators`]: [`shape`], [`disparity`], [`dct`], [`dictionary`],
+//!   [`blob`], [`transform`]): the patch geometry in the types, sheared patches that align
+//!   the views on a depth, dictionaries (the 5D DCT and blobs in flash) and the separable
+//!   synthesis and analysis transforms.
+//! - **solver** ([`solver`]: [`error`](solver::error), [`workspace`], [`sl0`], [`ascent`],
+//!   [`ball`], [`projection`], [`fractional`], [`pinv`], [`choice`], [`interpolate`]): the
+//!   caller-owned workspace every path works in, nD SL0 with the orthonormal fast path, the
+//!   noise ball a projection moves onto, the projection of half-pixel sheared patches (whose
+//!   measurements interpolate them), the paper's general pseudo-inverse path for kronecker
+//!   masks, the choice of an ensemble member per patch (exhaustive or screened), and
+//!   per-pixel spectral interpolation for patches that measure too few distinct bands.
+//! - **decode** ([`decode`]: [`tile`], [`overlap`]): a rectangle of the raw frame, patch by
+//!   patch, from a [`TileSource`] to a [`PatchSink`], into a caller-owned [`Workspace`]; and
+//!   patches at a stride below the patch size, averaged with a [`Window`] into a
+//!   caller-owned strip of lenslet rows, finished rows to a [`RowSink`].
+//!
+//! Each module is also at the crate root under its name of before the folders
+//! (`slf_firmware::transform`, `slf_firmware::tile`, ...), so integrators' paths still hold.
 //!
 //! The device application sits on top of the tile decoder, in a crate of its own
 //! (`slf-device`, in `firmware/device/` of the repository), so that this library depends on
@@ -96,48 +102,37 @@
 
 mod log;
 
-pub mod ascent;
-pub mod ball;
-pub mod blob;
-pub mod choice;
-pub mod dct;
-pub mod defects;
-pub mod dictionary;
-pub mod disparity;
-pub mod fractional;
-pub mod gains;
-pub mod interpolate;
-pub mod mask;
-pub mod overlap;
-pub mod pinv;
-pub mod projection;
-pub mod raw;
-pub mod shape;
-pub mod sl0;
-pub mod spi;
-pub mod tile;
-pub mod transform;
-pub mod workspace;
+pub mod decode;
+pub mod operators;
+pub mod sensor;
+pub mod solver;
+
+// Every module by its path of before the layer folders, for integrators' code.
+pub use decode::{overlap, tile};
+pub use operators::{blob, dct, dictionary, disparity, shape, transform};
+pub use sensor::{defects, gains, mask, raw, spi};
+pub use solver::{ascent, ball, choice, fractional, interpolate, pinv, projection, sl0, workspace};
 
 pub mod prelude;
 
 // The public API at the root: what decoding needs, by layer. The operators' and the
 // solver's internals (`transform::synthesize`, `projection::project_coefficients`,
 // `blob::write_blob`, `pinv::solve_pinv`, `sl0::solve_warm`, ...) stay in their modules.
-pub use blob::{DEFAULT_ENSEMBLE, Ensemble};
-pub use choice::{ChoiceRule, EnsembleModel, MemberChoice, ModelOutcome, PatchModel};
-pub use defects::{DefectList, Pixel};
-pub use dictionary::{Dictionary, DictionaryError};
-pub use disparity::{Disparity, DisparityRange};
-pub use mask::{BandTile, LensletSize, Mask, MaskFamily, SensingError};
-pub use overlap::{Overlap, OverlapDecoder, OverlapError, OverlapReport, RowSink, Window};
-pub use prelude::{PAPER_N, PaperDecoder, PaperDictionary, PaperEnsemble, PaperEnsembleModel, PaperPatch, SetupError};
-pub use raw::{Frame, FrameSource, LeU16Frame, RawFormat, RawFrame};
-pub use shape::{FullViewShape, PaperShape, PatchShape};
-pub use sl0::{Ended, Outcome, Sl0Config, SolveError, solve};
-pub use spi::{SpiFrameBuffer, SpiSourceError};
-pub use tile::{
+pub use decode::overlap::{Overlap, OverlapDecoder, OverlapError, OverlapReport, RowSink, Window};
+pub use decode::tile::{
     ConfigError, DecoderConfig, FrameReport, PatchFlags, PatchOrigin, PatchReport, PatchSink, SensorGeometry, Tile,
-    TileDecoder, TileError, TileReport, TileSource,
+    TileDecoder, TileError, TileReport,
 };
-pub use workspace::{Measurements, PaperWorkspace, Workspace};
+pub use operators::blob::{DEFAULT_ENSEMBLE, Ensemble};
+pub use operators::dictionary::{Dictionary, DictionaryError};
+pub use operators::disparity::{Disparity, DisparityRange};
+pub use operators::shape::{FullViewShape, PaperShape, PatchShape};
+pub use prelude::{PAPER_N, PaperDecoder, PaperDictionary, PaperEnsemble, PaperEnsembleModel, PaperPatch, SetupError};
+pub use sensor::defects::{DefectList, Pixel};
+pub use sensor::mask::{BandTile, LensletSize, Mask, MaskFamily, SensingError};
+pub use sensor::raw::{Frame, FrameSource, LeU16Frame, RawFormat, RawFrame};
+pub use sensor::source::TileSource;
+pub use sensor::spi::{SpiFrameBuffer, SpiSourceError};
+pub use solver::choice::{ChoiceRule, EnsembleModel, MemberChoice, ModelOutcome, PatchModel};
+pub use solver::sl0::{Ended, Outcome, Sl0Config, SolveError, solve};
+pub use solver::workspace::{Measurements, PaperWorkspace, Workspace};

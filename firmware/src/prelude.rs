@@ -12,21 +12,21 @@
 
 use core::fmt;
 
-pub use crate::blob::{DEFAULT_ENSEMBLE, Ensemble};
-pub use crate::choice::{ChoiceRule, EnsembleModel, MemberChoice, PatchModel};
-pub use crate::defects::{DefectList, Pixel};
-pub use crate::dictionary::{Dictionary, DictionaryError};
-pub use crate::disparity::{Disparity, DisparityRange};
-pub use crate::mask::{BandTile, LensletSize, Mask, MaskFamily, SensingError};
-pub use crate::overlap::{Overlap, OverlapDecoder, OverlapError, OverlapReport, RowSink, Window};
-pub use crate::raw::{FrameSource, LeU16Frame, RawFormat, RawFrame};
-pub use crate::sl0::{Ended, Outcome, Sl0Config, SolveError};
-pub use crate::spi::{SpiFrameBuffer, SpiSourceError};
-pub use crate::tile::{
+pub use crate::decode::overlap::{Overlap, OverlapDecoder, OverlapError, OverlapReport, RowSink, Window};
+pub use crate::decode::tile::{
     ConfigError, DecoderConfig, FrameReport, PatchOrigin, PatchReport, PatchSink, SensorGeometry, Tile, TileDecoder,
     TileError, TileReport, TileSource,
 };
-pub use crate::workspace::{PaperWorkspace, Workspace};
+pub use crate::operators::blob::{DEFAULT_ENSEMBLE, Ensemble};
+pub use crate::operators::dictionary::{Dictionary, DictionaryError};
+pub use crate::operators::disparity::{Disparity, DisparityRange};
+pub use crate::sensor::defects::{DefectList, Pixel};
+pub use crate::sensor::mask::{BandTile, LensletSize, Mask, MaskFamily, SensingError};
+pub use crate::sensor::raw::{FrameSource, LeU16Frame, RawFormat, RawFrame};
+pub use crate::sensor::spi::{SpiFrameBuffer, SpiSourceError};
+pub use crate::solver::choice::{ChoiceRule, EnsembleModel, MemberChoice, PatchModel};
+pub use crate::solver::sl0::{Ended, Outcome, Sl0Config, SolveError};
+pub use crate::solver::workspace::{PaperWorkspace, Workspace};
 
 /// Values in the paper's patch: 5 x 5 x 4 x 4 x 13.
 pub const PAPER_N: usize = 5200;

@@ -6,8 +6,8 @@
 //! `const { assert!(..) }` in each constructor checks `N` against the product at compile
 //! time: a wrong `N` does not build.
 
-/// The largest number of bands (filter types) the decoder handles.
-pub const MAX_BANDS: usize = 32;
+/// The largest number of bands a patch may have: the sensor's (its filter types).
+pub use crate::sensor::mask::MAX_BANDS;
 
 /// The shape of a patch; a zero-sized marker with the constants and index arithmetic.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -20,30 +20,23 @@
 use core::fmt;
 use core::num::NonZeroUsize;
 
-use crate::choice::{ModelOutcome, PatchModel};
-use crate::defects::DefectList;
-use crate::disparity::{Best, Consistency, Disparity, DisparityRange, HalfViews, is_half, reach, rounded_shift, shift};
-use crate::fractional::{MAX_GRID, to_sensor};
-use crate::interpolate::{bands_measured, interpolate_bands};
 use crate::log::log;
-use crate::mask::{LensletSize, Mask, MaskFamily};
-use crate::raw::{Invalid, RawFormat};
-use crate::shape::PatchShape;
-use crate::sl0::{Outcome, Sl0Config, SolveError};
-use crate::workspace::Workspace;
+use crate::operators::disparity::{
+    Best, Consistency, Disparity, DisparityRange, HalfViews, is_half, reach, rounded_shift, shift,
+};
+use crate::operators::shape::PatchShape;
+use crate::sensor::defects::DefectList;
+use crate::sensor::mask::{LensletSize, Mask, MaskFamily};
+use crate::sensor::raw::{Invalid, RawFormat};
+use crate::solver::choice::{ModelOutcome, PatchModel};
+use crate::solver::fractional::{MAX_GRID, to_sensor};
+use crate::solver::interpolate::{bands_measured, interpolate_bands};
+use crate::solver::sl0::{Outcome, Sl0Config, SolveError};
+use crate::solver::workspace::Workspace;
 
-/// Where raw samples come from.
-pub trait TileSource {
-    /// A read failure (bus error, short read, out of range). `Copy`, to travel in errors.
-    type Error: Copy + fmt::Debug;
-
-    /// Fills `out` with the `out.len()` consecutive samples of `snapshot`'s raw frame that
-    /// start at sensor pixel `(row, col)` and run along the row.
-    ///
-    /// # Errors
-    /// The source's own error; the decoder then abandons the current tile only.
-    fn read(&mut self, snapshot: usize, row: usize, col: usize, out: &mut [f32]) -> Result<(), Self::Error>;
-}
+/// The source trait lives with the raw frames (the sensor layer); named here too, where the
+/// decoder that reads it is.
+pub use crate::sensor::source::TileSource;
 
 /// Where decoded patches go.
 pub trait PatchSink<const N: usize> {
@@ -94,7 +87,7 @@ pub struct Tile {
 }
 
 /// Where a patch sits: its first lenslet, its angular window's first view, and the
-/// disparity it was sheared to ([`crate::disparity`]; zero: unsheared).
+/// disparity it was sheared to ([`crate::operators::disparity`]; zero: unsheared).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct PatchOrigin {
@@ -109,12 +102,12 @@ impl PatchOrigin {
     /// The sensor lenslet (row, col) whose pixel the patch's grid position `(s, t)` of
     /// view `(u, v)` of its window names, for `PS x PT`-lenslet patches and lenslets of
     /// `views` (rows, cols) views: the patch's own lenslet shifted by the shear. For a view
-    /// half a lenslet off the grid ([`crate::disparity::is_half`]) that pixel lies between
+    /// half a lenslet off the grid ([`crate::operators::disparity::is_half`]) that pixel lies between
     /// positions `s` and `s + 1`, and the last position names none (`None`). May lie
     /// outside the sensor (a sheared patch reaches beyond its rectangle; such values were
     /// not measured and a sink drops them). A sink puts the patch's value at `(s, t, u, v)`
     /// there: a decoded half-pixel patch is handed over at its pixels
-    /// ([`crate::fractional::to_sensor`]).
+    /// ([`crate::solver::fractional::to_sensor`]).
     #[inline]
     pub fn lenslet<const PS: usize, const PT: usize>(
         &self,
@@ -197,7 +190,7 @@ pub struct PatchReport {
     pub excluded: u16,
     /// An unsheared estimate of a block that was decoded sheared at the frame's edge: it
     /// is only there for the views no sheared patch reached, and a sink weighs it by
-    /// [`crate::disparity::FALLBACK_WEIGHT`].
+    /// [`crate::operators::disparity::FALLBACK_WEIGHT`].
     pub fallback: bool,
 }
 
@@ -308,7 +301,7 @@ pub struct DecoderConfig<'a> {
 }
 
 /// The tile decoder for patches of `PS x PT x PU x PV x B` (N values): a checked
-/// [`DecoderConfig`], and the capture's band gains (white balance, [`crate::gains`]; 1
+/// [`DecoderConfig`], and the capture's band gains (white balance, [`crate::sensor::gains`]; 1
 /// unless set by [`with_gains`](Self::with_gains)). Stateless; all mutable state is in the
 /// caller's [`Workspace`].
 #[derive(Clone, Copy, Debug)]
@@ -384,13 +377,13 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     }
 
     /// This decoder with band `b`'s measurements divided by `gains[b]` before the solve
-    /// and the decoded patch multiplied back (white balance, [`crate::gains`]); gains of 1
+    /// and the decoded patch multiplied back (white balance, [`crate::sensor::gains`]); gains of 1
     /// are the plain decode, bit for bit.
     ///
     /// # Errors
     /// [`ConfigError::Gains`] for a gain that is not finite and positive.
     pub fn with_gains(self, gains: &[f32; B]) -> Result<Self, ConfigError> {
-        if !crate::gains::valid(gains) {
+        if !crate::sensor::gains::valid(gains) {
             return Err(ConfigError::Gains);
         }
         Ok(Self { gains: *gains, ..self })
@@ -402,7 +395,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     }
 
     /// This decoder with each spatial block sheared to the disparity of `range` its
-    /// measurements agree with best ([`crate::disparity`]): the block's patches read, and
+    /// measurements agree with best ([`crate::operators::disparity`]): the block's patches read, and
     /// report in [`PatchOrigin::disparity`], sheared pixels. A sink must place a patch's
     /// values with [`PatchOrigin::lenslet`] (the [`crate::OverlapDecoder`]'s does).
     /// [`DisparityRange::OFF`] is the unsheared decode, bit for bit. Half-pixel
@@ -419,7 +412,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     }
 
     /// Grey-world band gains of a frame: every valid sample of the sensor (defects and
-    /// invalid samples left out) summed per band ([`crate::gains::gains_from_sums`]).
+    /// invalid samples left out) summed per band ([`crate::sensor::gains::gains_from_sums`]).
     /// Reads the frame once, one sensor row at a time in runs of up to 16 samples per
     /// snapshot.
     ///
@@ -463,7 +456,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                 *t += r;
             }
         }
-        Ok(crate::gains::gains_from_sums(&sums, &counts))
+        Ok(crate::sensor::gains::gains_from_sums(&sums, &counts))
     }
 
     /// Patch origins of one spatial block: every angular window.
@@ -599,7 +592,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     #[allow(clippy::too_many_arguments)]
     fn put_pixel(
         &self,
-        m: &mut crate::workspace::Measurements<N>,
+        m: &mut crate::solver::workspace::Measurements<N>,
         at: usize,
         row: usize,
         col: usize,

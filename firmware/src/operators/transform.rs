@@ -17,28 +17,11 @@
 //! give the same bits. Each transform costs `N * (PS + PT + PU + PV + B)` multiply-adds
 //! without folding ([`crate::PatchShape::TRANSFORM_MACS`]).
 
-use crate::dictionary::{Dictionary, Factors, Matrix};
-use crate::shape::PatchShape;
+use crate::operators::dictionary::{Dictionary, Factors, Fold, Matrix};
+use crate::operators::shape::PatchShape;
 
 /// Columns of one register block: one AVX2 register of f32.
 const LANES: usize = 8;
-
-/// Which symmetry of a mode's matrix a mode product uses; found when its dictionary is
-/// built ([`Dictionary::dct`], or checked in [`Dictionary::new`]).
-///
-/// The DCT-II's rows are even or odd about their middle, `C[a][D-1-c] = (-1)^a C[a][c]`.
-/// A product by such a matrix first adds and subtracts the input's mirrored rows and then
-/// needs about half the multiplies (13 instead of 25 for `D = 5`, 8 instead of 16 for
-/// `D = 4`); on a core whose multiplier is the bottleneck that is about half the time.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Fold {
-    /// No symmetry used: `D^2` multiply-adds per column.
-    Plain,
-    /// Rows even or odd, `M[a][D-1-c] = (-1)^a M[a][c]` (the DCT-II: analysis).
-    Rows,
-    /// Columns even or odd, `M[D-1-n][k] = (-1)^k M[n][k]` (its transpose: synthesis).
-    Columns,
-}
 
 const PLAIN: u8 = 0;
 const ROWS: u8 = 1;

@@ -24,7 +24,9 @@
 
 use core::fmt;
 
-use crate::shape::MAX_BANDS;
+/// The largest number of bands (filter types) the decoder handles. It lives with the masks,
+/// the lowest layer that counts bands; the patch shape names it too.
+pub const MAX_BANDS: usize = 32;
 
 /// The bands one sensor position sees, in snapshot order (distinct).
 pub type BandList = heapless::Vec<u8, MAX_BANDS>;

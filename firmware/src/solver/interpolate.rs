@@ -15,7 +15,7 @@
 //! the first and last; a pixel with no measurement takes the mean spectrum of those with
 //! one. The patch meets its measurements exactly.
 
-use crate::workspace::Measurements;
+use crate::solver::workspace::Measurements;
 
 /// How many distinct bands the patch measures anywhere (`B` bands per pixel, the last
 /// axis).

@@ -7,32 +7,33 @@
 //!
 //! **Fast path.** With an orthonormal dictionary and one-hot (selection) measurements the
 //! projection `S - A^+(A S - I)` is exactly: synthesise `X`, overwrite the measured entries
-//! of `X` with the measurements, analyse back; [`crate::projection`] computes the same in
+//! of `X` with the measurements, analyse back; [`crate::solver::projection`] computes the same in
 //! coefficient space, `S + D^T P^T (I - P D S)`, with the band mode only where a band is
 //! measured (197,600 instead of 322,400 multiply-adds a step at one measurement per pixel).
 //! The start, the minimum-norm solution `A^+ I`, is the analysis of the measurements with
 //! zeros elsewhere. This holds for every mask family; the paper's general pseudo-inverse
-//! form is in [`crate::pinv`], and a test shows the two agree on kronecker masks.
+//! form is in [`crate::solver::pinv`], and a test shows the two agree on kronecker masks.
 //!
 //! **Noise-aware mode.** With a noise level `noise > 0` (standard deviation per
 //! measurement, normalised units) the projection is onto the ball `||A S - I|| <= eps`,
 //! `eps = noise * sqrt(m)` for `m` measurements, as SL0 does for noisy data: a point inside
 //! the ball is left alone, one outside is moved to its surface. It stops fitting the noise.
 //! With shot noise (`shot > 0`) each measurement's variance grows with its value and the
-//! ball is weighted accordingly ([`crate::ball`]).
+//! ball is weighted accordingly ([`crate::solver::ball`]).
 //!
 //! Every loop is bounded by [`Sl0Config::max_iterations`]; how a solve ended is in its
 //! [`Outcome`], never a hang.
 
-use core::fmt;
+use crate::operators::dictionary::Dictionary;
+use crate::operators::transform::{analyze, synthesize};
+use crate::solver::ascent::ascend;
+use crate::solver::ball::{Ball, Move};
+use crate::solver::fractional::project_fractional;
+use crate::solver::projection::project_coefficients;
+use crate::solver::workspace::{Measurements, Workspace};
 
-use crate::ascent::ascend;
-use crate::ball::{Ball, Move};
-use crate::dictionary::Dictionary;
-use crate::fractional::project_fractional;
-use crate::projection::project_coefficients;
-use crate::transform::{analyze, synthesize};
-use crate::workspace::{Measurements, Workspace};
+/// Every solver path returns it; it lives below the workspace that checks measurements.
+pub use crate::solver::error::SolveError;
 
 /// Parameters of SL0 (Algorithm 1). Defaults in [`Sl0Config::DEFAULT`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -73,7 +74,7 @@ pub struct Sl0Config {
     /// brightness); with 0 only exactly flat patches (black, clipped) take it.
     pub flat: f32,
     /// A patch whose measurements cover fewer than this many distinct bands (and at least
-    /// one) is decoded by per-pixel spectral interpolation ([`crate::interpolate`]) instead of SL0, and ends
+    /// one) is decoded by per-pixel spectral interpolation ([`crate::solver::interpolate`]) instead of SL0, and ends
     /// as [`Ended::Interpolated`]; 0 solves every patch. Read by the tile decoder.
     pub min_bands: u8,
 }
@@ -155,55 +156,6 @@ impl Default for Sl0Config {
         Self::DEFAULT
     }
 }
-
-/// Errors of the solver layer.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum SolveError {
-    /// The patch has no valid measurement: nothing to decode.
-    NoMeasurements,
-    /// A config field is out of range.
-    InvalidConfig { field: &'static str },
-    /// A measurement index past the end of the patch.
-    IndexOutOfRange,
-    /// A measurement value that is NaN or infinite.
-    NonFiniteMeasurement,
-    /// The solution went non-finite (not expected for finite input; reported, not output).
-    NonFiniteResult,
-    /// The general (pseudo-inverse) path needs every entry its kronecker `Phi` selects
-    /// measured, and nothing else.
-    IncompleteKronecker,
-    /// The SVD behind a pseudo-inverse did not converge (`mode` 1..=5).
-    PseudoInverse { mode: u8 },
-    /// An ensemble member could not be read (not expected of a validated ensemble).
-    NoSuchMember,
-    /// Band gains that are not finite and positive, or more than `MAX_BANDS` of them.
-    BadGains,
-}
-
-impl fmt::Display for SolveError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match *self {
-            Self::NoMeasurements => f.write_str("patch has no valid measurement"),
-            Self::InvalidConfig { field } => {
-                write!(f, "solver config field `{field}` out of range")
-            }
-            Self::IndexOutOfRange => f.write_str("measurement index outside the patch"),
-            Self::NonFiniteMeasurement => f.write_str("measurement is not finite"),
-            Self::NonFiniteResult => f.write_str("solution is not finite"),
-            Self::IncompleteKronecker => {
-                f.write_str("general path needs exactly the entries the kronecker mask selects")
-            }
-            Self::PseudoInverse { mode } => {
-                write!(f, "pseudo-inverse of mode {mode} did not converge")
-            }
-            Self::NoSuchMember => f.write_str("ensemble member could not be read"),
-            Self::BadGains => f.write_str("band gains must be finite and positive, at most MAX_BANDS"),
-        }
-    }
-}
-
-impl core::error::Error for SolveError {}
 
 /// Why a solve stopped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -1,6 +1,6 @@
 //! The projection of a half-pixel sheared patch, whose measurements interpolate it.
 //!
-//! In a patch sheared to `d = n + 1/2` ([`crate::disparity`]) a view half a lenslet off
+//! In a patch sheared to `d = n + 1/2` ([`crate::operators::disparity`]) a view half a lenslet off
 //! the grid measures, at its entry `(s, t, u, v, b)`, the mean of the patch's values at
 //! `s` and `s + 1` (and of `t` and `t + 1` for a half column: the mean of four). Call
 //! that operator `M`. Its rows are not orthonormal, so SL0's projection
@@ -20,12 +20,12 @@
 //! costs one copy of the patch per direction and the band values of every pixel of a
 //! view a band is measured in: measured, about 1.5 times the fast path's projection.
 
-use crate::ball::Ball;
-use crate::dictionary::Dictionary;
-use crate::projection::{apply_move, band_bits, dot, slice_analysis, slice_synthesis};
-use crate::shape::PatchShape;
-use crate::transform::{Slice, flat, mode_rows, slice};
-use crate::workspace::Measurements;
+use crate::operators::dictionary::Dictionary;
+use crate::operators::shape::PatchShape;
+use crate::operators::transform::{Slice, flat, mode_rows, slice};
+use crate::solver::ball::Ball;
+use crate::solver::projection::{apply_move, band_bits, dot, slice_analysis, slice_synthesis};
+use crate::solver::workspace::Measurements;
 
 /// The largest view grid (`PS * PT`) a half-pixel patch may have: one band's system of a
 /// view is a dense `PS * PT` square on the stack (2.5 KiB at 25). The tile decoder offers
@@ -34,7 +34,7 @@ pub const MAX_GRID: usize = 25;
 
 /// Moves the coefficients `coeffs` (of `dict`) onto the interpolating measurements `m`
 /// (exactly, or onto the noise [`Ball`]); `scratch` is clobbered. Returns the residual
-/// norm before the move. [`crate::projection::project_coefficients`] for patches with
+/// norm before the move. [`crate::solver::projection::project_coefficients`] for patches with
 /// half views ([`Measurements::half_views`]).
 pub fn project_fractional<
     const PS: usize,
@@ -276,7 +276,7 @@ fn cholesky<const L: usize>(at: &[u8], r: &mut [f32; MAX_GRID], (hs, ht): (usize
 /// half axis, position `s` becomes the mean of `s` and `s + 1`, the value the pixel it
 /// read measured (the last position keeps its value; it names no pixel). In place.
 pub fn to_sensor<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
-    half: crate::disparity::HalfViews,
+    half: crate::operators::disparity::HalfViews,
     patch: &mut [f32; N],
 ) {
     const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };

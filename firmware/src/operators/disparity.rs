@@ -10,7 +10,7 @@
 //! which sensor pixels the patch reads, so each measurement is still one value of the
 //! patch (a one-hot selection) and the orthonormal fast path holds; the decoded values
 //! belong to the pixels that were read, and a sink puts them there
-//! ([`crate::tile::PatchOrigin::lenslet`]).
+//! ([`crate::decode::tile::PatchOrigin::lenslet`]).
 //!
 //! The disparity is chosen per spatial block, before any solve, from the measurements
 //! themselves ([`Consistency`]): with the views aligned, the samples of one point that
@@ -24,30 +24,30 @@
 //! view's measurement is then the mean of the two patch values on either side of its pixel
 //! (four on views odd in both axes: bilinear at the centre of four), so the operator is no
 //! longer a selection and the projection solves a small system per view and band
-//! ([`crate::fractional`]). Rounding each view's shift to a whole lenslet instead measured
+//! ([`crate::solver::fractional`]). Rounding each view's shift to a whole lenslet instead measured
 //! no better than the integers, and exact interpolation 2.6 to 3.6 dB better than the
 //! better integer on blocks near a half-integer (dense f64 reference,
 //! `host-sim/examples/fractional_shear.rs`); an orthonormal half-pixel shift put in the
 //! dictionary instead (selection reads kept) measured 1 to 8 dB worse than that. Half
 //! candidates are chosen by the same [`Consistency`] with each view's shift rounded away
 //! from zero. A decoded half-pixel patch is handed to sinks at its sensor pixels: the
-//! interpolated values ([`crate::fractional::to_sensor`]), the last grid position of a
-//! half view naming no pixel ([`crate::tile::PatchOrigin::lenslet`]).
+//! interpolated values ([`crate::solver::fractional::to_sensor`]), the last grid position of a
+//! half view naming no pixel ([`crate::decode::tile::PatchOrigin::lenslet`]).
 
-use crate::shape::MAX_BANDS;
+use crate::operators::shape::MAX_BANDS;
 
 /// The largest disparity magnitude a decoder searches (pixels per view step): a shear of
 /// `d` reaches `d (U - 1) / 2` lenslets beyond the patch, and sinks keep that halo.
 pub const MAX_DISPARITY: i8 = 3;
 
 /// The weight, relative to a sheared patch's, of an unsheared fallback estimate
-/// ([`crate::tile::PatchReport::fallback`]): small enough to change a value a sheared patch
+/// ([`crate::decode::tile::PatchReport::fallback`]): small enough to change a value a sheared patch
 /// reached by about a thousandth of the two estimates' difference, and the whole value
 /// where none did.
 pub const FALLBACK_WEIGHT: f32 = 1e-3;
 
 /// A disparity in half pixels per view step: whole pixels and halves, within
-/// `±MAX_DISPARITY`. Copied into every [`crate::tile::PatchOrigin`].
+/// `±MAX_DISPARITY`. Copied into every [`crate::decode::tile::PatchOrigin`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Disparity(i8);

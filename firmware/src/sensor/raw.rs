@@ -5,10 +5,10 @@
 //! above `max_valid` (a clipped, saturated pixel says only "at least this bright", and
 //! fed in as a value it would pull the solution down). Samples between 0 and the black
 //! level are dark noise and are kept. Anything else is left out of the constraints and
-//! the patch is flagged (see [`crate::tile::PatchFlags`]).
+//! the patch is flagged (see [`crate::decode::tile::PatchFlags`]).
 
-use crate::mask::SensingError;
-use crate::tile::TileSource;
+use crate::sensor::mask::SensingError;
+use crate::sensor::source::TileSource;
 
 /// How raw sample values map to the decoder's normalised units.
 #[derive(Clone, Copy, Debug, PartialEq)]

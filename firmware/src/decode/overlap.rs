@@ -22,10 +22,11 @@
 
 use core::fmt;
 
-use crate::choice::PatchModel;
-use crate::shape::PatchShape;
-use crate::tile::{ConfigError, PatchOrigin, PatchReport, PatchSink, Tile, TileDecoder, TileReport, TileSource};
-use crate::workspace::Workspace;
+use crate::decode::tile::{ConfigError, PatchOrigin, PatchReport, PatchSink, Tile, TileDecoder, TileReport};
+use crate::operators::shape::PatchShape;
+use crate::sensor::source::TileSource;
+use crate::solver::choice::PatchModel;
+use crate::solver::workspace::Workspace;
 
 /// How overlapping estimates of a value are weighed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -182,7 +183,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     }
 
     /// Lenslets a sheared patch reaches beyond its rectangle (rows, cols): the halo of
-    /// the tile decoder's disparity range ([`crate::disparity`]; 0 when it is off).
+    /// the tile decoder's disparity range ([`crate::operators::disparity`]; 0 when it is off).
     fn halo(&self) -> (usize, usize) {
         let (u, v) = self.views();
         let range = self.tiles.disparities();
@@ -412,7 +413,7 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
     type Error = core::convert::Infallible;
 
     fn accept(&mut self, o: PatchOrigin, patch: &[f32; N], r: &PatchReport) -> Result<(), Self::Error> {
-        let scale = if r.fallback { crate::disparity::FALLBACK_WEIGHT } else { 1.0 };
+        let scale = if r.fallback { crate::operators::disparity::FALLBACK_WEIGHT } else { 1.0 };
         let (vu, vv) = self.views;
         let (first, cols, window, frame_rows) = (self.first_col, self.cols, self.window, self.frame_rows);
         for s in 0..PS {

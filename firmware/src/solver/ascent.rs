@@ -79,7 +79,7 @@ fn exponents(mu: f32, inv: f32) -> (f32, f32) {
 /// keeps the weight's exponent in range without a branch.
 ///
 /// Returns the squared length of the step, `sum (mu s exp(-x))^2`: the solver's measure of
-/// how far the patch moved (see [`crate::sl0`]'s early stop).
+/// how far the patch moved (see [`crate::solver::sl0`]'s early stop).
 #[cfg(not(target_arch = "arm"))]
 #[inline]
 pub fn ascend(coeffs: &mut [f32], mu: f32, inv: f32) -> f32 {

@@ -3,7 +3,7 @@
 //! Algorithm 1 as the paper writes it, with `A_i = Phi_i D_i`:
 //! `S0 = I x_i A_i^+`, and each step `S <- S - (S x_i A_i - I) x_i A_i^+`. It does not need
 //! orthonormal matrices, which is why it is kept; with orthonormal ones it equals the fast
-//! path of [`crate::sl0`] (a test shows it). The pseudo-inverses are computed once, in
+//! path of [`crate::solver::sl0`] (a test shows it). The pseudo-inverses are computed once, in
 //! [`PinvOperator::new`] (an SVD each, in f64, via nalgebra), never per patch.
 //!
 //! `Phi5` is `k x B`; here it is padded to `B x B` with zero rows (and `I` with zero
@@ -14,14 +14,14 @@
 
 use nalgebra::{SMatrix, SVD};
 
-use crate::ascent::ascend;
-use crate::ball::Move;
-use crate::dictionary::{Dictionary, Factors, Matrix};
-use crate::mask::KroneckerPhi;
-use crate::shape::PatchShape;
-use crate::sl0::{Outcome, Sl0Config, SolveError, Step, max_abs, run_schedule, start};
-use crate::transform::{apply_in_place, synthesize};
-use crate::workspace::{Measurements, Workspace};
+use crate::operators::dictionary::{Dictionary, Factors, Matrix};
+use crate::operators::shape::PatchShape;
+use crate::operators::transform::{apply_in_place, synthesize};
+use crate::sensor::mask::KroneckerPhi;
+use crate::solver::ascent::ascend;
+use crate::solver::ball::Move;
+use crate::solver::sl0::{Outcome, Sl0Config, SolveError, Step, max_abs, run_schedule, start};
+use crate::solver::workspace::{Measurements, Workspace};
 
 /// Largest mode size the general path handles (its SVDs run at this fixed size).
 pub const PINV_MAX_DIM: usize = 16;
@@ -156,7 +156,7 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
 /// This is the paper's method as a reference: of [`Sl0Config`]'s additions it honours the
 /// early stop (`tolerance`, with the ascent step's length as the movement, an upper bound)
 /// but not the flat short path (`flat`) or the warm solve (`warm_start`, `warm_sigma_f`,
-/// `warm_steps`), which belong to the fast path ([`crate::solve`], [`crate::sl0::solve_warm`]).
+/// `warm_steps`), which belong to the fast path ([`crate::solve`], [`crate::solver::sl0::solve_warm`]).
 ///
 /// # Errors
 /// [`SolveError::InvalidConfig`], [`SolveError::NoMeasurements`],

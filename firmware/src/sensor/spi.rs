@@ -20,7 +20,7 @@ use core::fmt;
 use embedded_hal::digital::InputPin;
 use embedded_hal::spi::{Operation, SpiDevice};
 
-use crate::tile::TileSource;
+use crate::sensor::source::TileSource;
 
 /// The read command byte.
 pub const READ: u8 = 0x03;

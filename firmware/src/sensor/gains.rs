@@ -10,7 +10,7 @@
 //! grey again. For a one-hot mask this is a change of units per measurement, nothing
 //! else: the sensing stays a selection, the orthonormal fast path holds, and the decoded
 //! patch is multiplied back. Only the noise changes units too, so the noise ball weighs
-//! each band by its gain ([`crate::ball::Ball::weight`]).
+//! each band by its gain ([`crate::solver::ball::Ball::weight`]).
 //!
 //! Measured with the DCT at pixel k = 3 on held-out scenes (noise-free captures, gains
 //! from the truth; `docs/results-ensemble-validation.md`): +4.6 dB under A, +0.9 under D65,

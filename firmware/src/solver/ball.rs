@@ -23,7 +23,7 @@
 //! with unequal ones it is a point on the ellipsoid's surface (not the nearest, which needs
 //! a root search per step), found at the cost of one division per measurement.
 //!
-//! White-balanced values ([`crate::gains`]) are the sensor's divided by their band's gain
+//! White-balanced values ([`crate::sensor::gains`]) are the sensor's divided by their band's gain
 //! `g`, so their variance is the sensor's over `g^2`: the ball weighs each residual by its
 //! band's gain ([`Ball::weight`]), and is weighted whenever any gain differs from 1, even
 //! without shot noise.

@@ -23,11 +23,11 @@
 //! a `Slice` on the stack (4 KiB), so the workspace does not grow and the slice stays
 //! in the L1 cache from the synthesis to the analysis.
 
-use crate::ball::{Ball, Move};
-use crate::dictionary::Dictionary;
-use crate::shape::PatchShape;
-use crate::transform::{Slice, flat, mode_pixel, mode_rows, mode_rows_add, slice};
-use crate::workspace::Measurements;
+use crate::operators::dictionary::Dictionary;
+use crate::operators::shape::PatchShape;
+use crate::operators::transform::{Slice, flat, mode_pixel, mode_rows, mode_rows_add, slice};
+use crate::solver::ball::{Ball, Move};
+use crate::solver::workspace::Measurements;
 
 /// Multiply-adds of one projection with `measured` measurements: the pixel-mode synthesis
 /// and analysis, and `2 B` per measurement on the band axis.
@@ -84,7 +84,7 @@ pub fn project_coefficients<
 
 /// The synthesis of one spatial slice over the pixel modes after the first: `part` (its
 /// first mode already synthesised) to each pixel's band coefficients in `fibres`; `part`
-/// is clobbered. Shared by both projections ([`crate::fractional`]).
+/// is clobbered. Shared by both projections ([`crate::solver::fractional`]).
 #[inline(always)]
 pub(crate) fn slice_synthesis<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
     dict: &Dictionary<PS, PT, PU, PV, B>,

@@ -5,9 +5,9 @@
 //! one flag per patch value: coefficients, signal, and the measurements. `new` is a
 //! `const fn`, so a device can place it in a `static`.
 
-use crate::disparity::HalfViews;
-use crate::shape::{MAX_BANDS, PatchShape};
-use crate::sl0::SolveError;
+use crate::operators::disparity::HalfViews;
+use crate::operators::shape::{MAX_BANDS, PatchShape};
+use crate::solver::error::SolveError;
 
 /// The measurements of one patch, dense in the patch layout: entry `i` is measured (with
 /// its value in normalised units) or not. A one-hot mask measures each entry at most once.
@@ -18,9 +18,9 @@ use crate::sl0::SolveError;
 /// from its unmeasured entries alone, so it needs no buffer of its own.
 ///
 /// Values may be white-balanced: band `b`'s values divided by a gain `g_b`
-/// ([`crate::gains`]), so that the decode works on spectra with the illuminant's tilt
+/// ([`crate::sensor::gains`]), so that the decode works on spectra with the illuminant's tilt
 /// taken out. The gains travel with the values because the noise ball needs them: a value
-/// divided by `g_b` has its noise divided by `g_b` too ([`crate::ball::Ball::weight`]).
+/// divided by `g_b` has its noise divided by `g_b` too ([`crate::solver::ball::Ball::weight`]).
 /// Gains are 1 unless set, and [`clear`](Self::clear) keeps them (they are the unit of
 /// the values, not a measurement).
 #[derive(Clone, Debug)]
@@ -33,7 +33,7 @@ pub struct Measurements<const N: usize> {
     /// Whether any gain differs from 1.
     pub(crate) balanced: bool,
     /// The views whose measurements interpolate the patch (a half-pixel shear,
-    /// [`crate::disparity`]); none: every measurement is one value.
+    /// [`crate::operators::disparity`]); none: every measurement is one value.
     pub(crate) half: HalfViews,
 }
 
@@ -199,8 +199,8 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
 
     /// `patch = coefficients x_i D_i`, in place in the workspace (the coefficients are the
     /// scratch and are clobbered): one transform with no buffer outside the workspace.
-    pub fn synthesize(&mut self, dict: &crate::Dictionary<PS, PT, PU, PV, B>) {
-        crate::transform::synthesize(dict, &mut self.coeffs, &mut self.signal);
+    pub fn synthesize(&mut self, dict: &crate::operators::dictionary::Dictionary<PS, PT, PU, PV, B>) {
+        crate::operators::transform::synthesize(dict, &mut self.coeffs, &mut self.signal);
     }
 
     /// The decoded patch after a successful solve (layout of [`PatchShape::index`]).

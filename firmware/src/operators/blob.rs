@@ -21,7 +21,7 @@
 
 use crc::{CRC_32_ISO_HDLC, Crc};
 
-use crate::dictionary::{Dictionary, DictionaryError, Factors, Matrix};
+use crate::operators::dictionary::{Dictionary, DictionaryError, Factors, Matrix};
 
 /// The shipped default ensemble for the paper's patch (5 x 5 x 4 x 4 x 13): 8 members
 /// trained by `cargo run --release -p slf-host -- train -o firmware/dictionaries/ensemble8.slfd`
@@ -29,7 +29,7 @@ use crate::dictionary::{Dictionary, DictionaryError, Factors, Matrix};
 /// decoder balances a capture, 20,000 patches, tau 100, 10 iterations, seed 1; member 0 is
 /// the fixed 5D DCT) on rendered scenes only, never the named test scenes or real data.
 /// `Ensemble::<5, 5, 4, 4, 13>::new(DEFAULT_ENSEMBLE)` validates it.
-pub static DEFAULT_ENSEMBLE: &[u8] = include_bytes!("../dictionaries/ensemble8.slfd");
+pub static DEFAULT_ENSEMBLE: &[u8] = include_bytes!("../../dictionaries/ensemble8.slfd");
 
 /// The magic bytes at the start of a blob.
 pub const BLOB_MAGIC: [u8; 4] = *b"SLFD";

@@ -1,6 +1,6 @@
 //! Defective sensor pixels: positions that are never measurements.
 
-use crate::mask::SensingError;
+use crate::sensor::mask::SensingError;
 
 /// A sensor pixel position in the raw frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]

@@ -30,7 +30,7 @@
 //! wins 70 % of the patches, +0.01 dB and 0.65 instead of 0.68 degrees SA for 11-14 % less
 //! time.
 //!
-//! [`Measurements`]: crate::workspace::Measurements
+//! [`Measurements`]: crate::solver::workspace::Measurements
 //!
 //! The raw SL0 residual is near zero for every member (each solution meets the
 //! measurements), so it cannot rank them; the rules look at how sparse the solution is in
@@ -38,12 +38,12 @@
 //! four modes a spatial slice at a time, through a slice on the stack), so no buffer is
 //! added to the [`Workspace`].
 
-use crate::blob::Ensemble;
-use crate::dictionary::Dictionary;
-use crate::shape::PatchShape;
-use crate::sl0::{Ended, Outcome, Sl0Config, SolveError, solve, solve_warm};
-use crate::transform::analyze_preserving;
-use crate::workspace::Workspace;
+use crate::operators::blob::Ensemble;
+use crate::operators::dictionary::Dictionary;
+use crate::operators::shape::PatchShape;
+use crate::operators::transform::analyze_preserving;
+use crate::solver::sl0::{Ended, Outcome, Sl0Config, SolveError, solve, solve_warm};
+use crate::solver::workspace::Workspace;
 
 /// How much sparser than the DCT's own solution a member's must score to replace it
 /// (screened choice): below this factor the patch is the two solutions' weighted mean.

@@ -1,0 +1,20 @@
+//! The operators layer: the patch and the dictionaries it is sparse in.
+//!
+//! - [`shape`]: the patch geometry in the types (`PS x PT` lenslets, `PU x PV` views, `B`
+//!   bands) and its index arithmetic;
+//! - [`disparity`]: sheared patches, whose views are shifted to align on a depth, and the
+//!   consistency score that chooses the shear;
+//! - [`dct`]: the orthonormal DCT-II matrices as compile-time tables;
+//! - [`dictionary`]: one member, five small orthonormal matrices, checked when built;
+//! - [`blob`]: the ensemble's file format in flash (write, validate, read);
+//! - [`transform`]: the separable synthesis and analysis transforms and the mode products
+//!   the projections are built of.
+//!
+//! May use: the sensor layer (band counts). Used by the solver and decode layers.
+
+pub mod blob;
+pub mod dct;
+pub mod dictionary;
+pub mod disparity;
+pub mod shape;
+pub mod transform;

@@ -1,0 +1,20 @@
+//! The sensor layer: raw frames and what the camera's filters make of them.
+//!
+//! - [`raw`]: samples and which of them are measurements (finite, not negative, not
+//!   saturated), frames in RAM or flash, one [`FrameSource`](raw::FrameSource) per capture;
+//! - [`source`]: the [`TileSource`](source::TileSource) trait every frame source implements;
+//! - [`spi`]: a frame buffer read over `embedded-hal` SPI;
+//! - [`defects`]: the sensor's defect list;
+//! - [`mask`]: which band each pixel sees in each snapshot (the three mask families), and
+//!   [`MAX_BANDS`](mask::MAX_BANDS);
+//! - [`gains`]: the white balance, a gain per band.
+//!
+//! May use: nothing of the crate but the logging shim. Everything above (operators, solver,
+//! decode) may use it.
+
+pub mod defects;
+pub mod gains;
+pub mod mask;
+pub mod raw;
+pub mod source;
+pub mod spi;

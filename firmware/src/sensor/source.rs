@@ -1,0 +1,22 @@
+//! Where raw samples come from: the trait every frame source implements.
+//!
+//! The tile decoder asks a source for short runs of one row (`PV` samples of one lenslet's
+//! view row, per snapshot). That maps onto both random access into RAM ([`super::raw`]) and
+//! addressed reads of a serial frame buffer ([`super::spi`]); a sequential-only sensor FIFO
+//! is buffered tile by tile by its source. The trait lives here, beside the frames, so that
+//! the sources need nothing of the decoder above them.
+
+use core::fmt;
+
+/// Where raw samples come from.
+pub trait TileSource {
+    /// A read failure (bus error, short read, out of range). `Copy`, to travel in errors.
+    type Error: Copy + fmt::Debug;
+
+    /// Fills `out` with the `out.len()` consecutive samples of `snapshot`'s raw frame that
+    /// start at sensor pixel `(row, col)` and run along the row.
+    ///
+    /// # Errors
+    /// The source's own error; the decoder then abandons the current tile only.
+    fn read(&mut self, snapshot: usize, row: usize, col: usize, out: &mut [f32]) -> Result<(), Self::Error>;
+}

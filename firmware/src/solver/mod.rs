@@ -1,0 +1,29 @@
+//! The solver layer: one patch's measurements to one decoded patch.
+//!
+//! - [`error`]: [`SolveError`](error::SolveError), why a patch could not be decoded;
+//! - [`workspace`]: the caller-owned [`Workspace`](workspace::Workspace), the decoder's
+//!   whole RAM need, and the patch's [`Measurements`](workspace::Measurements). It lives
+//!   here, not with the tile decoder, because every solver path works in it;
+//! - [`ball`]: the noise ball a projection moves onto (per-measurement variance);
+//! - [`ascent`]: SL0's ascent step on the coefficients;
+//! - [`projection`]: the orthonormal fast path's projection onto the measurements;
+//! - [`fractional`]: the projection of half-pixel sheared patches, whose measurements
+//!   interpolate the patch;
+//! - [`pinv`]: the paper's general pseudo-inverse path for kronecker masks;
+//! - [`sl0`]: Algorithm 1, its configuration and how a solve ended;
+//! - [`choice`]: the ensemble's member choice per patch (exhaustive or screened);
+//! - [`interpolate`]: per-pixel spectral interpolation, for a patch that measures too few
+//!   bands for SL0.
+//!
+//! May use: the sensor and operators layers. Used by the decode layer.
+
+pub mod ascent;
+pub mod ball;
+pub mod choice;
+pub mod error;
+pub mod fractional;
+pub mod interpolate;
+pub mod pinv;
+pub mod projection;
+pub mod sl0;
+pub mod workspace;
