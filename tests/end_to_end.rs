@@ -18,12 +18,12 @@
 //! better at the same 5D cost, and the test holds it to at least 15 dB better at k = 3
 //! (measured: 23.1 dB).
 
-use slf_host::camera::{CameraConfig, simulate};
-use slf_host::capture::{Capture, MaskDescription};
-use slf_host::decode::{Basis, DecodeOptions, decode, decode_with};
+use slf_host::decode::cs::{Basis, DecodeOptions, decode, decode_with};
+use slf_host::eval::metrics::evaluate;
 use slf_host::firmware::{Dictionary, MaskFamily};
-use slf_host::metrics::evaluate;
-use slf_host::scene::{self, SceneSize};
+use slf_host::io::capture::{Capture, MaskDescription};
+use slf_host::sim::camera::{CameraConfig, simulate};
+use slf_host::sim::scene::{self, SceneSize};
 
 fn mask(family: &str, k: u8) -> MaskDescription {
     let family = match family {

@@ -2,14 +2,14 @@
 //! case asserts: no NaN or infinity in the output, the iteration bound honoured, and an
 //! error bound or a typed error. Error bounds were set from measurement (noted per case).
 
-use slf_host::bench::F64Dct;
-use slf_host::camera::{CameraConfig, simulate};
-use slf_host::capture::{Capture, MaskDescription, MaskSource};
-use slf_host::decode::{Basis, DecodeOptions, DecodeReport, NoiseSource, decode, decode_with};
+use slf_host::decode::cs::{Basis, DecodeOptions, DecodeReport, NoiseSource, decode, decode_with};
+use slf_host::eval::bench::F64Dct;
+use slf_host::eval::metrics::psnr;
 use slf_host::firmware::{Dictionary, Sl0Config};
-use slf_host::lightfield::LightField;
-use slf_host::metrics::psnr;
-use slf_host::scene::{self, SceneSize};
+use slf_host::io::capture::{Capture, MaskDescription, MaskSource};
+use slf_host::io::lightfield::LightField;
+use slf_host::sim::camera::{CameraConfig, simulate};
+use slf_host::sim::scene::{self, SceneSize};
 
 const SIZE: SceneSize = SceneSize { views: (5, 5), rows: 10, cols: 10 };
 

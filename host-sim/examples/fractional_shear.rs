@@ -20,10 +20,10 @@
 
 use anyhow::{Context, Result, ensure};
 use nalgebra::{DMatrix, DVector};
-use slf_host::camera::{CameraConfig, simulate};
-use slf_host::decode::{DecodeOptions, tile_decoder};
+use slf_host::decode::cs::{DecodeOptions, tile_decoder};
 use slf_host::firmware::{FrameSource, Sl0Config, TileSource};
-use slf_host::lightfield::read_npy;
+use slf_host::io::lightfield::read_npy;
+use slf_host::sim::camera::{CameraConfig, simulate};
 
 /// Blocks decoded at most per light field.
 const MAX_BLOCKS: usize = 12;

@@ -1,4 +1,4 @@
-"""Generates host-sim/src/import/rgb_basis_data.rs: the spectral-upsampling basis `slf import`
+"""Generates host-sim/src/io/import/rgb_basis_data.rs: the spectral-upsampling basis `slf import`
 lifts RGB views with, and the illuminant it renders them under.
 
 Run: pip install colour-science==0.4.7 && python3 host-sim/scripts/gen_rgb_basis.py
@@ -58,5 +58,5 @@ vals = [str(np.float32(v)) for v in d65.values]
 for i in range(0, len(vals), 9):
     out.append("    " + ", ".join(vals[i : i + 9]) + ",")
 out.append("];")
-open("host-sim/src/import/rgb_basis_data.rs", "w").write("\n".join(out) + "\n")
-print("wrote host-sim/src/import/rgb_basis_data.rs (then `cargo fmt` formats it as committed)")
+open("host-sim/src/io/import/rgb_basis_data.rs", "w").write("\n".join(out) + "\n")
+print("wrote host-sim/src/io/import/rgb_basis_data.rs (then `cargo fmt` formats it as committed)")

@@ -1,4 +1,4 @@
-"""Generates host-sim/src/spectra_data.rs: measured spectra at slf's 13 band centres.
+"""Generates host-sim/src/sim/spectra_data.rs: measured spectra at slf's 13 band centres.
 
 Run: pip install colour-science==0.4.7 && python3 host-sim/scripts/gen_spectra.py
 The output is committed; a test checks its shape and a few published properties.
@@ -111,5 +111,5 @@ for name in illuminants:
     v = v / v.max()
     out.append(f'    ("{name}", [' + ", ".join(f"{x:.4}" for x in v) + "]),")
 out.append("];")
-open("host-sim/src/spectra_data.rs", "w").write("\n".join(out) + "\n")
-print("wrote host-sim/src/spectra_data.rs")
+open("host-sim/src/sim/spectra_data.rs", "w").write("\n".join(out) + "\n")
+print("wrote host-sim/src/sim/spectra_data.rs")

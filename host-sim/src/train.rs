@@ -32,8 +32,8 @@ use slf_firmware::dictionary::Factors;
 use slf_firmware::transform::analyze;
 use slf_firmware::{Dictionary, PaperShape};
 
-use crate::decode::PaperDictionary;
-use crate::lightfield::LightField;
+use crate::decode::cs::PaperDictionary;
+use crate::io::lightfield::LightField;
 
 /// Values of one patch.
 pub const N: usize = 5200;
@@ -303,7 +303,7 @@ pub fn init_members(patches: &[f32], cfg: &TrainConfig) -> Vec<Member> {
     let fixed = usize::from(cfg.dct_member && cfg.members > 0);
     let mut members: Vec<Member> = Vec::with_capacity(cfg.members);
     if fixed == 1 {
-        let dct: Vec<Vec<f64>> = crate::baseline::Factors::dct_f64().0.into_iter().map(|(_, m)| m).collect();
+        let dct: Vec<Vec<f64>> = crate::decode::paper_1d::Factors::dct_f64().0.into_iter().map(|(_, m)| m).collect();
         members.push(Member(dct.try_into().unwrap_or_else(|_| unreachable!("five modes"))));
     }
     while members.len() < cfg.members {
@@ -394,12 +394,12 @@ pub enum Generator {
 /// Random light fields for training (seeds `seed..seed + count`; the named scenes of
 /// either generator use seeds below 1000, and `slf train` starts at 1000 + its seed).
 pub fn training_fields(count: usize, size: usize, seed: u64, generator: Generator) -> Vec<LightField> {
-    let size = crate::scene::SceneSize { views: (5, 5), rows: size, cols: size };
+    let size = crate::sim::scene::SceneSize { views: (5, 5), rows: size, cols: size };
     (0..count as u64)
         .into_par_iter()
         .map(|i| match generator {
-            Generator::Toy => crate::scene::random(seed + i).render(size),
-            Generator::Realistic => crate::realistic::realistic(seed + i).render(size),
+            Generator::Toy => crate::sim::scene::random(seed + i).render(size),
+            Generator::Realistic => crate::sim::realistic::realistic(seed + i).render(size),
         })
         .collect()
 }

@@ -2,10 +2,10 @@
 //! gains are reported and can be given, and under a steep illuminant the balanced decode
 //! is measurably nearer the truth.
 
-use slf_host::camera::{CameraConfig, simulate};
-use slf_host::decode::{Balance, Basis, DecodeOptions, decode_with, tile_decoder};
-use slf_host::metrics::evaluate;
-use slf_host::scene::SceneSize;
+use slf_host::decode::cs::{Balance, Basis, DecodeOptions, decode_with, tile_decoder};
+use slf_host::eval::metrics::evaluate;
+use slf_host::sim::camera::{CameraConfig, simulate};
+use slf_host::sim::scene::SceneSize;
 
 /// Tungsten light (CIE A: blue bands at a tenth of the red) at pixel k = 3, with the
 /// default sensor's noise: the balanced DCT decode beats the plain one by at least 0.5 dB
@@ -14,7 +14,7 @@ use slf_host::scene::SceneSize;
 #[test]
 fn balance_helps_under_tungsten_light() {
     let truth =
-        slf_host::realistic::lookup("tungsten").unwrap().render(SceneSize { views: (5, 5), rows: 40, cols: 40 });
+        slf_host::sim::realistic::lookup("tungsten").unwrap().render(SceneSize { views: (5, 5), rows: 40, cols: 40 });
     let cap = simulate(&truth, &CameraConfig::pixel(3, 3)).unwrap();
     let psnr = |balance| {
         let opts = DecodeOptions { balance, ..DecodeOptions::disjoint() };
@@ -42,7 +42,8 @@ fn balance_helps_under_tungsten_light() {
 
 #[test]
 fn bad_gains_are_refused_with_a_message() {
-    let truth = slf_host::realistic::lookup("outdoor").unwrap().render(SceneSize { views: (5, 5), rows: 10, cols: 10 });
+    let truth =
+        slf_host::sim::realistic::lookup("outdoor").unwrap().render(SceneSize { views: (5, 5), rows: 10, cols: 10 });
     let cap = simulate(&truth, &CameraConfig::pixel(3, 1)).unwrap();
     let mut g = [1.0f32; 13];
     g[3] = 0.0;
@@ -57,7 +58,7 @@ fn bad_gains_are_refused_with_a_message() {
 /// measured at 40 x 40: +0.10 dB, and -0.78 dB with a margin of 1).
 #[test]
 fn ensemble_does_not_lose_to_the_dct_on_a_smooth_scene() {
-    let truth = slf_host::scene::named("smooth").unwrap().render(SceneSize { views: (5, 5), rows: 40, cols: 40 });
+    let truth = slf_host::sim::scene::named("smooth").unwrap().render(SceneSize { views: (5, 5), rows: 40, cols: 40 });
     let cap = simulate(&truth, &CameraConfig::pixel(3, 3)).unwrap();
     let psnr = |basis: &Basis| {
         let (lf, _) = decode_with(&cap, basis, &DecodeOptions::disjoint()).unwrap();

@@ -11,9 +11,9 @@
 //! config against 1e-4. The f64 comparison uses the DCT computed in f64 (the f32 tables are
 //! orthonormal only to about 1e-7), and the 1D method accumulates its dense products in f64.
 
-use slf_host::baseline::{Dense1D, Factors, solve_5d};
+use slf_host::decode::paper_1d::{Dense1D, Factors, solve_5d};
 use slf_host::firmware::{Dictionary, LensletSize, Mask, PaperShape, PaperWorkspace, Sl0Config, solve};
-use slf_host::scene::{self, SceneSize};
+use slf_host::sim::scene::{self, SceneSize};
 
 fn max_diff<T: Copy + Into<f64>>(a: &[T], b: &[T]) -> f64 {
     a.iter().zip(b).map(|(&x, &y)| (x.into() - y.into()).abs()).fold(0.0, f64::max)

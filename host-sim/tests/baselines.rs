@@ -1,10 +1,10 @@
 //! The no-CS baselines against values worked out by hand.
 
-use slf_host::camera::{CameraConfig, simulate};
-use slf_host::capture::Capture;
-use slf_host::demosaic::{DemosaicConfig, PpidConfig, demosaic, interpolate, ppid};
-use slf_host::lightfield::LightField;
-use slf_host::metrics::evaluate;
+use slf_host::decode::baselines::{DemosaicConfig, PpidConfig, demosaic, interpolate, ppid};
+use slf_host::eval::metrics::evaluate;
+use slf_host::io::capture::Capture;
+use slf_host::io::lightfield::LightField;
+use slf_host::sim::camera::{CameraConfig, simulate};
 
 mod common;
 use common::small_smooth;
@@ -107,19 +107,19 @@ fn a_capture_with_no_measurement_is_an_error_naming_it() {
 fn patch_count_is_what_the_cs_decoder_decodes() {
     // Baselines are timed per CS patch of the same capture: the count must be the decoder's.
     for (views, size) in [(5, 12), (4, 12), (5, 11)] {
-        let truth = slf_host::scene::named("smooth").unwrap().render(slf_host::scene::SceneSize {
+        let truth = slf_host::sim::scene::named("smooth").unwrap().render(slf_host::sim::scene::SceneSize {
             views: (views, views),
             rows: size,
             cols: size,
         });
         let cap = simulate(&truth, &CameraConfig::pixel(3, 1)).unwrap();
-        let (_, r) = slf_host::decode::decode_with(
+        let (_, r) = slf_host::decode::cs::decode_with(
             &cap,
-            &slf_host::decode::Basis::Dct,
-            &slf_host::decode::DecodeOptions::disjoint(),
+            &slf_host::decode::cs::Basis::Dct,
+            &slf_host::decode::cs::DecodeOptions::disjoint(),
         )
         .unwrap();
-        let n = slf_host::decode::patch_count(&cap).unwrap();
+        let n = slf_host::decode::cs::patch_count(&cap).unwrap();
         assert_eq!(n, u64::from(r.patches.decoded + r.patches.failed), "{views} views, {size} lenslets");
     }
 }
@@ -172,9 +172,9 @@ fn ppid_follows_a_brightness_edge() {
 /// interpolates the sensor's values, the balanced decode the balanced ones.
 #[test]
 fn kronecker_patches_with_too_few_bands_are_interpolated() {
-    use slf_host::capture::MaskDescription;
-    use slf_host::decode::{Balance, Basis, DecodeOptions, decode_with};
+    use slf_host::decode::cs::{Balance, Basis, DecodeOptions, decode_with};
     use slf_host::firmware::{MaskFamily, Sl0Config};
+    use slf_host::io::capture::MaskDescription;
     let truth = LightField::from_fn((5, 5), 20, 15, 13, |u, v, y, x, b| {
         0.2 + 0.03 * b as f32
             + 0.02 * ((u + 2 * v + 3 * y + 5 * x) % 7) as f32

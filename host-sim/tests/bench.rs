@@ -1,7 +1,7 @@
 //! The bench's Pareto front: per mask family and k, the points no other point beats in
 //! both time and PSNR.
 
-use slf_host::bench::{Point, mark_pareto};
+use slf_host::eval::bench::{Point, mark_pareto};
 
 fn p(mask: &str, k: u8, ms: f64, psnr: f64) -> Point {
     Point {

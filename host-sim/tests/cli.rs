@@ -226,9 +226,9 @@ fn nothing_decoded_is_a_failure_and_many_flagged_patches_a_warning() {
     let p = |name: &str| dir.path().join(name);
     stdout(slf().args(["scene", "smooth", "--size", "12", "-o"]).arg(p("lf.npy")));
     // A light field far above white: simulate warns, and every patch is saturated.
-    let lf = slf_host::lightfield::read_npy(&p("lf.npy")).unwrap();
-    let bright = slf_host::lightfield::LightField { data: lf.data.iter().map(|_| 50.0).collect(), ..lf.clone() };
-    slf_host::lightfield::write_npy(&p("bright.npy"), &bright, slf_host::lightfield::Dtype::F32).unwrap();
+    let lf = slf_host::io::lightfield::read_npy(&p("lf.npy")).unwrap();
+    let bright = slf_host::io::lightfield::LightField { data: lf.data.iter().map(|_| 50.0).collect(), ..lf.clone() };
+    slf_host::io::lightfield::write_npy(&p("bright.npy"), &bright, slf_host::io::lightfield::Dtype::F32).unwrap();
     let warn = stderr_of_success(slf().arg("simulate").arg(p("bright.npy")).arg("-o").arg(p("cap")));
     assert!(warn.contains("warning") && warn.contains("3600 of 3600 pixels (100.00 %) saturated"), "{warn}");
     // Before: exit 0 and a file of zeros.
@@ -262,9 +262,9 @@ fn bad_light_fields_are_refused_with_what_is_wrong() {
     let dir = tempfile::tempdir().unwrap();
     let p = |name: &str| dir.path().join(name);
     stdout(slf().args(["scene", "smooth", "--size", "12", "-o"]).arg(p("lf.npy")));
-    let lf = slf_host::lightfield::read_npy(&p("lf.npy")).unwrap();
+    let lf = slf_host::io::lightfield::read_npy(&p("lf.npy")).unwrap();
     // (H, W, U, V, B) read as (U, V, H, W, B): more views than lenslets.
-    let mut swapped = slf_host::lightfield::LightField::zeros((12, 12), 5, 5, 13);
+    let mut swapped = slf_host::io::lightfield::LightField::zeros((12, 12), 5, 5, 13);
     for (u, v, y, x, b) in (0..5).flat_map(|u| {
         (0..5).flat_map(move |v| {
             (0..12).flat_map(move |y| (0..12).flat_map(move |x| (0..13).map(move |b| (u, v, y, x, b))))
@@ -273,14 +273,14 @@ fn bad_light_fields_are_refused_with_what_is_wrong() {
         let i = swapped.index(y, x, u, v, b);
         swapped.data[i] = lf.get(u, v, y, x, b);
     }
-    slf_host::lightfield::write_npy(&p("swapped.npy"), &swapped, slf_host::lightfield::Dtype::F32).unwrap();
+    slf_host::io::lightfield::write_npy(&p("swapped.npy"), &swapped, slf_host::io::lightfield::Dtype::F32).unwrap();
     let e = failure(slf().arg("simulate").arg(p("swapped.npy")).arg("-o").arg(p("cap")));
     assert!(e.contains("swapped.npy") && e.contains("(H, W, U, V, B)"), "{e}");
     // NaN in a light field: eval, simulate and train refuse it (before: "PSNR NaN", exit 0;
     // train panicked).
     let mut nan = lf.clone();
     nan.data.iter_mut().for_each(|x| *x = f32::NAN);
-    slf_host::lightfield::write_npy(&p("nan.npy"), &nan, slf_host::lightfield::Dtype::F32).unwrap();
+    slf_host::io::lightfield::write_npy(&p("nan.npy"), &nan, slf_host::io::lightfield::Dtype::F32).unwrap();
     for args in [
         vec!["eval", "lf.npy", "nan.npy"],
         vec!["eval", "nan.npy", "lf.npy"],
@@ -379,7 +379,7 @@ fn baselines_decode_from_the_command_line() {
 
 #[test]
 fn import_from_the_command_line_and_other_band_counts_resampled() {
-    use slf_host::lightfield::{Dtype, LightField, read_npy, write_npy};
+    use slf_host::io::lightfield::{Dtype, LightField, read_npy, write_npy};
     let dir = tempfile::tempdir().unwrap();
     let p = |name: &str| dir.path().join(name);
     // A 31-band light field, 400..=700 nm by 10, flat 0.4: refused without its

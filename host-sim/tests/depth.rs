@@ -4,14 +4,14 @@
 //! overlap ring, and the command line.
 
 use assert_cmd::Command;
-use slf_host::camera::{CameraConfig, simulate};
-use slf_host::decode::{Basis, DecodeOptions, decode_with, disparity_per_lenslet, tile_decoder};
+use slf_host::decode::cs::{Basis, DecodeOptions, decode_with, disparity_per_lenslet, tile_decoder};
+use slf_host::eval::metrics::psnr;
 use slf_host::firmware::disparity::Disparity;
 use slf_host::firmware::{Dictionary, DisparityRange, FrameSource, Overlap, OverlapDecoder, PaperWorkspace};
-use slf_host::lightfield::{Dtype, LightField, write_npy};
-use slf_host::metrics::psnr;
-use slf_host::scene::{Layer, Scene, SceneSize, Shape, Texture};
-use slf_host::spectra::{D65, colorchecker};
+use slf_host::io::lightfield::{Dtype, LightField, write_npy};
+use slf_host::sim::camera::{CameraConfig, simulate};
+use slf_host::sim::scene::{Layer, Scene, SceneSize, Shape, Texture};
+use slf_host::sim::spectra::{D65, colorchecker};
 
 mod common;
 use common::Rows;

@@ -3,10 +3,10 @@
 
 use std::io::Write;
 
-use slf_host::camera::{CameraConfig, simulate};
-use slf_host::capture::{Capture, MaskDescription, MaskSource};
-use slf_host::lightfield::{Dtype, LightField, read_npy, write_npy};
-use slf_host::scene::{self, SceneSize};
+use slf_host::io::capture::{Capture, MaskDescription, MaskSource};
+use slf_host::io::lightfield::{Dtype, LightField, read_npy, write_npy};
+use slf_host::sim::camera::{CameraConfig, simulate};
+use slf_host::sim::scene::{self, SceneSize};
 
 fn small() -> LightField {
     scene::named("texture").unwrap().render(SceneSize { views: (5, 5), rows: 10, cols: 15 })
@@ -167,7 +167,7 @@ fn previews_are_scaled_at_least_4x_and_labelled() {
     recon.data.iter_mut().enumerate().for_each(|(i, x)| *x += 0.01 * (i % 7) as f32);
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("preview.png");
-    slf_host::preview::write_comparison(&p, &truth, &recon).unwrap();
+    slf_host::eval::preview::write_comparison(&p, &truth, &recon).unwrap();
     let img = image::open(&p).unwrap().into_rgb8();
     let (w, h) = (truth.cols as u32, truth.rows as u32);
     // Three panels, each at least 4x, with room for the labels and the colour bar.

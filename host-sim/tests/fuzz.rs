@@ -15,9 +15,9 @@ use proptest::prelude::*;
 #[path = "../../firmware/tests/common/fuzz_runner.rs"]
 mod fuzz_runner;
 use fuzz_runner::{cases, runner};
-use slf_host::camera::{CameraConfig, simulate};
-use slf_host::capture::Capture;
-use slf_host::npy::{self, Values};
+use slf_host::io::capture::Capture;
+use slf_host::io::npy::{self, Values};
+use slf_host::sim::camera::{CameraConfig, simulate};
 
 mod common;
 use common::{npy_bytes, small_smooth};

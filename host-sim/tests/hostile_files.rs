@@ -9,10 +9,10 @@ use std::path::{Path, PathBuf};
 use std::sync::mpsc;
 use std::time::Duration;
 
-use slf_host::camera::{CameraConfig, simulate};
-use slf_host::capture::{Capture, read_frame, write_frame};
-use slf_host::lightfield::{LightField, read_npy, read_npy_with_notes};
-use slf_host::npy::{self, NpyErrorKind, Values};
+use slf_host::io::capture::{Capture, read_frame, write_frame};
+use slf_host::io::lightfield::{LightField, read_npy, read_npy_with_notes};
+use slf_host::io::npy::{self, NpyErrorKind, Values};
+use slf_host::sim::camera::{CameraConfig, simulate};
 
 mod common;
 use common::{npy_bytes, small_smooth};
@@ -219,7 +219,7 @@ fn the_reader_agrees_with_npyz_on_files_npyz_writes() {
         data: (0..360).map(|i| (i as f32 * 0.37).sin().abs()).collect(),
     };
     let p = dir.path().join("lf.npy");
-    slf_host::lightfield::write_npy(&p, &lf, slf_host::lightfield::Dtype::F32).unwrap();
+    slf_host::io::lightfield::write_npy(&p, &lf, slf_host::io::lightfield::Dtype::F32).unwrap();
     let a = npy::read(&p).unwrap();
     assert_eq!(a.shape, [2, 3, 4, 5, 3]);
     assert_eq!(a.values, Values::F32(lf.data.clone()));
@@ -343,7 +343,7 @@ fn hostile_capture_descriptions_are_one_line_errors() {
     // An oversized capture.json is refused before reading (a sparse file: no disk used).
     let (dir, _) = saved_capture();
     let f = std::fs::OpenOptions::new().write(true).open(dir.path().join("capture.json")).unwrap();
-    f.set_len(slf_host::capture::MAX_DESCRIPTION + 1).unwrap();
+    f.set_len(slf_host::io::capture::MAX_DESCRIPTION + 1).unwrap();
     let e = format!("{:#}", Capture::load(dir.path()).unwrap_err());
     assert!(e.contains("more than the"), "{e}");
 }
@@ -353,21 +353,21 @@ fn blobs_larger_than_any_real_blob_are_refused_before_reading() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("big.slfd");
     let f = std::fs::File::create(&p).unwrap();
-    f.set_len(slf_host::decode::MAX_BLOB as u64 + 1).unwrap(); // sparse
-    let e = format!("{:#}", slf_host::decode::read_blob(&p).unwrap_err());
+    f.set_len(slf_host::decode::cs::MAX_BLOB as u64 + 1).unwrap(); // sparse
+    let e = format!("{:#}", slf_host::decode::cs::read_blob(&p).unwrap_err());
     assert!(e.contains("big.slfd") && e.contains("of the largest dictionary blob"), "{e}");
     #[cfg(unix)]
     {
-        let e = format!("{:#}", slf_host::decode::read_blob(Path::new("/dev/zero")).unwrap_err());
+        let e = format!("{:#}", slf_host::decode::cs::read_blob(Path::new("/dev/zero")).unwrap_err());
         assert!(e.contains("not a regular file"), "{e}");
     }
     // The shipped blob passes, with its name in any error of a damaged copy.
     std::fs::write(&p, slf_host::firmware::DEFAULT_ENSEMBLE).unwrap();
-    assert_eq!(slf_host::decode::read_blob(&p).unwrap(), slf_host::firmware::DEFAULT_ENSEMBLE);
+    assert_eq!(slf_host::decode::cs::read_blob(&p).unwrap(), slf_host::firmware::DEFAULT_ENSEMBLE);
     let mut bad = slf_host::firmware::DEFAULT_ENSEMBLE.to_vec();
     bad[100] ^= 1;
     std::fs::write(&p, bad).unwrap();
-    let e = format!("{:#}", slf_host::decode::read_blob(&p).unwrap_err());
+    let e = format!("{:#}", slf_host::decode::cs::read_blob(&p).unwrap_err());
     assert!(e.contains("big.slfd: dictionary blob checksum mismatch"), "{e}");
 }
 
@@ -378,8 +378,9 @@ fn a_capture_the_decoder_refuses_names_its_description() {
     let dir = tempfile::tempdir().unwrap();
     simulate(&lf, &CameraConfig::pixel(3, 1)).unwrap().save(dir.path()).unwrap();
     let cap = Capture::load(dir.path()).unwrap();
-    let opts = slf_host::decode::DecodeOptions::default();
-    let e = format!("{:#}", slf_host::decode::decode_with(&cap, &slf_host::decode::Basis::Dct, &opts).unwrap_err());
+    let opts = slf_host::decode::cs::DecodeOptions::default();
+    let e =
+        format!("{:#}", slf_host::decode::cs::decode_with(&cap, &slf_host::decode::cs::Basis::Dct, &opts).unwrap_err());
     assert!(e.contains("capture.json") && e.contains("more views than a lenslet"), "{e}");
     assert_eq!(e.lines().count(), 1, "{e}");
 }

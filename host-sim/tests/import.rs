@@ -4,15 +4,15 @@
 use std::path::Path;
 
 use image::{ImageBuffer, Luma, Rgb};
-use slf_host::import::bands::{BandFilter, CAMERA_FILTER, Resampler, parse_wavelengths};
-use slf_host::import::cube::{self, CubeConfig, Depth, Light, d65_at};
-use slf_host::import::parallax::{Disparity, estimate, warp};
-use slf_host::import::pfm::{parse_pfm, pfm_bytes};
-use slf_host::import::rgb::{RgbLift, srgb_to_linear};
-use slf_host::import::rgb_basis_data::MALLETT_2019;
-use slf_host::import::views::{Fill, Naming, ViewsConfig, import_views, view_name};
-use slf_host::import::{Crop, Geometry, Plane};
-use slf_host::spectra_data::BAND_NM;
+use slf_host::io::import::bands::{BandFilter, CAMERA_FILTER, Resampler, parse_wavelengths};
+use slf_host::io::import::cube::{self, CubeConfig, Depth, Light, d65_at};
+use slf_host::io::import::parallax::{Disparity, estimate, warp};
+use slf_host::io::import::pfm::{parse_pfm, pfm_bytes};
+use slf_host::io::import::rgb::{RgbLift, srgb_to_linear};
+use slf_host::io::import::rgb_basis_data::MALLETT_2019;
+use slf_host::io::import::views::{Fill, Naming, ViewsConfig, import_views, view_name};
+use slf_host::io::import::{Crop, Geometry, Plane};
+use slf_host::sim::spectra_data::BAND_NM;
 
 /// The slow obvious reference of band resampling: `∫ f(λ) g(λ - c) dλ / ∫ g(λ - c) dλ`
 /// over `c ± 50 nm` (2 FWHM), g the camera's Gaussian, in f64 with 0.001 nm steps.
@@ -392,7 +392,7 @@ fn write_h5(path: &Path, shape: &[u64], f: impl Fn(usize) -> f32) {
 
 #[test]
 fn hdf5_light_fields_are_read_in_any_axis_order() {
-    use slf_host::import::hdf5::{Hdf5Layout, read_hdf5};
+    use slf_host::io::import::hdf5::{Hdf5Layout, read_hdf5};
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("lf.h5");
     // Stored as (H, W, U, V, B) = (3, 4, 2, 5, 13); value = 1000 h + 100 w + 10 u + v + b / 100.

@@ -3,8 +3,8 @@
 
 use std::path::Path;
 
-use slf_host::lightfield::read_npy;
-use slf_host::metrics::evaluate;
+use slf_host::eval::metrics::evaluate;
+use slf_host::io::lightfield::read_npy;
 
 fn expected() -> serde_json::Value {
     let text =

@@ -2,11 +2,11 @@
 //! noise ball comes from the capture's description unless told otherwise, a capture
 //! without one decodes exactly, and every decoded value lies in `[0, top]`.
 
-use slf_host::camera::{CameraConfig, simulate};
-use slf_host::capture::Capture;
-use slf_host::decode::{Basis, DecodeOptions, NoiseSource, decode_with};
+use slf_host::decode::cs::{Basis, DecodeOptions, NoiseSource, decode_with};
 use slf_host::firmware::Sl0Config;
-use slf_host::lightfield::LightField;
+use slf_host::io::capture::Capture;
+use slf_host::io::lightfield::LightField;
+use slf_host::sim::camera::{CameraConfig, simulate};
 
 mod common;
 

@@ -1,13 +1,13 @@
 //! Overlapping patches against the slow obvious reference: every patch decoded on its own
 //! (a one-patch tile each), then averaged with the window's weights in f64.
 
-use slf_host::camera::{CameraConfig, simulate};
-use slf_host::decode::{Basis, DecodeOptions, Window, decode_with, tile_decoder};
+use slf_host::decode::cs::{Basis, DecodeOptions, Window, decode_with, tile_decoder};
 use slf_host::firmware::{
     Dictionary, DisparityRange, FrameSource, Overlap, OverlapDecoder, PaperShape, PaperWorkspace, PatchOrigin,
     PatchReport, PatchSink, SolveError, Tile,
 };
-use slf_host::lightfield::LightField;
+use slf_host::io::lightfield::LightField;
+use slf_host::sim::camera::{CameraConfig, simulate};
 
 mod common;
 use common::Rows;
@@ -212,7 +212,7 @@ fn with_overlap_the_grid_is_gone_on_a_smooth_ramp() {
 /// the inside steps, worked by hand on a light field with a known seam.
 #[test]
 fn adaptive_overlap_decodes_shifted_patches_only_at_seams() {
-    use slf_host::decode::Seams;
+    use slf_host::decode::cs::Seams;
     let truth = common::small_smooth(5);
     let capture = simulate(&truth, &CameraConfig::pixel(4, 1)).unwrap();
     let opts = |stride: u8, adaptive| DecodeOptions { stride: (stride, stride), adaptive, ..DecodeOptions::default() };

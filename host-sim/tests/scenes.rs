@@ -1,8 +1,8 @@
 //! Scenes and spectra: deterministic, correct parallax and occlusion, spectra as published.
 
-use slf_host::preview::{linear_srgb, xyz};
-use slf_host::scene::{self, Layer, Scene, SceneSize, Shape, Texture};
-use slf_host::spectra::{BAND_NM, CMF_1931, COLORCHECKER, D65, colorchecker, narrow_band, under_d65};
+use slf_host::eval::preview::{linear_srgb, xyz};
+use slf_host::sim::scene::{self, Layer, Scene, SceneSize, Shape, Texture};
+use slf_host::sim::spectra::{BAND_NM, CMF_1931, COLORCHECKER, D65, colorchecker, narrow_band, under_d65};
 
 const SIZE: SceneSize = SceneSize { views: (5, 5), rows: 40, cols: 40 };
 
@@ -95,7 +95,7 @@ fn white_under_d65_is_white_in_srgb() {
 
 #[test]
 fn measured_sets_and_illuminants_are_as_published() {
-    use slf_host::spectra::{ILLUMINANTS, MEASURED, illuminant};
+    use slf_host::sim::spectra::{ILLUMINANTS, MEASURED, illuminant};
     // Four colour checkers (24, 24, 24, 30), CIE TCS (14 + 15), NIST CQS (15), RAW to ACES (190).
     assert_eq!(MEASURED.len(), 24 * 3 + 30 + 14 + 15 + 15 + 190);
     let sets: std::collections::BTreeSet<&str> = MEASURED.iter().map(|m| m.0).collect();
@@ -123,7 +123,7 @@ fn measured_sets_and_illuminants_are_as_published() {
 
 #[test]
 fn realistic_scenes_are_deterministic_distinct_and_in_range() {
-    use slf_host::realistic::{NAMES, lookup, realistic};
+    use slf_host::sim::realistic::{NAMES, lookup, realistic};
     for name in NAMES {
         let a = lookup(name).unwrap().render(SIZE);
         assert_eq!(a, lookup(name).unwrap().render(SIZE), "{name}");
@@ -177,7 +177,7 @@ fn a_slanted_plane_has_continuous_disparity() {
 
 #[test]
 fn a_highlight_moves_across_views_unlike_its_surface() {
-    use slf_host::scene::Highlight;
+    use slf_host::sim::scene::Highlight;
     let grey = colorchecker("neutral 5 (.70 D)").unwrap();
     let card = Layer {
         highlight: Some(Highlight { cy: 0.5, cx: 0.5, radius: 0.05, strength: 0.5, shift: 1.5 }),

@@ -2,8 +2,8 @@
 #![allow(dead_code)] // each test binary uses a part
 
 use slf_host::firmware::RowSink;
-use slf_host::lightfield::LightField;
-use slf_host::scene::{SceneSize, named};
+use slf_host::io::lightfield::LightField;
+use slf_host::sim::scene::{SceneSize, named};
 
 /// An `.npy` file byte by byte: magic, version, the header length field, header, body.
 pub fn npy_bytes(version: u8, header: &str, body: &[u8]) -> Vec<u8> {

@@ -1,0 +1,54 @@
+//! `slf evaluate`: every baseline, the DCT and the ensemble on the given light fields at
+//! pixel k = 1, 3 and lenslet k = 3: PSNR / SSIM / SA and ms per patch, per scene and mean
+//! (`table.md`), and previews of a zoomed crop at pixel k = 1.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use slf_host::decode::cs::read_blob;
+use slf_host::eval::evaluation::{SETTINGS, evaluate_set, table};
+use slf_host::firmware::DEFAULT_ENSEMBLE;
+use slf_host::io::lightfield::read_npy;
+
+use super::import::with_camera_bands;
+use crate::args::{WindowArg, ranged};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Light fields, (U, V, H, W, 13) .npy; each is named by its file stem.
+    #[arg(required = true, num_args = 1..)]
+    pub inputs: Vec<PathBuf>,
+    /// Output folder (table.md and previews).
+    #[arg(short, long, default_value = "slf-evaluate")]
+    pub out: PathBuf,
+    /// Ensemble blob (default: the shipped one).
+    #[arg(long)]
+    pub blob: Option<PathBuf>,
+    /// Also decode with overlapping patches at these strides (1..=4 lenslets), as
+    /// extra rows for the DCT and the ensemble (default: the decoder's default, 3).
+    #[arg(long, value_delimiter = ',', value_parser = ranged::<1, 4>, default_value = "3")]
+    pub stride: Vec<usize>,
+    /// How overlapping patches are averaged in those rows.
+    #[arg(long, value_enum, default_value_t = WindowArg::Tapered)]
+    pub window: WindowArg,
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let Args { inputs, out, blob, stride, window } = args;
+    let blob = match blob {
+        Some(p) => read_blob(&p)?,
+        None => DEFAULT_ENSEMBLE.to_vec(),
+    };
+    let mut scenes = Vec::new();
+    for p in &inputs {
+        let name = p.file_stem().map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+        scenes.push((name, with_camera_bands(read_npy(p)?, None, p)?));
+    }
+    let strides: Vec<(u8, u8)> = stride.iter().map(|&s| (s as u8, s as u8)).collect();
+    let rows = evaluate_set(&scenes, &SETTINGS, &blob, &strides, window.window(), &out)?;
+    let t = table(&rows, &SETTINGS);
+    let path = out.join("table.md");
+    std::fs::write(&path, &t).with_context(|| format!("cannot write {}", path.display()))?;
+    println!("{t}wrote {}", path.display());
+    Ok(())
+}

@@ -1,0 +1,28 @@
+//! `slf sweep`: PSNR / SSIM / SA of every test scene x mask family x k, decoded with
+//! `--dictionary`; a markdown table.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use slf_host::eval::report;
+
+use crate::args::{BasisArgs, ranged};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Spatial size (lenslets per side), 5..=1024.
+    #[arg(long, default_value_t = 60, value_parser = ranged::<5, 1024>)]
+    pub size: usize,
+    /// Snapshot counts.
+    #[arg(long, value_delimiter = ',', default_value = "1,3,5,7")]
+    pub k: Vec<u8>,
+    /// Also write the table to this file.
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    #[command(flatten)]
+    pub basis: BasisArgs,
+}
+
+pub fn run(args: Args) -> Result<()> {
+    report::sweep(args.size, &args.k, args.output.as_deref(), &args.basis.basis()?)
+}

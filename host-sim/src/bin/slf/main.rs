@@ -1,0 +1,116 @@
+//! `slf`: simulate captures of the compressive spectral light-field camera, decode them
+//! with the firmware decoder, and measure the result. `slf --help` lists the commands.
+//!
+//! One file per command in `commands/` (its clap arguments and its `run`); argument groups
+//! and value parsers that several commands share in `args.rs`. This file only dispatches.
+
+mod args;
+mod commands;
+
+use std::process::ExitCode;
+
+use anyhow::Result;
+use clap::{Parser, Subcommand};
+use commands::{
+    baseline, bench, compare, decode, demo, device_capture, device_check, eval, evaluate, import, scene, simulate,
+    sweep, train,
+};
+
+#[derive(Parser)]
+#[command(name = "slf", version, about = "Compressive spectral light-field camera: simulate, decode, measure")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Simulate a default scene with the pixel mask at k = 1 and k = 3, decode, report, preview.
+    Demo(demo::Args),
+    /// Write a named test scene or a random training scene as a (U, V, H, W, B) .npy.
+    Scene(scene::Args),
+    /// Real data in: views, hyperspectral cubes, other light fields, as a (U, V, H, W, 13)
+    /// light field .npy.
+    Import(import::Args),
+    /// Record a light field with the camera model: writes a capture folder.
+    Simulate(simulate::Args),
+    /// Decode a capture folder into a light field .npy.
+    Decode(decode::Args),
+    /// PSNR, SSIM and spectral angle of a reconstruction against the ground truth.
+    Eval(eval::Args),
+    /// The paper's 1D method against the 5D decoder on the same patches: time and memory.
+    Baseline(baseline::Args),
+    /// Learn a dictionary ensemble from light fields (or random training scenes); writes a blob.
+    Train(train::Args),
+    /// PSNR / SSIM / SA of every test scene x mask family x k, decoded with --dictionary
+    /// (default: the shipped ensemble, screened); a markdown table.
+    Sweep(sweep::Args),
+    /// Speed against error: sweep solver settings, bases, masks and k; CSV, markdown, PNG.
+    Bench(bench::Args),
+    /// Every baseline, the DCT and the ensemble on the given light fields at pixel k = 1, 3
+    /// and lenslet k = 3: PSNR / SSIM / SA and ms per patch per scene and mean (table.md),
+    /// and previews of a zoomed crop at pixel k = 1.
+    Evaluate(evaluate::Args),
+    /// Write the capture the device binary decodes (frames as .npy and `capture.rs` constants).
+    DeviceCapture(device_capture::Args),
+    /// Compare the device binary's output (its semihosting log) with the host's decode of
+    /// the same tiles; fails above 1e-5 relative difference.
+    DeviceCheck(device_check::Args),
+    /// Mean PSNR / SSIM / SA over the test scenes for {DCT, ensemble exhaustive, ensemble
+    /// screened} x {pixel, lenslet, kronecker} x k, and time per patch; a markdown table.
+    Compare(compare::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            use clap::error::ErrorKind;
+            if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
+                let _ = e.print();
+                return ExitCode::SUCCESS;
+            }
+            if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
+                eprintln!(
+                    "error: a command is required: demo, scene, simulate, decode, eval, baseline or sweep (see `slf --help`)"
+                );
+                return ExitCode::from(2);
+            }
+            // One readable line: clap's first line (its message), without usage and tips.
+            let text = e.render().to_string();
+            let first = text.lines().next().unwrap_or("error: invalid arguments");
+            eprintln!("{first} (see `slf --help`)");
+            return ExitCode::from(2);
+        }
+    };
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        // The reader of our output went away (`| head`): it has what it wanted.
+        Err(e) if e.downcast_ref::<std::io::Error>().is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe) => {
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Demo(args) => demo::run(args),
+        Command::Scene(args) => scene::run(args),
+        Command::Import(args) => import::run(args),
+        Command::Simulate(args) => simulate::run(args),
+        Command::Decode(args) => decode::run(args),
+        Command::Eval(args) => eval::run(args),
+        Command::Baseline(args) => baseline::run(args),
+        Command::Train(args) => train::run(args),
+        Command::Sweep(args) => sweep::run(args),
+        Command::Bench(args) => bench::run(args),
+        Command::Evaluate(args) => evaluate::run(args),
+        Command::DeviceCapture(args) => device_capture::run(args),
+        Command::DeviceCheck(args) => device_check::run(args),
+        Command::Compare(args) => compare::run(args),
+    }
+}

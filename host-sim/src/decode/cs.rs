@@ -1,0 +1,643 @@
+//! Decoding a capture on the workstation with the firmware's own tile decoder, in parallel
+//! over tiles (rayon), one [`PaperWorkspace`] per worker thread.
+//!
+//! Where a patch has fewer views than a lenslet, the decoder's overlapping angular windows
+//! each give an estimate of the shared views; so do the end-aligned edge tiles for the
+//! lenslets they share with the grid, and (by default) the patch grids shifted by the
+//! stride ([`DEFAULT_STRIDE`], [`Window::Tapered`]). Every estimate is averaged into the
+//! light field with its window's weight. The solver's noise ball comes from the capture's
+//! noise description unless told otherwise ([`NoiseSource`]).
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use anyhow::{Result, anyhow, ensure};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use rayon::prelude::*;
+use slf_firmware::disparity::Disparity;
+use slf_firmware::{
+    Dictionary, DisparityRange, FrameSource, PaperShape, PaperWorkspace, PatchModel, PatchOrigin, PatchReport,
+    PatchSink, Sl0Config, SolveError, Tile, TileDecoder, TileReport,
+};
+
+use crate::io::capture::Capture;
+use crate::io::lightfield::LightField;
+
+/// The decoder's patch: the paper's 5 x 5 lenslets x 4 x 4 views x 13 bands.
+pub type PaperDictionary = Dictionary<5, 5, 4, 4, 13>;
+
+/// Which basis decodes: the 5D DCT, or an ensemble with a member choice.
+#[derive(Clone, Debug)]
+pub enum Basis {
+    Dct,
+    /// A blob (the shipped [`slf_firmware::DEFAULT_ENSEMBLE`] unless told otherwise) and how
+    /// members are chosen.
+    Ensemble {
+        blob: Vec<u8>,
+        choice: slf_firmware::MemberChoice,
+    },
+}
+
+impl Basis {
+    /// The shipped ensemble with screened member choice: the default.
+    pub fn default_ensemble() -> Self {
+        Self::Ensemble {
+            blob: slf_firmware::DEFAULT_ENSEMBLE.to_vec(),
+            choice: slf_firmware::MemberChoice::Screened(slf_firmware::ChoiceRule::DEFAULT),
+        }
+    }
+
+    /// A short name for reports.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Dct => "DCT",
+            Self::Ensemble { choice: slf_firmware::MemberChoice::Screened(_), .. } => "ensemble screened",
+            Self::Ensemble { choice: slf_firmware::MemberChoice::ScreenedResolve(_), .. } => {
+                "ensemble screened, DCT wins re-solved"
+            }
+            Self::Ensemble { choice: slf_firmware::MemberChoice::Exhaustive(_), .. } => "ensemble exhaustive",
+        }
+    }
+}
+
+/// The largest dictionary blob of the decoder's patch: 65,535 members, the format's limit.
+pub const MAX_BLOB: usize = slf_firmware::blob::blob_len([5, 5, 4, 4, 13], u16::MAX as usize);
+
+/// Reads and validates a dictionary blob file; a file larger than [`MAX_BLOB`], a FIFO or a
+/// device is refused before reading.
+///
+/// # Errors
+/// A message with the file and what is wrong.
+pub fn read_blob(path: &std::path::Path) -> Result<Vec<u8>> {
+    crate::io::capture::regular_file(
+        path,
+        MAX_BLOB as u64,
+        "of the largest dictionary blob of the decoder's patch (65,535 members)",
+    )?;
+    let blob = std::fs::read(path).map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
+    slf_firmware::Ensemble::<5, 5, 4, 4, 13>::new(&blob).map_err(|e| anyhow!("{}: {e}", path.display()))?;
+    Ok(blob)
+}
+
+/// Decodes `capture` with `basis` (see [`decode`]).
+///
+/// # Errors
+/// An invalid blob, or what [`decode`] reports.
+pub fn decode_with(capture: &Capture, basis: &Basis, opts: &DecodeOptions) -> Result<(LightField, DecodeReport)> {
+    match basis {
+        Basis::Dct => decode(capture, &Dictionary::dct(), opts),
+        Basis::Ensemble { blob, choice } => {
+            let ensemble = slf_firmware::Ensemble::<5, 5, 4, 4, 13>::new(blob).map_err(|e| anyhow!("{e}"))?;
+            decode(capture, &slf_firmware::EnsembleModel::new(ensemble, *choice), opts)
+        }
+    }
+}
+
+/// Patches the CS decoder decodes in `capture` (every tile's patches in every angular
+/// window): the unit that times per patch are given in, also for methods without patches.
+///
+/// # Errors
+/// A capture the decoder does not take.
+pub fn patch_count(capture: &Capture) -> Result<u64> {
+    let decoder = capture.decoder(Sl0Config::DEFAULT)?;
+    let windows = decoder.windows().count() as u64;
+    Ok(decoder.tiles((2, 2)).map(|t| u64::from(t.lenslet_rows / 5) * u64::from(t.lenslet_cols / 5) * windows).sum())
+}
+
+/// How overlapping patches are averaged where they meet: the firmware's window, so the
+/// host and the device weigh estimates alike.
+pub use slf_firmware::overlap::Window;
+
+/// Where the projection's noise ball comes from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum NoiseSource {
+    /// The capture's noise description ([`Capture::noise_model`]); exact projection if it
+    /// has none.
+    #[default]
+    Capture,
+    /// [`Sl0Config::noise`] and [`Sl0Config::shot`] as given (both 0: exact).
+    Config,
+}
+
+/// The default stride: 3 lenslets, with [`Window::Tapered`]. Chosen on the speed-against-
+/// error plot (`docs/results-real.md`, `docs/bench`): on three real scenes (HCI, 128 x 128)
+/// stride 3 tapered gains 1.2 / 1.4 / 2.1 dB over disjoint patches at pixel k = 1 / 3 and
+/// lenslet k = 3 for 3.8 times the patches, stride 2 another 0.2-0.4 dB for 8.2 times; on a
+/// smooth ramp the error's step across the disjoint grid's borders falls from 1.9 times the
+/// inside step to 1.0 (1.18 with the uniform window), so no grid shows. The seam-driven
+/// adaptive rule ([`DecodeOptions::adaptive`]) lands on the uniform strides' curve, not
+/// above it, so it is off by default.
+pub const DEFAULT_STRIDE: (u8, u8) = (3, 3);
+
+/// The white balance of a decode ([`slf_firmware::gains`]): each band's measurements divided
+/// by a gain before the solve and the decoded patch multiplied back.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum Balance {
+    /// Gains of 1: the plain decode.
+    Off,
+    /// Grey world: each band's mean over the capture's valid samples
+    /// ([`slf_firmware::TileDecoder::estimate_gains`]), as the device does it.
+    #[default]
+    GreyWorld,
+    /// These gains (e.g. from a white reference or a known illuminant).
+    Gains([f32; 13]),
+}
+
+/// How to decode.
+#[derive(Clone, Copy, Debug)]
+pub struct DecodeOptions {
+    pub sl0: Sl0Config,
+    /// Where the noise ball comes from.
+    pub noise: NoiseSource,
+    /// Patches per tile (rows, cols): the unit of parallel work.
+    pub tile_patches: (u16, u16),
+    /// Show a progress bar once the run has taken a second.
+    pub progress: bool,
+    /// Lenslets between patch origins (rows, cols), each in 1..=5. 5 is the grid of
+    /// disjoint patches; smaller strides add patch grids shifted by multiples of the stride,
+    /// (5 / stride)^2 times the patches, averaged by [`Self::window`]. Default
+    /// [`DEFAULT_STRIDE`] with the tapered window.
+    pub stride: (u8, u8),
+    /// How overlapping patches are averaged.
+    pub window: Window,
+    /// Decode a shifted patch only where the disjoint grid's first pass shows a seam there:
+    /// where the steps across the grid's borders inside the patch are more than this many
+    /// times the steps between the other lenslets ([`Seams::score`]); `None` decodes every
+    /// shifted patch.
+    pub adaptive: Option<f32>,
+    /// The white balance.
+    pub balance: Balance,
+    /// The disparities each spatial block may be sheared to ([`slf_firmware::disparity`]);
+    /// `None` (the default): the capture's, [`DisparityRange::for_snapshots`] (-1..=1, in
+    /// half pixels for a single snapshot); [`DisparityRange::OFF`] decodes every patch
+    /// unsheared.
+    pub disparities: Option<DisparityRange>,
+}
+
+impl Default for DecodeOptions {
+    fn default() -> Self {
+        Self {
+            sl0: Sl0Config::DEFAULT,
+            noise: NoiseSource::Capture,
+            tile_patches: (2, 2),
+            progress: false,
+            stride: DEFAULT_STRIDE,
+            window: Window::Tapered,
+            adaptive: None,
+            balance: Balance::default(),
+            disparities: None,
+        }
+    }
+}
+
+impl DecodeOptions {
+    /// Disjoint patches (stride 5, the uniform window), unsheared, otherwise the defaults:
+    /// the grid the firmware's tile decoder walks, one estimate per patch and angular
+    /// window, as the device decodes its tiles.
+    pub fn disjoint() -> Self {
+        Self { stride: (5, 5), window: Window::Uniform, disparities: Some(DisparityRange::OFF), ..Self::default() }
+    }
+
+    /// The disparities a decode of `capture` searches: [`Self::disparities`], or the
+    /// capture's default.
+    pub fn disparities_for(&self, capture: &Capture) -> DisparityRange {
+        let snapshots = u8::try_from(capture.description.frames.len()).unwrap_or(u8::MAX);
+        self.disparities.unwrap_or(DisparityRange::for_snapshots(snapshots))
+    }
+
+    /// The solver's config for `capture`: [`Self::sl0`] with the noise ball from
+    /// [`Self::noise`].
+    pub fn solver_config(&self, capture: &Capture) -> Sl0Config {
+        match (self.noise, capture.noise_model()) {
+            (NoiseSource::Config, _) => self.sl0,
+            (NoiseSource::Capture, Some((noise, shot))) => Sl0Config { noise, shot, ..self.sl0 },
+            (NoiseSource::Capture, None) => Sl0Config { noise: 0.0, shot: 0.0, ..self.sl0 },
+        }
+    }
+}
+
+/// The firmware's tile decoder for `capture` as [`decode`] runs it: the solver config of
+/// [`DecodeOptions::solver_config`] and the band gains of [`DecodeOptions::balance`]
+/// (estimated from the frame for [`Balance::GreyWorld`], as the device does).
+///
+/// # Errors
+/// A capture the decoder cannot take, or gains that are not finite and positive.
+pub fn tile_decoder<'a>(capture: &'a Capture, opts: &DecodeOptions) -> Result<TileDecoder<'a, 5, 5, 4, 4, 13, 5200>> {
+    let decoder = capture.decoder(opts.solver_config(capture))?;
+    let gains = match opts.balance {
+        Balance::Off => [1.0; 13],
+        Balance::GreyWorld => {
+            let raw = capture.raw_frames()?;
+            decoder
+                .estimate_gains(&mut FrameSource::new(&raw))
+                .map_err(|e| anyhow!("{}: cannot read the frame for its white balance: {e:?}", capture.source()))?
+        }
+        Balance::Gains(g) => g,
+    };
+    let decoder = decoder.with_gains(&gains).map_err(|e| anyhow!("gains {gains:?}: {e}"))?;
+    Ok(decoder.with_disparities(opts.disparities_for(capture)))
+}
+
+/// The tiles of the patch grids shifted by `(dy, dx)` lenslets for every multiple of the
+/// stride below 5 other than (0, 0), each of at most `per` patches, whole patches only
+/// (the unshifted grid, with its edge strips, already covers every lenslet).
+pub fn shifted_tiles(lenslets: (usize, usize), stride: (u8, u8), per: (u16, u16)) -> Vec<Tile> {
+    let offsets = |s: u8| (0..5usize).step_by(usize::from(s.clamp(1, 5)));
+    let spans = |total: usize, off: usize, per: usize| -> Vec<(usize, usize)> {
+        let whole = total.saturating_sub(off) / 5;
+        let per = per.max(1);
+        (0..whole.div_ceil(per)).map(|i| (off + i * per * 5, per.min(whole - i * per) * 5)).collect()
+    };
+    let mut tiles = Vec::new();
+    for dy in offsets(stride.0) {
+        for dx in offsets(stride.1) {
+            if (dy, dx) == (0, 0) {
+                continue;
+            }
+            for &(r0, nr) in &spans(lenslets.0, dy, usize::from(per.0)) {
+                for &(c0, nc) in &spans(lenslets.1, dx, usize::from(per.1)) {
+                    tiles.push(Tile {
+                        lenslet_row: r0 as u16,
+                        lenslet_col: c0 as u16,
+                        lenslet_rows: nr as u16,
+                        lenslet_cols: nc as u16,
+                    });
+                }
+            }
+        }
+    }
+    tiles
+}
+
+/// What a decode did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct DecodeReport {
+    pub patches: TileReport,
+    pub tiles: usize,
+    pub failed_tiles: usize,
+    /// SL0 steps over all patches (the last solve of each).
+    pub steps: u64,
+    /// Solves over all patches (more than one per patch with an ensemble).
+    pub solves: u64,
+    /// The ensemble member each decoded patch used, by patch origin (empty for a single
+    /// dictionary).
+    pub member_map: Vec<(PatchOrigin, u16)>,
+    /// Light-field values no decoded patch covered (left at 0).
+    pub uncovered: usize,
+    /// Values of a view no (sheared) patch covered, taken from the lenslet's other views.
+    pub filled: usize,
+    /// The disparity each spatial block was sheared to, by its first patch's origin
+    /// (empty when the decode searched no disparity).
+    pub disparity_map: Vec<(PatchOrigin, Disparity)>,
+    /// Wall time, seconds.
+    pub seconds: f64,
+    /// The band gains the decode used (1 without white balance).
+    pub gains: [f32; 13],
+}
+
+/// Weighted sums of the patch estimates over one tile's lenslets and the halo a sheared
+/// patch reaches beyond them (`halo` lenslets on every side), all views and bands.
+struct TileSums {
+    tile: Tile,
+    views: (usize, usize),
+    window: Window,
+    halo: usize,
+    sum: Vec<f32>,
+    weight: Vec<f32>,
+    steps: u64,
+    solves: u64,
+    members: Vec<(PatchOrigin, u16)>,
+    disparities: Vec<(PatchOrigin, Disparity)>,
+}
+
+impl TileSums {
+    fn new(tile: Tile, views: (usize, usize), window: Window, halo: usize) -> Self {
+        let (rows, cols) = (tile.lenslet_rows as usize + 2 * halo, tile.lenslet_cols as usize + 2 * halo);
+        let n = rows * cols * views.0 * views.1 * 13;
+        let (sum, weight) = (vec![0.0; n], vec![0.0; n]);
+        Self {
+            tile,
+            views,
+            window,
+            halo,
+            sum,
+            weight,
+            steps: 0,
+            solves: 0,
+            members: Vec::new(),
+            disparities: Vec::new(),
+        }
+    }
+
+    /// Lenslet rows and columns of the buffer.
+    fn extent(&self) -> (usize, usize) {
+        (self.tile.lenslet_rows as usize + 2 * self.halo, self.tile.lenslet_cols as usize + 2 * self.halo)
+    }
+
+    /// Index in the buffer's `(s, t, u, v, b)` order, `(s, t)` counted from the halo's corner.
+    fn at(&self, s: usize, t: usize, u: usize, v: usize, b: usize) -> usize {
+        (((s * self.extent().1 + t) * self.views.0 + u) * self.views.1 + v) * 13 + b
+    }
+}
+
+impl PatchSink<5200> for TileSums {
+    type Error = core::convert::Infallible;
+
+    fn accept(&mut self, o: PatchOrigin, patch: &[f32; 5200], report: &PatchReport) -> Result<(), Self::Error> {
+        self.steps += u64::from(report.outcome.iterations);
+        self.solves += u64::from(report.solves);
+        if let Some(m) = report.member {
+            self.members.push((o, m));
+        }
+        if (o.view_row, o.view_col) == (0, 0) && self.halo > 0 && !report.fallback {
+            self.disparities.push((o, o.disparity));
+        }
+        let scale = if report.fallback { slf_firmware::disparity::FALLBACK_WEIGHT } else { 1.0 };
+        // The halo's corner, in sensor lenslets.
+        let (r0, c0) =
+            (self.tile.lenslet_row as isize - self.halo as isize, self.tile.lenslet_col as isize - self.halo as isize);
+        let (rows, cols) = self.extent();
+        for (i, &x) in patch.iter().enumerate() {
+            let [s, t, u, v, b] = PaperShape::coordinates(i);
+            // The pixel the value was read from (sheared patches: shifted per view).
+            let Some((r, c)) = o.lenslet::<5, 5>(s, t, u, v, self.views) else { continue };
+            let (Ok(r), Ok(c)) = (usize::try_from(r - r0), usize::try_from(c - c0)) else { continue };
+            if r >= rows || c >= cols {
+                continue;
+            }
+            let j = self.at(r, c, o.view_row as usize + u, o.view_col as usize + v, b);
+            let w = scale * self.window.weight::<5, 5>(s, t);
+            self.sum[j] += w * x;
+            self.weight[j] += w;
+        }
+        Ok(())
+    }
+
+    fn reject(&mut self, _: PatchOrigin, _: SolveError) -> Result<(), Self::Error> {
+        Ok(())
+    }
+}
+
+/// Decodes every tile of `capture` with `model` (a dictionary or an ensemble); returns the
+/// light field `(U, V, S, T, 13)`.
+///
+/// # Errors
+/// A capture the decoder cannot take (band count, views, mask), with the reason.
+pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
+    capture: &Capture,
+    model: &M,
+    opts: &DecodeOptions,
+) -> Result<(LightField, DecodeReport)> {
+    let start = Instant::now();
+    let d = &capture.description;
+    ensure!(d.bands_nm.len() == 13, "the decoder's patch has 13 bands, the capture {}", d.bands_nm.len());
+    let decoder = tile_decoder(capture, opts)?;
+    let gains = *decoder.gains();
+    let raw = capture.raw_frames()?;
+    ensure!(
+        (1..=5).contains(&opts.stride.0) && (1..=5).contains(&opts.stride.1),
+        "stride {:?}: each axis must be in 1..=5 lenslets",
+        opts.stride
+    );
+    let base: Vec<Tile> = decoder.tiles(opts.tile_patches).collect();
+    ensure!(
+        !base.is_empty(),
+        "the sensor ({} x {} lenslets) is smaller than one 5 x 5 patch",
+        d.lenslets[0],
+        d.lenslets[1]
+    );
+    let lenslets = (d.lenslets[0], d.lenslets[1]);
+    let views = (d.views[0], d.views[1]);
+    let range = decoder.config().raw.range();
+    let halo = decoder.disparities().halo(views.0.max(views.1));
+    let run = |tiles: &[Tile]| -> Vec<(TileSums, Result<TileReport, String>)> {
+        let bar = ProgressBar::with_draw_target(Some(tiles.len() as u64), ProgressDrawTarget::hidden());
+        bar.set_style(
+            ProgressStyle::with_template("decoding {bar:40} {pos}/{len} tiles, {elapsed} elapsed, {eta} left")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        let shown = AtomicBool::new(false);
+        let out = tiles
+            .par_iter()
+            .map_init(
+                || Box::new(PaperWorkspace::new()),
+                |ws, &tile| {
+                    let mut sums = TileSums::new(tile, views, opts.window, halo);
+                    let mut source = FrameSource::new(&raw);
+                    let r = decoder.decode_tile(model, tile, &mut source, &mut sums, ws).map_err(|e| e.to_string());
+                    bar.inc(1);
+                    if opts.progress && start.elapsed().as_secs_f64() > 1.0 && !shown.swap(true, Ordering::Relaxed) {
+                        bar.set_draw_target(ProgressDrawTarget::stderr());
+                    }
+                    (sums, r)
+                },
+            )
+            .collect();
+        bar.finish_and_clear();
+        out
+    };
+    // Every patch in one parallel pass; with the adaptive rule, the disjoint grid first and
+    // then the shifted patches its seams ask for.
+    let mut tiles = base;
+    if opts.adaptive.is_none() {
+        tiles.extend(shifted_tiles(lenslets, opts.stride, opts.tile_patches));
+    }
+    let mut results = run(&tiles);
+    if let Some(threshold) = opts.adaptive {
+        let (first, _) = aggregate(&results, views, lenslets, tiles.len(), range);
+        let seams = Seams::new(&first);
+        let chosen: Vec<Tile> = shifted_tiles(lenslets, opts.stride, (1, 1))
+            .into_iter()
+            .filter(|t| seams.score(t.lenslet_row as usize, t.lenslet_col as usize) > threshold)
+            .collect();
+        results.extend(run(&chosen));
+        tiles.extend(chosen);
+    }
+    let (lf, mut report) = aggregate(&results, views, lenslets, tiles.len(), range);
+    report.seconds = start.elapsed().as_secs_f64();
+    report.gains = gains;
+    Ok((lf, report))
+}
+
+/// The light field and the report from every tile's sums: each value the weighted mean of
+/// the patch estimates that cover it.
+fn aggregate(
+    results: &[(TileSums, Result<TileReport, String>)],
+    views: (usize, usize),
+    lenslets: (usize, usize),
+    tiles: usize,
+    (lo, hi): (f32, f32),
+) -> (LightField, DecodeReport) {
+    let mut lf = LightField::zeros(views, lenslets.0, lenslets.1, 13);
+    let mut sum = vec![0.0f32; lf.data.len()];
+    let mut weight = vec![0.0f32; lf.data.len()];
+    let mut report = DecodeReport { tiles, ..DecodeReport::default() };
+    for (sums, r) in results {
+        match r {
+            Ok(t) => {
+                report.patches.decoded += t.decoded;
+                report.patches.flagged += t.flagged;
+                report.patches.failed += t.failed;
+            }
+            Err(_) => report.failed_tiles += 1,
+        }
+        report.steps += sums.steps;
+        report.solves += sums.solves;
+        report.member_map.extend_from_slice(&sums.members);
+        report.disparity_map.extend_from_slice(&sums.disparities);
+        let tile = sums.tile;
+        let (rows, cols) = sums.extent();
+        for s in 0..rows {
+            for t in 0..cols {
+                let (Some(r), Some(c)) = (
+                    (tile.lenslet_row as usize + s).checked_sub(sums.halo),
+                    (tile.lenslet_col as usize + t).checked_sub(sums.halo),
+                ) else {
+                    continue;
+                };
+                if r >= lenslets.0 || c >= lenslets.1 {
+                    continue;
+                }
+                for u in 0..views.0 {
+                    for v in 0..views.1 {
+                        let src = sums.at(s, t, u, v, 0);
+                        let dst = lf.index(u, v, r, c, 0);
+                        for b in 0..13 {
+                            sum[dst + b] += sums.sum[src + b];
+                            weight[dst + b] += sums.weight[src + b];
+                        }
+                    }
+                }
+            }
+        }
+    }
+    // Each value the weighted mean of estimates in the sensor's range [lo, hi]: the clamp
+    // takes off only what rounding adds (the firmware's overlap ring does the same).
+    for ((x, &s), &w) in lf.data.iter_mut().zip(&sum).zip(&weight) {
+        if w > 0.0 {
+            *x = (s / w).clamp(lo, hi);
+        }
+    }
+    // A view of a lenslet no (sheared) patch covered takes the mean of the lenslet's
+    // covered views, as the firmware's overlap ring does; a lenslet with none stays 0.
+    for r in 0..lenslets.0 {
+        for c in 0..lenslets.1 {
+            for b in 0..13 {
+                let (mut mean, mut covered) = (0.0f32, 0u32);
+                for u in 0..views.0 {
+                    for v in 0..views.1 {
+                        let i = lf.index(u, v, r, c, b);
+                        if weight[i] > 0.0 {
+                            mean += lf.data[i];
+                            covered += 1;
+                        }
+                    }
+                }
+                for u in 0..views.0 {
+                    for v in 0..views.1 {
+                        let i = lf.index(u, v, r, c, b);
+                        if weight[i] > 0.0 {
+                            continue;
+                        }
+                        if covered > 0 {
+                            lf.data[i] = (mean / covered as f32).clamp(lo, hi);
+                            report.filled += 1;
+                        } else {
+                            report.uncovered += 1;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    (lf, report)
+}
+
+/// The disparity per lenslet (row-major, `rows x cols`) from a decode's
+/// [`DecodeReport::disparity_map`]: the mean of the chosen disparities of the 5 x 5 blocks
+/// that cover the lenslet (overlapping blocks at a stride below 5), NaN where none does.
+pub fn disparity_per_lenslet(blocks: &[(PatchOrigin, Disparity)], rows: usize, cols: usize) -> Vec<f32> {
+    let mut sum = vec![0.0f32; rows * cols];
+    let mut count = vec![0u32; rows * cols];
+    for (o, d) in blocks {
+        for r in o.lenslet_row as usize..(o.lenslet_row as usize + 5).min(rows) {
+            for c in o.lenslet_col as usize..(o.lenslet_col as usize + 5).min(cols) {
+                sum[r * cols + c] += d.as_f32();
+                count[r * cols + c] += 1;
+            }
+        }
+    }
+    sum.iter().zip(&count).map(|(&s, &n)| if n > 0 { s / n as f32 } else { f32::NAN }).collect()
+}
+
+/// Steps between neighbouring lenslets of a decoded light field (mean absolute difference
+/// over views and bands), to find where the disjoint grid's borders show.
+pub struct Seams {
+    /// Step between lenslet rows `y - 1` and `y` at column `x` (`y >= 1`), row-major.
+    down: Vec<f32>,
+    /// Step between lenslet columns `x - 1` and `x` at row `y` (`x >= 1`), row-major.
+    right: Vec<f32>,
+    cols: usize,
+    rows: usize,
+}
+
+impl Seams {
+    /// The steps of `lf`.
+    pub fn new(lf: &LightField) -> Self {
+        let (rows, cols) = (lf.rows, lf.cols);
+        let per = (lf.views.0 * lf.views.1 * lf.bands) as f32;
+        let step = |(y0, x0): (usize, usize), (y1, x1): (usize, usize)| {
+            let mut total = 0.0f32;
+            for u in 0..lf.views.0 {
+                for v in 0..lf.views.1 {
+                    let (a, b) = (lf.spectrum(u, v, y0, x0), lf.spectrum(u, v, y1, x1));
+                    total += a.iter().zip(b).map(|(p, q)| (p - q).abs()).sum::<f32>();
+                }
+            }
+            total / per
+        };
+        let mut down = vec![0.0; rows * cols];
+        let mut right = vec![0.0; rows * cols];
+        for y in 0..rows {
+            for x in 0..cols {
+                if y > 0 {
+                    down[y * cols + x] = step((y - 1, x), (y, x));
+                }
+                if x > 0 {
+                    right[y * cols + x] = step((y, x - 1), (y, x));
+                }
+            }
+        }
+        Self { down, right, cols, rows }
+    }
+
+    /// How much the disjoint grid's borders inside the patch at `(row, col)` stand out: the
+    /// mean step across them over the mean step between the patch's other lenslets (0 for
+    /// a patch that crosses no border).
+    pub fn score(&self, row: usize, col: usize) -> f32 {
+        let (mut seam, mut seams, mut inner, mut inners) = (0.0f32, 0u32, 0.0f32, 0u32);
+        for y in row..(row + 5).min(self.rows) {
+            for x in col..(col + 5).min(self.cols) {
+                let i = y * self.cols + x;
+                // Steps into (y, x) from above and from the left, inside the patch.
+                for (inside, at_border, step) in
+                    [(y > row, y % 5 == 0, self.down[i]), (x > col, x % 5 == 0, self.right[i])]
+                {
+                    if !inside {
+                        continue;
+                    }
+                    if at_border {
+                        (seam, seams) = (seam + step, seams + 1);
+                    } else {
+                        (inner, inners) = (inner + step, inners + 1);
+                    }
+                }
+            }
+        }
+        if seams == 0 {
+            return 0.0;
+        }
+        let inner = if inners > 0 { inner / inners as f32 } else { 0.0 };
+        (seam / seams as f32) / inner.max(1e-6)
+    }
+}

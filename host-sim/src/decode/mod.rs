@@ -1,0 +1,17 @@
+//! Decoding captures: compressed sensing with the firmware's decoder, and the methods it
+//! is measured against.
+//!
+//! - [`cs`]: the firmware's tile decoder over a capture in parallel (rayon), with
+//!   overlapping patches, white balance, the noise model and the depth search;
+//! - [`baselines`]: decode methods without compressed sensing (per-pixel interpolation, a
+//!   neighbourhood demosaic, PPID);
+//! - [`paper_1d`]: the paper's 1D method (explicit Kronecker matrices) and a 5D SL0 in f64,
+//!   the references for the equivalence, speed and memory claims;
+//! - [`device`]: the device binary's capture, and the check of its log against the host.
+//!
+//! May use: [`crate::io`], [`crate::sim`]. Used by the train and eval layers.
+
+pub mod baselines;
+pub mod cs;
+pub mod device;
+pub mod paper_1d;

@@ -1,0 +1,178 @@
+//! `slf evaluate`: every decode method a user could pick, on light fields they bring.
+//!
+//! For each light field (imported with `slf import`, or slf's own), each capture setting
+//! (by default the camera's single shot, pixel mask k = 1; pixel k = 3; lenslet k = 3) and
+//! each method (the three baselines without compressed sensing, the DCT, the shipped or a
+//! given ensemble, screened): PSNR, SSIM, spectral angle and time per patch, per scene and
+//! as the mean over scenes, as a markdown table. Every method decodes the same capture
+//! (same mask, same noise).
+//!
+//! Times are on one thread for every method, per 5 x 5-lenslet patch of the sensor's
+//! disjoint grid: the whole frame's time divided by that grid's patch count, for the
+//! baselines (which have no patches) and for overlapping patches (which decode more), so
+//! the column is a cost per frame and compares. Previews (truth, reconstruction, error) of a zoomed
+//! central crop of each scene at the first setting go to the output folder.
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use slf_firmware::{ChoiceRule, MaskFamily, MemberChoice};
+
+use crate::decode::baselines::Baseline;
+use crate::decode::cs::{Basis, DecodeOptions, Window, decode_with, patch_count};
+use crate::eval::metrics::{Metrics, evaluate};
+use crate::eval::preview::write_comparison;
+use crate::io::capture::MaskDescription;
+use crate::io::lightfield::LightField;
+use crate::sim::camera::{CameraConfig, simulate};
+
+/// A capture setting: mask family and snapshots.
+pub type Setting = (MaskFamily, u8);
+
+/// The default settings: the camera's single shot, three shots, and the lenslet mask.
+pub const SETTINGS: [Setting; 3] = [(MaskFamily::Pixel, 1), (MaskFamily::Pixel, 3), (MaskFamily::Lenslet, 3)];
+
+/// Side of the zoomed crop in the previews, lenslets.
+const CROP: usize = 64;
+
+/// One method's result on one scene and setting.
+#[derive(Clone, Debug)]
+pub struct Row {
+    /// Scene name.
+    pub scene: String,
+    /// The setting.
+    pub setting: Setting,
+    /// Method name.
+    pub method: String,
+    /// Quality.
+    pub metrics: Metrics,
+    /// Milliseconds per patch on one thread.
+    pub ms_per_patch: f64,
+}
+
+/// A method: a baseline, or CS with a basis at a stride and window.
+type Method = (String, Option<Baseline>, Option<(Basis, (u8, u8), Window)>);
+
+/// The methods compared: the baselines, then CS with the DCT and with `blob` screened on
+/// disjoint patches, then both again at each of `strides`.
+fn methods(blob: &[u8], strides: &[(u8, u8)], window: Window) -> Vec<Method> {
+    let mut m: Vec<Method> = Baseline::ALL.iter().map(|b| (b.name().to_string(), Some(*b), None)).collect();
+    let bases =
+        [Basis::Dct, Basis::Ensemble { blob: blob.to_vec(), choice: MemberChoice::Screened(ChoiceRule::DEFAULT) }];
+    for &stride in std::iter::once(&(5, 5)).chain(strides) {
+        for basis in &bases {
+            let name = if stride == (5, 5) {
+                basis.name().to_string()
+            } else {
+                format!("{}, stride {}, {}", basis.name(), stride.0, format!("{window:?}").to_lowercase())
+            };
+            m.push((name, None, Some((basis.clone(), stride, window))));
+        }
+    }
+    m
+}
+
+/// A central `CROP x CROP` window of every view (the whole field if smaller).
+fn central_crop(lf: &LightField) -> LightField {
+    let (r, c) = (lf.rows.min(CROP), lf.cols.min(CROP));
+    lf.window((lf.rows - r) / 2, (lf.cols - c) / 2, r, c)
+}
+
+/// A file-name-safe version of a method's name.
+fn slug(s: &str) -> String {
+    let s: String = s.chars().map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_lowercase() } else { '-' }).collect();
+    s.split('-').filter(|p| !p.is_empty()).collect::<Vec<_>>().join("-")
+}
+
+/// Runs every method on every scene and setting; writes `table.md` and previews to `out`.
+///
+/// # Errors
+/// A failed simulation or decode, or a file that cannot be written.
+pub fn evaluate_set(
+    scenes: &[(String, LightField)],
+    settings: &[Setting],
+    blob: &[u8],
+    strides: &[(u8, u8)],
+    window: Window,
+    out: &Path,
+) -> Result<Vec<Row>> {
+    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+    let one = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
+    let threads = rayon::current_num_threads() as f64;
+    let mut rows = Vec::new();
+    for (si, &(family, k)) in settings.iter().enumerate() {
+        let cam = CameraConfig::pixel(7, k).with_mask(MaskDescription::seeded(family, 7, k));
+        for (name, truth) in scenes {
+            let capture = simulate(truth, &cam).with_context(|| name.clone())?;
+            let patches = patch_count(&capture)? as f64;
+            for (method, baseline, basis) in methods(blob, strides, window) {
+                let (recon, ms) = match (baseline, &basis) {
+                    (Some(b), _) => {
+                        let (recon, r) = one.install(|| b.run(&capture))?;
+                        (recon, 1e3 * r.seconds / patches)
+                    }
+                    (None, Some((basis, stride, window))) => {
+                        let opts = DecodeOptions {
+                            progress: false,
+                            stride: *stride,
+                            window: *window,
+                            ..DecodeOptions::default()
+                        };
+                        let (recon, r) = decode_with(&capture, basis, &opts)?;
+                        anyhow::ensure!(r.failed_tiles == 0 && r.uncovered == 0, "{name}: {method} lost tiles");
+                        (recon, 1e3 * r.seconds * threads / patches)
+                    }
+                    _ => unreachable!("a method is a baseline or a basis"),
+                };
+                let metrics = evaluate(truth, &recon)?;
+                println!(
+                    "{name} {family:?} k={k} {method}: {:.2} dB, SSIM {:.4}, SA {:.2} deg, {:.3} ms/patch",
+                    metrics.psnr, metrics.ssim, metrics.sa, ms
+                );
+                if si == 0 {
+                    let p = out.join(format!("{}_{}.png", slug(name), slug(&method)));
+                    write_comparison(&p, &central_crop(truth), &central_crop(&recon))?;
+                }
+                rows.push(Row { scene: name.clone(), setting: (family, k), method, metrics, ms_per_patch: ms });
+            }
+        }
+    }
+    Ok(rows)
+}
+
+/// The table: per setting, each scene's rows then the mean over scenes of each method.
+pub fn table(rows: &[Row], settings: &[Setting]) -> String {
+    let mut lines = vec![
+        "| scene | mask | k | method | PSNR dB | SSIM | SA deg | ms / patch (1 core) |".to_string(),
+        "| --- | --- | --- | --- | --- | --- | --- | --- |".to_string(),
+    ];
+    for &(family, k) in settings {
+        let here: Vec<&Row> = rows.iter().filter(|r| r.setting == (family, k)).collect();
+        let fam = format!("{family:?}").to_lowercase();
+        for r in &here {
+            lines.push(format!(
+                "| {} | {fam} | {k} | {} | {:.2} | {:.4} | {:.2} | {:.3} |",
+                r.scene, r.method, r.metrics.psnr, r.metrics.ssim, r.metrics.sa, r.ms_per_patch
+            ));
+        }
+        let mut names: Vec<&str> = Vec::new();
+        for r in &here {
+            if !names.contains(&r.method.as_str()) {
+                names.push(&r.method);
+            }
+        }
+        for m in names {
+            let of: Vec<&&Row> = here.iter().filter(|r| r.method == m).collect();
+            let n = of.len() as f64;
+            let mean = |f: &dyn Fn(&Row) -> f64| of.iter().map(|r| f(r)).sum::<f64>() / n;
+            lines.push(format!(
+                "| **mean** | {fam} | {k} | {m} | **{:.2}** | {:.4} | {:.2} | {:.3} |",
+                mean(&|r| r.metrics.psnr),
+                mean(&|r| r.metrics.ssim),
+                mean(&|r| r.metrics.sa),
+                mean(&|r| r.ms_per_patch)
+            ));
+        }
+    }
+    lines.join("\n") + "\n"
+}

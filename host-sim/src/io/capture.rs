@@ -1,0 +1,572 @@
+//! Captures on disk: a folder with one raw frame per snapshot and a `capture.json`.
+//!
+//! The format is documented in `docs/capture-format.md`; another tool can write a capture
+//! that `slf decode` reads. Loading checks everything and says what is wrong and where.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, anyhow, bail, ensure};
+use serde::{Deserialize, Serialize};
+use slf_firmware::{
+    BandTile, DecoderConfig, DefectList, LensletSize, Mask, MaskFamily, Pixel, RawFormat, RawFrame, SensorGeometry,
+    Sl0Config, TileDecoder,
+};
+
+use crate::io::lightfield::{read_npy_u16_2d, write_npy_u16_2d};
+
+/// The largest `capture.json` read (a long defect list fits many times over).
+pub const MAX_DESCRIPTION: u64 = 64 << 20;
+
+use slf_firmware::shape::MAX_BANDS;
+
+/// The description file's name inside a capture folder.
+pub const DESCRIPTION: &str = "capture.json";
+/// The `format` field's value.
+pub const FORMAT: &str = "slf-capture";
+/// The `version` field's value.
+pub const VERSION: u32 = 1;
+
+/// The mask, by family and seed, or (pixel and lenslet) as an explicit periodic tile.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "family", rename_all = "lowercase")]
+pub enum MaskDescription {
+    /// Band per sensor pixel and snapshot.
+    Pixel(MaskSource),
+    /// Band per lenslet and snapshot.
+    Lenslet(MaskSource),
+    /// The paper's: band per block of `block` lenslets and snapshot.
+    Kronecker { snapshots: u8, seed: u64, block: [u8; 2] },
+}
+
+impl MaskDescription {
+    /// A seeded mask of `family` with `snapshots` snapshots; a kronecker mask's block is the
+    /// decoder's patch (5 x 5 lenslets).
+    pub fn seeded(family: MaskFamily, seed: u64, snapshots: u8) -> Self {
+        let src = MaskSource { snapshots: Some(snapshots), seed: Some(seed), tile: None };
+        match family {
+            MaskFamily::Pixel => Self::Pixel(src),
+            MaskFamily::Lenslet => Self::Lenslet(src),
+            MaskFamily::Kronecker => Self::Kronecker { snapshots, seed, block: [5, 5] },
+        }
+    }
+}
+
+/// A seed and snapshot count, or a tile `tile[snapshot][row][col]` of band indices.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaskSource {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub snapshots: Option<u8>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tile: Option<Vec<Vec<Vec<u8>>>>,
+}
+
+/// Sensor noise as simulated: the decoder's noise model by default ([`Capture::noise_model`]).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NoiseDescription {
+    /// Electrons collected at the white level (shot noise).
+    pub full_well_electrons: f32,
+    /// Read noise standard deviation in DN.
+    pub read_noise_dn: f32,
+}
+
+/// `capture.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CaptureDescription {
+    pub format: String,
+    pub version: u32,
+    /// Lenslet rows and columns `[S, T]`.
+    pub lenslets: [usize; 2],
+    /// Pixels (views) under a lenslet `[U, V]`; the frame is `S*U x T*V`.
+    pub views: [usize; 2],
+    /// Band centres in nm, one per filter type.
+    pub bands_nm: Vec<f32>,
+    pub mask: MaskDescription,
+    /// Frame files, one per snapshot, in snapshot order, relative to the folder.
+    pub frames: Vec<String>,
+    /// Sensor bit depth (informational).
+    pub bits: u8,
+    /// Raw value of no light.
+    pub black_level: f32,
+    /// Raw value of a white surface in the brightest band.
+    pub white_level: f32,
+    /// Raw values at or above this are saturated and not used.
+    pub saturation_level: f32,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub noise: Option<NoiseDescription>,
+    /// `[row, col]` of pixels that are not measurements.
+    #[serde(default)]
+    pub defective_pixels: Vec<[u32; 2]>,
+}
+
+/// A loaded capture: description, frames and the checked pieces the decoder needs.
+#[derive(Clone, Debug)]
+pub struct Capture {
+    pub description: CaptureDescription,
+    /// One raw frame per snapshot, row-major.
+    pub frames: Vec<Vec<u16>>,
+    /// Flattened tile bands (`[snapshot][row][col]`) when the mask is a tile.
+    tile_bands: Vec<u8>,
+    /// Defective pixels, sorted.
+    defects: Vec<Pixel>,
+    /// The `capture.json` it was loaded from, if any.
+    source: Option<PathBuf>,
+}
+
+impl Capture {
+    /// Builds a capture from a description and frames, checking them against each other.
+    ///
+    /// # Errors
+    /// A message naming the field that is wrong.
+    pub fn new(description: CaptureDescription, frames: Vec<Vec<u16>>) -> Result<Self> {
+        let d = &description;
+        let (rows, cols) = d.frame_size()?;
+        ensure!(frames.len() == d.frames.len(), "{} frames for {} names", frames.len(), d.frames.len());
+        for (i, f) in frames.iter().enumerate() {
+            ensure!(
+                f.len() == rows * cols,
+                "frame {i} ({}) holds {} pixels, expected {rows} x {cols}",
+                d.frames[i],
+                f.len()
+            );
+        }
+        let tile_bands = match &d.mask {
+            MaskDescription::Pixel(MaskSource { tile: Some(t), .. })
+            | MaskDescription::Lenslet(MaskSource { tile: Some(t), .. }) => {
+                ensure!(!t.is_empty() && !t[0].is_empty() && !t[0][0].is_empty(), "mask.tile is empty");
+                let (r, c) = (t[0].len(), t[0][0].len());
+                ensure!(t.len() <= MAX_BANDS, "mask.tile has {} snapshots, at most {}", t.len(), MAX_BANDS);
+                ensure!(
+                    r <= usize::from(u16::MAX) && c <= usize::from(u16::MAX),
+                    "mask.tile is {r} x {c} cells, at most {} x {}",
+                    u16::MAX,
+                    u16::MAX
+                );
+                ensure!(
+                    t.iter().all(|s| s.len() == r && s.iter().all(|row| row.len() == c)),
+                    "mask.tile: every snapshot must be {r} rows of {c} columns"
+                );
+                t.iter().flatten().flatten().copied().collect()
+            }
+            _ => Vec::new(),
+        };
+        let mut defects = Vec::with_capacity(d.defective_pixels.len());
+        for &[r, c] in &d.defective_pixels {
+            ensure!(
+                (r as usize) < rows && (c as usize) < cols,
+                "defective pixel [{r}, {c}] outside the {rows} x {cols} frame"
+            );
+            defects.push(Pixel { row: r as u16, col: c as u16 });
+        }
+        defects.sort();
+        defects.dedup();
+        let capture = Self { description, frames, tile_bands, defects, source: None };
+        let mask = capture.mask()?;
+        ensure!(
+            mask.snapshots() == capture.frames.len(),
+            "mask has {} snapshots, capture has {} frames",
+            mask.snapshots(),
+            capture.frames.len()
+        );
+        Ok(capture)
+    }
+
+    /// Pixels at or above the saturation level over all frames, defective pixels left out,
+    /// and all pixels.
+    pub fn saturated_pixels(&self) -> (usize, usize) {
+        let sat = self.description.saturation_level;
+        let cols = self.frame_size().1;
+        let mut count = 0;
+        for frame in &self.frames {
+            for (i, &x) in frame.iter().enumerate() {
+                let p = Pixel { row: (i / cols) as u16, col: (i % cols) as u16 };
+                count += usize::from(f32::from(x) >= sat && self.defects.binary_search(&p).is_err());
+            }
+        }
+        (count, self.frames.iter().map(Vec::len).sum())
+    }
+
+    /// Sensor geometry.
+    pub fn sensor(&self) -> SensorGeometry {
+        let d = &self.description;
+        SensorGeometry {
+            lenslets: (d.lenslets[0] as u16, d.lenslets[1] as u16),
+            lenslet: LensletSize { rows: d.views[0] as u8, cols: d.views[1] as u8 },
+        }
+    }
+
+    /// Frame size `(rows, cols)`.
+    pub fn frame_size(&self) -> (usize, usize) {
+        self.sensor().frame_size()
+    }
+
+    /// The mask, built by the firmware's own code.
+    ///
+    /// # Errors
+    /// What the firmware rejects (counts, tile contents), or a missing seed or tile.
+    pub fn mask(&self) -> Result<Mask<'_>> {
+        let d = &self.description;
+        let bands = d.bands_nm.len() as u8;
+        let lenslet = self.sensor().lenslet;
+        let m = match &d.mask {
+            MaskDescription::Kronecker { snapshots, seed, block } => {
+                Mask::kronecker(*seed, *snapshots, bands, lenslet, (block[0], block[1]))
+            }
+            MaskDescription::Pixel(src) | MaskDescription::Lenslet(src) => {
+                let pixel = matches!(d.mask, MaskDescription::Pixel(_));
+                match (&src.tile, src.seed, src.snapshots) {
+                    (Some(t), None, snapshots) => {
+                        let k = t.len() as u8;
+                        if let Some(s) = snapshots {
+                            ensure!(s == k, "mask.snapshots is {s} but mask.tile has {k} snapshots");
+                        }
+                        let tile = BandTile::new(t[0].len() as u16, t[0][0].len() as u16, k, bands, &self.tile_bands)
+                            .map_err(|e| anyhow::anyhow!("mask.tile: {e}"))?;
+                        if pixel {
+                            Mask::pixel_tile(tile, bands, lenslet)
+                        } else {
+                            Mask::lenslet_tile(tile, bands, lenslet)
+                        }
+                    }
+                    (None, Some(seed), Some(k)) => {
+                        if pixel {
+                            Mask::pixel(seed, k, bands, lenslet)
+                        } else {
+                            Mask::lenslet(seed, k, bands, lenslet)
+                        }
+                    }
+                    _ => bail!("mask: give either `seed` and `snapshots`, or `tile`"),
+                }
+            }
+        };
+        m.map_err(|e| anyhow::anyhow!("mask: {e}"))
+    }
+
+    /// How raw values map to measurements.
+    pub fn raw_format(&self) -> RawFormat {
+        let d = &self.description;
+        RawFormat { black: d.black_level, white: d.white_level, max_valid: d.saturation_level - 0.5 }
+    }
+
+    /// The sensor's noise in the decoder's normalised units, `(noise, shot)` as
+    /// [`Sl0Config`] takes them: a measurement `y` has variance `noise^2 + shot * max(y, 0)`.
+    /// Read noise and the quantisation of whole DN (`1/12` DN^2) make the floor; shot noise
+    /// is `1 / electrons at white` (a Poisson count's variance is its mean). `None` when
+    /// the capture does not describe its noise.
+    pub fn noise_model(&self) -> Option<(f32, f32)> {
+        let d = &self.description;
+        let n = d.noise?;
+        let range = f64::from(d.white_level - d.black_level);
+        let floor = (f64::from(n.read_noise_dn).powi(2) + 1.0 / 12.0) / (range * range);
+        Some((floor.sqrt() as f32, (1.0 / f64::from(n.full_well_electrons)) as f32))
+    }
+
+    /// The firmware's tile decoder for this capture (the paper's 5 x 5 x 4 x 4 x 13 patch).
+    ///
+    /// # Errors
+    /// A mask or geometry the decoder does not take, with the reason.
+    pub fn decoder(&self, sl0: Sl0Config) -> Result<TileDecoder<'_, 5, 5, 4, 4, 13, 5200>> {
+        let mask = self.mask().map_err(|e| anyhow!("{}: {e:#}", self.source()))?;
+        let config =
+            DecoderConfig { sensor: self.sensor(), mask, raw: self.raw_format(), defects: self.defects(), sl0 };
+        TileDecoder::new(config).map_err(|e| anyhow!("{}: the decoder does not take this capture: {e}", self.source()))
+    }
+
+    /// The frames as the decoder reads them.
+    ///
+    /// # Errors
+    /// A frame whose size differs from the description's (checked in `new`, so not expected).
+    pub fn raw_frames(&self) -> Result<Vec<RawFrame<'_, u16>>> {
+        let (rows, cols) = self.frame_size();
+        self.frames.iter().map(|f| RawFrame::new(f, rows, cols).map_err(|e| anyhow::anyhow!("{e}"))).collect()
+    }
+
+    /// The defect list for the decoder.
+    pub fn defects(&self) -> DefectList<'_> {
+        // Sorted and deduplicated in `new`, so this cannot fail.
+        DefectList::new(&self.defects).unwrap_or_default()
+    }
+
+    /// Loads a capture folder.
+    ///
+    /// # Errors
+    /// A message with the file and what is wrong in it.
+    pub fn load(dir: &Path) -> Result<Self> {
+        let desc_path = dir.join(DESCRIPTION);
+        let named = |e: anyhow::Error| anyhow!("{}: {e:#}", desc_path.display());
+        let text = read_small_file(&desc_path, MAX_DESCRIPTION)?;
+        let description: CaptureDescription = serde_json::from_str(&text)
+            .map_err(|e| anyhow!("{}: invalid capture description: {e}", desc_path.display()))?;
+        let (rows, cols) = description.frame_size().map_err(named)?;
+        ensure!(
+            (1..=MAX_BANDS).contains(&description.frames.len()),
+            "{}: frames lists {} files, expected 1..={MAX_BANDS} (one per snapshot)",
+            desc_path.display(),
+            description.frames.len()
+        );
+        let mut frames = Vec::with_capacity(description.frames.len());
+        for (i, name) in description.frames.iter().enumerate() {
+            let path = frame_path(dir, name).map_err(|e| anyhow!("{}: frames[{i}]: {e:#}", desc_path.display()))?;
+            let frame = read_frame(&path)?;
+            ensure!(
+                (frame.rows, frame.cols) == (rows, cols),
+                "{}: frame is {} x {}, {} implies {rows} x {cols}",
+                path.display(),
+                frame.rows,
+                frame.cols,
+                DESCRIPTION
+            );
+            ensure!(
+                description.saturation_level <= frame.top as f32,
+                "{}: the file's largest value is {} (its MAXVAL or bit depth), below saturation_level {} in {}: \
+                 saturated pixels would read as measurements",
+                path.display(),
+                frame.top,
+                description.saturation_level,
+                DESCRIPTION
+            );
+            frames.push(frame.data);
+        }
+        let mut capture = Self::new(description, frames).map_err(named)?;
+        capture.source = Some(desc_path);
+        Ok(capture)
+    }
+
+    /// Where the capture was loaded from (its `capture.json`), for messages.
+    pub fn source(&self) -> String {
+        self.source.as_ref().map_or_else(|| "the capture".into(), |p| p.display().to_string())
+    }
+
+    /// Writes the capture folder: `capture.json` and the frames under their names
+    /// (the extension picks the format: `.pgm`, `.png` or `.npy`).
+    ///
+    /// # Errors
+    /// I/O and encoding errors, with the file.
+    pub fn save(&self, dir: &Path) -> Result<()> {
+        fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        let (rows, cols) = self.frame_size();
+        for (name, data) in self.description.frames.iter().zip(&self.frames) {
+            write_frame(&dir.join(name), data, rows, cols)?;
+        }
+        let path = dir.join(DESCRIPTION);
+        let text = serde_json::to_string_pretty(&self.description)?;
+        fs::write(&path, text + "\n").with_context(|| format!("cannot write {}", path.display()))
+    }
+}
+
+/// A raw frame as read from a file.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FrameFile {
+    /// Values as stored (DN), row-major.
+    pub data: Vec<u16>,
+    pub rows: usize,
+    pub cols: usize,
+    /// The largest value the file can hold: a PGM's MAXVAL, 255 or 65535 for PNG and `.npy`.
+    pub top: u32,
+}
+
+/// Reads a 16-bit raw frame: binary PGM (P5), 8- or 16-bit grey PNG, or `.npy` (uint16, 2
+/// axes). Values are DN as stored, whatever a PGM's MAXVAL says (image libraries rescale
+/// a MAXVAL of 4095 to 65535 for display; a decoder must not).
+///
+/// # Errors
+/// A message with the file and what is wrong.
+pub fn read_frame(path: &Path) -> Result<FrameFile> {
+    let len = regular_file(path, u64::MAX, "")?;
+    match extension(path).as_str() {
+        "npy" => {
+            let (data, rows, cols) = read_npy_u16_2d(path)?;
+            Ok(FrameFile { data, rows, cols, top: u32::from(u16::MAX) })
+        }
+        "pgm" => read_pgm(path, len),
+        "png" => {
+            let img = image::open(path).with_context(|| format!("{}: cannot decode image", path.display()))?;
+            let color = img.color();
+            let top = match color {
+                image::ColorType::L8 => 255,
+                image::ColorType::L16 => 65535,
+                _ => bail!("{}: raw frame must be single-channel grey, found {color:?}", path.display()),
+            };
+            let g = img.into_luma16();
+            let (w, h) = g.dimensions();
+            let data = if top == 255 { g.into_raw().iter().map(|&x| x / 257).collect() } else { g.into_raw() };
+            Ok(FrameFile { data, rows: h as usize, cols: w as usize, top })
+        }
+        other => bail!("{}: unknown frame format {other:?} (use .pgm, .png or .npy)", path.display()),
+    }
+}
+
+/// A binary PGM: the header through the image library, the samples as stored.
+fn read_pgm(path: &Path, file_len: u64) -> Result<FrameFile> {
+    use image::codecs::pnm::{PnmDecoder, PnmSubtype, SampleEncoding};
+    let file = fs::File::open(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let decoder = PnmDecoder::new(std::io::BufReader::new(file))
+        .map_err(|e| anyhow!("{}: not a PGM file: {e}", path.display()))?;
+    let (mut reader, header) = decoder.into_inner();
+    ensure!(
+        header.subtype() == PnmSubtype::Graymap(SampleEncoding::Binary),
+        "{}: a raw frame is a binary PGM (P5), this file is {:?}",
+        path.display(),
+        header.subtype()
+    );
+    let (w, h, top) = (header.width(), header.height(), header.maximal_sample());
+    ensure!((1..=65535).contains(&top), "{}: MAXVAL {top} out of 1..=65535", path.display());
+    let bytes_per = if top > 255 { 2u64 } else { 1 };
+    let count = u64::from(w) * u64::from(h);
+    ensure!(
+        count * bytes_per <= file_len,
+        "{}: {w} x {h} pixels need {} bytes, the file has {file_len}",
+        path.display(),
+        count * bytes_per
+    );
+    let mut raw = vec![0u8; (count * bytes_per) as usize];
+    std::io::Read::read_exact(&mut reader, &mut raw)
+        .with_context(|| format!("{}: truncated: {w} x {h} pixels promised", path.display()))?;
+    let data: Vec<u16> = if bytes_per == 2 {
+        raw.chunks_exact(2).map(|c| u16::from_be_bytes([c[0], c[1]])).collect()
+    } else {
+        raw.iter().map(|&x| u16::from(x)).collect()
+    };
+    if let Some(i) = data.iter().position(|&x| u32::from(x) > top) {
+        bail!("{}: pixel ({}, {}) is {}, above MAXVAL {top}", path.display(), i / w as usize, i % w as usize, data[i]);
+    }
+    Ok(FrameFile { data, rows: h as usize, cols: w as usize, top })
+}
+
+/// Writes a 16-bit raw frame; the extension picks PGM, PNG or `.npy`.
+///
+/// # Errors
+/// I/O and encoding errors, with the file.
+pub fn write_frame(path: &Path, data: &[u16], rows: usize, cols: usize) -> Result<()> {
+    match extension(path).as_str() {
+        "npy" => write_npy_u16_2d(path, data, rows, cols).with_context(|| format!("cannot write {}", path.display())),
+        "pgm" => {
+            // P5 with MAXVAL 65535, as docs/capture-format.md says: values as stored.
+            use image::codecs::pnm::{GraymapHeader, PnmEncoder, SampleEncoding};
+            ensure!(data.len() == rows * cols, "frame size does not match its data");
+            let header = GraymapHeader {
+                encoding: SampleEncoding::Binary,
+                height: rows as u32,
+                width: cols as u32,
+                maxwhite: u32::from(u16::MAX),
+            };
+            let file = fs::File::create(path).with_context(|| format!("cannot write {}", path.display()))?;
+            let mut out = std::io::BufWriter::new(file);
+            let bytes: Vec<u8> = data.iter().flat_map(|x| x.to_ne_bytes()).collect();
+            PnmEncoder::new(&mut out)
+                .with_header(header.into())
+                .encode(&bytes[..], cols as u32, rows as u32, image::ExtendedColorType::L16)
+                .with_context(|| format!("cannot write {}", path.display()))?;
+            std::io::Write::flush(&mut out).with_context(|| format!("cannot write {}", path.display()))
+        }
+        "png" => {
+            let img =
+                image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_raw(cols as u32, rows as u32, data.to_vec())
+                    .context("frame size does not match its data")?;
+            img.save(path).with_context(|| format!("cannot write {}", path.display()))
+        }
+        other => bail!("{}: unknown frame format {other:?} (use .pgm, .png or .npy)", path.display()),
+    }
+}
+
+fn extension(path: &Path) -> String {
+    path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
+}
+
+/// Frame file names for `k` snapshots with extension `ext`.
+pub fn frame_names(k: usize, ext: &str) -> Vec<String> {
+    (0..k).map(|j| format!("snapshot_{j}.{ext}")).collect()
+}
+
+/// The folder path's description file.
+pub fn description_path(dir: &Path) -> PathBuf {
+    dir.join(DESCRIPTION)
+}
+
+/// Reads a regular file of at most `max` bytes as text; larger files, FIFOs and devices are
+/// refused before reading.
+///
+/// # Errors
+/// A message with the file and what is wrong.
+pub fn read_small_file(path: &Path, max: u64) -> Result<String> {
+    regular_file(path, max, "this file can need")?;
+    fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))
+}
+
+/// The size of `path`, checked before anything opens it: a regular file (opening a FIFO
+/// blocks until a writer comes, a device may never end) of at most `max` bytes (`why` says
+/// where the limit comes from).
+///
+/// # Errors
+/// A message with the file and what is wrong.
+pub fn regular_file(path: &Path, max: u64, why: &str) -> Result<u64> {
+    let meta = fs::metadata(path).with_context(|| format!("cannot read {}", path.display()))?;
+    ensure!(meta.is_file(), "{}: not a regular file (a FIFO, device or folder is not read)", path.display());
+    ensure!(meta.len() <= max, "{}: {} bytes, more than the {max} {why}", path.display(), meta.len());
+    Ok(meta.len())
+}
+
+/// A frame's path: `name` must be a relative path inside the capture folder.
+///
+/// # Errors
+/// An absolute path, `..`, or an empty name.
+pub fn frame_path(dir: &Path, name: &str) -> Result<PathBuf> {
+    use std::path::Component;
+    let rel = Path::new(name);
+    ensure!(!name.is_empty(), "an empty file name");
+    ensure!(
+        rel.components().all(|c| matches!(c, Component::Normal(_) | Component::CurDir)),
+        "{name:?} is not a path inside the capture folder (no absolute paths, no '..')"
+    );
+    Ok(dir.join(rel))
+}
+
+impl CaptureDescription {
+    /// Checks the geometry, format and levels, and returns the frame size `(rows, cols)`.
+    ///
+    /// # Errors
+    /// A message naming the field that is wrong and its range.
+    pub fn frame_size(&self) -> Result<(usize, usize)> {
+        ensure!(self.format == FORMAT, "format is {:?}, expected {FORMAT:?}", self.format);
+        ensure!(self.version == VERSION, "version {} is not supported (this slf reads {VERSION})", self.version);
+        ensure!(
+            self.lenslets.iter().all(|&x| (1..=usize::from(u16::MAX)).contains(&x)),
+            "lenslets {:?} out of range 1..={}",
+            self.lenslets,
+            u16::MAX
+        );
+        ensure!(self.views.iter().all(|&x| (1..=255).contains(&x)), "views {:?} out of range 1..=255", self.views);
+        let rows = self.lenslets[0].checked_mul(self.views[0]);
+        let cols = self.lenslets[1].checked_mul(self.views[1]);
+        let (Some(rows), Some(cols)) = (rows, cols) else {
+            bail!("lenslets {:?} x views {:?} overflows", self.lenslets, self.views);
+        };
+        ensure!(
+            rows <= usize::from(u16::MAX) && cols <= usize::from(u16::MAX),
+            "lenslets {:?} x views {:?} is a {rows} x {cols} frame, at most {} x {}",
+            self.lenslets,
+            self.views,
+            u16::MAX,
+            u16::MAX
+        );
+        ensure!(
+            (1..=32).contains(&self.bands_nm.len()),
+            "bands_nm has {} entries, expected 1..=32",
+            self.bands_nm.len()
+        );
+        ensure!(
+            self.black_level.is_finite()
+                && self.white_level.is_finite()
+                && self.saturation_level.is_finite()
+                && self.white_level > self.black_level
+                && self.saturation_level > self.black_level,
+            "levels: need finite black_level < white_level and black_level < saturation_level"
+        );
+        Ok((rows, cols))
+    }
+}

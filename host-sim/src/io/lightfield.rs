@@ -1,0 +1,239 @@
+//! Spectral light fields in memory and in `.npy` files.
+//!
+//! Axes are `(U, V, H, W, B)`: view row, view column, spatial row, spatial column, band,
+//! row-major with the band fastest, the layout of the public multispectral light-field
+//! dataset the paper evaluates on (Schambach and Puente Leon, 2020). Values are f32 in
+//! `[0, 1]` (1 = a white surface in the brightest band); files may also hold uint16
+//! (`0..=65535` maps to `[0, 1]`).
+
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::Path;
+
+use npyz::WriterBuilder;
+
+/// A spectral light field, `(U, V, H, W, B)`, f32.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightField {
+    /// Views: rows `U`, columns `V`.
+    pub views: (usize, usize),
+    /// Spatial rows `H` (lenslet rows of the camera).
+    pub rows: usize,
+    /// Spatial columns `W`.
+    pub cols: usize,
+    /// Bands `B`.
+    pub bands: usize,
+    /// Values, row-major `(U, V, H, W, B)`.
+    pub data: Vec<f32>,
+}
+
+impl LightField {
+    /// A light field of zeros.
+    pub fn zeros(views: (usize, usize), rows: usize, cols: usize, bands: usize) -> Self {
+        let n = views.0 * views.1 * rows * cols * bands;
+        Self { views, rows, cols, bands, data: vec![0.0; n] }
+    }
+
+    /// A light field whose value at `(u, v, y, x, b)` is `f(u, v, y, x, b)`.
+    pub fn from_fn(
+        views: (usize, usize),
+        rows: usize,
+        cols: usize,
+        bands: usize,
+        f: impl Fn(usize, usize, usize, usize, usize) -> f32,
+    ) -> Self {
+        let mut lf = Self::zeros(views, rows, cols, bands);
+        for i in 0..lf.data.len() {
+            let (u, v, y, x, b) = lf.coordinates(i);
+            lf.data[i] = f(u, v, y, x, b);
+        }
+        lf
+    }
+
+    /// The spatial window `rows x cols` from `(row, col)` of every view (inside the field).
+    pub fn window(&self, row: usize, col: usize, rows: usize, cols: usize) -> Self {
+        let mut out = Self::zeros(self.views, rows, cols, self.bands);
+        let n = cols * self.bands;
+        for u in 0..self.views.0 {
+            for v in 0..self.views.1 {
+                for y in 0..rows {
+                    let src = self.index(u, v, row + y, col, 0);
+                    let dst = out.index(u, v, y, 0, 0);
+                    out.data[dst..dst + n].copy_from_slice(&self.data[src..src + n]);
+                }
+            }
+        }
+        out
+    }
+
+    /// The shape as `[U, V, H, W, B]`.
+    pub fn shape(&self) -> [usize; 5] {
+        [self.views.0, self.views.1, self.rows, self.cols, self.bands]
+    }
+
+    /// Index of `(u, v, y, x, b)`.
+    #[inline]
+    pub fn index(&self, u: usize, v: usize, y: usize, x: usize, b: usize) -> usize {
+        (((u * self.views.1 + v) * self.rows + y) * self.cols + x) * self.bands + b
+    }
+
+    /// The `(u, v, y, x, b)` of a data index.
+    pub fn coordinates(&self, i: usize) -> (usize, usize, usize, usize, usize) {
+        let b = i % self.bands;
+        let i = i / self.bands;
+        let x = i % self.cols;
+        let i = i / self.cols;
+        let y = i % self.rows;
+        let i = i / self.rows;
+        (i / self.views.1, i % self.views.1, y, x, b)
+    }
+
+    /// Value at `(u, v, y, x, b)`.
+    #[inline]
+    pub fn get(&self, u: usize, v: usize, y: usize, x: usize, b: usize) -> f32 {
+        self.data[self.index(u, v, y, x, b)]
+    }
+
+    /// The spectrum at `(u, v, y, x)`.
+    pub fn spectrum(&self, u: usize, v: usize, y: usize, x: usize) -> &[f32] {
+        let i = self.index(u, v, y, x, 0);
+        &self.data[i..i + self.bands]
+    }
+
+    /// The largest value.
+    pub fn max(&self) -> f32 {
+        self.data.iter().fold(0.0f32, |m, &x| m.max(x))
+    }
+}
+
+/// How a light field is stored in a file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Dtype {
+    /// float32, values in `[0, 1]`.
+    F32,
+    /// uint16, `[0, 1]` scaled to `0..=65535`.
+    U16,
+}
+
+use crate::io::npy::{self, Values};
+pub use crate::io::npy::{NpyError, NpyErrorKind};
+
+fn io_err(path: &Path) -> impl Fn(std::io::Error) -> NpyError + '_ {
+    move |source| NpyError::new(path, NpyErrorKind::Io(source))
+}
+
+/// Reads a 5-axis `(U, V, H, W, B)` light field from `.npy` (float32, float64 or uint16;
+/// C or Fortran order) and prints to stderr, as `note: FILE: ...`, any conversion made.
+///
+/// # Errors
+/// [`NpyError`] saying what is wrong and where: I/O, header, dtype, rank, an empty axis,
+/// truncation, values that are not finite.
+pub fn read_npy(path: &Path) -> Result<LightField, NpyError> {
+    let (lf, notes) = read_npy_with_notes(path)?;
+    for n in notes {
+        eprintln!("note: {}: {n}", path.display());
+    }
+    Ok(lf)
+}
+
+/// As [`read_npy`], returning the conversion notes instead of printing them.
+///
+/// # Errors
+/// As [`read_npy`].
+pub fn read_npy_with_notes(path: &Path) -> Result<(LightField, Vec<String>), NpyError> {
+    let a = npy::read(path)?;
+    let shape_err = |what: String| NpyError::new(path, NpyErrorKind::Shape(what));
+    let s = &a.shape;
+    if s.len() != 5 {
+        return Err(shape_err(format!("{} axes {s:?}, expected 5 (U, V, H, W, B)", s.len())));
+    }
+    if s.contains(&0) {
+        return Err(shape_err(format!("shape {s:?} has an empty axis")));
+    }
+    let data = a.values.into_f32();
+    let lf = LightField { views: (s[0], s[1]), rows: s[2], cols: s[3], bands: s[4], data };
+    let bad = lf.data.iter().filter(|x| !x.is_finite()).count();
+    if let Some(first) = lf.data.iter().position(|x| !x.is_finite()) {
+        let (u, v, y, x, b) = lf.coordinates(first);
+        return Err(shape_err(format!(
+            "{bad} of {} values are not finite (NaN or infinite), the first at (u, v, y, x, b) = ({u}, {v}, {y}, {x}, {b})",
+            lf.data.len()
+        )));
+    }
+    Ok((lf, a.notes))
+}
+
+/// Writes a light field as a 5-axis `.npy` file of `dtype` (uint16 clamps to `[0, 1]`).
+///
+/// # Errors
+/// I/O errors, with the path.
+pub fn write_npy(path: &Path, lf: &LightField, dtype: Dtype) -> Result<(), NpyError> {
+    let shape: Vec<u64> = lf.shape().iter().map(|&x| x as u64).collect();
+    let file = BufWriter::new(File::create(path).map_err(io_err(path))?);
+    match dtype {
+        Dtype::F32 => {
+            let mut w = npyz::WriteOptions::new()
+                .default_dtype()
+                .shape(&shape)
+                .writer(file)
+                .begin_nd()
+                .map_err(io_err(path))?;
+            w.extend(lf.data.iter().copied()).map_err(io_err(path))?;
+            w.finish().map_err(io_err(path))
+        }
+        Dtype::U16 => {
+            let mut w = npyz::WriteOptions::new()
+                .default_dtype()
+                .shape(&shape)
+                .writer(file)
+                .begin_nd()
+                .map_err(io_err(path))?;
+            w.extend(lf.data.iter().map(|&x| (x.clamp(0.0, 1.0) * 65535.0).round() as u16)).map_err(io_err(path))?;
+            w.finish().map_err(io_err(path))
+        }
+    }
+}
+
+/// Writes a uint16 2D array (a raw frame) as `.npy`.
+///
+/// # Errors
+/// I/O errors.
+pub fn write_npy_u16_2d(path: &Path, data: &[u16], rows: usize, cols: usize) -> std::io::Result<()> {
+    write_npy_2d(path, data, rows, cols)
+}
+
+/// Writes an f32 2D `.npy` array (a disparity map).
+///
+/// # Errors
+/// I/O errors.
+pub fn write_npy_f32_2d(path: &Path, data: &[f32], rows: usize, cols: usize) -> std::io::Result<()> {
+    write_npy_2d(path, data, rows, cols)
+}
+
+fn write_npy_2d<T: npyz::AutoSerialize + Copy>(
+    path: &Path,
+    data: &[T],
+    rows: usize,
+    cols: usize,
+) -> std::io::Result<()> {
+    let file = BufWriter::new(File::create(path)?);
+    let mut w = npyz::WriteOptions::new().default_dtype().shape(&[rows as u64, cols as u64]).writer(file).begin_nd()?;
+    w.extend(data.iter().copied())?;
+    w.finish()
+}
+
+/// Reads a uint16 2D `.npy` array (a raw frame): `(data, rows, cols)`.
+///
+/// # Errors
+/// [`NpyError`]: what is wrong and where.
+pub fn read_npy_u16_2d(path: &Path) -> Result<(Vec<u16>, usize, usize), NpyError> {
+    let a = npy::read(path)?;
+    let shape_err = |what: String| NpyError::new(path, NpyErrorKind::Shape(what));
+    if a.shape.len() != 2 {
+        return Err(shape_err(format!("a raw frame has 2 axes (H, W), this array {:?}", a.shape)));
+    }
+    match a.values {
+        Values::U16(v) => Ok((v, a.shape[0], a.shape[1])),
+        Values::F32(_) => Err(shape_err("a raw frame holds uint16 ('<u2') values, this array floats".into())),
+    }
+}

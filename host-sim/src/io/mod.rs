@@ -1,0 +1,16 @@
+//! Files in and out: `.npy`, light fields, capture folders, and real data imported as the
+//! camera's bands.
+//!
+//! - [`npy`]: `.npy` files of float32, float64 or uint16 in either byte order and either
+//!   memory order, every size checked before anything is allocated;
+//! - [`lightfield`]: the `(U, V, H, W, B)` light field and its `.npy` files;
+//! - [`capture`]: the capture folder (frames and `capture.json`), loaded and saved;
+//! - [`import`]: views, hyperspectral cubes, HDF5 light fields and band resampling.
+//!
+//! May use: nothing of this crate (the firmware crate's checked types). Used by every
+//! layer above.
+
+pub mod capture;
+pub mod import;
+pub mod lightfield;
+pub mod npy;

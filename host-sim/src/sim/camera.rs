@@ -1,0 +1,176 @@
+//! The camera model: a light field to raw frames.
+//!
+//! Pixel `(s*U + u, t*V + v)` lies under lenslet `(s, t)` at view `(u, v)` and, in snapshot
+//! `j`, integrates band `mask.band(j, row, col)` of the light field there (the firmware's own
+//! mask code decides, so simulation and decoding agree by construction). The signal is
+//! `L * full_well` electrons with Poisson shot noise, converted to DN between the black and
+//! white levels, plus Gaussian read noise, rounded and clipped to the sensor's bits (the top
+//! code is saturated). Defective pixels are stuck at 0 or the top code and listed in the
+//! capture description, as a calibrated camera would list them.
+
+use anyhow::{Result, ensure};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, Normal, Poisson};
+
+use crate::io::capture::{
+    Capture, CaptureDescription, FORMAT, MaskDescription, MaskSource, NoiseDescription, VERSION, frame_names,
+};
+use crate::io::lightfield::LightField;
+use crate::sim::spectra::BAND_NM;
+
+/// Everything about the simulated camera besides the light field.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CameraConfig {
+    pub mask: MaskDescription,
+    /// Sensor bits (12 is usual).
+    pub bits: u8,
+    /// Raw value of no light.
+    pub black_level: u16,
+    /// Fraction of the range between black and the top code that a white surface fills
+    /// (headroom for highlights; 0.9 by default).
+    pub white_fraction: f32,
+    /// Electrons at the white level; `None` for no shot noise.
+    pub full_well: Option<f32>,
+    /// Read noise, DN.
+    pub read_noise: f32,
+    /// Fraction of pixels that are defective.
+    pub defect_fraction: f64,
+    /// Seed of the noise and defects.
+    pub seed: u64,
+    /// Frame file extension: `pgm`, `png` or `npy`.
+    pub frame_ext: String,
+}
+
+impl CameraConfig {
+    /// A `pixel` mask camera with `k` snapshots and the default sensor: 12 bits, black 64,
+    /// white at 90 % of the range, 20,000 e- full well, 2 DN read noise, no defects.
+    pub fn pixel(seed: u64, k: u8) -> Self {
+        Self {
+            mask: MaskDescription::Pixel(MaskSource { snapshots: Some(k), seed: Some(seed), tile: None }),
+            bits: 12,
+            black_level: 64,
+            white_fraction: 0.9,
+            full_well: Some(20_000.0),
+            read_noise: 2.0,
+            defect_fraction: 0.0,
+            seed,
+            frame_ext: "pgm".into(),
+        }
+    }
+
+    /// The same sensor with another mask.
+    pub fn with_mask(self, mask: MaskDescription) -> Self {
+        Self { mask, ..self }
+    }
+
+    /// No noise at all (shot or read): for tests that isolate the decoder.
+    pub fn noiseless(self) -> Self {
+        Self { full_well: None, read_noise: 0.0, ..self }
+    }
+
+    /// Snapshots the mask takes.
+    pub fn snapshots(&self) -> usize {
+        match &self.mask {
+            MaskDescription::Kronecker { snapshots, .. } => *snapshots as usize,
+            MaskDescription::Pixel(s) | MaskDescription::Lenslet(s) => {
+                s.tile.as_ref().map(|t| t.len()).or(s.snapshots.map(usize::from)).unwrap_or(0)
+            }
+        }
+    }
+}
+
+/// Records `lf` (views = the lenslet's pixels) with `cam`.
+///
+/// # Errors
+/// A bad mask or sensor description.
+pub fn simulate(lf: &LightField, cam: &CameraConfig) -> Result<Capture> {
+    ensure!(lf.bands == BAND_NM.len(), "light field has {} bands, the camera {}", lf.bands, BAND_NM.len());
+    ensure!(
+        lf.views.0 <= lf.rows && lf.views.1 <= lf.cols,
+        "the light field has more views ({} x {}) than lenslets ({} x {}): slf reads (U, V, H, W, B); \
+         is this array (H, W, U, V, B)? (numpy: np.transpose(a, (2, 3, 0, 1, 4)))",
+        lf.views.0,
+        lf.views.1,
+        lf.rows,
+        lf.cols
+    );
+    ensure!(
+        cam.full_well.is_none_or(|f| f.is_finite() && f > 0.0),
+        "full well {:?} electrons: must be finite and above 0",
+        cam.full_well
+    );
+    ensure!(
+        cam.read_noise.is_finite() && cam.read_noise >= 0.0,
+        "read noise {} DN: must be finite, at or above 0",
+        cam.read_noise
+    );
+    ensure!((0.0..1.0).contains(&cam.defect_fraction), "defect fraction {} out of [0, 1)", cam.defect_fraction);
+    ensure!(
+        cam.white_fraction.is_finite() && cam.white_fraction > 0.0 && cam.white_fraction <= 1.0,
+        "white fraction {} out of (0, 1]",
+        cam.white_fraction
+    );
+    ensure!((1..=16).contains(&cam.bits), "bits {} out of 1..=16", cam.bits);
+    let top = ((1u32 << cam.bits) - 1) as f32;
+    let black = f32::from(cam.black_level);
+    ensure!(black < top, "black level {black} at or above the top code {top}");
+    let white = black + cam.white_fraction * (top - black);
+    let (lu, lv) = lf.views;
+    let (rows, cols) = (lf.rows * lu, lf.cols * lv);
+    let k = cam.snapshots();
+
+    let mut rng = ChaCha8Rng::seed_from_u64(cam.seed);
+    let defects: Vec<[u32; 2]> = (0..rows * cols)
+        .filter(|_| cam.defect_fraction > 0.0 && rng.random_bool(cam.defect_fraction.min(1.0)))
+        .map(|p| [(p / cols) as u32, (p % cols) as u32])
+        .collect();
+    let description = CaptureDescription {
+        format: FORMAT.into(),
+        version: VERSION,
+        lenslets: [lf.rows, lf.cols],
+        views: [lu, lv],
+        bands_nm: BAND_NM.to_vec(),
+        mask: cam.mask.clone(),
+        frames: frame_names(k, &cam.frame_ext),
+        bits: cam.bits,
+        black_level: black,
+        white_level: white,
+        saturation_level: top,
+        noise: cam.full_well.map(|fw| NoiseDescription { full_well_electrons: fw, read_noise_dn: cam.read_noise }),
+        defective_pixels: defects.clone(),
+    };
+    // Build the mask through the capture so the description is checked the same way as a
+    // loaded one.
+    let blank = Capture::new(description.clone(), vec![vec![0; rows * cols]; k])?;
+    let mask = blank.mask()?;
+    let read = Normal::new(0.0f32, cam.read_noise.max(0.0)).map_err(|e| anyhow::anyhow!("read noise: {e}"))?;
+    let mut frames = vec![vec![0u16; rows * cols]; k];
+    for row in 0..rows {
+        for col in 0..cols {
+            let bands = mask.bands_at(row, col);
+            let (s, u, t, v) = (row / lu, row % lu, col / lv, col % lv);
+            for (j, &band) in bands.iter().enumerate() {
+                let l = lf.get(u, v, s, t, band as usize).max(0.0);
+                let signal = match cam.full_well {
+                    Some(fw) if l > 0.0 => {
+                        let e = f64::from(l * fw);
+                        let noisy = Poisson::new(e).map(|p| p.sample(&mut rng) as f32).unwrap_or(l * fw);
+                        noisy / fw
+                    }
+                    _ => l,
+                };
+                let dn =
+                    black + signal * (white - black) + if cam.read_noise > 0.0 { read.sample(&mut rng) } else { 0.0 };
+                frames[j][row * cols + col] = dn.round().clamp(0.0, top) as u16;
+            }
+        }
+    }
+    for &[r, c] in &defects {
+        let stuck = if rng.random_bool(0.5) { 0 } else { top as u16 };
+        for f in &mut frames {
+            f[r as usize * cols + c as usize] = stuck;
+        }
+    }
+    Capture::new(description, frames)
+}

@@ -1,0 +1,17 @@
+//! The simulator: spectral scenes and the camera that records them.
+//!
+//! - [`spectra`] (tables in [`spectra_data`]): measured and synthetic reflectances and
+//!   illuminants at the camera's 13 band centres;
+//! - [`scene`]: the named test scenes and the random training scenes;
+//! - [`realistic`]: scenes that look like the world (slanted and curved surfaces, 1/f
+//!   textures, measured spectra, five illuminants);
+//! - [`camera`]: a light field to raw frames with the firmware's masks, noise, black level,
+//!   quantisation, saturation and defects, as a capture.
+//!
+//! May use: [`crate::io`]. Used by the decode, train and eval layers.
+
+pub mod camera;
+pub mod realistic;
+pub mod scene;
+pub mod spectra;
+pub mod spectra_data;
