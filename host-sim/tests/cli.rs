@@ -435,3 +435,34 @@ fn evaluate_compares_every_method_per_scene_and_on_average() {
     }
     assert!(p("out/a_dct.png").exists() && p("out/b_baseline-ppid-mihoubi-et-al-2017.png").exists());
 }
+
+/// `--preset` names a basis, stride, window, disparities and sigma_min: the preview decodes
+/// the same bits as those flags spelled out, a flag given with a preset overrides the
+/// preset's value, and `best` decodes more patches than the default.
+#[test]
+fn presets_are_their_flags_and_flags_override_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    stdout(slf().args(["scene", "depth", "--size", "20", "-o"]).arg(p("truth.npy")));
+    stdout(slf().arg("simulate").arg(p("truth.npy")).arg("-o").arg(p("cap")).args(["--mask", "pixel"]));
+    let decode = |out: &str, args: &[&str]| {
+        let text = stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p(out)).arg("-q").args(args));
+        let patches = text.lines().find(|l| l.starts_with("decoded ")).unwrap().split(' ').nth(1).unwrap().to_string();
+        (std::fs::read(p(out)).unwrap(), patches.parse::<usize>().unwrap())
+    };
+    let (preview, n_preview) = decode("preview.npy", &["--preset", "preview"]);
+    let spelled =
+        ["--dictionary", "dct", "--stride", "5", "--window", "uniform", "--disparities=-1:1", "--sigma-min", "3e-3"];
+    let (flags, n_flags) = decode("flags.npy", &spelled);
+    assert_eq!(n_preview, n_flags);
+    assert!(preview == flags, "--preset preview is not its flags");
+    // A flag beside the preset wins: the preview at stride 3 decodes more patches, and
+    // is the default's stride with the preview's other choices.
+    let (_, n_stride3) = decode("s3.npy", &["--preset", "preview", "--stride", "3"]);
+    assert!(n_stride3 > n_preview, "{n_stride3} <= {n_preview}");
+    let (default, n_default) = decode("default.npy", &[]);
+    let (named, n_named) = decode("named.npy", &["--preset", "default"]);
+    assert!(default == named && n_default == n_named, "--preset default is not the default");
+    let (_, n_best) = decode("best.npy", &["--preset", "best"]);
+    assert!(n_best > n_default && n_default > n_preview, "{n_best} / {n_default} / {n_preview}");
+}

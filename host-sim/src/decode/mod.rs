@@ -7,7 +7,8 @@
 //!   neighbourhood demosaic, PPID);
 //! - [`paper_1d`]: the paper's 1D method (explicit Kronecker matrices) and a 5D SL0 in f64,
 //!   the references for the equivalence, speed and memory claims;
-//! - [`device`]: the device binary's capture, and the check of its log against the host.
+//! - [`device`]: the device binary's capture, and the check of its log against the host;
+//! - [`preset`]: the named decodes (`preview`, `default`, `best`) on the speed-error curve.
 //!
 //! May use: [`crate::io`], [`crate::sim`]. Used by the train and eval layers.
 
@@ -15,3 +16,4 @@ pub mod baselines;
 pub mod cs;
 pub mod device;
 pub mod paper_1d;
+pub mod preset;

@@ -1,11 +1,12 @@
 //! Values and argument groups that several commands share: ranges for clap, the mask
-//! family, the overlap window, the basis and the white balance.
+//! family, the overlap window, the basis, the preset and the white balance.
 
 use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::ValueEnum;
 use slf_host::decode::cs::{Balance, Basis, read_blob};
+use slf_host::decode::preset::Preset;
 use slf_host::firmware::{ChoiceRule, DEFAULT_ENSEMBLE, MaskFamily, MemberChoice};
 use slf_host::io::capture::MaskDescription;
 
@@ -61,6 +62,29 @@ impl WindowArg {
     }
 }
 
+/// `--preset`: a named point on the speed-against-error curve
+/// ([`slf_host::decode::preset`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum PresetArg {
+    /// Fast, for the camera's screen and batch triage: the DCT on disjoint patches,
+    /// whole-pixel shears only, SL0 to sigma 3e-3.
+    Preview,
+    /// The screened ensemble at stride 3 with the capture's disparities.
+    Default,
+    /// The default at stride 2: slower, measured to gain.
+    Best,
+}
+
+impl PresetArg {
+    pub fn preset(self) -> Preset {
+        match self {
+            PresetArg::Preview => Preset::Preview,
+            PresetArg::Default => Preset::Default,
+            PresetArg::Best => Preset::Best,
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum DictionaryKind {
     /// The 5D DCT.
@@ -83,9 +107,9 @@ pub enum Choice {
 
 #[derive(clap::Args, Clone, Debug)]
 pub struct BasisArgs {
-    /// Basis to decode with.
-    #[arg(long, value_enum, default_value_t = DictionaryKind::Ensemble)]
-    dictionary: DictionaryKind,
+    /// Basis to decode with [default: ensemble; dct with `slf decode --preset preview`].
+    #[arg(long, value_enum)]
+    dictionary: Option<DictionaryKind>,
     /// How an ensemble member is chosen per patch.
     #[arg(long, value_enum, default_value_t = Choice::Screened)]
     choice: Choice,
@@ -96,7 +120,16 @@ pub struct BasisArgs {
 
 impl BasisArgs {
     pub fn basis(&self) -> Result<Basis> {
-        Ok(match self.dictionary {
+        self.basis_for(Preset::Default)
+    }
+
+    /// The basis the flags name, or `preset`'s where --dictionary is not given.
+    pub fn basis_for(&self, preset: Preset) -> Result<Basis> {
+        let preset_kind = match preset.basis() {
+            Basis::Dct => DictionaryKind::Dct,
+            Basis::Ensemble { .. } => DictionaryKind::Ensemble,
+        };
+        Ok(match self.dictionary.unwrap_or(preset_kind) {
             DictionaryKind::Dct => Basis::Dct,
             DictionaryKind::Ensemble => {
                 let blob = match &self.blob {

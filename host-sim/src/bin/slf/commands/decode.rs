@@ -12,7 +12,7 @@ use slf_host::firmware::{DisparityRange, Sl0Config, gains};
 use slf_host::io::capture::Capture;
 use slf_host::io::lightfield::{Dtype, write_npy, write_npy_f32_2d};
 
-use crate::args::{BalanceArg, BasisArgs, WindowArg, ranged};
+use crate::args::{BalanceArg, BasisArgs, PresetArg, WindowArg, ranged};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -24,6 +24,10 @@ pub struct Args {
     /// Decode method: compressed sensing, or a baseline without it.
     #[arg(long, value_enum, default_value_t = Method::Cs)]
     pub method: Method,
+    /// A named decode: its basis, stride, window, disparities and sigma_min; any of those
+    /// flags given as well overrides the preset's value.
+    #[arg(long, value_enum, default_value_t = PresetArg::Default)]
+    pub preset: PresetArg,
     #[command(flatten)]
     pub solver: SolverArgs,
     #[command(flatten)]
@@ -33,12 +37,13 @@ pub struct Args {
     #[arg(long)]
     pub member_map: Option<PathBuf>,
     /// Lenslets between patch origins, 1..=5 (5: disjoint patches, which show their
-    /// grid; smaller strides decode (5 / stride)^2 times the patches and average them).
-    #[arg(long, default_value_t = 3, value_parser = ranged::<1, 5>)]
-    pub stride: usize,
-    /// How overlapping patches are averaged.
-    #[arg(long, value_enum, default_value_t = WindowArg::Tapered)]
-    pub window: WindowArg,
+    /// grid; smaller strides decode (5 / stride)^2 times the patches and average them)
+    /// [default: 3; preview 5, best 2].
+    #[arg(long, value_parser = ranged::<1, 5>)]
+    pub stride: Option<usize>,
+    /// How overlapping patches are averaged [default: tapered; preview uniform].
+    #[arg(long, value_enum)]
+    pub window: Option<WindowArg>,
     /// With a stride below 5: decode a shifted patch only where a first pass on the
     /// disjoint grid shows a seam inside it, steps across the grid's borders more than
     /// this many times those between its other lenslets.
@@ -54,7 +59,7 @@ pub struct Args {
     pub gains: Option<Vec<f32>>,
     /// Disparities (pixels per view step) each 5 x 5-lenslet block may be sheared to
     /// before decoding, MIN:MAX[:STEP] (default -1:1:0.5 for a single snapshot, -1:1 for
-    /// more; 0:0 decodes unsheared; a STEP of 0.5 adds the half-pixel shears, whose
+    /// more and with --preset preview; 0:0 decodes unsheared; a STEP of 0.5 adds the half-pixel shears, whose
     /// measurements interpolate the patch); chosen per block by how well the views'
     /// same-band samples agree.
     #[arg(long, value_parser = disparity_range, value_name = "MIN:MAX[:STEP]", allow_hyphen_values = true)]
@@ -76,6 +81,7 @@ pub fn run(args: Args) -> Result<()> {
         capture,
         output,
         method,
+        preset,
         solver,
         basis,
         member_map,
@@ -118,16 +124,19 @@ pub fn run(args: Args) -> Result<()> {
         );
         return Ok(());
     }
+    let preset = preset.preset();
+    let base = preset.options();
+    let stride = stride.map_or(base.stride, |s| (s as u8, s as u8));
     let opts = DecodeOptions {
-        sl0: solver.config()?,
+        sl0: solver.config(&base.sl0)?,
         noise: solver.noise_source(),
         progress: !quiet,
-        stride: (stride as u8, stride as u8),
-        window: window.window(),
+        stride,
+        window: window.map_or(base.window, WindowArg::window),
         adaptive,
         balance,
-        disparities,
-        ..DecodeOptions::default()
+        disparities: disparities.or(base.disparities),
+        ..base
     };
     anyhow::ensure!(
         disparity_map.is_none() || !opts.disparities_for(&cap).is_off(),
@@ -136,7 +145,7 @@ pub fn run(args: Args) -> Result<()> {
     if let Some(a) = adaptive {
         anyhow::ensure!(a.is_finite() && a >= 0.0, "--adaptive {a}: must be finite, at or above 0");
     }
-    let (lf, r) = decode_with(&cap, &basis.basis()?, &opts)?;
+    let (lf, r) = decode_with(&cap, &basis.basis_for(preset)?, &opts)?;
     let p = &r.patches;
     let all = p.decoded + p.failed;
     anyhow::ensure!(
@@ -244,9 +253,10 @@ pub struct SolverArgs {
     /// SL0 step size mu.
     #[arg(long, default_value_t = Sl0Config::DEFAULT.mu)]
     mu: f32,
-    /// SL0 smallest sigma (normalised units, white = 1).
-    #[arg(long, default_value_t = Sl0Config::DEFAULT.sigma_min)]
-    sigma_min: f32,
+    /// SL0 smallest sigma (normalised units, white = 1) [default: 1e-3; 3e-3 with --preset
+    /// preview].
+    #[arg(long)]
+    sigma_min: Option<f32>,
     /// Hard bound on SL0 steps per patch.
     #[arg(long, default_value_t = Sl0Config::DEFAULT.max_iterations)]
     max_iterations: u32,
@@ -297,12 +307,13 @@ impl SolverArgs {
         }
     }
 
-    fn config(&self) -> Result<Sl0Config> {
+    /// The flags' configuration; `sigma_min` from `base` (the preset's) unless given.
+    fn config(&self, base: &Sl0Config) -> Result<Sl0Config> {
         let c = Sl0Config {
             sigma_f: self.sigma_f,
             steps: self.steps,
             mu: self.mu,
-            sigma_min: self.sigma_min,
+            sigma_min: self.sigma_min.unwrap_or(base.sigma_min),
             max_iterations: self.max_iterations,
             noise: self.noise.unwrap_or(0.0),
             shot: self.shot.unwrap_or(0.0),

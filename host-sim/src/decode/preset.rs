@@ -1,0 +1,66 @@
+//! Presets: named points on the speed-against-error curve, so a user picks a decode by
+//! what it is for instead of by a dozen solver flags.
+//!
+//! - [`Preset::Preview`]: the camera's screen and batch triage. The 5D DCT on the grid of
+//!   disjoint patches, sheared to whole-pixel disparities (-1..=1) per block, SL0 down to
+//!   `sigma_min = 3e-3`: one solve a patch, a quarter of the default's patches, no
+//!   half-pixel shears (their projection costs about 1.5 times a whole one's).
+//! - [`Preset::Default`]: the screened ensemble at stride 3 with the tapered window, the
+//!   capture's disparities (half pixels at one snapshot): what `slf decode` does unless told.
+//! - [`Preset::Best`]: the default at stride 2, where every lenslet is covered by more
+//!   patches: `(5 / 2)^2` instead of `(5 / 3)^2` times the disjoint grid's patches.
+//!
+//! What each costs and gains is measured, not assumed: `slf bench` plots the presets as
+//! named points, and `docs/bench/README.md` gives their table (PSNR, SSIM, SA and time on
+//! the same scenes in one run).
+
+use crate::decode::cs::{Basis, DecodeOptions, Window};
+use slf_firmware::{DisparityRange, Sl0Config};
+
+/// A named decode configuration: a basis and decode options.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Preset {
+    /// Fast: the DCT, disjoint patches, whole-pixel shears.
+    Preview,
+    /// The default decode.
+    Default,
+    /// Slower where it is measured to gain: the default at stride 2.
+    Best,
+}
+
+impl Preset {
+    /// Every preset, fastest first.
+    pub const ALL: [Self; 3] = [Self::Preview, Self::Default, Self::Best];
+
+    /// The preset's lower-case name, as the CLI spells it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Preview => "preview",
+            Self::Default => "default",
+            Self::Best => "best",
+        }
+    }
+
+    /// The decode options (progress off; callers set it).
+    pub fn options(self) -> DecodeOptions {
+        match self {
+            Self::Preview => DecodeOptions {
+                sl0: Sl0Config { sigma_min: 3e-3, ..Sl0Config::DEFAULT },
+                stride: (5, 5),
+                window: Window::Uniform,
+                disparities: Some(DisparityRange::DEFAULT),
+                ..DecodeOptions::default()
+            },
+            Self::Default => DecodeOptions::default(),
+            Self::Best => DecodeOptions { stride: (2, 2), ..DecodeOptions::default() },
+        }
+    }
+
+    /// The basis: the 5D DCT for the preview, the shipped ensemble (screened) otherwise.
+    pub fn basis(self) -> Basis {
+        match self {
+            Self::Preview => Basis::Dct,
+            Self::Default | Self::Best => Basis::default_ensemble(),
+        }
+    }
+}
