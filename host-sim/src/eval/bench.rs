@@ -6,7 +6,12 @@
 //! runs through the same tile pipeline). Every point records PSNR / SSIM / SA (mean over the
 //! scenes) and time per patch on one thread and on all threads. Output: a CSV, a markdown
 //! table with the Pareto front (per mask family: no other point is both faster and better)
-//! marked, and a PNG plot of PSNR against time per patch, one curve per mask family.
+//! marked, and a PNG plot of PSNR against time per patch, one curve per mask family, on
+//! which the presets (`slf decode --preset`) and the baselines are labelled by name.
+//!
+//! Each point also gives a frame figure: the seconds a 512 x 512-pixel-per-view frame
+//! (the paper's scale, 5 x 5 views) takes on one core at that point's time per patch of
+//! the disjoint grid.
 
 use std::path::Path;
 use std::time::Instant;
@@ -22,6 +27,7 @@ use slf_firmware::{
 use crate::decode::baselines::Baseline;
 use crate::decode::cs::{Basis, DecodeOptions, NoiseSource, Window, decode, decode_with, patch_count};
 use crate::decode::paper_1d::{Factors, analyze_5d, solve_5d};
+use crate::decode::preset::Preset;
 use crate::eval::metrics::evaluate;
 use crate::io::capture::MaskDescription;
 use crate::io::lightfield::LightField;
@@ -90,7 +96,26 @@ pub struct Point {
     pub ms_all: f64,
     /// Solves per patch of the disjoint grid.
     pub solves: f64,
+    /// Seconds for a [`FRAME_LENSLETS`]-square frame (5 x 5 views) on one thread, at
+    /// [`Self::ms_one`] per patch of its disjoint grid.
+    pub frame_s: f64,
     pub pareto: bool,
+}
+
+/// Lenslets per side of the frame figure: 512 x 512 pixels per view, the paper's scale.
+pub const FRAME_LENSLETS: u64 = 512;
+
+/// Patches of the disjoint grid of a [`FRAME_LENSLETS`]-square frame with `windows`
+/// angular windows: the decoder's 5 x 5-lenslet blocks that fit, as [`patch_count`] counts
+/// them.
+pub fn frame_patches(windows: u64) -> u64 {
+    (FRAME_LENSLETS / 5).pow(2) * windows
+}
+
+/// The name a point is labelled with on the plot: a preset's or a baseline's; other
+/// points are the sweep around them and stay unlabelled.
+pub fn label(setting: &str) -> Option<&str> {
+    setting.strip_prefix("preset ").or_else(|| Baseline::ALL.iter().map(|b| b.name()).find(|&n| n == setting))
 }
 
 /// Sweep size.
@@ -241,6 +266,9 @@ fn settings(quick: bool) -> Vec<(String, Decoder, DecodeOptions)> {
             unsheared(3, Window::Tapered, Some(1.2)),
         ));
     }
+    // The presets, as `slf decode --preset` runs them (the best only in the full sweep).
+    let presets = Preset::ALL.into_iter().filter(|&p| !quick || p != Preset::Best);
+    decode_points.extend(presets.map(|p| (format!("preset {}", p.name()), Decoder::Basis(p.basis()), p.options())));
     points.splice(decode_points_at..decode_points_at, decode_points);
     points
 }
@@ -303,8 +331,8 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Point>> {
             for (name, dec, opts) in &settings {
                 let family_name = format!("{family:?}").to_lowercase();
                 bar.set_message(format!("{family_name} k={k} {name}"));
-                let (mut p, mut s, mut a, mut t1, mut ta, mut solves, mut patches) =
-                    (0.0, 0.0, 0.0, 0.0, 0.0, 0u64, 0u64);
+                let (mut p, mut s, mut a, mut t1, mut ta, mut solves, mut patches, mut frame) =
+                    (0.0, 0.0, 0.0, 0.0, 0.0, 0u64, 0u64, 0.0);
                 for (truth, capture) in truths.iter().zip(&captures) {
                     let start = Instant::now();
                     let (recon, report) = one.install(|| run_decoder(capture, dec, opts))?;
@@ -317,7 +345,12 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Point>> {
                     solves += report.solves;
                     // Per patch of the disjoint grid: a frame's cost, also for overlapping
                     // patches (which decode more of them) and baselines (which have none).
-                    patches += patch_count(capture)?;
+                    let n = patch_count(capture)?;
+                    patches += n;
+                    // The same capture's angular windows at the frame's size.
+                    let blocks =
+                        (capture.description.lenslets[0] as u64 / 5) * (capture.description.lenslets[1] as u64 / 5);
+                    frame += frame_patches(n / blocks.max(1)) as f64;
                     bar.inc(1);
                 }
                 let n = truths.len() as f64;
@@ -332,6 +365,7 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Point>> {
                     ms_one: 1e3 * t1 / np,
                     ms_all: 1e3 * ta / np,
                     solves: solves as f64 / np,
+                    frame_s: 1e-3 * (1e3 * t1 / np) * frame / n,
                     pareto: false,
                 });
             }
@@ -340,6 +374,13 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Point>> {
     bar.finish_and_clear();
     mark_pareto(&mut points);
     Ok(points)
+}
+
+/// A label as the plot prints it: a baseline without its "baseline: " and its reference
+/// ("PPID", not "baseline: PPID (Mihoubi et al. 2017)"); the colour names the series.
+fn short(label: &str) -> &str {
+    let name = label.strip_prefix("baseline: ").unwrap_or(label);
+    name.split(" (").next().unwrap_or(name)
 }
 
 /// Marks, per mask family and k, the points no other point beats in both time (one
@@ -376,10 +417,11 @@ pub fn write(points: &[Point], dir: &Path) -> Result<()> {
         "ms_per_patch_1_thread",
         "ms_per_patch_all_threads",
         "solves_per_patch",
+        "frame_512_s_1_thread",
         "pareto",
     ])?;
     let mut md = String::from(
-        "| mask | k | setting | PSNR dB | SSIM | SA deg | ms / patch (1 thread) | ms / patch (all) | solves | Pareto |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n",
+        "| mask | k | setting | PSNR dB | SSIM | SA deg | ms / patch (1 thread) | ms / patch (all) | solves | 512 x 512 frame, s (1 thread) | Pareto |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n",
     );
     for p in points {
         csv.write_record([
@@ -392,10 +434,11 @@ pub fn write(points: &[Point], dir: &Path) -> Result<()> {
             format!("{:.4}", p.ms_one),
             format!("{:.4}", p.ms_all),
             format!("{:.2}", p.solves),
+            format!("{:.2}", p.frame_s),
             p.pareto.to_string(),
         ])?;
         md += &format!(
-            "| {} | {} | {} | {:.2} | {:.4} | {:.2} | {:.2} | {:.2} | {:.1} | {} |\n",
+            "| {} | {} | {} | {:.2} | {:.4} | {:.2} | {:.2} | {:.2} | {:.1} | {:.1} | {} |\n",
             p.mask,
             p.k,
             p.setting,
@@ -405,6 +448,7 @@ pub fn write(points: &[Point], dir: &Path) -> Result<()> {
             p.ms_one,
             p.ms_all,
             p.solves,
+            p.frame_s,
             if p.pareto { "yes" } else { "" }
         );
     }
@@ -443,6 +487,17 @@ fn plot(points: &[Point], path: &Path) -> Result<()> {
             .map_err(|e| anyhow::anyhow!("{e}"))?
             .label(format!("{mask} k={k}"))
             .legend(move |(x, y)| Circle::new((x, y), 4, c.filled()));
+        // Presets and baselines by name, beside their dot.
+        let style = ("sans-serif", 14).into_font().color(&c);
+        chart
+            .draw_series(pts.iter().filter_map(|p| {
+                label(&p.setting).map(|name| {
+                    EmptyElement::at((p.ms_one, p.psnr))
+                        + Circle::new((0, 0), 7, c.stroke_width(2))
+                        + Text::new(short(name).to_string(), (8, -20), style.clone())
+                })
+            }))
+            .map_err(|e| anyhow::anyhow!("{e}"))?;
         let mut front: Vec<(f64, f64)> = pts.iter().filter(|p| p.pareto).map(|p| (p.ms_one, p.psnr)).collect();
         front.sort_by(|a, b| a.0.total_cmp(&b.0));
         chart.draw_series(LineSeries::new(front, c.stroke_width(2))).map_err(|e| anyhow::anyhow!("{e}"))?;
@@ -535,15 +590,17 @@ mod tests {
             ms_one: 1.5,
             ms_all: 0.8,
             solves: 2.25,
+            frame_s: 12.5,
             pareto: true,
         };
         let dir = tempfile::tempdir().unwrap();
         write(&[point("DCT default"), point("ensemble screened, tolerance 1e-3, flat 4e-3")], dir.path()).unwrap();
         let mut r = csv::Reader::from_path(dir.path().join("bench.csv")).unwrap();
         let rows: Vec<csv::StringRecord> = r.records().map(|x| x.unwrap()).collect();
-        assert_eq!(r.headers().unwrap().len(), 10);
+        assert_eq!(r.headers().unwrap().len(), 11);
         assert_eq!(rows.len(), 2);
-        assert!(rows.iter().all(|row| row.len() == 10));
+        assert!(rows.iter().all(|row| row.len() == 11));
+        assert_eq!(&rows[0][9], "12.50");
         assert_eq!(&rows[1][2], "ensemble screened, tolerance 1e-3, flat 4e-3");
         assert_eq!(&rows[1][3], "31.5000");
     }
