@@ -9,6 +9,8 @@
 #
 #   bash scripts/results-depth.sh OUT_DIR > tables.md
 #   SLF_MODELS="ensemble ensemble+halves" bash scripts/results-depth.sh OUT_DIR  # some rows
+#   SLF_SETTINGS="pixel:1" SLF_MODELS="demosaic ppid preview default best" \
+#     RAYON_NUM_THREADS=1 bash scripts/results-depth.sh OUT_DIR  # the presets, one thread
 #
 # The real light fields are scripts/real-eval.sh's 128 x 128 crops, in $SLF_REAL (default
 # /tmp/hci/real); their licence allows evaluation only.
@@ -29,7 +31,8 @@ done
 all="demosaic=--method,demosaic ppid=--method,ppid dct=--dictionary,dct,--disparities=0:0
 dct+depth=--dictionary,dct,--disparities=-1:1 dct+halves=--dictionary,dct,--disparities=-1:1:0.5
 ensemble=--disparities=0:0 ensemble+depth=--disparities=-1:1 ensemble+depth2=--disparities=-2:2
-ensemble+halves=--disparities=-1:1:0.5"
+ensemble+halves=--disparities=-1:1:0.5
+preview=--preset,preview default=--preset,default best=--preset,best"
 models=""
 for m in $all; do
   case " ${SLF_MODELS:-${m%%=*}} " in *" ${m%%=*} "*) models="$models $m" ;; esac
@@ -41,7 +44,7 @@ table() {
   for lf in "$@"; do header="$header $(basename "$lf" .npy) |"; rule="$rule --- |"; done
   echo "$header mean PSNR | mean SSIM | mean SA | seconds |"
   echo "$rule --- | --- | --- | --- |"
-  for s in pixel:1 pixel:3 lenslet:3; do
+  for s in ${SLF_SETTINGS:-pixel:1 pixel:3 lenslet:3}; do
     mask=${s%:*}; k=${s#*:}
     for m in $models; do
       name=${m%%=*}; args=${m#*=}; args=${args//,/ }
@@ -58,7 +61,7 @@ table() {
         sp=$(echo "$sp + $p" | bc -l); ss=$(echo "$ss + $q" | bc -l); sa=$(echo "$sa + $a" | bc -l)
         secs=$(echo "$secs + ${t:-0}" | bc -l); n=$((n + 1))
       done
-      printf '%s %.2f | %.4f | %.2f | %.1f |\n' "$row" "$(echo "$sp / $n" | bc -l)" "$(echo "$ss / $n" | bc -l)" \
+      printf '%s %.2f | %.4f | %.2f | %.2f |\n' "$row" "$(echo "$sp / $n" | bc -l)" "$(echo "$ss / $n" | bc -l)" \
         "$(echo "$sa / $n" | bc -l)" "$secs"
     done
   done

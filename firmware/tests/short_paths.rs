@@ -185,3 +185,73 @@ fn the_short_path_only_takes_flat_patches() {
     let mut ws = measured(&vec![3e38f32; 5200], 3);
     assert_eq!(solve(&dct(), &Sl0Config::DEFAULT, &mut ws).unwrap_err(), SolveError::NonFiniteResult);
 }
+
+/// The band-gain fill is exact for a patch of one spectrum at one brightness, keeps every
+/// measurement, and is its definition elsewhere: each unmeasured value is its pixel's gain
+/// times its band's mean, checked against a direct f64 computation on a random patch.
+#[test]
+fn the_band_gain_fill_is_its_definition_and_exact_for_one_spectrum() {
+    use slf_firmware::solver::fill::fill_bands;
+    let spectrum: Vec<f32> = (0..13).map(|b| 0.2 + 0.05 * b as f32).collect();
+    let truth: Vec<f32> = (0..5200).map(|i| 0.7 * spectrum[i % 13]).collect();
+    let ws = measured(&truth, 1);
+    let mut out = [0.0f32; 5200];
+    fill_bands::<13, 5200>(ws.measurements(), &mut out);
+    let worst = out.iter().zip(&truth).map(|(a, b)| (a - b).abs() / b).fold(0.0f32, f32::max);
+    assert!(worst < 1e-5, "one spectrum is filled to {worst} relative");
+
+    // Any patch: against f64 sums of the definition.
+    let noisy: Vec<f32> = (0..5200).map(|i| 0.1 + 0.8 * ((i * 7919 % 1009) as f32 / 1009.0)).collect();
+    let ws = measured(&noisy, 1);
+    let m = ws.measurements();
+    fill_bands::<13, 5200>(m, &mut out);
+    let (mut sum, mut count) = ([0.0f64; 13], [0u32; 13]);
+    for i in 0..5200 {
+        if let Some(y) = m.get(i) {
+            sum[i % 13] += f64::from(y);
+            count[i % 13] += 1;
+        }
+    }
+    assert!(count.iter().all(|&c| c > 0), "a 5 x 5 x 4 x 4 patch at k = 1 sees every band");
+    let mean: Vec<f64> = (0..13).map(|b| sum[b] / f64::from(count[b])).collect();
+    for p in 0..400 {
+        let own: Vec<usize> = (0..13).filter(|&b| m.get(p * 13 + b).is_some()).collect();
+        let gain = if own.is_empty() {
+            1.0
+        } else {
+            own.iter().map(|&b| f64::from(m.get(p * 13 + b).unwrap())).sum::<f64>()
+                / own.iter().map(|&b| mean[b]).sum::<f64>()
+        };
+        for b in 0..13 {
+            let want = m.get(p * 13 + b).map_or(gain * mean[b], f64::from);
+            let got = f64::from(out[p * 13 + b]);
+            assert!((got - want).abs() <= 1e-5 * want.abs().max(1.0), "pixel {p} band {b}: {got} vs {want}");
+        }
+    }
+}
+
+/// A cold solve from the fill (`cold_start` 0.05 and below: the fill's DC is about 13 times
+/// the zero-filled start's) meets the measurements, starts lower and so takes fewer steps
+/// than from the minimum-norm start, and on a smooth patch (which the
+/// fill nearly is) decodes within a small margin of the full schedule's error; `cold_start`
+/// outside (0, 1] is refused by name.
+#[test]
+fn a_cold_solve_from_the_fill_takes_fewer_steps_and_meets_the_measurements() {
+    let truth = smooth_patch::<5, 5, 4, 4, 13, 5200>(3);
+    let mut ws = measured(&truth, 1);
+    let full = solve(&dct(), &Sl0Config::DEFAULT, &mut ws).unwrap();
+    let full_err = rel_err32(ws.patch(), &truth);
+    for cold_start in [0.05f32, 0.03, 0.01] {
+        let cfg = Sl0Config { cold_start, ..Sl0Config::DEFAULT };
+        let out = solve(&dct(), &cfg, &mut ws).unwrap();
+        assert_eq!(out.ended, Ended::SigmaMin);
+        assert!(out.iterations < full.iterations, "{cold_start}: {} vs {} steps", out.iterations, full.iterations);
+        assert!(misfit(&ws) <= 1e-5, "{cold_start}: misfit {}", misfit(&ws));
+        let err = rel_err32(ws.patch(), &truth);
+        assert!(err <= 1.5 * full_err + 1e-3, "{cold_start}: {err} vs {full_err}");
+    }
+    for bad in [0.0f32, -0.5, 1.5, f32::NAN] {
+        let cfg = Sl0Config { cold_start: bad, ..Sl0Config::DEFAULT };
+        assert_eq!(solve(&dct(), &cfg, &mut ws), Err(SolveError::InvalidConfig { field: "cold_start" }));
+    }
+}

@@ -424,19 +424,26 @@ fn evaluate_compares_every_method_per_scene_and_on_average() {
     stdout(slf().args(["scene", "texture", "--size", "15", "-o"]).arg(p("b.npy")));
     stdout(slf().arg("evaluate").arg(p("a.npy")).arg(p("b.npy")).arg("-o").arg(p("out")));
     let table = std::fs::read_to_string(p("out/table.md")).unwrap();
-    // 3 settings x (2 scenes + mean) x 7 methods (3 baselines, DCT and ensemble on disjoint
-    // patches and at the default stride 3, tapered), and a header of 2 lines.
-    assert_eq!(table.lines().count(), 2 + 3 * 3 * 7, "{table}");
+    // 3 settings x (2 scenes + mean) x 8 methods (3 baselines, DCT and ensemble on disjoint
+    // patches, the 3 presets), and a header of 2 lines.
+    assert_eq!(table.lines().count(), 2 + 3 * 3 * 8, "{table}");
     for m in ["per-pixel interpolation", "neighbourhood demosaic", "PPID", "| DCT |", "| ensemble screened |"] {
         assert_eq!(table.matches(m).count(), 9, "{m}: {table}");
     }
-    for m in ["| DCT, stride 3, tapered |", "| ensemble screened, stride 3, tapered |"] {
+    for m in ["| preset preview |", "| preset default |", "| preset best |"] {
         assert_eq!(table.matches(m).count(), 9, "{m}: {table}");
     }
     assert!(p("out/a_dct.png").exists() && p("out/b_baseline-ppid-mihoubi-et-al-2017.png").exists());
+    // Extra strides add the DCT's and the ensemble's rows.
+    stdout(slf().arg("evaluate").arg(p("a.npy")).arg("-o").arg(p("out2")).args(["--stride", "3"]));
+    let table = std::fs::read_to_string(p("out2/table.md")).unwrap();
+    for m in ["| DCT, stride 3, tapered |", "| ensemble screened, stride 3, tapered |"] {
+        assert_eq!(table.matches(m).count(), 6, "{m}: {table}");
+    }
 }
 
-/// `--preset` names a basis, stride, window, disparities and sigma_min: the preview decodes
+/// `--preset` names a basis, stride, window, disparities, edge fallback, sigma_min and
+/// cold start: the preview decodes
 /// the same bits as those flags spelled out, a flag given with a preset overrides the
 /// preset's value, and `best` decodes more patches than the default.
 #[test]
@@ -451,8 +458,21 @@ fn presets_are_their_flags_and_flags_override_them() {
         (std::fs::read(p(out)).unwrap(), patches.parse::<usize>().unwrap())
     };
     let (preview, n_preview) = decode("preview.npy", &["--preset", "preview"]);
-    let spelled =
-        ["--dictionary", "dct", "--stride", "5", "--window", "uniform", "--disparities=-1:1", "--sigma-min", "3e-3"];
+    let spelled = [
+        "--dictionary",
+        "dct",
+        "--stride",
+        "5",
+        "--window",
+        "uniform",
+        "--disparities=-1:1",
+        "--edge-fallback",
+        "false",
+        "--sigma-min",
+        "3e-3",
+        "--cold-start",
+        "0.03",
+    ];
     let (flags, n_flags) = decode("flags.npy", &spelled);
     assert_eq!(n_preview, n_flags);
     assert!(preview == flags, "--preset preview is not its flags");
@@ -460,6 +480,9 @@ fn presets_are_their_flags_and_flags_override_them() {
     // is the default's stride with the preview's other choices.
     let (_, n_stride3) = decode("s3.npy", &["--preset", "preview", "--stride", "3"]);
     assert!(n_stride3 > n_preview, "{n_stride3} <= {n_preview}");
+    // The edge fallback: on, the sheared blocks at the frame's edge add patches.
+    let (_, n_fallback) = decode("fb.npy", &["--preset", "preview", "--edge-fallback", "true"]);
+    assert!(n_fallback > n_preview, "{n_fallback} <= {n_preview}");
     let (default, n_default) = decode("default.npy", &[]);
     let (named, n_named) = decode("named.npy", &["--preset", "default"]);
     assert!(default == named && n_default == n_named, "--preset default is not the default");

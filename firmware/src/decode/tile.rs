@@ -317,6 +317,7 @@ pub struct TileDecoder<
     config: DecoderConfig<'a>,
     gains: [f32; B],
     disparities: DisparityRange,
+    edge_fallback: bool,
 }
 
 /// Origins of the angular windows along one axis: `ceil(views / patch)` windows of
@@ -368,7 +369,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             return Err(ConfigError::RawFormat);
         }
         sl0.validate().map_err(ConfigError::Solver)?;
-        Ok(Self { config, gains: [1.0; B], disparities: DisparityRange::OFF })
+        Ok(Self { config, gains: [1.0; B], disparities: DisparityRange::OFF, edge_fallback: true })
     }
 
     /// The checked config.
@@ -409,6 +410,22 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     /// The candidate disparities the decode searches.
     pub fn disparities(&self) -> DisparityRange {
         self.disparities
+    }
+
+    /// This decoder with or without the edge fallback (on unless turned off): a block
+    /// sheared at the frame's edge is decoded unsheared as well, so the views of its edge
+    /// lenslets that no sheared patch reached get a decode
+    /// ([`PatchReport::fallback`]). Off, those values are left to the sink (the host fills
+    /// them from their lenslet's other views): one patch a window fewer per edge block,
+    /// a fifth of the patches of a 128 x 128-lenslet frame at disparities -1..1, less on a
+    /// larger one.
+    pub fn with_edge_fallback(self, on: bool) -> Self {
+        Self { edge_fallback: on, ..self }
+    }
+
+    /// Whether sheared edge blocks are also decoded unsheared.
+    pub fn edge_fallback(&self) -> bool {
+        self.edge_fallback
     }
 
     /// Grey-world band gains of a frame: every valid sample of the sensor (defects and
@@ -698,7 +715,10 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                 // lenslets to no patch (their points lie outside the other views): an
                 // unsheared decode of the block fills them, weighed so little that it
                 // changes nothing a sheared patch reached.
-                if disparity != Disparity::ZERO && self.near_edge(row as usize, col as usize, disparity) {
+                if self.edge_fallback
+                    && disparity != Disparity::ZERO
+                    && self.near_edge(row as usize, col as usize, disparity)
+                {
                     for (view_row, view_col) in self.windows() {
                         let origin = PatchOrigin {
                             lenslet_row: row,

@@ -10,6 +10,8 @@
 //! - [`fractional`]: the projection of half-pixel sheared patches, whose measurements
 //!   interpolate the patch;
 //! - [`pinv`]: the paper's general pseudo-inverse path for kronecker masks;
+//! - [`fill`]: the band-gain fill, a start for the cold solve that holds the patch's
+//!   brightness and colour;
 //! - [`sl0`]: Algorithm 1, its configuration and how a solve ended;
 //! - [`choice`]: the ensemble's member choice per patch (exhaustive or screened);
 //! - [`interpolate`]: per-pixel spectral interpolation, for a patch that measures too few
@@ -21,6 +23,7 @@ pub mod ascent;
 pub mod ball;
 pub mod choice;
 pub mod error;
+pub mod fill;
 pub mod fractional;
 pub mod interpolate;
 pub mod pinv;

@@ -172,6 +172,10 @@ pub struct DecodeOptions {
     /// half pixels for a single snapshot); [`DisparityRange::OFF`] decodes every patch
     /// unsheared.
     pub disparities: Option<DisparityRange>,
+    /// Whether a block sheared at the frame's edge is decoded unsheared as well
+    /// ([`TileDecoder::with_edge_fallback`]); off, the views no sheared patch reached are
+    /// filled from their lenslet's other views. On by default.
+    pub edge_fallback: bool,
 }
 
 impl Default for DecodeOptions {
@@ -186,6 +190,7 @@ impl Default for DecodeOptions {
             adaptive: None,
             balance: Balance::default(),
             disparities: None,
+            edge_fallback: true,
         }
     }
 }
@@ -235,7 +240,7 @@ pub fn tile_decoder<'a>(capture: &'a Capture, opts: &DecodeOptions) -> Result<Ti
         Balance::Gains(g) => g,
     };
     let decoder = decoder.with_gains(&gains).map_err(|e| anyhow!("gains {gains:?}: {e}"))?;
-    Ok(decoder.with_disparities(opts.disparities_for(capture)))
+    Ok(decoder.with_disparities(opts.disparities_for(capture)).with_edge_fallback(opts.edge_fallback))
 }
 
 /// The tiles of the patch grids shifted by `(dy, dx)` lenslets for every multiple of the

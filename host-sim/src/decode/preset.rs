@@ -2,9 +2,11 @@
 //! what it is for instead of by a dozen solver flags.
 //!
 //! - [`Preset::Preview`]: the camera's screen and batch triage. The 5D DCT on the grid of
-//!   disjoint patches, sheared to whole-pixel disparities (-1..=1) per block, SL0 down to
-//!   `sigma_min = 3e-3`: one solve a patch, a quarter of the default's patches, no
-//!   half-pixel shears (their projection costs about 1.5 times a whole one's).
+//!   disjoint patches, sheared to whole-pixel disparities (-1..=1) per block without the
+//!   edge fallback, SL0 from the band-gain fill ([`slf_firmware::solver::fill`]) at 0.03 of
+//!   its largest coefficient down to `sigma_min = 3e-3`: one solve a patch of about 50
+//!   steps, a quarter of the default's patches, no half-pixel shears (their projection
+//!   costs about 1.5 times a whole one's).
 //! - [`Preset::Default`]: the screened ensemble at stride 3 with the tapered window, the
 //!   capture's disparities (half pixels at one snapshot): what `slf decode` does unless told.
 //! - [`Preset::Best`]: the default at stride 2, where every lenslet is covered by more
@@ -20,7 +22,7 @@ use slf_firmware::{DisparityRange, Sl0Config};
 /// A named decode configuration: a basis and decode options.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Preset {
-    /// Fast: the DCT, disjoint patches, whole-pixel shears.
+    /// Fast: the DCT, disjoint patches, whole-pixel shears, a filled start.
     Preview,
     /// The default decode.
     Default,
@@ -45,10 +47,11 @@ impl Preset {
     pub fn options(self) -> DecodeOptions {
         match self {
             Self::Preview => DecodeOptions {
-                sl0: Sl0Config { sigma_min: 3e-3, ..Sl0Config::DEFAULT },
+                sl0: Sl0Config { sigma_min: 3e-3, cold_start: 0.03, ..Sl0Config::DEFAULT },
                 stride: (5, 5),
                 window: Window::Uniform,
                 disparities: Some(DisparityRange::DEFAULT),
+                edge_fallback: false,
                 ..DecodeOptions::default()
             },
             Self::Default => DecodeOptions::default(),

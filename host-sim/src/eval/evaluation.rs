@@ -2,9 +2,10 @@
 //!
 //! For each light field (imported with `slf import`, or slf's own), each capture setting
 //! (by default the camera's single shot, pixel mask k = 1; pixel k = 3; lenslet k = 3) and
-//! each method (the three baselines without compressed sensing, the DCT, the shipped or a
-//! given ensemble, screened): PSNR, SSIM, spectral angle and time per patch, per scene and
-//! as the mean over scenes, as a markdown table. Every method decodes the same capture
+//! each method (the three baselines without compressed sensing, the DCT and the shipped or
+//! a given ensemble, screened, on disjoint patches, and the presets of `slf decode
+//! --preset`): PSNR, SSIM, spectral angle and time per patch, per scene and as the mean
+//! over scenes, as a markdown table. Every method decodes the same capture
 //! (same mask, same noise).
 //!
 //! Times are on one thread for every method, per 5 x 5-lenslet patch of the sensor's
@@ -20,6 +21,7 @@ use slf_firmware::{ChoiceRule, MaskFamily, MemberChoice};
 
 use crate::decode::baselines::Baseline;
 use crate::decode::cs::{Basis, DecodeOptions, Window, decode_with, patch_count};
+use crate::decode::preset::Preset;
 use crate::eval::metrics::{Metrics, evaluate};
 use crate::eval::preview::write_comparison;
 use crate::io::capture::MaskDescription;
@@ -50,11 +52,12 @@ pub struct Row {
     pub ms_per_patch: f64,
 }
 
-/// A method: a baseline, or CS with a basis at a stride and window.
-type Method = (String, Option<Baseline>, Option<(Basis, (u8, u8), Window)>);
+/// A method: a baseline, or CS with a basis and decode options.
+type Method = (String, Option<Baseline>, Option<(Basis, DecodeOptions)>);
 
 /// The methods compared: the baselines, then CS with the DCT and with `blob` screened on
-/// disjoint patches, then both again at each of `strides`.
+/// disjoint patches, both again at each of `strides`, then the presets (`blob` for the
+/// ensemble's).
 fn methods(blob: &[u8], strides: &[(u8, u8)], window: Window) -> Vec<Method> {
     let mut m: Vec<Method> = Baseline::ALL.iter().map(|b| (b.name().to_string(), Some(*b), None)).collect();
     let bases =
@@ -66,8 +69,16 @@ fn methods(blob: &[u8], strides: &[(u8, u8)], window: Window) -> Vec<Method> {
             } else {
                 format!("{}, stride {}, {}", basis.name(), stride.0, format!("{window:?}").to_lowercase())
             };
-            m.push((name, None, Some((basis.clone(), stride, window))));
+            let opts = DecodeOptions { stride, window, ..DecodeOptions::default() };
+            m.push((name, None, Some((basis.clone(), opts))));
         }
+    }
+    for preset in Preset::ALL {
+        let basis = match preset.basis() {
+            Basis::Dct => Basis::Dct,
+            Basis::Ensemble { choice, .. } => Basis::Ensemble { blob: blob.to_vec(), choice },
+        };
+        m.push((format!("preset {}", preset.name()), None, Some((basis, preset.options()))));
     }
     m
 }
@@ -111,13 +122,8 @@ pub fn evaluate_set(
                         let (recon, r) = one.install(|| b.run(&capture))?;
                         (recon, 1e3 * r.seconds / patches)
                     }
-                    (None, Some((basis, stride, window))) => {
-                        let opts = DecodeOptions {
-                            progress: false,
-                            stride: *stride,
-                            window: *window,
-                            ..DecodeOptions::default()
-                        };
+                    (None, Some((basis, opts))) => {
+                        let opts = DecodeOptions { progress: false, ..*opts };
                         let (recon, r) = decode_with(&capture, basis, &opts)?;
                         anyhow::ensure!(r.failed_tiles == 0 && r.uncovered == 0, "{name}: {method} lost tiles");
                         (recon, 1e3 * r.seconds * threads / patches)

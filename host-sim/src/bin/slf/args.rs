@@ -67,7 +67,8 @@ impl WindowArg {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum PresetArg {
     /// Fast, for the camera's screen and batch triage: the DCT on disjoint patches,
-    /// whole-pixel shears only, SL0 to sigma 3e-3.
+    /// whole-pixel shears without the edge fallback, SL0 from the band-gain fill at 0.03
+    /// of its largest coefficient to sigma 3e-3.
     Preview,
     /// The screened ensemble at stride 3 with the capture's disparities.
     Default,

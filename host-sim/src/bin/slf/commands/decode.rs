@@ -24,7 +24,8 @@ pub struct Args {
     /// Decode method: compressed sensing, or a baseline without it.
     #[arg(long, value_enum, default_value_t = Method::Cs)]
     pub method: Method,
-    /// A named decode: its basis, stride, window, disparities and sigma_min; any of those
+    /// A named decode: its basis, stride, window, disparities, edge fallback, sigma_min and
+    /// cold start; any of those
     /// flags given as well overrides the preset's value.
     #[arg(long, value_enum, default_value_t = PresetArg::Default)]
     pub preset: PresetArg,
@@ -64,6 +65,12 @@ pub struct Args {
     /// same-band samples agree.
     #[arg(long, value_parser = disparity_range, value_name = "MIN:MAX[:STEP]", allow_hyphen_values = true)]
     pub disparities: Option<DisparityRange>,
+    /// Decode a block sheared at the frame's edge unsheared as well, for the views of its
+    /// edge lenslets no sheared patch reached (false: those values come from their
+    /// lenslet's other views, a fifth fewer patches on a 128 x 128-lenslet frame)
+    /// [default: true; false with --preset preview].
+    #[arg(long, value_name = "BOOL")]
+    pub edge_fallback: Option<bool>,
     /// Also write the chosen disparity per lenslet (.npy, lenslet rows x cols, f32: the
     /// mean over the blocks that cover it); not with --disparities 0:0.
     #[arg(long)]
@@ -91,6 +98,7 @@ pub fn run(args: Args) -> Result<()> {
         balance,
         gains,
         disparities,
+        edge_fallback,
         disparity_map,
         dtype,
         quiet,
@@ -136,6 +144,7 @@ pub fn run(args: Args) -> Result<()> {
         adaptive,
         balance,
         disparities: disparities.or(base.disparities),
+        edge_fallback: edge_fallback.unwrap_or(base.edge_fallback),
         ..base
     };
     anyhow::ensure!(
@@ -286,6 +295,12 @@ pub struct SolverArgs {
     /// The warm solve's steps per sigma level.
     #[arg(long, default_value_t = Sl0Config::DEFAULT.warm_steps)]
     warm_steps: u16,
+    /// Where a cold solve starts, in (0, 1]: 1 the minimum-norm solution at its largest
+    /// coefficient; below 1 the band-gain fill (each pixel's gain times each band's mean
+    /// over the patch) at that fraction of its largest coefficient, fewer sigma levels
+    /// [default: 1; 0.03 with --preset preview].
+    #[arg(long)]
+    cold_start: Option<f32>,
     /// Short path: a patch whose measurements of each band agree within this (normalised
     /// units) is decoded as each band's mean, with no solve; 0: exactly flat patches only.
     #[arg(long, default_value_t = Sl0Config::DEFAULT.flat)]
@@ -307,7 +322,8 @@ impl SolverArgs {
         }
     }
 
-    /// The flags' configuration; `sigma_min` from `base` (the preset's) unless given.
+    /// The flags' configuration; `sigma_min` and `cold_start` from `base` (the preset's)
+    /// unless given.
     fn config(&self, base: &Sl0Config) -> Result<Sl0Config> {
         let c = Sl0Config {
             sigma_f: self.sigma_f,
@@ -321,6 +337,7 @@ impl SolverArgs {
             warm_start: self.warm_start,
             warm_sigma_f: self.warm_sigma_f,
             warm_steps: self.warm_steps,
+            cold_start: self.cold_start.unwrap_or(base.cold_start),
             flat: self.flat,
             min_bands: self.min_bands,
         };

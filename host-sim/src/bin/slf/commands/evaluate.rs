@@ -25,8 +25,9 @@ pub struct Args {
     #[arg(long)]
     pub blob: Option<PathBuf>,
     /// Also decode with overlapping patches at these strides (1..=4 lenslets), as
-    /// extra rows for the DCT and the ensemble (default: the decoder's default, 3).
-    #[arg(long, value_delimiter = ',', value_parser = ranged::<1, 4>, default_value = "3")]
+    /// extra rows for the DCT and the ensemble (default: none; the presets' rows hold the
+    /// default decode at stride 3 and the best at stride 2).
+    #[arg(long, value_delimiter = ',', value_parser = ranged::<1, 4>)]
     pub stride: Vec<usize>,
     /// How overlapping patches are averaged in those rows.
     #[arg(long, value_enum, default_value_t = WindowArg::Tapered)]
