@@ -26,8 +26,9 @@
 //!   the views on a depth, dictionaries (the 5D DCT and blobs in flash) and the separable
 //!   synthesis and analysis transforms.
 //! - **solver** ([`solver`]: [`error`](solver::error), [`workspace`], [`sl0`], [`ascent`],
-//!   [`ball`], [`projection`], [`fractional`], [`pinv`], [`choice`], [`interpolate`]): the
-//!   caller-owned workspace every path works in, nD SL0 with the orthonormal fast path, the
+//!   [`ball`], [`projection`], [`fractional`], [`pinv`], [`fill`](solver::fill), [`choice`],
+//!   [`interpolate`]): the caller-owned workspace every path works in, nD SL0 with the
+//!   orthonormal fast path and its cold start from the band-gain fill, the
 //!   noise ball a projection moves onto, the projection of half-pixel sheared patches (whose
 //!   measurements interpolate them), the paper's general pseudo-inverse path for kronecker
 //!   masks, the choice of an ensemble member per patch (exhaustive or screened), and

@@ -18,8 +18,9 @@
 //!   firmware's masks, noise, black level, quantisation, saturation and defects.
 //! - [`decode`]: the firmware's tile decoder over a capture in parallel ([`decode::cs`]),
 //!   the baselines a user would pick instead of compressed sensing ([`decode::baselines`]),
-//!   the paper's 1D method ([`decode::paper_1d`]) and the device binary's capture and check
-//!   ([`decode::device`]).
+//!   the paper's 1D method ([`decode::paper_1d`]), the device binary's capture and check
+//!   ([`decode::device`]), and the named decodes `preview`, `default`, `best`
+//!   ([`decode::preset`]).
 //! - [`train`]: learning a dictionary ensemble into a firmware blob.
 //! - [`eval`]: metrics (PSNR, SSIM, SA), sRGB previews, every method on light fields a user
 //!   brings ([`eval::evaluation`]), the tables of `slf demo`, `sweep` and `compare`
