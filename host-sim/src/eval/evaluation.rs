@@ -182,3 +182,32 @@ pub fn table(rows: &[Row], settings: &[Setting]) -> String {
     }
     lines.join("\n") + "\n"
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The methods: the baselines, the DCT and the ensemble on disjoint patches, both again
+    /// per extra stride, then the presets as `slf decode --preset` runs them.
+    #[test]
+    fn methods_are_the_baselines_the_bases_per_stride_and_the_presets() {
+        let names = |strides: &[(u8, u8)]| -> Vec<String> {
+            methods(slf_firmware::DEFAULT_ENSEMBLE, strides, Window::Tapered).into_iter().map(|m| m.0).collect()
+        };
+        let plain = names(&[]);
+        assert_eq!(plain.len(), Baseline::ALL.len() + 2 + Preset::ALL.len());
+        assert_eq!(&plain[plain.len() - 3..], ["preset preview", "preset default", "preset best"]);
+        let strided = names(&[(3, 3)]);
+        assert_eq!(strided.len(), plain.len() + 2);
+        assert!(strided.contains(&"DCT, stride 3, tapered".to_string()), "{strided:?}");
+        assert!(strided.contains(&"ensemble screened, stride 3, tapered".to_string()), "{strided:?}");
+        // The presets' options are the presets'.
+        let all = methods(slf_firmware::DEFAULT_ENSEMBLE, &[], Window::Tapered);
+        let (_, _, Some((basis, opts))) = &all[all.len() - 3] else { panic!("the preview is a CS method") };
+        assert!(matches!(basis, Basis::Dct));
+        assert_eq!(opts.stride, Preset::Preview.options().stride);
+        assert!(!opts.edge_fallback);
+        let (_, _, Some((_, best))) = &all[all.len() - 1] else { panic!("best is a CS method") };
+        assert_eq!(best.stride, (2, 2));
+    }
+}
