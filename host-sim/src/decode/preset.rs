@@ -61,9 +61,22 @@ impl Preset {
 
     /// The basis: the 5D DCT for the preview, the shipped ensemble (screened) otherwise.
     pub fn basis(self) -> Basis {
-        match self {
-            Self::Preview => Basis::Dct,
-            Self::Default | Self::Best => Basis::default_ensemble(),
+        self.basis_with(slf_firmware::DEFAULT_ENSEMBLE)
+    }
+
+    /// Whether the preset decodes with the 5D DCT (else with an ensemble).
+    pub fn uses_dct(self) -> bool {
+        self == Self::Preview
+    }
+
+    /// [`Self::basis`] with the ensemble `blob` in place of the shipped one.
+    pub fn basis_with(self, blob: &[u8]) -> Basis {
+        if self.uses_dct() {
+            return Basis::Dct;
+        }
+        Basis::Ensemble {
+            blob: blob.to_vec(),
+            choice: slf_firmware::MemberChoice::Screened(slf_firmware::ChoiceRule::DEFAULT),
         }
     }
 }

@@ -74,11 +74,7 @@ fn methods(blob: &[u8], strides: &[(u8, u8)], window: Window) -> Vec<Method> {
         }
     }
     for preset in Preset::ALL {
-        let basis = match preset.basis() {
-            Basis::Dct => Basis::Dct,
-            Basis::Ensemble { choice, .. } => Basis::Ensemble { blob: blob.to_vec(), choice },
-        };
-        m.push((format!("preset {}", preset.name()), None, Some((basis, preset.options()))));
+        m.push((format!("preset {}", preset.name()), None, Some((preset.basis_with(blob), preset.options()))));
     }
     m
 }

@@ -126,10 +126,7 @@ impl BasisArgs {
 
     /// The basis the flags name, or `preset`'s where --dictionary is not given.
     pub fn basis_for(&self, preset: Preset) -> Result<Basis> {
-        let preset_kind = match preset.basis() {
-            Basis::Dct => DictionaryKind::Dct,
-            Basis::Ensemble { .. } => DictionaryKind::Ensemble,
-        };
+        let preset_kind = if preset.uses_dct() { DictionaryKind::Dct } else { DictionaryKind::Ensemble };
         Ok(match self.dictionary.unwrap_or(preset_kind) {
             DictionaryKind::Dct => Basis::Dct,
             DictionaryKind::Ensemble => {
