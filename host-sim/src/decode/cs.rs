@@ -84,11 +84,24 @@ pub fn read_blob(path: &std::path::Path) -> Result<Vec<u8>> {
 /// # Errors
 /// An invalid blob, or what [`decode`] reports.
 pub fn decode_with(capture: &Capture, basis: &Basis, opts: &DecodeOptions) -> Result<(LightField, DecodeReport)> {
+    decode_with_observer(capture, basis, opts, &|_, _| {})
+}
+
+/// [`decode_with`], calling `observer` after each tile (see [`decode_observed`]).
+///
+/// # Errors
+/// An invalid blob, or what [`decode`] reports.
+pub fn decode_with_observer(
+    capture: &Capture,
+    basis: &Basis,
+    opts: &DecodeOptions,
+    observer: &(dyn Fn(usize, usize) + Sync),
+) -> Result<(LightField, DecodeReport)> {
     match basis {
-        Basis::Dct => decode(capture, &Dictionary::dct(), opts),
+        Basis::Dct => decode_observed(capture, &Dictionary::dct(), opts, observer),
         Basis::Ensemble { blob, choice } => {
             let ensemble = slf_firmware::Ensemble::<5, 5, 4, 4, 13>::new(blob).map_err(|e| anyhow!("{e}"))?;
-            decode(capture, &slf_firmware::EnsembleModel::new(ensemble, *choice), opts)
+            decode_observed(capture, &slf_firmware::EnsembleModel::new(ensemble, *choice), opts, observer)
         }
     }
 }
@@ -393,6 +406,21 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
     model: &M,
     opts: &DecodeOptions,
 ) -> Result<(LightField, DecodeReport)> {
+    decode_observed(capture, model, opts, &|_, _| {})
+}
+
+/// [`decode`], calling `observer` after each tile with (tiles done, tiles in the pass), from
+/// the worker threads: a progress display of the caller's own (the Python package's
+/// callback). The adaptive rule ([`DecodeOptions::adaptive`]) makes a second pass.
+///
+/// # Errors
+/// As [`decode`].
+pub fn decode_observed<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
+    capture: &Capture,
+    model: &M,
+    opts: &DecodeOptions,
+    observer: &(dyn Fn(usize, usize) + Sync),
+) -> Result<(LightField, DecodeReport)> {
     let start = Instant::now();
     let d = &capture.description;
     ensure!(d.bands_nm.len() == 13, "the decoder's patch has 13 bands, the capture {}", d.bands_nm.len());
@@ -431,6 +459,7 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
                     let mut source = FrameSource::new(&raw);
                     let r = decoder.decode_tile(model, tile, &mut source, &mut sums, ws).map_err(|e| e.to_string());
                     bar.inc(1);
+                    observer(bar.position() as usize, tiles.len());
                     if opts.progress && start.elapsed().as_secs_f64() > 1.0 && !shown.swap(true, Ordering::Relaxed) {
                         bar.set_draw_target(ProgressDrawTarget::stderr());
                     }

@@ -8,7 +8,9 @@
 //! - [`paper_1d`]: the paper's 1D method (explicit Kronecker matrices) and a 5D SL0 in f64,
 //!   the references for the equivalence, speed and memory claims;
 //! - [`device`]: the device binary's capture, and the check of its log against the host;
-//! - [`preset`]: the named decodes (`preview`, `default`, `best`) on the speed-error curve.
+//! - [`preset`]: the named decodes (`preview`, `default`, `best`) on the speed-error curve;
+//! - [`settings`]: what a user asks of a decode (`slf decode`'s flags, `slf.decode`'s
+//!   keywords), parsed once and resolved to a basis and options.
 //!
 //! May use: [`crate::io`], [`crate::sim`]. Used by the train and eval layers.
 
@@ -17,3 +19,4 @@ pub mod cs;
 pub mod device;
 pub mod paper_1d;
 pub mod preset;
+pub mod settings;

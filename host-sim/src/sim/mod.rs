@@ -6,12 +6,20 @@
 //! - [`realistic`]: scenes that look like the world (slanted and curved surfaces, 1/f
 //!   textures, measured spectra, five illuminants);
 //! - [`camera`]: a light field to raw frames with the firmware's masks, noise, black level,
-//!   quantisation, saturation and defects, as a capture.
+//!   quantisation, saturation and defects, as a capture;
+//! - [`settings`]: what a user asks of a simulated capture (`slf simulate`'s flags,
+//!   `slf.simulate`'s keywords);
+//! - [`flags`]: parsers the settings types share;
+//! - [`import`]: real data as the camera sees it (`slf import views` and `cube`'s flags, a
+//!   light field brought to the camera's 13 bands), with [`crate::io::import`]'s readers.
 //!
 //! May use: [`crate::io`]. Used by the decode, train and eval layers.
 
 pub mod camera;
+pub mod flags;
+pub mod import;
 pub mod realistic;
 pub mod scene;
+pub mod settings;
 pub mod spectra;
 pub mod spectra_data;

@@ -44,6 +44,26 @@ pub fn lookup(name: &str) -> Option<Scene> {
     crate::sim::scene::named(name).or_else(|| named(name))
 }
 
+/// The scene `slf scene NAME` renders: a named one ([`lookup`]), `random` (a training scene
+/// of the shipped ensemble, [`crate::sim::scene::random`]) or `realistic` ([`realistic`]),
+/// the last two drawn from `seed`.
+///
+/// # Errors
+/// An unknown name, with the names there are.
+pub fn by_name(name: &str, seed: u64) -> anyhow::Result<Scene> {
+    match name {
+        "random" => Ok(crate::sim::scene::random(seed)),
+        "realistic" => Ok(realistic(seed)),
+        _ => lookup(name).ok_or_else(|| {
+            anyhow::anyhow!(
+                "unknown scene {name:?}: one of {:?}, {:?}, random or realistic",
+                crate::sim::scene::NAMES,
+                NAMES
+            )
+        }),
+    }
+}
+
 /// A random realistic scene (seeded; any illuminant of the table).
 pub fn realistic(seed: u64) -> Scene {
     draw(seed, None)

@@ -6,7 +6,8 @@ use std::path::PathBuf;
 use anyhow::Result;
 use slf_host::eval::report;
 
-use crate::args::{BasisArgs, ranged};
+use crate::args::ranged;
+use slf_host::decode::settings::BasisSettings;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -20,7 +21,7 @@ pub struct Args {
     #[arg(long, default_value_t = 100, value_parser = ranged::<5, 2048>)]
     pub size: usize,
     #[command(flatten)]
-    pub basis: BasisArgs,
+    pub basis: BasisSettings,
 }
 
 pub fn run(args: Args) -> Result<()> {

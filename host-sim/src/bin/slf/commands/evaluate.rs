@@ -10,8 +10,9 @@ use slf_host::eval::evaluation::{SETTINGS, evaluate_set, table};
 use slf_host::firmware::DEFAULT_ENSEMBLE;
 use slf_host::io::lightfield::read_npy;
 
-use super::import::with_camera_bands;
-use crate::args::{WindowArg, ranged};
+use super::import::camera_bands;
+use crate::args::ranged;
+use slf_host::decode::settings::WindowKind;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -30,8 +31,8 @@ pub struct Args {
     #[arg(long, value_delimiter = ',', value_parser = ranged::<1, 4>)]
     pub stride: Vec<usize>,
     /// How overlapping patches are averaged in those rows.
-    #[arg(long, value_enum, default_value_t = WindowArg::Tapered)]
-    pub window: WindowArg,
+    #[arg(long, value_enum, default_value_t = WindowKind::Tapered)]
+    pub window: WindowKind,
 }
 
 pub fn run(args: Args) -> Result<()> {
@@ -43,7 +44,7 @@ pub fn run(args: Args) -> Result<()> {
     let mut scenes = Vec::new();
     for p in &inputs {
         let name = p.file_stem().map_or("scene".into(), |s| s.to_string_lossy().into_owned());
-        scenes.push((name, with_camera_bands(read_npy(p)?, None, p)?));
+        scenes.push((name, camera_bands(read_npy(p)?, None, p)?));
     }
     let strides: Vec<(u8, u8)> = stride.iter().map(|&s| (s as u8, s as u8)).collect();
     let rows = evaluate_set(&scenes, &SETTINGS, &blob, &strides, window.window(), &out)?;

@@ -3,10 +3,10 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use slf_host::io::lightfield::{Dtype, write_npy};
 use slf_host::sim::realistic;
-use slf_host::sim::scene::{self, SceneSize};
+use slf_host::sim::scene::SceneSize;
 
 use crate::args::ranged;
 
@@ -36,13 +36,7 @@ pub struct Args {
 
 pub fn run(args: Args) -> Result<()> {
     let Args { name, output, seed, size, views, dtype } = args;
-    let s = match name.as_str() {
-        "random" => scene::random(seed),
-        "realistic" => realistic::realistic(seed),
-        _ => realistic::lookup(&name).with_context(|| {
-            format!("unknown scene {name:?}: one of {:?}, {:?}, random or realistic", scene::NAMES, realistic::NAMES)
-        })?,
-    };
+    let s = realistic::by_name(&name, seed)?;
     let size = SceneSize { views: (views, views), rows: size, cols: size };
     size.check().map_err(|e| anyhow::anyhow!("--size {} with --views {views}: {e}", size.rows))?;
     let lf = s.render(size);

@@ -8,7 +8,8 @@ use clap::ValueEnum;
 use slf_host::io::lightfield::read_npy;
 use slf_host::train;
 
-use crate::args::{BalanceArg, ranged};
+use crate::args::ranged;
+use slf_host::decode::settings::WhiteBalance;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -52,8 +53,8 @@ pub struct Args {
     pub generator: GeneratorArg,
     /// White balance of the training light fields, as the decoder balances a capture
     /// (grey: each band divided by its mean over the light field).
-    #[arg(long, value_enum, default_value_t = BalanceArg::Grey)]
-    pub balance: BalanceArg,
+    #[arg(long, value_enum, default_value_t = WhiteBalance::Grey)]
+    pub balance: WhiteBalance,
 }
 
 pub fn run(args: Args) -> Result<()> {
@@ -83,8 +84,8 @@ pub fn run(args: Args) -> Result<()> {
         input.iter().map(|p| read_npy(p)).collect::<Result<Vec<_>, _>>()?
     };
     let fields = match balance {
-        BalanceArg::Grey => fields.iter().map(train::white_balanced).collect(),
-        BalanceArg::Off => fields,
+        WhiteBalance::Grey => fields.iter().map(train::white_balanced).collect(),
+        WhiteBalance::Off => fields,
     };
     train::train_blob(&fields, patches, &cfg, &output)
 }

@@ -1,0 +1,518 @@
+//! What a user asks of a decode: every choice `slf decode`'s flags name, in one place, so
+//! the command and the Python package (`slf.decode`) take the same settings with the same
+//! defaults, ranges and one-line errors.
+//!
+//! [`DecodeSettings`] is a `clap` argument group: the CLI flattens it into `slf decode`, and
+//! [`DecodeSettings::from_flags`] parses the same flags from a list of strings (the Python
+//! package turns its keywords into them), so there is one parser, not two. An unset flag is
+//! the preset's value ([`Preset`]) or the solver's default ([`Sl0Config::DEFAULT`]).
+//! [`DecodeSettings::run`] resolves them ([`DecodeSettings::resolve`]), refuses what does
+//! not fit together, and decodes by compressed sensing or by a baseline.
+
+use std::path::PathBuf;
+
+use anyhow::{Result, anyhow, bail, ensure};
+use clap::{Args, FromArgMatches, ValueEnum};
+use slf_firmware::disparity::MAX_DISPARITY;
+use slf_firmware::{ChoiceRule, DEFAULT_ENSEMBLE, DisparityRange, MemberChoice, Sl0Config, gains};
+
+use crate::decode::baselines::{Baseline, BaselineReport};
+use crate::decode::cs::{
+    Balance, Basis, DecodeOptions, DecodeReport, NoiseSource, Window, decode_with_observer, read_blob,
+};
+use crate::decode::preset::Preset;
+use crate::io::capture::Capture;
+use crate::io::lightfield::LightField;
+use crate::sim::flags::one_line;
+
+/// Decode method: compressed sensing, or a baseline without it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum Method {
+    /// Compressed sensing: the firmware's SL0 decoder with --dictionary.
+    #[default]
+    Cs,
+    /// Baseline: per pixel, the spectrum interpolated between the bands it measured.
+    Interpolate,
+    /// Baseline: each band from the nearby pixels and views that measured it, matched to
+    /// each pixel's own measurements.
+    Demosaic,
+    /// Baseline: PPID, demosaicking by the pseudo-panchromatic image (Mihoubi et al. 2017).
+    Ppid,
+}
+
+impl Method {
+    /// The baseline this method names; `None` for compressed sensing.
+    pub fn baseline(self) -> Option<Baseline> {
+        match self {
+            Method::Cs => None,
+            Method::Interpolate => Some(Baseline::Interpolate),
+            Method::Demosaic => Some(Baseline::Demosaic),
+            Method::Ppid => Some(Baseline::Ppid),
+        }
+    }
+}
+
+/// `--dictionary`: the basis kind.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum DictionaryKind {
+    /// The 5D DCT.
+    Dct,
+    /// A learned ensemble (the shipped one unless --blob says otherwise).
+    Ensemble,
+}
+
+/// `--choice`: how an ensemble member is chosen per patch.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Choice {
+    /// Solve with the DCT, pick the member that best represents it, solve with that (2
+    /// solves); where the DCT's own solution is sparser, average the two.
+    Screened,
+    /// As screened, but where the DCT's own solution is sparser, solve with the DCT again
+    /// from the member's solution (3 solves).
+    ScreenedResolve,
+    /// Solve with every member, keep the sparsest (K + 1 solves).
+    Exhaustive,
+}
+
+/// `--window`: how overlapping patches are averaged.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum WindowKind {
+    /// Every value of a patch counts the same.
+    Uniform,
+    /// Lenslets weigh 1, 2, 3, 2, 1 across a patch (per axis, multiplied).
+    Tapered,
+}
+
+impl WindowKind {
+    /// The firmware's window.
+    pub fn window(self) -> Window {
+        match self {
+            WindowKind::Uniform => Window::Uniform,
+            WindowKind::Tapered => Window::Tapered,
+        }
+    }
+}
+
+/// `--balance`: the white balance without given gains.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum WhiteBalance {
+    /// Each band's mean over the frame (grey world).
+    Grey,
+    /// No white balance (gains of 1).
+    Off,
+}
+
+impl WhiteBalance {
+    /// The decoder's balance.
+    pub fn balance(self) -> Balance {
+        match self {
+            Self::Grey => Balance::GreyWorld,
+            Self::Off => Balance::Off,
+        }
+    }
+}
+
+/// The basis flags, shared by the commands that decode (`decode`, `sweep`, `demo`).
+#[derive(Args, Clone, Debug)]
+pub struct BasisSettings {
+    /// Basis to decode with [default: ensemble; dct with --preset preview].
+    #[arg(long, value_enum)]
+    pub dictionary: Option<DictionaryKind>,
+    /// How an ensemble member is chosen per patch.
+    #[arg(long, value_enum, default_value_t = Choice::Screened)]
+    pub choice: Choice,
+    /// Ensemble blob (default: the shipped 8-member ensemble).
+    #[arg(long)]
+    pub blob: Option<PathBuf>,
+}
+
+impl BasisSettings {
+    /// The basis the flags name, with the default preset's where --dictionary is not given.
+    ///
+    /// # Errors
+    /// An unreadable blob.
+    pub fn basis(&self) -> Result<Basis> {
+        self.basis_for(Preset::Default)
+    }
+
+    /// The basis the flags name, or `preset`'s where --dictionary is not given.
+    ///
+    /// # Errors
+    /// An unreadable blob, or a blob with the DCT.
+    pub fn basis_for(&self, preset: Preset) -> Result<Basis> {
+        let preset_kind = if preset.uses_dct() { DictionaryKind::Dct } else { DictionaryKind::Ensemble };
+        Ok(match self.dictionary.unwrap_or(preset_kind) {
+            DictionaryKind::Dct => Basis::Dct,
+            DictionaryKind::Ensemble => {
+                let blob = match &self.blob {
+                    Some(p) => read_blob(p)?,
+                    None => DEFAULT_ENSEMBLE.to_vec(),
+                };
+                let rule = ChoiceRule::DEFAULT;
+                let choice = match self.choice {
+                    Choice::Screened => MemberChoice::Screened(rule),
+                    Choice::ScreenedResolve => MemberChoice::ScreenedResolve(rule),
+                    Choice::Exhaustive => MemberChoice::Exhaustive(rule),
+                };
+                Basis::Ensemble { blob, choice }
+            }
+        })
+    }
+}
+
+/// The solver's flags; each unset one is the preset's value ([`Preset::options`]).
+#[derive(Args, Clone, Debug)]
+pub struct SolverSettings {
+    /// SL0 sigma decrease factor per level, in (0, 1).
+    #[arg(long, default_value_t = Sl0Config::DEFAULT.sigma_f)]
+    pub sigma_f: f32,
+    /// SL0 steps per sigma level (L).
+    #[arg(long, default_value_t = Sl0Config::DEFAULT.steps)]
+    pub steps: u16,
+    /// SL0 step size mu.
+    #[arg(long, default_value_t = Sl0Config::DEFAULT.mu)]
+    pub mu: f32,
+    /// SL0 smallest sigma (normalised units, white = 1) [default: 1e-3; 3e-3 with --preset
+    /// preview].
+    #[arg(long)]
+    pub sigma_min: Option<f32>,
+    /// Hard bound on SL0 steps per patch.
+    #[arg(long, default_value_t = Sl0Config::DEFAULT.max_iterations)]
+    pub max_iterations: u32,
+    /// Noise standard deviation per measurement (normalised units), instead of the
+    /// capture's noise description; 0 (with no --shot) forces equality.
+    #[arg(long, conflicts_with = "exact")]
+    pub noise: Option<f32>,
+    /// Shot noise: variance per unit of a measurement's value (normalised units, 1 /
+    /// electrons at white), instead of the capture's noise description.
+    #[arg(long, conflicts_with = "exact")]
+    pub shot: Option<f32>,
+    /// Exact projection: the decode equals the measurements, whatever noise the capture
+    /// describes. Without --exact, --noise or --shot the noise ball comes from the capture.
+    #[arg(long)]
+    pub exact: bool,
+    /// Early stop: end a patch's solve once a sigma level moves it by less than this RMS
+    /// per value (normalised units); 0 never stops early.
+    #[arg(long, default_value_t = Sl0Config::DEFAULT.tolerance)]
+    pub tolerance: f32,
+    /// The ensemble's second solve starts from the DCT's patch at this fraction of its
+    /// largest coefficient, in (0, 1]; 1 is a cold start.
+    #[arg(long, default_value_t = Sl0Config::DEFAULT.warm_start)]
+    pub warm_start: f32,
+    /// The warm solve's sigma decrease factor per level, in (0, 1).
+    #[arg(long, default_value_t = Sl0Config::DEFAULT.warm_sigma_f)]
+    pub warm_sigma_f: f32,
+    /// The warm solve's steps per sigma level.
+    #[arg(long, default_value_t = Sl0Config::DEFAULT.warm_steps)]
+    pub warm_steps: u16,
+    /// Where a cold solve starts, in (0, 1]: 1 the minimum-norm solution at its largest
+    /// coefficient; below 1 the band-gain fill (each pixel's gain times each band's mean
+    /// over the patch) at that fraction of its largest coefficient, fewer sigma levels
+    /// [default: 1; 0.03 with --preset preview].
+    #[arg(long)]
+    pub cold_start: Option<f32>,
+    /// Short path: a patch whose measurements of each band agree within this (normalised
+    /// units) is decoded as each band's mean, with no solve; 0: exactly flat patches only.
+    #[arg(long, default_value_t = Sl0Config::DEFAULT.flat)]
+    pub flat: f32,
+    /// A patch whose measurements cover fewer distinct bands than this (a kronecker mask's
+    /// patch sees k, or up to 4k across mask blocks) is interpolated per pixel instead of
+    /// solved; 0 solves every patch (the paper's decode).
+    #[arg(long, default_value_t = Sl0Config::DEFAULT.min_bands)]
+    pub min_bands: u8,
+}
+
+impl SolverSettings {
+    /// Where the noise ball comes from: the capture unless told.
+    pub fn noise_source(&self) -> NoiseSource {
+        if self.exact || self.noise.is_some() || self.shot.is_some() {
+            NoiseSource::Config
+        } else {
+            NoiseSource::Capture
+        }
+    }
+
+    /// The flags' configuration; `sigma_min` and `cold_start` from `base` (the preset's)
+    /// unless given.
+    ///
+    /// # Errors
+    /// A value out of its range, named.
+    pub fn config(&self, base: &Sl0Config) -> Result<Sl0Config> {
+        let c = Sl0Config {
+            sigma_f: self.sigma_f,
+            steps: self.steps,
+            mu: self.mu,
+            sigma_min: self.sigma_min.unwrap_or(base.sigma_min),
+            max_iterations: self.max_iterations,
+            noise: self.noise.unwrap_or(0.0),
+            shot: self.shot.unwrap_or(0.0),
+            tolerance: self.tolerance,
+            warm_start: self.warm_start,
+            warm_sigma_f: self.warm_sigma_f,
+            warm_steps: self.warm_steps,
+            cold_start: self.cold_start.unwrap_or(base.cold_start),
+            flat: self.flat,
+            min_bands: self.min_bands,
+        };
+        c.validate().map_err(|e| anyhow!("{e}"))?;
+        Ok(c)
+    }
+}
+
+/// Everything `slf decode` and `slf.decode` are asked, but where the capture comes from and
+/// where the results go.
+#[derive(Args, Clone, Debug)]
+pub struct DecodeSettings {
+    /// Decode method: compressed sensing, or a baseline without it.
+    #[arg(long, value_enum, default_value_t = Method::Cs)]
+    pub method: Method,
+    /// A named decode: its basis, stride, window, disparities, edge fallback, sigma_min and
+    /// cold start; any of those flags given as well overrides the preset's value.
+    #[arg(long, value_enum, default_value_t = Preset::Default)]
+    pub preset: Preset,
+    #[command(flatten)]
+    pub solver: SolverSettings,
+    #[command(flatten)]
+    pub basis: BasisSettings,
+    /// Lenslets between patch origins, 1..=5 (5: disjoint patches, which show their
+    /// grid; smaller strides decode (5 / stride)^2 times the patches and average them)
+    /// [default: 3; preview 5, best 2].
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=5))]
+    pub stride: Option<u8>,
+    /// How overlapping patches are averaged [default: tapered; preview uniform].
+    #[arg(long, value_enum)]
+    pub window: Option<WindowKind>,
+    /// With a stride below 5: decode a shifted patch only where a first pass on the
+    /// disjoint grid shows a seam inside it, steps across the grid's borders more than
+    /// this many times those between its other lenslets.
+    #[arg(long)]
+    pub adaptive: Option<f32>,
+    /// White balance: each band divided by a gain before the solve and multiplied back
+    /// (grey: each band's mean over the frame, as the device does it).
+    #[arg(long, value_enum, default_value_t = WhiteBalance::Grey)]
+    pub balance: WhiteBalance,
+    /// The 13 band gains, comma-separated (e.g. from a white reference); replaces
+    /// --balance.
+    #[arg(long, value_delimiter = ',', value_name = "G1,...,G13")]
+    pub gains: Option<Vec<f32>>,
+    /// Disparities (pixels per view step) each 5 x 5-lenslet block may be sheared to
+    /// before decoding, MIN:MAX[:STEP] (default -1:1:0.5 for a single snapshot, -1:1 for
+    /// more and with --preset preview; 0:0 decodes unsheared; a STEP of 0.5 adds the
+    /// half-pixel shears, whose measurements interpolate the patch); chosen per block by
+    /// how well the views' same-band samples agree.
+    #[arg(long, value_parser = disparity_range, value_name = "MIN:MAX[:STEP]", allow_hyphen_values = true)]
+    pub disparities: Option<DisparityRange>,
+    /// Decode a block sheared at the frame's edge unsheared as well, for the views of its
+    /// edge lenslets no sheared patch reached (false: those values come from their
+    /// lenslet's other views, a fifth fewer patches on a 128 x 128-lenslet frame)
+    /// [default: true; false with --preset preview].
+    #[arg(long, value_name = "BOOL")]
+    pub edge_fallback: Option<bool>,
+}
+
+/// A decode's light field and what it reports.
+#[derive(Clone, Debug)]
+pub struct Decoded {
+    /// `(U, V, H, W, 13)`.
+    pub light_field: LightField,
+    /// What the method reports.
+    pub outcome: Outcome,
+}
+
+/// What a decode reports, by method.
+#[derive(Clone, Debug)]
+pub enum Outcome {
+    /// Compressed sensing: the options it ran with (presets and flags resolved) and its
+    /// report.
+    Cs { options: DecodeOptions, report: Box<DecodeReport> },
+    /// A baseline's report.
+    Baseline { method: Method, report: BaselineReport },
+}
+
+impl DecodeSettings {
+    /// The settings from `slf decode`'s flags (without the capture, `-o` and the output
+    /// flags), e.g. `["--preset", "preview", "--stride=3"]`.
+    ///
+    /// # Errors
+    /// The parser's message, one line, naming the flag (e.g. `invalid value '7' for
+    /// '--stride <STRIDE>': 7 is not in 1..=5`).
+    pub fn from_flags<I, S>(flags: I) -> Result<Self, String>
+    where
+        I: IntoIterator<Item = S>,
+        S: Into<std::ffi::OsString> + Clone,
+    {
+        let cmd = Self::augment_args(clap::Command::new("decode").no_binary_name(true));
+        let parsed = cmd.try_get_matches_from(flags).and_then(|m| Self::from_arg_matches(&m));
+        parsed.map_err(|e| one_line(&e))
+    }
+
+    /// The compressed-sensing decode these settings ask for: the basis and the options.
+    ///
+    /// # Errors
+    /// A flag out of range or flags that do not fit together, named; an unreadable blob.
+    pub fn resolve(&self) -> Result<(Basis, DecodeOptions)> {
+        let base = self.preset.options();
+        let balance = match &self.gains {
+            Some(g) => {
+                let g: [f32; 13] =
+                    g.as_slice().try_into().map_err(|_| anyhow!("--gains: 13 values, got {}", g.len()))?;
+                ensure!(gains::valid(&g), "--gains: every gain must be finite and positive");
+                Balance::Gains(g)
+            }
+            None => self.balance.balance(),
+        };
+        if let Some(a) = self.adaptive {
+            ensure!(a.is_finite() && a >= 0.0, "--adaptive {a}: must be finite, at or above 0");
+        }
+        let options = DecodeOptions {
+            sl0: self.solver.config(&base.sl0)?,
+            noise: self.solver.noise_source(),
+            stride: self.stride.map_or(base.stride, |s| (s, s)),
+            window: self.window.map_or(base.window, WindowKind::window),
+            adaptive: self.adaptive,
+            balance,
+            disparities: self.disparities.or(base.disparities),
+            edge_fallback: self.edge_fallback.unwrap_or(base.edge_fallback),
+            ..base
+        };
+        Ok((self.basis.basis_for(self.preset)?, options))
+    }
+
+    /// Decodes `capture`. `progress` shows a bar on stderr once the decode has taken a
+    /// second; `observer` is called after each tile with (tiles done, tiles in the pass).
+    ///
+    /// # Errors
+    /// What [`Self::resolve`] refuses; a capture the method cannot take; a decode where no
+    /// patch decoded (every patch saturated, defective or unreadable).
+    pub fn run(&self, capture: &Capture, progress: bool, observer: &(dyn Fn(usize, usize) + Sync)) -> Result<Decoded> {
+        if let Some(baseline) = self.method.baseline() {
+            let (light_field, report) = baseline.run(capture)?;
+            return Ok(Decoded { light_field, outcome: Outcome::Baseline { method: self.method, report } });
+        }
+        let (basis, options) = self.resolve()?;
+        let options = DecodeOptions { progress, ..options };
+        let (light_field, report) = decode_with_observer(capture, &basis, &options, observer)?;
+        let p = &report.patches;
+        if p.decoded == 0 {
+            bail!(
+                "no patch decoded ({} failed, {} of {} tiles failed): every patch saturated, defective or \
+                 unreadable",
+                p.failed,
+                report.failed_tiles,
+                report.tiles
+            );
+        }
+        Ok(Decoded { light_field, outcome: Outcome::Cs { options, report: Box::new(report) } })
+    }
+}
+
+impl Decoded {
+    /// A warning when more than [`WARN_FRACTION`] of the patches failed or were flagged, or
+    /// a tile failed.
+    pub fn warning(&self) -> Option<String> {
+        let Outcome::Cs { report: r, .. } = &self.outcome else { return None };
+        let p = &r.patches;
+        let all = p.decoded + p.failed;
+        ((p.failed + p.flagged) as f64 > WARN_FRACTION * f64::from(all) || r.failed_tiles > 0).then(|| {
+            format!(
+                "{} of {all} patches failed and {} were flagged (pixels left out), {} tiles failed",
+                p.failed, p.flagged, r.failed_tiles
+            )
+        })
+    }
+}
+
+/// A decode warns when more than this fraction of patches failed or were flagged.
+pub const WARN_FRACTION: f64 = 0.01;
+
+/// `MIN:MAX[:STEP]`, integer disparities around 0 (e.g. `-1:1`) within the decoder's
+/// limit, in steps of 1 (the default) or 0.5.
+///
+/// # Errors
+/// The accepted forms, with the decoder's limit.
+pub fn disparity_range(s: &str) -> Result<DisparityRange, String> {
+    let bad = || {
+        let m = MAX_DISPARITY;
+        format!(
+            "{s:?}: want MIN:MAX[:STEP], integers with -{m} <= MIN <= 0 <= MAX <= {m} and a step of 1 or 0.5 (e.g. -1:1:0.5)"
+        )
+    };
+    let mut parts = s.split(':');
+    let (Some(a), Some(b), step, None) = (parts.next(), parts.next(), parts.next(), parts.next()) else {
+        return Err(bad());
+    };
+    let (a, b) = (a.trim().parse::<i8>().map_err(|_| bad())?, b.trim().parse::<i8>().map_err(|_| bad())?);
+    let halves = match step.map(str::trim) {
+        None | Some("1") => false,
+        Some("0.5") | Some(".5") => true,
+        Some(_) => return Err(bad()),
+    };
+    DisparityRange::new(a, b).map(|r| r.with_halves(halves)).ok_or_else(bad)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn resolved(flags: &[&str]) -> (Basis, DecodeOptions) {
+        DecodeSettings::from_flags(flags).and_then(|s| s.resolve().map_err(|e| e.to_string())).unwrap()
+    }
+
+    #[test]
+    fn no_flags_is_the_default_preset() {
+        let (basis, o) = resolved(&[]);
+        let d = Preset::Default.options();
+        assert_eq!(basis.name(), Preset::Default.basis().name());
+        assert_eq!(
+            (o.stride, o.window, o.disparities, o.edge_fallback),
+            (d.stride, d.window, d.disparities, d.edge_fallback)
+        );
+        assert_eq!(o.sl0, Sl0Config::DEFAULT);
+        assert_eq!((o.noise, o.balance), (NoiseSource::Capture, Balance::GreyWorld));
+    }
+
+    #[test]
+    fn a_preset_then_flags_over_it() {
+        let p = Preset::Preview.options();
+        let (basis, o) = resolved(&["--preset", "preview"]);
+        assert!(matches!(basis, Basis::Dct));
+        assert_eq!(
+            (o.stride, o.window, o.disparities, o.edge_fallback),
+            (p.stride, p.window, p.disparities, p.edge_fallback)
+        );
+        assert_eq!((o.sl0.sigma_min, o.sl0.cold_start), (p.sl0.sigma_min, p.sl0.cold_start));
+        let (basis, o) = resolved(&[
+            "--preset=preview",
+            "--stride=2",
+            "--dictionary=ensemble",
+            "--sigma-min=0.002",
+            "--disparities=-2:2:0.5",
+        ]);
+        assert!(matches!(basis, Basis::Ensemble { .. }));
+        assert_eq!(
+            (o.stride, o.window, o.sl0.sigma_min, o.sl0.cold_start),
+            ((2, 2), p.window, 0.002, p.sl0.cold_start)
+        );
+        assert_eq!(o.disparities, DisparityRange::new(-2, 2).map(|r| r.with_halves(true)));
+        let (_, o) = resolved(&["--exact", "--balance", "off", "--edge-fallback", "false"]);
+        assert_eq!((o.noise, o.balance, o.edge_fallback), (NoiseSource::Config, Balance::Off, false));
+    }
+
+    #[test]
+    fn errors_are_one_line_and_name_the_flag() {
+        for (flags, says) in [
+            (&["--stride", "9"][..], "--stride"),
+            (&["--preset", "fast"][..], "--preset"),
+            (&["--disparities", "3:1"][..], "MIN:MAX"),
+            (&["--exact", "--noise", "0.1"][..], "--noise"),
+            (&["--bogus"][..], "--bogus"),
+        ] {
+            let e = DecodeSettings::from_flags(flags).unwrap_err();
+            assert!(e.contains(says) && !e.contains('\n') && !e.starts_with("error"), "{flags:?}: {e}");
+        }
+        let s = DecodeSettings::from_flags(["--gains", "1,2"]).unwrap();
+        assert_eq!(s.resolve().unwrap_err().to_string(), "--gains: 13 values, got 2");
+        let s = DecodeSettings::from_flags(["--adaptive=-1"]).unwrap();
+        assert!(s.resolve().unwrap_err().to_string().starts_with("--adaptive -1"));
+    }
+}

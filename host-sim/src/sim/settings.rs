@@ -1,0 +1,201 @@
+//! What a user asks of a simulated capture: `slf simulate`'s flags, in one place for the
+//! command and the Python package (`slf.simulate`), so both take the same defaults and
+//! ranges and give the same one-line errors ([`SimulateSettings::from_flags`] parses the
+//! flags from strings, the way the package passes its keywords).
+
+use anyhow::{Context, Result};
+use clap::{Args, FromArgMatches, ValueEnum};
+use slf_firmware::MaskFamily;
+
+use crate::io::capture::{Capture, MaskDescription};
+use crate::io::lightfield::LightField;
+use crate::sim::camera::{CameraConfig, simulate};
+use crate::sim::flags::{one_line, positive};
+use crate::sim::import::with_camera_bands;
+
+/// `--mask`: the mask family, which band each pixel sees in each snapshot.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Family {
+    /// A band per sensor pixel and snapshot.
+    Pixel,
+    /// A band per lenslet and snapshot: every view of a lenslet sees it.
+    Lenslet,
+    /// The paper's separable mask: a band per 5 x 5-lenslet patch and snapshot.
+    Kronecker,
+}
+
+impl Family {
+    /// The firmware's mask family.
+    pub fn family(self) -> MaskFamily {
+        match self {
+            Family::Pixel => MaskFamily::Pixel,
+            Family::Lenslet => MaskFamily::Lenslet,
+            Family::Kronecker => MaskFamily::Kronecker,
+        }
+    }
+
+    /// The mask drawn from `seed` for `k` snapshots.
+    pub fn mask(self, seed: u64, k: u8) -> MaskDescription {
+        MaskDescription::seeded(self.family(), seed, k)
+    }
+}
+
+/// The frame file format a saved capture uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum FrameFormat {
+    /// Binary 16-bit PGM (P5).
+    Pgm,
+    /// 16-bit grey PNG.
+    Png,
+    /// uint16 `.npy`, 2 axes.
+    Npy,
+}
+
+impl FrameFormat {
+    /// The frame files' extension.
+    pub fn extension(self) -> &'static str {
+        match self {
+            FrameFormat::Pgm => "pgm",
+            FrameFormat::Png => "png",
+            FrameFormat::Npy => "npy",
+        }
+    }
+}
+
+/// `slf simulate`'s settings: the camera and its noise, but not where the light field comes
+/// from or where the capture goes.
+#[derive(Args, Clone, Debug)]
+pub struct SimulateSettings {
+    /// Wavelengths of the light field's bands when it does not have the camera's 13
+    /// (START:STOP:STEP or a comma list, nm): resampled over the camera's band filters.
+    #[arg(long)]
+    pub wavelengths: Option<String>,
+    /// Mask family: which band each pixel sees in each snapshot.
+    #[arg(long, value_enum, default_value_t = Family::Pixel)]
+    pub mask: Family,
+    /// Snapshots k (1..=13).
+    #[arg(short, long, default_value_t = 1)]
+    pub snapshots: u8,
+    /// Seed of the mask, noise and defects.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Read noise, DN (finite, at or above 0).
+    #[arg(long, default_value_t = 2.0, value_parser = non_negative)]
+    pub read_noise: f32,
+    /// Electrons at white (shot noise); finite, above 0.
+    #[arg(long, default_value_t = 20_000.0, value_parser = positive)]
+    pub full_well: f32,
+    /// No shot or read noise.
+    #[arg(long)]
+    pub no_noise: bool,
+    /// Fraction of defective pixels, in [0, 1).
+    #[arg(long, default_value_t = 0.0, value_parser = fraction)]
+    pub defects: f64,
+    /// Frame file format.
+    #[arg(long, value_enum, default_value_t = FrameFormat::Pgm)]
+    pub format: FrameFormat,
+}
+
+/// A simulated capture and what a user should hear about it.
+#[derive(Clone, Debug)]
+pub struct Simulated {
+    pub capture: Capture,
+    /// Notes (bands resampled) and warnings (pixels saturated), one line each.
+    pub notes: Vec<String>,
+}
+
+impl SimulateSettings {
+    /// The settings from `slf simulate`'s flags (without the input and `-o`), e.g.
+    /// `["--mask=lenslet", "--snapshots=3"]`.
+    ///
+    /// # Errors
+    /// The parser's message, one line, naming the flag.
+    pub fn from_flags<I, S>(flags: I) -> Result<Self, String>
+    where
+        I: IntoIterator<Item = S>,
+        S: Into<std::ffi::OsString> + Clone,
+    {
+        let cmd = Self::augment_args(clap::Command::new("simulate").no_binary_name(true));
+        cmd.try_get_matches_from(flags).and_then(|m| Self::from_arg_matches(&m)).map_err(|e| one_line(&e))
+    }
+
+    /// The camera these settings describe.
+    pub fn camera(&self) -> CameraConfig {
+        let mut cam =
+            CameraConfig::pixel(self.seed, self.snapshots).with_mask(self.mask.mask(self.seed, self.snapshots));
+        cam.read_noise = self.read_noise;
+        cam.full_well = Some(self.full_well);
+        cam.defect_fraction = self.defects;
+        cam.frame_ext = self.format.extension().to_string();
+        if self.no_noise { cam.noiseless() } else { cam }
+    }
+
+    /// Records `lf` (named `source` in messages) with the camera.
+    ///
+    /// # Errors
+    /// Wavelengths that do not parse or fit the light field; a light field the camera
+    /// cannot record (see [`simulate`]).
+    pub fn run(&self, lf: LightField, source: &str) -> Result<Simulated> {
+        let (lf, note) = with_camera_bands(lf, self.wavelengths.as_deref(), source)?;
+        let cam = self.camera();
+        let capture = simulate(&lf, &cam).with_context(|| source.to_string())?;
+        let mut notes: Vec<String> = note.into_iter().collect();
+        let (clipped, total) = capture.saturated_pixels();
+        if clipped > 0 {
+            notes.push(format!(
+                "warning: {source}: {clipped} of {total} pixels ({:.2} %) saturated: the light field exceeds \
+                 white (max {:.3}, clips at {:.3}); saturated pixels are not measurements",
+                100.0 * clipped as f64 / total as f64,
+                lf.max(),
+                1.0 / cam.white_fraction
+            ));
+        }
+        Ok(Simulated { capture, notes })
+    }
+}
+
+/// A finite number at or above zero, for clap.
+fn non_negative(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err(format!("{s:?} is not a finite number at or above 0")),
+    }
+}
+
+/// A fraction in `[0, 1)`, for clap.
+fn fraction(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if (0.0..1.0).contains(&v) => Ok(v),
+        _ => Err(format!("{s:?} is not a fraction in [0, 1)")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn no_flags_is_the_commands_camera() {
+        let s = SimulateSettings::from_flags(std::iter::empty::<&str>()).unwrap();
+        let cam = s.camera();
+        let mut want = CameraConfig::pixel(1, 1).with_mask(MaskDescription::seeded(MaskFamily::Pixel, 1, 1));
+        want.read_noise = 2.0;
+        want.full_well = Some(20_000.0);
+        assert_eq!(cam, want);
+        let s = SimulateSettings::from_flags(["--mask=lenslet", "-s", "3", "--seed=4", "--no-noise", "--format=npy"])
+            .unwrap();
+        let cam = s.camera();
+        assert_eq!((cam.snapshots(), cam.frame_ext.as_str(), cam.read_noise), (3, "npy", 0.0));
+        assert_eq!(cam.mask, MaskDescription::seeded(MaskFamily::Lenslet, 4, 3));
+    }
+
+    #[test]
+    fn ranges_are_refused_in_one_line() {
+        for (flag, says) in
+            [("--read-noise=-1", "at or above 0"), ("--full-well=0", "above 0"), ("--defects=1", "[0, 1)")]
+        {
+            let e = SimulateSettings::from_flags([flag]).unwrap_err();
+            assert!(e.contains(says) && e.contains(flag.split('=').next().unwrap()) && !e.contains('\n'), "{e}");
+        }
+    }
+}

@@ -1,0 +1,426 @@
+"""slf: the decoder of a compressive multispectral light-field camera, from numpy.
+
+A scene to a decoded light field and its quality::
+
+    import slf
+    lf = slf.scene("depth", size=60)          # (U, V, H, W, 13) float32
+    out = slf.decode(slf.simulate(lf, k=1))   # the same shape
+    slf.evaluate(lf, out)                     # {'psnr': ..., 'ssim': ..., 'sa': ...}
+
+Every function runs the same code as a command of the ``slf`` CLI, with the same defaults:
+a keyword is the command's flag with ``_`` for ``-`` (``sigma_min=`` is ``--sigma-min``),
+left at ``None`` for the command's default, and the errors are the command's, one line,
+raised as ``ValueError`` (a value out of range, a wrong shape) or ``OSError`` (a file).
+
+Light fields are ``(U, V, H, W, B)`` float32 arrays: U x V views, H x W lenslets (pixels
+per view), B = 13 bands from 400 to 700 nm by 25. Other float dtypes and memory orders are
+accepted and converted (a warning says so); a capture holds its raw frames as a
+``(k, rows, cols)`` uint16 array and its description as a dict (``capture.json``).
+
+Many captures on a Dask cluster: :func:`slf.batch.decode_folder`.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+import warnings
+from typing import Any, Callable, Dict, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _slf
+
+__version__ = _slf.__version__
+
+__all__ = [
+    "Capture",
+    "decode",
+    "evaluate",
+    "import_cube",
+    "import_views",
+    "load_capture",
+    "scene",
+    "simulate",
+]
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+
+def _flag(name: str, value: Any) -> Optional[str]:
+    """One ``--name=value`` flag of the CLI, or None for a keyword left at its default."""
+    if value is None or value is False:
+        return None
+    flag = "--" + name.replace("_", "-")
+    if value is True:
+        return flag
+    if isinstance(value, (list, tuple)):
+        value = ",".join(str(v) for v in value)
+    return f"{flag}={value}"
+
+
+def _flags(**kwargs: Any) -> list:
+    return [f for f in (_flag(k, v) for k, v in kwargs.items()) if f is not None]
+
+
+def _as_float32(a: Any, what: str, axes: str) -> np.ndarray:
+    """``a`` as a C-ordered float32 array of 5 axes; converted (and said) if it is not."""
+    arr = np.asarray(a)
+    if arr.dtype.kind not in "fiu":
+        raise ValueError(f"{what}: dtype {arr.dtype} is not a real number type (want float32)")
+    if arr.ndim != 5:
+        raise ValueError(f"{what}: want 5 axes {axes}, got {arr.ndim} of shape {arr.shape}")
+    if arr.dtype != np.float32 or not arr.flags.c_contiguous:
+        how = []
+        if arr.dtype != np.float32:
+            how.append(f"{arr.dtype} to float32")
+        if not arr.flags.c_contiguous:
+            how.append("to C order")
+        warnings.warn(f"slf: {what} converted ({', '.join(how)}): a copy", stacklevel=3)
+        arr = np.ascontiguousarray(arr, dtype=np.float32)
+    return arr
+
+
+class Capture:
+    """A capture: the raw frames of k snapshots and their description.
+
+    ``frames`` is a ``(k, rows, cols)`` uint16 array (the sensor's values, black level
+    included); ``description`` the dict of ``capture.json`` (lenslets, views, bands, mask,
+    levels, noise, defective pixels). Made by :func:`simulate`, read by
+    :func:`load_capture`, written by :meth:`save` as the folder ``slf simulate`` writes and
+    ``slf decode`` reads. Constructing one checks the frames against the description.
+    """
+
+    def __init__(self, frames: np.ndarray, description: Dict[str, Any]):
+        frames = np.asarray(frames)
+        if frames.dtype != np.uint16:
+            raise ValueError(f"frames: dtype {frames.dtype}, want uint16 (raw sensor values)")
+        frames = np.ascontiguousarray(frames)
+        text = _slf.check_capture(frames, json.dumps(description))
+        self.frames: np.ndarray = frames
+        self.description: Dict[str, Any] = json.loads(text)
+
+    @property
+    def snapshots(self) -> int:
+        """k, the number of frames."""
+        return int(self.frames.shape[0])
+
+    @property
+    def lenslets(self) -> Tuple[int, int]:
+        """Lenslet rows and columns (H, W of the decoded light field)."""
+        r, c = self.description["lenslets"]
+        return int(r), int(c)
+
+    @property
+    def views(self) -> Tuple[int, int]:
+        """Views per lenslet, rows and columns (U, V)."""
+        u, v = self.description["views"]
+        return int(u), int(v)
+
+    def save(self, path: PathLike) -> None:
+        """Writes the capture folder ``path`` (``capture.json`` and one frame file per
+        snapshot, in the format its names say), as ``slf simulate -o path`` does."""
+        _slf.save_capture(self.frames, json.dumps(self.description), os.fspath(path))
+
+    def __repr__(self) -> str:
+        mask = self.description.get("mask", {}).get("family", "?")
+        return (
+            f"Capture(k={self.snapshots}, lenslets={self.lenslets}, views={self.views}, "
+            f"mask={mask!r}, frames={self.frames.shape[1]}x{self.frames.shape[2]} uint16)"
+        )
+
+
+def _from_parts(parts: Tuple[np.ndarray, str]) -> Capture:
+    frames, text = parts
+    c = Capture.__new__(Capture)
+    c.frames = frames
+    c.description = json.loads(text)
+    return c
+
+
+def scene(name: str, size: int = 100, views: int = 5, seed: int = 0) -> np.ndarray:
+    """A test scene as ``slf scene`` renders it: ``(views, views, size, size, 13)`` float32.
+
+    ``name``: a test scene (smooth, texture, depth, saturated, dark), a realistic one
+    (outdoor, tungsten, office, led), ``random`` (a training scene of the shipped ensemble)
+    or ``realistic`` (slanted and curved surfaces, 1/f textures, measured spectra), the last
+    two drawn from ``seed``.
+    """
+    for n, v in (("size", size), ("views", views), ("seed", seed)):
+        if not isinstance(v, (int, np.integer)) or v < 0:
+            raise ValueError(f"{n}: want a whole number at or above 0, got {v!r}")
+    if not 1 <= size <= 4096:
+        raise ValueError(f"size {size}: want 1..=4096 (as `slf scene --size`)")
+    if not 1 <= views <= 16:
+        raise ValueError(f"views {views}: want 1..=16 (as `slf scene --views`)")
+    return _slf.scene(name, int(size), int(views), int(seed))
+
+
+def simulate(
+    lf: np.ndarray,
+    mask: str = "pixel",
+    k: int = 1,
+    seed: int = 1,
+    noise: bool = True,
+    *,
+    read_noise: Optional[float] = None,
+    full_well: Optional[float] = None,
+    defects: Optional[float] = None,
+    wavelengths: Optional[str] = None,
+    format: Optional[str] = None,
+) -> Capture:
+    """Records the light field ``lf`` ``(U, V, H, W, B)`` with the camera, as ``slf simulate``.
+
+    ``mask``: pixel, lenslet or kronecker; ``k``: snapshots (1..=13); ``seed``: the mask's,
+    the noise's and the defects'; ``noise=False`` is ``--no-noise``. ``read_noise`` (DN,
+    default 2), ``full_well`` (electrons at white, default 20000), ``defects`` (fraction of
+    defective pixels, default 0), ``wavelengths`` (of ``lf``'s bands when it does not have
+    the camera's 13: ``"START:STOP:STEP"`` or a comma list, nm) and ``format`` (of the frame
+    files :meth:`Capture.save` writes: pgm, png, npy) as the command's flags.
+    """
+    arr = _as_float32(lf, "lf", "(U, V, H, W, B)")
+    args = _flags(
+        mask=mask,
+        snapshots=k,
+        seed=seed,
+        no_noise=not noise,
+        read_noise=read_noise,
+        full_well=full_well,
+        defects=defects,
+        wavelengths=wavelengths,
+        format=format,
+    )
+    frames, text, notes = _slf.simulate(arr, args)
+    for n in notes:
+        warnings.warn(f"slf: {n}", stacklevel=2)
+    return _from_parts((frames, text))
+
+
+def load_capture(path: PathLike) -> Capture:
+    """Reads a capture folder (``capture.json`` and its frames) as ``slf decode`` does."""
+    p = os.fspath(path)
+    if not os.path.isdir(p):
+        raise FileNotFoundError(f"{p}: no such capture folder")
+    return _from_parts(_slf.load_capture(p))
+
+
+def _progress_callback(progress: Any) -> Optional[Callable[[int, int], None]]:
+    """``progress`` as a ``(done, total)`` callback: a callable as is, True a tqdm bar
+    (a line on stderr without tqdm), None or False nothing."""
+    if progress is None or progress is False:
+        return None
+    if callable(progress):
+        return progress
+    try:
+        from tqdm.auto import tqdm  # type: ignore
+    except ImportError:
+        tqdm = None
+    state: Dict[str, Any] = {}
+
+    def update(done: int, total: int) -> None:
+        if tqdm is not None:
+            bar = state.get("bar")
+            if bar is None or bar.total != total:
+                if bar is not None:
+                    bar.close()
+                bar = state["bar"] = tqdm(total=total, unit="tile", desc="decoding")
+            bar.update(done - bar.n)
+            if done == total:
+                bar.close()
+        else:
+            sys.stderr.write(f"\rdecoding {done}/{total} tiles")
+            if done == total:
+                sys.stderr.write("\n")
+            sys.stderr.flush()
+
+    return update
+
+
+def decode(
+    capture: Union[Capture, PathLike],
+    method: str = "cs",
+    preset: str = "default",
+    *,
+    stride: Optional[int] = None,
+    window: Optional[str] = None,
+    disparities: Union[None, str, Sequence[float]] = None,
+    edge_fallback: Optional[bool] = None,
+    dictionary: Optional[str] = None,
+    choice: Optional[str] = None,
+    blob: Optional[PathLike] = None,
+    balance: Optional[str] = None,
+    gains: Optional[Sequence[float]] = None,
+    adaptive: Optional[float] = None,
+    sigma_f: Optional[float] = None,
+    steps: Optional[int] = None,
+    mu: Optional[float] = None,
+    sigma_min: Optional[float] = None,
+    max_iterations: Optional[int] = None,
+    noise: Optional[float] = None,
+    shot: Optional[float] = None,
+    exact: bool = False,
+    tolerance: Optional[float] = None,
+    warm_start: Optional[float] = None,
+    warm_sigma_f: Optional[float] = None,
+    warm_steps: Optional[int] = None,
+    cold_start: Optional[float] = None,
+    flat: Optional[float] = None,
+    min_bands: Optional[int] = None,
+    threads: Optional[int] = None,
+    progress: Any = None,
+    report: bool = False,
+) -> Union[np.ndarray, Tuple[np.ndarray, Dict[str, Any]]]:
+    """Decodes a capture (or a capture folder's path) as ``slf decode`` does, bit for bit.
+
+    Returns the light field ``(U, V, H, W, 13)`` float32, or with ``report=True`` the pair
+    ``(light field, report)``: a dict of patches decoded / flagged / failed, tiles, solves,
+    steps, band gains, seconds, the per-lenslet disparity map (``report["disparity"]``, an
+    array, or None when no disparity was searched) and a ``warning`` when over 1 % of the
+    patches failed or were flagged.
+
+    ``method``: cs (compressed sensing), interpolate, demosaic or ppid (baselines).
+    ``preset``: preview (fast), default or best; any keyword below overrides the preset's
+    value. The keywords are ``slf decode``'s flags (see ``slf decode --help``):
+    ``stride`` 1..=5, ``window`` uniform or tapered, ``disparities`` ``"MIN:MAX[:STEP]"``
+    or ``(min, max[, step])``, ``edge_fallback``, ``dictionary`` dct or ensemble,
+    ``choice``, ``blob`` (an ensemble file), ``balance`` grey or off, ``gains`` (13),
+    ``adaptive`` and the solver's ``sigma_f`` ... ``min_bands``.
+
+    ``threads``: threads of this decode (None: one per core; 1 inside a Dask task).
+    ``progress``: True for a bar (tqdm if installed), or a callable ``f(done, total)``
+    called after each tile, from the decode's threads. The GIL is released while decoding.
+    """
+    cap = capture if isinstance(capture, Capture) else load_capture(capture)
+    if isinstance(disparities, (list, tuple)):
+        disparities = ":".join(f"{d:g}" for d in disparities)
+    if edge_fallback is not None:
+        edge_fallback = "true" if edge_fallback else "false"  # type: ignore[assignment]
+    if blob is not None:
+        blob = os.fspath(blob)
+    args = _flags(
+        method=method,
+        preset=preset,
+        stride=stride,
+        window=window,
+        disparities=disparities,
+        edge_fallback=edge_fallback,
+        dictionary=dictionary,
+        choice=choice,
+        blob=blob,
+        balance=balance,
+        gains=gains,
+        adaptive=adaptive,
+        sigma_f=sigma_f,
+        steps=steps,
+        mu=mu,
+        sigma_min=sigma_min,
+        max_iterations=max_iterations,
+        noise=noise,
+        shot=shot,
+        exact=exact,
+        tolerance=tolerance,
+        warm_start=warm_start,
+        warm_sigma_f=warm_sigma_f,
+        warm_steps=warm_steps,
+        cold_start=cold_start,
+        flat=flat,
+        min_bands=min_bands,
+    )
+    lf, rep = _slf.decode(cap.frames, json.dumps(cap.description), args, threads, _progress_callback(progress))
+    if "warning" in rep:
+        warnings.warn(f"slf: {rep['warning']}", stacklevel=2)
+    return (lf, rep) if report else lf
+
+
+def evaluate(truth: np.ndarray, recon: np.ndarray) -> Dict[str, float]:
+    """PSNR (dB, data range = max of ``truth``), SSIM and spectral angle (degrees) of
+    ``recon`` against ``truth``, both ``(U, V, H, W, B)``, as ``slf eval``:
+    ``{"psnr", "ssim", "sa", "data_range"}``."""
+    t = _as_float32(truth, "truth", "(U, V, H, W, B)")
+    r = _as_float32(recon, "recon", "(U, V, H, W, B)")
+    if t.shape != r.shape:
+        raise ValueError(f"shapes differ: truth {t.shape}, recon {r.shape}")
+    return dict(_slf.evaluate(t, r))
+
+
+def _imported(out: Tuple[np.ndarray, Optional[np.ndarray], list], source: str, with_disparity: bool) -> Any:
+    lf, disparity, notes = out
+    for n in notes:
+        warnings.warn(f"slf: {source}: {n}", stacklevel=3)
+    return (lf, disparity) if with_disparity else lf
+
+
+def import_views(
+    folder: PathLike,
+    *,
+    pattern: Optional[str] = None,
+    index_base: Optional[int] = None,
+    grid: Optional[Tuple[int, int]] = None,
+    views: Optional[Tuple[int, int]] = None,
+    start: Optional[Tuple[int, int]] = None,
+    crop: Optional[Tuple[int, int, int, int]] = None,
+    resize: Optional[Tuple[int, int]] = None,
+    fill: Optional[str] = None,
+    linear: bool = False,
+    disparity: Optional[PathLike] = None,
+    max_disparity: Optional[float] = None,
+    with_disparity: bool = False,
+) -> Any:
+    """A folder of RGB views as the camera's 13 bands, as ``slf import views``:
+    ``(U, V, H, W, 13)`` float32, or ``(light field, disparity)`` with
+    ``with_disparity=True`` (the centre view's disparity map, or None).
+
+    HCI benchmark naming unless ``pattern`` (``"view_{row:02}_{col:02}.png"``);
+    ``grid`` the full view grid (default 9, 9), ``views`` the window read (default 5, 5),
+    ``start`` its first view (default centred), ``crop`` (row, col, rows, cols) and
+    ``resize`` (rows, cols) in pixels, ``fill="warp"`` to make missing views.
+    """
+    args = [os.fspath(folder)] + _flags(
+        pattern=pattern,
+        index_base=index_base,
+        grid=grid,
+        views=views,
+        start=start,
+        crop=crop,
+        resize=resize,
+        fill=fill,
+        linear=linear,
+        disparity=None if disparity is None else os.fspath(disparity),
+        max_disparity=max_disparity,
+    )
+    return _imported(_slf.import_views(args), os.fspath(folder), with_disparity)
+
+
+def import_cube(
+    input: PathLike,
+    *,
+    wavelengths: Optional[str] = None,
+    white: Optional[float] = None,
+    light: Optional[str] = None,
+    views: Optional[Tuple[int, int]] = None,
+    disparity: Optional[float] = None,
+    disparity_map: Optional[PathLike] = None,
+    crop: Optional[Tuple[int, int, int, int]] = None,
+    resize: Optional[Tuple[int, int]] = None,
+    with_disparity: bool = False,
+) -> Any:
+    """A hyperspectral cube (an ``(H, W, B)`` .npy, or a folder of band images) as a light
+    field of the camera's 13 bands, its views made by a disparity, as ``slf import cube``.
+
+    ``wavelengths`` of the cube's bands (``"START:STOP:STEP"`` or a comma list, nm),
+    ``white`` the value of a perfect white, ``light`` reflectance (lit by D65) or radiance,
+    ``views`` (U, V), ``disparity`` a plane's (pixels per view step) or ``disparity_map``
+    a .pfm of the cube's size.
+    """
+    args = [os.fspath(input)] + _flags(
+        wavelengths=wavelengths,
+        white=white,
+        light=light,
+        views=views,
+        disparity=disparity,
+        disparity_map=None if disparity_map is None else os.fspath(disparity_map),
+        crop=crop,
+        resize=resize,
+    )
+    return _imported(_slf.import_cube(args), os.fspath(input), with_disparity)

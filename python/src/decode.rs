@@ -1,0 +1,98 @@
+//! The decode: `slf decode`'s flags ([`DecodeSettings`]) on a capture held in numpy, with
+//! the GIL released, on a thread pool of the caller's size, and a progress callback.
+
+use std::sync::Mutex;
+
+use numpy::{PyArrayDyn, PyReadonlyArrayDyn};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use slf_host::decode::cs::disparity_per_lenslet;
+use slf_host::decode::settings::{DecodeSettings, Outcome};
+
+use crate::arrays::{plane, to_array};
+use crate::capture::from_parts;
+use crate::errors::{OrPy, flags};
+
+/// Decodes the capture `(frames, description JSON)` with `slf decode`'s flags `args`:
+/// `(light field, report)`. `threads`: the decode's threads (`None`: one per core);
+/// `progress(done, total)` is called from the worker threads after each tile.
+#[pyfunction]
+#[pyo3(signature = (frames, description, args, threads=None, progress=None))]
+pub fn decode<'py>(
+    py: Python<'py>,
+    frames: PyReadonlyArrayDyn<'py, u16>,
+    description: &str,
+    args: Vec<String>,
+    threads: Option<usize>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<(Bound<'py, PyArrayDyn<f32>>, Bound<'py, PyDict>)> {
+    let settings = DecodeSettings::from_flags(&args).map_err(flags)?;
+    let capture = from_parts(&frames, description)?;
+    if threads == Some(0) {
+        return Err(PyValueError::new_err("threads: at least 1 (None: one per core)"));
+    }
+    // The first exception the callback raised; the decode runs on, and it is raised after.
+    let raised: Mutex<Option<PyErr>> = Mutex::new(None);
+    let observer = |done: usize, total: usize| {
+        if let Some(cb) = &progress {
+            Python::attach(|py| {
+                if let Err(e) = cb.call1(py, (done, total)) {
+                    raised.lock().map(|mut r| r.get_or_insert(e).clone_ref(py)).ok();
+                }
+            });
+        }
+    };
+    let decoded = py
+        .detach(|| {
+            let run = || settings.run(&capture, false, &observer);
+            match threads {
+                None => run(),
+                Some(n) => rayon::ThreadPoolBuilder::new()
+                    .num_threads(n)
+                    .build()
+                    .map_err(|e| anyhow::anyhow!("threads: {e}"))
+                    .and_then(|pool| pool.install(run)),
+            }
+        })
+        .or_py()?;
+    if let Some(e) = raised.lock().ok().and_then(|mut r| r.take()) {
+        return Err(e);
+    }
+    let report = PyDict::new(py);
+    if let Some(w) = decoded.warning() {
+        report.set_item("warning", w)?;
+    }
+    let d = &capture.description;
+    match &decoded.outcome {
+        Outcome::Baseline { method, report: r } => {
+            report.set_item("method", format!("{method:?}").to_lowercase())?;
+            report.set_item("measured", r.measured)?;
+            report.set_item("filled", r.filled)?;
+            report.set_item("seconds", r.seconds)?;
+        }
+        Outcome::Cs { options, report: r } => {
+            report.set_item("method", "cs")?;
+            report.set_item("preset", settings.preset.name())?;
+            report.set_item("decoded", r.patches.decoded)?;
+            report.set_item("flagged", r.patches.flagged)?;
+            report.set_item("failed", r.patches.failed)?;
+            report.set_item("tiles", r.tiles)?;
+            report.set_item("failed_tiles", r.failed_tiles)?;
+            report.set_item("solves", r.solves)?;
+            report.set_item("steps", r.steps)?;
+            report.set_item("filled", r.filled)?;
+            report.set_item("gains", r.gains.to_vec())?;
+            report.set_item("seconds", r.seconds)?;
+            report.set_item("stride", options.stride.0)?;
+            if options.disparities_for(&capture).is_off() {
+                report.set_item("disparity", py.None())?;
+            } else {
+                let (rows, cols) = (d.lenslets[0], d.lenslets[1]);
+                let map = disparity_per_lenslet(&r.disparity_map, rows, cols);
+                report.set_item("disparity", plane(py, map, rows, cols)?)?;
+            }
+        }
+    }
+    Ok((to_array(py, decoded.light_field)?, report))
+}

@@ -1,0 +1,44 @@
+//! Light fields to record: the named scenes of `slf scene`, and the camera of
+//! `slf simulate` ([`SimulateSettings`], the command's own flags).
+
+use numpy::{PyArrayDyn, PyReadonlyArrayDyn};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use slf_host::sim::realistic;
+use slf_host::sim::scene::SceneSize;
+use slf_host::sim::settings::SimulateSettings;
+
+use crate::arrays::{light_field, to_array};
+use crate::capture::to_parts;
+use crate::errors::{OrPy, flags};
+
+/// Renders a scene `(U, V, H, W, 13)`: `name` as `slf scene` takes it.
+#[pyfunction]
+pub fn scene<'py>(
+    py: Python<'py>,
+    name: &str,
+    size: usize,
+    views: usize,
+    seed: u64,
+) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
+    let s = realistic::by_name(name, seed).or_py()?;
+    let shape = SceneSize { views: (views, views), rows: size, cols: size };
+    shape.check().map_err(|e| PyValueError::new_err(format!("size {size} with views {views}: {e}")))?;
+    let lf = py.detach(|| s.render(shape));
+    to_array(py, lf)
+}
+
+/// Records `lf` with the camera `slf simulate` would use with these flags: `(frames,
+/// description JSON, notes)`.
+#[pyfunction]
+pub fn simulate<'py>(
+    py: Python<'py>,
+    lf: PyReadonlyArrayDyn<'py, f32>,
+    args: Vec<String>,
+) -> PyResult<(Bound<'py, PyArrayDyn<u16>>, String, Vec<String>)> {
+    let settings = SimulateSettings::from_flags(&args).map_err(flags)?;
+    let lf = light_field(&lf, "lf")?;
+    let simulated = py.detach(|| settings.run(lf, "lf")).or_py()?;
+    let (frames, json) = to_parts(py, simulated.capture)?;
+    Ok((frames, json, simulated.notes))
+}

@@ -1,0 +1,75 @@
+"""Many captures on a local Dask cluster of 2 worker processes (loopback only): every
+output equals the single-process decode, a broken capture is reported and loses nothing
+else, and the documented example script does the same."""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import slf
+import slf.batch
+
+from dask import distributed
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "decode_folder.py"
+
+
+@pytest.fixture(scope="module")
+def folder(tmp_path_factory, depth):
+    """Four captures of the depth scene (seeds 1..4) and one with a truncated frame."""
+    root = tmp_path_factory.mktemp("captures")
+    for seed in range(1, 5):
+        slf.simulate(depth, k=1, seed=seed).save(root / f"cap{seed}")
+    slf.simulate(depth, k=1, seed=9).save(root / "broken")
+    (root / "broken" / "snapshot_0.pgm").write_bytes(b"P5\n100 100\n65535\n" + b"\x00" * 10)
+    return root
+
+
+def expected(folder, name):
+    return slf.decode(folder / name, preset="preview", threads=1)
+
+
+def test_local_cluster_matches_single_process(folder, tmp_path):
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None
+    ) as cluster, distributed.Client(cluster) as client:
+        assert len(client.scheduler_info()["workers"]) == 2
+        seen = []
+        results = slf.batch.decode_folder(folder, tmp_path / "out", client, on_result=seen.append, preset="preview")
+    assert [r.name for r in results] == ["broken", "cap1", "cap2", "cap3", "cap4"]
+    assert sorted(r.name for r in seen) == sorted(r.name for r in results)
+    broken, good = results[0], results[1:]
+    assert not broken.ok and "snapshot_0.pgm" in broken.error and broken.output is None
+    assert not (tmp_path / "out" / "broken.npy").exists()
+    for r in good:
+        assert r.ok, r.error
+        assert np.array_equal(np.load(r.output), expected(folder, r.name)), r.name
+    # Different captures, different light fields: the outputs are not one file four times.
+    assert not np.array_equal(np.load(good[0].output), np.load(good[1].output))
+
+
+def test_in_process_without_a_client(folder, tmp_path):
+    results = slf.batch.decode_folder([folder / "cap1", folder / "broken"], tmp_path, preset="preview")
+    assert [r.ok for r in results] == [True, False]
+    assert np.array_equal(np.load(results[0].output), expected(folder, "cap1"))
+
+
+def test_example_script(folder, tmp_path):
+    p = subprocess.run(
+        [sys.executable, str(EXAMPLE), str(folder), str(tmp_path), "--workers", "2", "--preset", "preview"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert p.returncode == 1, p.stdout + p.stderr  # one capture failed, the others decoded
+    assert "broken: FAILED" in p.stdout and "decoded 4 of 5 captures" in p.stdout, p.stdout
+    for seed in range(1, 5):
+        assert np.array_equal(np.load(tmp_path / f"cap{seed}.npy"), expected(folder, f"cap{seed}"))
+
+
+def test_no_captures_is_an_error(tmp_path):
+    with pytest.raises(ValueError, match="no capture folders"):
+        slf.batch.captures_in(tmp_path)

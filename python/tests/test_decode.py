@@ -1,0 +1,70 @@
+"""The decode from Python: threads, progress, reports, the GIL released."""
+
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import slf
+
+
+def test_threads_do_not_change_the_result(capture):
+    one = slf.decode(capture, preset="preview", threads=1)
+    two = slf.decode(capture, preset="preview", threads=2)
+    assert np.array_equal(one, two)
+
+
+def test_report(capture, depth):
+    lf, report = slf.decode(capture, preset="preview", report=True)
+    assert report["method"] == "cs" and report["preset"] == "preview"
+    assert report["decoded"] > 0 and report["failed"] == 0 and report["stride"] == 5
+    assert len(report["gains"]) == 13 and report["seconds"] > 0
+    assert report["disparity"].shape == (20, 20)
+    _, off = slf.decode(capture, preset="preview", disparities="0:0", report=True)
+    assert off["disparity"] is None
+    assert slf.evaluate(depth, lf)["psnr"] > 20
+
+
+def test_progress_callback(capture):
+    calls = []
+    slf.decode(capture, preset="preview", progress=lambda done, total: calls.append((done, total)))
+    assert calls, "the callback was never called"
+    total = calls[0][1]
+    assert sorted(d for d, _ in calls) == list(range(1, total + 1))
+    assert all(t == total for _, t in calls)
+
+
+def test_progress_errors_are_raised(capture):
+    def boom(done, total):
+        raise RuntimeError("stop here")
+
+    with pytest.raises(RuntimeError, match="stop here"):
+        slf.decode(capture, preset="preview", progress=boom)
+
+
+def test_gil_is_released(capture):
+    """Another Python thread runs while a decode is under way."""
+    ticks = []
+    stop = threading.Event()
+
+    def tick():
+        while not stop.is_set():
+            ticks.append(time.perf_counter())
+            time.sleep(0.001)
+
+    t = threading.Thread(target=tick)
+    t.start()
+    start = time.perf_counter()
+    slf.decode(capture, threads=1)
+    end = time.perf_counter()
+    stop.set()
+    t.join()
+    during = [x for x in ticks if start < x < end]
+    assert len(during) >= 5, f"{len(during)} ticks in a {end - start:.2f} s decode"
+
+
+def test_baseline_report(capture):
+    lf, report = slf.decode(capture, method="demosaic", report=True)
+    assert report["method"] == "demosaic" and report["measured"] > 0
+    assert lf.shape == (5, 5, 20, 20, 13)

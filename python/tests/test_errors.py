@@ -1,0 +1,105 @@
+"""Bad input raises a clear, one-line exception: ValueError for values and shapes (the axis
+named), OSError for files; odd but valid input (float64, Fortran order, views) is converted."""
+
+import json
+import warnings
+
+import numpy as np
+import pytest
+
+import slf
+
+
+def test_wrong_axes_are_named(depth):
+    with pytest.raises(ValueError, match=r"want 5 axes \(U, V, H, W, B\), got 4"):
+        slf.simulate(depth[0])
+    with pytest.raises(ValueError, match=r"frames: want 3 axes \(snapshots, rows, cols\)"):
+        slf.Capture(np.zeros((100, 100), np.uint16), {})
+
+
+def test_band_count_needs_wavelengths(depth):
+    with pytest.raises(ValueError, match="12 bands; the camera has 13.*wavelengths"):
+        slf.simulate(depth[..., :12])
+
+
+def test_nan_is_refused_with_its_place(depth):
+    bad = depth.copy()
+    bad[1, 2, 3, 4, 5] = np.nan
+    bad[4, 4, 4, 4, 4] = np.inf
+    with pytest.raises(ValueError, match=r"2 values are NaN or infinite, the first at \(u, v, h, w, b\) = \(1, 2, 3, 4, 5\)"):
+        slf.simulate(bad)
+    with pytest.raises(ValueError, match="recon: 2 values are NaN"):
+        slf.evaluate(depth, bad)
+
+
+def test_wrong_dtypes(depth, capture):
+    with pytest.raises(ValueError, match="dtype <U1 is not a real number type"):
+        slf.simulate(np.full(depth.shape, "a"))
+    with pytest.raises(ValueError, match="frames: dtype float32, want uint16"):
+        slf.Capture(capture.frames.astype(np.float32), capture.description)
+
+
+def test_float64_fortran_and_views_are_converted_once(depth):
+    ref = slf.simulate(depth)
+    for odd in (depth.astype(np.float64), np.asfortranarray(depth), depth[:, :, ::1, :, :]):
+        with warnings.catch_warnings(record=True) as w:
+            warnings.simplefilter("always")
+            got = slf.simulate(odd)
+        assert np.array_equal(got.frames, ref.frames)
+        assert len(w) == int(odd.dtype != np.float32 or not odd.flags.c_contiguous)
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
+        slf.simulate(np.asfortranarray(depth.astype(np.float64)))
+    assert len(w) == 1 and "float64 to float32, to C order" in str(w[0].message)
+
+
+def test_missing_files_are_oserrors(tmp_path):
+    with pytest.raises(FileNotFoundError, match="no such capture folder"):
+        slf.load_capture(tmp_path / "nothing")
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(OSError):
+        slf.load_capture(tmp_path / "empty")
+    with pytest.raises(OSError):
+        slf.import_cube(tmp_path / "nothing.npy", wavelengths="400:700:10")
+
+
+def test_a_broken_capture_is_named(tmp_path, capture):
+    capture.save(tmp_path / "c")
+    (tmp_path / "c" / "snapshot_0.pgm").write_bytes(b"P5\n3 3\n65535\n")
+    with pytest.raises(ValueError, match="snapshot_0.pgm"):
+        slf.load_capture(tmp_path / "c")
+    d = dict(capture.description, lenslets=[21, 20])
+    with pytest.raises(ValueError, match="frame 0"):
+        slf.Capture(capture.frames, d)
+    with pytest.raises(ValueError, match="invalid capture description"):
+        slf.Capture(capture.frames, {"format": "slf-capture"})
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"stride": 7}, "--stride"),
+        ({"preset": "fast"}, "invalid value 'fast' for '--preset"),
+        ({"method": "magic"}, "--method"),
+        ({"disparities": "5:1"}, "MIN:MAX"),
+        ({"gains": [1.0, 2.0]}, "--gains: 13 values, got 2"),
+        ({"mu": -1.0}, "mu"),
+        ({"threads": 0}, "threads: at least 1"),
+        ({"window": "round"}, "--window"),
+    ],
+)
+def test_bad_decode_settings(capture, kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        slf.decode(capture, **kwargs)
+
+
+def test_shapes_differ_in_evaluate(depth):
+    with pytest.raises(ValueError, match="shapes differ"):
+        slf.evaluate(depth, depth[:, :, :10])
+
+
+def test_scene_arguments():
+    with pytest.raises(ValueError, match="unknown scene \"nope\""):
+        slf.scene("nope")
+    with pytest.raises(ValueError, match="size 0"):
+        slf.scene("depth", size=0)
