@@ -15,12 +15,17 @@
 //! - [`sim`]: the simulator: spectra ([`sim::spectra`]), synthetic test scenes
 //!   ([`sim::scene`]) and scenes that look like the world ([`sim::realistic`]), and the
 //!   camera model ([`sim::camera`]) that turns a light field into raw frames with the
-//!   firmware's masks, noise, black level, quantisation, saturation and defects.
+//!   firmware's masks, noise, black level, quantisation, saturation and defects; the flags
+//!   of `slf simulate` and `slf import` ([`sim::settings`], [`sim::import`]).
 //! - [`decode`]: the firmware's tile decoder over a capture in parallel ([`decode::cs`]),
 //!   the baselines a user would pick instead of compressed sensing ([`decode::baselines`]),
 //!   the paper's 1D method ([`decode::paper_1d`]), the device binary's capture and check
-//!   ([`decode::device`]), and the named decodes `preview`, `default`, `best`
-//!   ([`decode::preset`]).
+//!   ([`decode::device`]), the named decodes `preview`, `default`, `best`
+//!   ([`decode::preset`]) and `slf decode`'s flags ([`decode::settings`]).
+//!
+//! The `settings` types are `clap` argument groups that parse from strings as well, so the
+//! `slf` command and the Python package (`python/`) take the same flags with the same
+//! defaults, ranges and messages.
 //! - [`train`]: learning a dictionary ensemble into a firmware blob.
 //! - [`eval`]: metrics (PSNR, SSIM, SA), sRGB previews, every method on light fields a user
 //!   brings ([`eval::evaluation`]), the tables of `slf demo`, `sweep` and `compare`
