@@ -37,7 +37,23 @@ for w in 1 2; do
   rows="$rows| $w | $n | $secs | $rate | $speedup |"$'\n'
 done
 
-table="| workers (1 thread each) | captures | seconds | captures / s | against 1 worker |
+# Without Dask: one process, each decode on every core (rayon), one capture after another.
+alone=$("$py" - "$dir/captures" "$dir/alone" "$preset" <<'PY'
+import sys, time
+import slf.batch
+start = time.perf_counter()
+results = slf.batch.decode_folder(sys.argv[1], sys.argv[2], preset=sys.argv[3], threads=None)
+wall = time.perf_counter() - start
+assert all(r.ok for r in results), [r.error for r in results if not r.ok]
+print(f"{wall:.2f} {len(results) / wall:.3f}")
+PY
+)
+secs=${alone% *}
+rate=${alone#* }
+speedup=$(awk -v r="$rate" -v b="$base" 'BEGIN { printf "%.2f", r / b }')
+rows="$rows| none: one process, each decode on all $(nproc) cores | $n | $secs | $rate | $speedup |"$'\n'
+
+table="| Dask workers (1 thread each) | captures | seconds | captures / s | against 1 worker |
 | --- | --- | --- | --- | --- |
 ${rows}
 $n realistic scenes of $size x $size lenslets (5 x 5 views), pixel mask, k = 1, preset \`$preset\`,
