@@ -14,7 +14,7 @@ use std::path::PathBuf;
 use anyhow::{Result, anyhow, bail, ensure};
 use clap::{Args, FromArgMatches, ValueEnum};
 use slf_firmware::disparity::MAX_DISPARITY;
-use slf_firmware::{ChoiceRule, DEFAULT_ENSEMBLE, DisparityRange, MemberChoice, Sl0Config, gains};
+use slf_firmware::{ChoiceRule, DEFAULT_ENSEMBLE, DisparityRange, MemberChoice, Sl0Config, SolveError, gains};
 
 use crate::decode::baselines::{Baseline, BaselineReport};
 use crate::decode::cs::{
@@ -254,8 +254,40 @@ impl SolverSettings {
             flat: self.flat,
             min_bands: self.min_bands,
         };
-        c.validate().map_err(|e| anyhow!("{e}"))?;
-        Ok(c)
+        match c.validate() {
+            Ok(()) => Ok(c),
+            Err(SolveError::InvalidConfig { field }) => {
+                let value = match field {
+                    "sigma_f" => c.sigma_f.to_string(),
+                    "steps" => c.steps.to_string(),
+                    "mu" => c.mu.to_string(),
+                    "sigma_min" => c.sigma_min.to_string(),
+                    "max_iterations" => c.max_iterations.to_string(),
+                    "noise" => c.noise.to_string(),
+                    "shot" => c.shot.to_string(),
+                    "tolerance" => c.tolerance.to_string(),
+                    "warm_start" => c.warm_start.to_string(),
+                    "warm_sigma_f" => c.warm_sigma_f.to_string(),
+                    "warm_steps" => c.warm_steps.to_string(),
+                    "cold_start" => c.cold_start.to_string(),
+                    "flat" => c.flat.to_string(),
+                    _ => String::from("?"),
+                };
+                bail!("--{} {value}: must be {}", field.replace('_', "-"), config_range(field))
+            }
+            Err(e) => bail!("{e}"),
+        }
+    }
+}
+
+/// The range [`Sl0Config::validate`] holds `field` to, in words.
+fn config_range(field: &str) -> &'static str {
+    match field {
+        "sigma_f" | "warm_sigma_f" => "in (0, 1)",
+        "warm_start" | "cold_start" => "in (0, 1]",
+        "steps" | "warm_steps" | "max_iterations" => "at least 1",
+        "mu" | "sigma_min" => "finite and above 0",
+        _ => "finite and at or above 0",
     }
 }
 
@@ -512,6 +544,13 @@ mod tests {
         }
         let s = DecodeSettings::from_flags(["--gains", "1,2"]).unwrap();
         assert_eq!(s.resolve().unwrap_err().to_string(), "--gains: 13 values, got 2");
+        // A solver value out of its range: the flag, the value and the range.
+        let s = DecodeSettings::from_flags(["--sigma-f", "1.5"]).unwrap();
+        assert_eq!(s.resolve().unwrap_err().to_string(), "--sigma-f 1.5: must be in (0, 1)");
+        let s = DecodeSettings::from_flags(["--cold-start=0"]).unwrap();
+        assert_eq!(s.resolve().unwrap_err().to_string(), "--cold-start 0: must be in (0, 1]");
+        let s = DecodeSettings::from_flags(["--mu=-1"]).unwrap();
+        assert_eq!(s.resolve().unwrap_err().to_string(), "--mu -1: must be finite and above 0");
         let s = DecodeSettings::from_flags(["--adaptive=-1"]).unwrap();
         assert!(s.resolve().unwrap_err().to_string().starts_with("--adaptive -1"));
     }
