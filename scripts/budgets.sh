@@ -36,6 +36,9 @@ macs = int(re.search(r"transform macs (\d+)", log).group(1))
 stack = int(re.search(r"^stack peak bytes (\d+)", log, re.M).group(1))
 disjoint_stack = int(re.search(r"^disjoint stack peak bytes (\d+)", log, re.M).group(1))
 ws = int(re.search(r"workspace bytes (\d+)", log).group(1))
+# The device's workspace is the size firmware/tests/solver.rs pins on the host and the
+# README and crate docs give.
+assert ws == 67_744, f"the device's Workspace is {ws} B; firmware/tests/solver.rs, the README and lib.rs say 67,744"
 strip = int(re.search(r"strip bytes (\d+)", log).group(1))
 strip_cols = int(re.search(r"strip columns (\d+)", log).group(1))
 ov = re.search(r"overlap patches (\d+) bands (\d+) uncovered \d+ frame-patches (\d+)", log)
