@@ -167,7 +167,7 @@ fn previews_are_scaled_at_least_4x_and_labelled() {
     recon.data.iter_mut().enumerate().for_each(|(i, x)| *x += 0.01 * (i % 7) as f32);
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("preview.png");
-    slf_host::eval::preview::write_comparison(&p, &truth, &recon).unwrap();
+    slf_host::eval::preview::write_comparison(&p, &truth, &recon, "a label").unwrap();
     let img = image::open(&p).unwrap().into_rgb8();
     let (w, h) = (truth.cols as u32, truth.rows as u32);
     // Three panels, each at least 4x, with room for the labels and the colour bar.
@@ -176,6 +176,20 @@ fn previews_are_scaled_at_least_4x_and_labelled() {
     let text =
         (0..img.width()).flat_map(|x| (0..30).map(move |y| (x, y))).filter(|&(x, y)| img.get_pixel(x, y)[0] > 150);
     assert!(text.count() > 200, "no labels drawn");
+    // The method's label under the reconstruction (the middle panel): text there that an
+    // empty label does not draw.
+    let q = dir.path().join("unlabelled.png");
+    slf_host::eval::preview::write_comparison(&q, &truth, &recon, "").unwrap();
+    let bare = image::open(&q).unwrap().into_rgb8();
+    let s4 = 4.max(300u32.div_ceil(w.max(h)));
+    let (x0, y0) = (2 * 12 + w * s4, 34 + h * s4 + 8);
+    let bright = |im: &image::RgbImage| {
+        (x0..x0 + w * s4)
+            .flat_map(|x| (y0..y0 + 24).map(move |y| (x, y)))
+            .filter(|&(x, y)| im.get_pixel(x, y)[0] > 150)
+            .count()
+    };
+    assert!(bright(&img) > bright(&bare) + 20, "no label under the reconstruction");
     // The colour bar's ends: black at 0, white at full scale.
     let scale = 4.max(300u32.div_ceil(w.max(h)));
     let (bar_x, bar_y) = (3 * 12 + 2 * w * scale, 34 + h * scale + 10 + 7);

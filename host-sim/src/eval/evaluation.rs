@@ -133,7 +133,8 @@ pub fn evaluate_set(
                 );
                 if si == 0 {
                     let p = out.join(format!("{}_{}.png", slug(name), slug(&method)));
-                    write_comparison(&p, &central_crop(truth), &central_crop(&recon))?;
+                    let label = format!("{method}, {} k = {k}", format!("{family:?}").to_lowercase());
+                    write_comparison(&p, &central_crop(truth), &central_crop(&recon), &label)?;
                 }
                 rows.push(Row { scene: name.clone(), setting: (family, k), method, metrics, ms_per_patch: ms });
             }

@@ -73,11 +73,12 @@ fn heat(t: f64) -> Rgb<u8> {
 /// Writes a PNG of the central view: ground truth | reconstruction | error map (mean
 /// absolute error over bands, full scale = 10 % of the truth's maximum), each panel scaled
 /// up at least 4 times (nearest neighbour), labelled, with the error map's colour bar and
-/// its scale in the image.
+/// its scale in the image. `label` (the method, mask and k) is written under the
+/// reconstruction, so the image says what made it.
 ///
 /// # Errors
 /// Shapes that differ, or the file cannot be written.
-pub fn write_comparison(path: &Path, truth: &LightField, recon: &LightField) -> Result<()> {
+pub fn write_comparison(path: &Path, truth: &LightField, recon: &LightField, label: &str) -> Result<()> {
     use plotters::prelude::*;
     ensure!(truth.shape() == recon.shape(), "shapes differ");
     let e = exposure(truth);
@@ -120,6 +121,7 @@ pub fn write_comparison(path: &Path, truth: &LightField, recon: &LightField) -> 
         };
         text(&format!("ground truth, view ({u}, {v})"), x0[0], 8, &font)?;
         text("reconstruction", x0[1], 8, &font)?;
+        text(label, x0[1], top + ph + 12, &small)?;
         text("mean |error| over bands", x0[2], 8, &font)?;
         text("0", bar.0, bar.1 + bar.3 + 4, &small)?;
         let hi = format!("{full:.3} (10 % of max)");

@@ -61,7 +61,8 @@ pub fn demo(out: &Path, name: &str, size: usize, basis: &Basis) -> Result<()> {
         let (recon, m, r) = run_one(&truth, &cam, basis, true)?;
         println!("{}", row(name, "pixel", k, &m, r.seconds));
         write_npy(&out.join(format!("recon_k{k}.npy")), &recon, Dtype::F32)?;
-        write_comparison(&out.join(format!("preview_k{k}.png")), &truth, &recon)?;
+        let label = format!("{}, pixel k = {k}", basis.name());
+        write_comparison(&out.join(format!("preview_k{k}.png")), &truth, &recon, &label)?;
     }
     println!("PSNR data range = max of ground truth ({:.4}).", truth.max());
     println!(
