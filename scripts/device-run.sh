@@ -7,6 +7,6 @@ cd "$(dirname "$0")/.."
 mkdir -p target
 cargo build --release -p slf-host -q
 # The runner in .cargo/config.toml wraps qemu in `timeout`; semihosting exit 0 = success.
-cargo run --release -q -p slf-device --target thumbv7em-none-eabihf > target/device.log
+cargo run --profile device -q -p slf-device --target thumbv7em-none-eabihf > target/device.log
 grep -v '^data' target/device.log
 ./target/release/slf device-check target/device.log --capture firmware/device/capture

@@ -3,7 +3,7 @@
 //!
 //! Build for the camera's core, or run it in qemu (the runner in `.cargo/config.toml`):
 //!
-//!     cargo run --release -p slf-device --example frame_in_ram --target thumbv7em-none-eabihf
+//!     cargo run --profile device -p slf-device --example frame_in_ram --target thumbv7em-none-eabihf
 //!
 //! On the host (`cargo run -p slf-device --example frame_in_ram`) the same `decode` runs.
 #![cfg_attr(target_os = "none", no_std, no_main)]

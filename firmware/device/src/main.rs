@@ -12,7 +12,7 @@
 //! `scripts/wincount/wincount.c` counts instructions per transform and per patch. The
 //! stack is painted at start and scanned at the end for its peak depth.
 //!
-//! Run: `cargo run --release -p slf-device --target thumbv7em-none-eabihf` (qemu is the
+//! Run: `cargo run --profile device -p slf-device --target thumbv7em-none-eabihf` (qemu is the
 //! runner, see `.cargo/config.toml`). On the host this file builds to a stub that says so.
 #![cfg_attr(target_os = "none", no_std, no_main)]
 
