@@ -483,3 +483,23 @@ fn presets_are_their_flags_and_flags_override_them() {
     let (_, n_best) = decode("best.npy", &["--preset", "best"]);
     assert!(n_best > n_default && n_default > n_preview, "{n_best} / {n_default} / {n_preview}");
 }
+
+/// Where the results go is checked before the decode (issue 32, item 11): an output in a
+/// missing folder or a folder as a file is refused first, and a file that exists is left
+/// as it was when another output is refused.
+#[test]
+fn unwritable_outputs_are_refused_before_decoding() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    stdout(slf().args(["scene", "smooth", "--size", "10", "-o"]).arg(p("t.npy")));
+    stdout(slf().arg("simulate").arg(p("t.npy")).arg("-o").arg(p("cap")));
+    let e = failure(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("missing/x.npy")));
+    assert!(e.contains("cannot write") && e.contains("checked before decoding"), "{e}");
+    assert_eq!(e.matches("No such file").count(), 1, "said once: {e}");
+    let e = failure(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("out.npy")).arg("--member-map").arg(dir.path()));
+    assert!(e.contains("a folder"), "{e}");
+    assert!(!p("out.npy").exists(), "no output left behind");
+    std::fs::write(p("keep.npy"), b"old").unwrap();
+    failure(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("keep.npy")).arg("--disparity-map").arg(p("no/d.npy")));
+    assert_eq!(std::fs::read(p("keep.npy")).unwrap(), b"old");
+}

@@ -86,6 +86,10 @@ def test_a_broken_capture_is_named(tmp_path, capture):
         ({"mu": -1.0}, "mu"),
         ({"threads": 0}, "threads: at least 1"),
         ({"window": "round"}, "--window"),
+        ({"min_bands": 14}, "--min-bands 14: at most 13"),
+        ({"adaptive": 2.0, "stride": 5}, "--adaptive needs a stride below 5"),
+        ({"blob": "e.slfd", "dictionary": "dct"}, "--blob names an ensemble"),
+        ({"sigma_f": 1.5}, r"--sigma-f 1.5: must be in \(0, 1\)"),
     ],
 )
 def test_bad_decode_settings(capture, kwargs, message):

@@ -407,7 +407,25 @@ impl DecodeSettings {
             edge_fallback: self.edge_fallback.unwrap_or(base.edge_fallback),
             ..base
         };
-        Ok((self.basis.basis_for(self.preset)?, options))
+        // Flags the decode would otherwise ignore in silence.
+        let bands = PATCH_BANDS;
+        ensure!(
+            usize::from(options.sl0.min_bands) <= bands,
+            "--min-bands {}: at most {bands}, the patch's bands (above, every patch would be interpolated; 0 \
+             solves every patch)",
+            options.sl0.min_bands
+        );
+        ensure!(
+            self.adaptive.is_none() || options.stride != (5, 5),
+            "--adaptive needs a stride below 5: on the disjoint grid there are no shifted patches to choose"
+        );
+        let basis = self.basis.basis_for(self.preset)?;
+        ensure!(
+            self.basis.blob.is_none() || !matches!(basis, Basis::Dct),
+            "--blob names an ensemble, but this decode uses the DCT ({}): add --dictionary ensemble or drop --blob",
+            if self.basis.dictionary.is_some() { "--dictionary dct" } else { "--preset preview" }
+        );
+        Ok((basis, options))
     }
 
     /// Decodes `capture`. `progress` shows a bar on stderr once the decode has taken a
@@ -453,6 +471,9 @@ impl Decoded {
         })
     }
 }
+
+/// Bands of the decoder's patch (the camera's 13).
+const PATCH_BANDS: usize = 13;
 
 /// A decode warns when more than this fraction of patches failed or were flagged.
 pub const WARN_FRACTION: f64 = 0.01;
@@ -551,6 +572,19 @@ mod tests {
         assert_eq!(s.resolve().unwrap_err().to_string(), "--cold-start 0: must be in (0, 1]");
         let s = DecodeSettings::from_flags(["--mu=-1"]).unwrap();
         assert_eq!(s.resolve().unwrap_err().to_string(), "--mu -1: must be finite and above 0");
+        // Flags that would be ignored are refused (issue 32, items 5 and 9).
+        for (flags, says) in [
+            (&["--min-bands", "14"][..], "--min-bands 14: at most 13"),
+            (&["--adaptive", "2", "--stride", "5"][..], "--adaptive needs a stride below 5"),
+            (&["--adaptive", "2", "--preset", "preview"][..], "--adaptive needs a stride below 5"),
+            (&["--blob", "e.slfd", "--dictionary", "dct"][..], "--blob names an ensemble, but this decode uses the DCT (--dictionary dct)"),
+            (&["--blob", "e.slfd", "--preset", "preview"][..], "(--preset preview)"),
+        ] {
+            let e = DecodeSettings::from_flags(flags).unwrap().resolve().unwrap_err().to_string();
+            assert!(e.contains(says), "{flags:?}: {e}");
+        }
+        resolved(&["--min-bands", "13"]);
+        resolved(&["--adaptive", "2"]);
         let s = DecodeSettings::from_flags(["--adaptive=-1"]).unwrap();
         assert!(s.resolve().unwrap_err().to_string().starts_with("--adaptive -1"));
     }

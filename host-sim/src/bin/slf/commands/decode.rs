@@ -2,7 +2,7 @@
 //! firmware's decoder, in parallel over tiles) or by a baseline without it. The decode's
 //! flags are [`DecodeSettings`], shared with the Python package.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use slf_host::decode::cs::{Balance, NoiseSource, disparity_per_lenslet};
@@ -38,6 +38,10 @@ pub struct Args {
 
 pub fn run(args: Args) -> Result<()> {
     let Args { capture, output, settings, member_map, disparity_map, dtype, quiet } = args;
+    // Where the results go is checked before the decode, not found unwritable after it.
+    for path in std::iter::once(&output).chain(&member_map).chain(&disparity_map) {
+        check_writable(path)?;
+    }
     let cap = Capture::load(&capture)?;
     let cs = settings.method.baseline().is_none();
     anyhow::ensure!(cs || member_map.is_none(), "--member-map needs --method cs (baselines use no ensemble)");
@@ -126,5 +130,21 @@ pub fn run(args: Args) -> Result<()> {
         r.seconds,
         output.display()
     );
+    Ok(())
+}
+
+/// Fails if `path` cannot be written: a folder, a missing parent, no permission. Leaves an
+/// existing file as it was, and no new one behind.
+fn check_writable(path: &Path) -> Result<()> {
+    let existed = path.exists();
+    anyhow::ensure!(!path.is_dir(), "cannot write {}: a folder", path.display());
+    std::fs::OpenOptions::new()
+        .append(true)
+        .create(true)
+        .open(path)
+        .with_context(|| format!("cannot write {} (checked before decoding)", path.display()))?;
+    if !existed {
+        std::fs::remove_file(path).with_context(|| format!("cannot remove {}", path.display()))?;
+    }
     Ok(())
 }
