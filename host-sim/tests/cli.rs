@@ -503,3 +503,18 @@ fn unwritable_outputs_are_refused_before_decoding() {
     failure(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("keep.npy")).arg("--disparity-map").arg(p("no/d.npy")));
     assert_eq!(std::fs::read(p("keep.npy")).unwrap(), b"old");
 }
+
+/// `slf evaluate` names rows and previews by the file's stem: two inputs of one stem are
+/// refused before anything is decoded (issue 32, item 6).
+#[test]
+fn evaluate_refuses_two_inputs_of_one_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    std::fs::create_dir_all(p("a")).unwrap();
+    std::fs::create_dir_all(p("b")).unwrap();
+    stdout(slf().args(["scene", "smooth", "--size", "12", "-o"]).arg(p("a/s.npy")));
+    stdout(slf().args(["scene", "texture", "--size", "12", "-o"]).arg(p("b/s.npy")));
+    let e = failure(slf().arg("evaluate").arg(p("a/s.npy")).arg(p("b/s.npy")).arg("-o").arg(p("out")));
+    assert!(e.contains("both named \"s\"") && e.contains("rename one"), "{e}");
+    assert!(!p("out/table.md").exists());
+}

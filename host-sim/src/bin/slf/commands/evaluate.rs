@@ -41,9 +41,17 @@ pub fn run(args: Args) -> Result<()> {
         Some(p) => read_blob(&p)?,
         None => DEFAULT_ENSEMBLE.to_vec(),
     };
-    let mut scenes = Vec::new();
-    for p in &inputs {
+    let mut scenes: Vec<(String, _)> = Vec::new();
+    for (i, p) in inputs.iter().enumerate() {
         let name = p.file_stem().map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+        // Rows and previews are named by the file's stem: two of one name would share them.
+        if let Some(j) = scenes.iter().position(|(n, _)| *n == name) {
+            anyhow::bail!(
+                "{} and {} are both named {name:?} (rows and previews are named by the file's stem): rename one",
+                inputs[j].display(),
+                inputs[i].display()
+            );
+        }
         scenes.push((name, camera_bands(read_npy(p)?, None, p)?));
     }
     let strides: Vec<(u8, u8)> = stride.iter().map(|&s| (s as u8, s as u8)).collect();
