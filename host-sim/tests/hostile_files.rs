@@ -249,6 +249,14 @@ fn pgm_values_are_dn_as_stored_whatever_maxval_says() {
     pgm_4095(&p, 6, 10, &bad);
     let e = format!("{:#}", read_frame(&p).unwrap_err());
     assert!(e.contains("pixel (1, 3) is 4096, above MAXVAL 4095"), "{e}");
+    // Bytes after the image (a writer that disagrees with its header): refused (issue 32,
+    // item 7), not read as a valid frame.
+    pgm_4095(&p, 6, 10, &data);
+    let mut long = std::fs::read(&p).unwrap();
+    long.extend([0u8; 100]);
+    std::fs::write(&p, long).unwrap();
+    let e = format!("{:#}", read_frame(&p).unwrap_err());
+    assert!(e.contains("bytes after the 10 x 6 pixels"), "{e}");
     // slf writes P5 (not P7/PAM) with the values as they are.
     let q = dir.path().join("w.pgm");
     write_frame(&q, &data, 6, 10).unwrap();

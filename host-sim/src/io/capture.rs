@@ -427,6 +427,15 @@ fn read_pgm(path: &Path, file_len: u64) -> Result<FrameFile> {
     let mut raw = vec![0u8; (count * bytes_per) as usize];
     std::io::Read::read_exact(&mut reader, &mut raw)
         .with_context(|| format!("{}: truncated: {w} x {h} pixels promised", path.display()))?;
+    // A frame file holds one image: bytes after it mean a writer that disagrees with the
+    // header (a wrong size, a second image), so the file is refused, not half read.
+    let mut rest = [0u8; 1];
+    let extra = std::io::Read::read(&mut reader, &mut rest).with_context(|| format!("cannot read {}", path.display()))?;
+    ensure!(
+        extra == 0,
+        "{}: bytes after the {w} x {h} pixels the header promises (the file is longer than its image)",
+        path.display()
+    );
     let data: Vec<u16> = if bytes_per == 2 {
         raw.chunks_exact(2).map(|c| u16::from_be_bytes([c[0], c[1]])).collect()
     } else {
