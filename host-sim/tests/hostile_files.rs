@@ -392,3 +392,37 @@ fn a_capture_the_decoder_refuses_names_its_description() {
     assert!(e.contains("capture.json") && e.contains("more views than a lenslet"), "{e}");
     assert_eq!(e.lines().count(), 1, "{e}");
 }
+
+/// A capture's noise description out of any camera's range is refused where the capture
+/// is made or loaded, and a capture with no pixel above the black level is not decoded
+/// to zeros (issue 32, item 7).
+#[test]
+fn captures_without_signal_or_with_impossible_noise_are_refused() {
+    use slf_host::decode::settings::DecodeSettings;
+    use slf_host::io::capture::Capture;
+    use slf_host::sim::camera::{CameraConfig, simulate};
+    use slf_host::sim::realistic;
+    use slf_host::sim::scene::SceneSize;
+
+    let lf = realistic::lookup("depth").unwrap().render(SceneSize { views: (5, 5), rows: 10, cols: 10 });
+    let cap = simulate(&lf, &CameraConfig::pixel(1, 1)).unwrap();
+    let mut d = cap.description.clone();
+    let mut noise = d.noise.unwrap();
+    noise.read_noise_dn = 1e30;
+    d.noise = Some(noise);
+    let e = format!("{:#}", Capture::new(d.clone(), cap.frames.clone()).unwrap_err());
+    assert!(e.contains("noise.read_noise_dn 1000000000000000000000000000000: must be finite"), "{e}");
+    noise.read_noise_dn = 2.0;
+    noise.full_well_electrons = 0.0;
+    d.noise = Some(noise);
+    let e = format!("{:#}", Capture::new(d, cap.frames.clone()).unwrap_err());
+    assert!(e.contains("noise.full_well_electrons 0"), "{e}");
+    // Every pixel at the black level: refused by every method, not decoded to zeros.
+    let black = cap.description.black_level as u16;
+    let dark = Capture::new(cap.description.clone(), vec![vec![black; cap.frames[0].len()]]).unwrap();
+    for method in ["cs", "demosaic", "ppid", "interpolate"] {
+        let s = DecodeSettings::from_flags(["--method", method]).unwrap();
+        let e = format!("{:#}", s.run(&dark, false, &|_, _| {}).unwrap_err());
+        assert!(e.contains("no light was recorded"), "{method}: {e}");
+    }
+}

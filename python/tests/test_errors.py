@@ -107,3 +107,12 @@ def test_scene_arguments():
         slf.scene("nope")
     with pytest.raises(ValueError, match="size 0"):
         slf.scene("depth", size=0)
+
+
+def test_impossible_noise_and_no_light(capture):
+    d = dict(capture.description, noise={"full_well_electrons": 20000.0, "read_noise_dn": 1e30})
+    with pytest.raises(ValueError, match="noise.read_noise_dn"):
+        slf.Capture(capture.frames, d)
+    dark = slf.Capture(np.full_like(capture.frames, int(capture.description["black_level"])), capture.description)
+    with pytest.raises(ValueError, match="no light was recorded"):
+        slf.decode(dark)

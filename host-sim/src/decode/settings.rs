@@ -435,6 +435,13 @@ impl DecodeSettings {
     /// What [`Self::resolve`] refuses; a capture the method cannot take; a decode where no
     /// patch decoded (every patch saturated, defective or unreadable).
     pub fn run(&self, capture: &Capture, progress: bool, observer: &(dyn Fn(usize, usize) + Sync)) -> Result<Decoded> {
+        // A frame with no pixel above the black level recorded no light (a lens cap, an
+        // exposure of zero): every method would decode zeros.
+        let black = capture.description.black_level;
+        ensure!(
+            capture.frames.iter().flatten().any(|&x| f32::from(x) > black),
+            "every pixel of every frame is at or below the black level ({black} DN): no light was recorded"
+        );
         if let Some(baseline) = self.method.baseline() {
             let (light_field, report) = baseline.run(capture)?;
             return Ok(Decoded { light_field, outcome: Outcome::Baseline { method: self.method, report } });

@@ -165,6 +165,22 @@ impl Capture {
         }
         defects.sort();
         defects.dedup();
+        if let Some(n) = d.noise {
+            // Noise above the signal's whole range is not a camera: its projection ball
+            // would hold any image (a read noise of 1e30 decoded at 7 dB, without a word).
+            let range = d.white_level - d.black_level;
+            ensure!(
+                n.read_noise_dn.is_finite() && n.read_noise_dn >= 0.0 && n.read_noise_dn < range,
+                "noise.read_noise_dn {}: must be finite, at or above 0 and below the signal range \
+                 (white_level - black_level = {range} DN)",
+                n.read_noise_dn
+            );
+            ensure!(
+                n.full_well_electrons.is_finite() && n.full_well_electrons >= 1.0,
+                "noise.full_well_electrons {}: must be finite and at least 1",
+                n.full_well_electrons
+            );
+        }
         let capture = Self { description, frames, tile_bands, defects, source: None };
         let mask = capture.mask()?;
         ensure!(
