@@ -399,8 +399,6 @@ fn a_capture_the_decoder_refuses_names_its_description() {
 #[test]
 fn captures_without_signal_or_with_impossible_noise_are_refused() {
     use slf_host::decode::settings::DecodeSettings;
-    use slf_host::io::capture::Capture;
-    use slf_host::sim::camera::{CameraConfig, simulate};
     use slf_host::sim::realistic;
     use slf_host::sim::scene::SceneSize;
 
