@@ -182,10 +182,12 @@ fn out_of_range_arguments_name_the_argument_and_its_range() {
     let x = dir.path().join("x.npy");
     // Before: panics (size 0), a 63 TB allocation (views 100000), an unusable file (views 0).
     let cases: &[(&[&str], &str)] = &[
-        (&["scene", "depth", "--size", "0"], "'--size <SIZE>': 0 is out of range 1..=4096"),
-        (&["scene", "depth", "--size", "100000000"], "100000000 is out of range 1..=4096"),
-        (&["scene", "depth", "--views", "100000", "--size", "11"], "'--views <VIEWS>': 100000 is out of range 1..=16"),
-        (&["scene", "depth", "--views", "0"], "'--views <VIEWS>': 0 is out of range 1..=16"),
+        (&["scene", "depth", "--size", "0"], "'--size <SIZE>': 0 is out of range 5..=4096"),
+        (&["scene", "depth", "--size", "4"], "'--size <SIZE>': 4 is out of range 5..=4096"),
+        (&["scene", "depth", "--size", "100000000"], "100000000 is out of range 5..=4096"),
+        (&["scene", "depth", "--views", "100000", "--size", "11"], "'--views <VIEWS>': 100000 is out of range 4..=16"),
+        (&["scene", "depth", "--views", "0"], "'--views <VIEWS>': 0 is out of range 4..=16"),
+        (&["scene", "depth", "--views", "3"], "'--views <VIEWS>': 3 is out of range 4..=16"),
         (&["scene", "depth", "--views", "16", "--size", "4096"], "--size 4096 with --views 16"),
         (&["demo", "--size", "0"], "0 is out of range 5..=2048"),
         (&["compare", "--size", "0"], "0 is out of range 5..=1024"),
@@ -414,6 +416,19 @@ fn import_from_the_command_line_and_other_band_counts_resampled() {
     std::fs::create_dir(p("views")).unwrap();
     let e = failure(slf().args(["import", "views"]).arg(p("views")).arg("-o").arg(p("v.npy")));
     assert!(e.contains("input_Cam020.png"), "{e}");
+    // Light fields the decoder could not take are refused by the import, with the minimum
+    // (issue 32, item 12): not written for simulate or decode to refuse with a wrong hint.
+    let e = failure(slf().args(["import", "views"]).arg(p("views")).args(["--views", "1,1", "-o"]).arg(p("v.npy")));
+    assert!(e.contains("--views 1,1: the decoder needs at least 4,4"), "{e}");
+    let e = failure(
+        slf()
+            .args(["import", "cube"])
+            .arg(p("cube.npy"))
+            .args(["--wavelengths", "400,500,600,700", "--resize", "3,3", "-o"])
+            .arg(p("s.npy")),
+    );
+    assert!(e.contains("the import is 3 x 3 pixels a view: the decoder needs at least 5 x 5"), "{e}");
+    assert!(!p("v.npy").exists() && !p("s.npy").exists());
 }
 
 #[test]

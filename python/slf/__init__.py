@@ -150,10 +150,10 @@ def scene(name: str, size: int = 100, views: int = 5, seed: int = 0) -> np.ndarr
     for n, v in (("size", size), ("views", views), ("seed", seed)):
         if not isinstance(v, (int, np.integer)) or v < 0:
             raise ValueError(f"{n}: want a whole number at or above 0, got {v!r}")
-    if not 1 <= size <= 4096:
-        raise ValueError(f"size {size}: want 1..=4096 (as `slf scene --size`)")
-    if not 1 <= views <= 16:
-        raise ValueError(f"views {views}: want 1..=16 (as `slf scene --views`)")
+    if not 5 <= size <= 4096:
+        raise ValueError(f"size {size}: want 5..=4096 (as `slf scene --size`: the decoder's patch is 5 x 5 lenslets)")
+    if not 4 <= views <= 16:
+        raise ValueError(f"views {views}: want 4..=16 (as `slf scene --views`: the decoder's patch takes 4 x 4)")
     return _slf.scene(name, int(size), int(views), int(seed))
 
 

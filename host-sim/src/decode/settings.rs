@@ -584,7 +584,10 @@ mod tests {
             (&["--min-bands", "14"][..], "--min-bands 14: at most 13"),
             (&["--adaptive", "2", "--stride", "5"][..], "--adaptive needs a stride below 5"),
             (&["--adaptive", "2", "--preset", "preview"][..], "--adaptive needs a stride below 5"),
-            (&["--blob", "e.slfd", "--dictionary", "dct"][..], "--blob names an ensemble, but this decode uses the DCT (--dictionary dct)"),
+            (
+                &["--blob", "e.slfd", "--dictionary", "dct"][..],
+                "--blob names an ensemble, but this decode uses the DCT (--dictionary dct)",
+            ),
             (&["--blob", "e.slfd", "--preset", "preview"][..], "(--preset preview)"),
         ] {
             let e = DecodeSettings::from_flags(flags).unwrap().resolve().unwrap_err().to_string();

@@ -446,7 +446,8 @@ fn read_pgm(path: &Path, file_len: u64) -> Result<FrameFile> {
     // A frame file holds one image: bytes after it mean a writer that disagrees with the
     // header (a wrong size, a second image), so the file is refused, not half read.
     let mut rest = [0u8; 1];
-    let extra = std::io::Read::read(&mut reader, &mut rest).with_context(|| format!("cannot read {}", path.display()))?;
+    let extra =
+        std::io::Read::read(&mut reader, &mut rest).with_context(|| format!("cannot read {}", path.display()))?;
     ensure!(
         extra == 0,
         "{}: bytes after the {w} x {h} pixels the header promises (the file is longer than its image)",

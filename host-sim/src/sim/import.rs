@@ -10,7 +10,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result, bail, ensure};
 use clap::{Args, FromArgMatches, ValueEnum};
 
 use crate::io::import::bands::{CAMERA_FILTER, parse_wavelengths};
@@ -129,8 +129,11 @@ impl ViewsSettings {
             disparity: self.disparity.clone(),
             max_disparity: self.max_disparity,
         };
+        check_views(self.views)?;
         let lift = RgbLift::new(&BAND_NM, CAMERA_FILTER)?;
-        import_views(&self.folder, &cfg, &lift)
+        let imported = import_views(&self.folder, &cfg, &lift)?;
+        check_lenslets(&imported.lightfield)?;
+        Ok(imported)
     }
 }
 
@@ -183,6 +186,7 @@ impl CubeSettings {
     /// # Errors
     /// What the readers refuse; a cube whose band count has no wavelengths.
     pub fn run(&self) -> Result<Imported> {
+        check_views(self.views)?;
         let input = &self.input;
         let (data, notes) =
             if input.is_dir() { (cube::read_band_folder(input)?, Vec::new()) } else { cube::read_cube_npy(input)? };
@@ -210,8 +214,35 @@ impl CubeSettings {
             geometry: self.geometry.geometry(),
         };
         let (lightfield, disparity) = cube::to_lightfield(&bands, &cfg, (data.rows, data.cols))?;
+        check_lenslets(&lightfield)?;
         Ok(Imported { lightfield, disparity, notes })
     }
+}
+
+/// The fewest views a side the decoder takes: its patch's 4 x 4 angular window.
+pub const MIN_VIEWS: usize = 4;
+/// The fewest lenslets a side the decoder takes: its patch's 5 x 5.
+pub const MIN_LENSLETS: usize = 5;
+
+/// Refuses a window of views the decoder could not take, before anything is read.
+fn check_views((u, v): (usize, usize)) -> Result<()> {
+    ensure!(
+        u >= MIN_VIEWS && v >= MIN_VIEWS,
+        "--views {u},{v}: the decoder needs at least {MIN_VIEWS},{MIN_VIEWS} (its patch's angular window)"
+    );
+    Ok(())
+}
+
+/// Refuses an imported light field smaller than one patch, naming the size to ask for.
+fn check_lenslets(lf: &LightField) -> Result<()> {
+    ensure!(
+        lf.rows >= MIN_LENSLETS && lf.cols >= MIN_LENSLETS,
+        "the import is {} x {} pixels a view: the decoder needs at least {MIN_LENSLETS} x {MIN_LENSLETS} (its \
+         patch's lenslets); --crop or --resize larger",
+        lf.rows,
+        lf.cols
+    );
+    Ok(())
 }
 
 /// A light field with the camera's bands: as given if it has 13, resampled from

@@ -23,11 +23,11 @@ pub struct Args {
     /// Seed of a random scene.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Spatial rows and columns, 1..=4096.
-    #[arg(long, default_value_t = 100, value_parser = ranged::<1, 4096>)]
+    /// Spatial rows and columns (lenslets), 5..=4096: the decoder's patch is 5 x 5.
+    #[arg(long, default_value_t = 100, value_parser = ranged::<5, 4096>)]
     pub size: usize,
-    /// Views per side, 1..=16.
-    #[arg(long, default_value_t = 5, value_parser = ranged::<1, 16>)]
+    /// Views per side, 4..=16: the decoder's patch takes 4 x 4.
+    #[arg(long, default_value_t = 5, value_parser = ranged::<4, 16>)]
     pub views: usize,
     /// Stored dtype.
     #[arg(long, value_enum, default_value_t = Dtype::F32)]
