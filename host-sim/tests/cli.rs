@@ -159,7 +159,7 @@ fn bad_files_and_arguments_are_one_line_errors() {
     // Out-of-range solver and mask arguments.
     stdout(slf().arg("simulate").arg(p("a.npy")).arg("-o").arg(p("cap")));
     let e = failure(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("x.npy")).args(["--sigma-f", "1.5"]));
-    assert!(e.contains("sigma_f"), "{e}");
+    assert!(e.contains("--sigma-f 1.5: must be in (0, 1)"), "{e}");
     let e = failure(slf().arg("simulate").arg(p("a.npy")).arg("-o").arg(p("cap2")).args(["-s", "14"]));
     assert!(e.contains("14 snapshots"), "{e}");
     // clap's own errors: unknown flag, bad value, missing argument; one line each.
