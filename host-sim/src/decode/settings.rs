@@ -12,7 +12,7 @@
 use std::path::PathBuf;
 
 use anyhow::{Result, anyhow, bail, ensure};
-use clap::{Args, FromArgMatches, ValueEnum};
+use clap::{Args, ValueEnum};
 use slf_firmware::disparity::MAX_DISPARITY;
 use slf_firmware::{ChoiceRule, DEFAULT_ENSEMBLE, DisparityRange, MemberChoice, Sl0Config, SolveError, gains};
 
@@ -23,7 +23,7 @@ use crate::decode::cs::{
 use crate::decode::preset::Preset;
 use crate::io::capture::Capture;
 use crate::io::lightfield::LightField;
-use crate::sim::flags::one_line;
+use crate::sim::flags::parse;
 
 /// Decode method: compressed sensing, or a baseline without it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
@@ -373,9 +373,7 @@ impl DecodeSettings {
         I: IntoIterator<Item = S>,
         S: Into<std::ffi::OsString> + Clone,
     {
-        let cmd = Self::augment_args(clap::Command::new("decode").no_binary_name(true));
-        let parsed = cmd.try_get_matches_from(flags).and_then(|m| Self::from_arg_matches(&m));
-        parsed.map_err(|e| one_line(&e))
+        parse("decode", flags)
     }
 
     /// The compressed-sensing decode these settings ask for: the basis and the options.

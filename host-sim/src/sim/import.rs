@@ -11,7 +11,7 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail, ensure};
-use clap::{Args, FromArgMatches, ValueEnum};
+use clap::{Args, ValueEnum};
 
 use crate::io::import::bands::{CAMERA_FILTER, parse_wavelengths};
 use crate::io::import::cube::{self, CubeConfig, Depth, Light};
@@ -19,7 +19,7 @@ use crate::io::import::rgb::RgbLift;
 use crate::io::import::views::{Fill, Imported, Naming, ViewsConfig, import_views};
 use crate::io::import::{Crop, Geometry, resample_lightfield};
 use crate::io::lightfield::LightField;
-use crate::sim::flags::{one_line, pair, positive};
+use crate::sim::flags::{pair, parse, positive};
 use crate::sim::spectra_data::BAND_NM;
 
 /// Where the spatial part of an import is cut and scaled.
@@ -107,8 +107,7 @@ impl ViewsSettings {
         I: IntoIterator<Item = S>,
         S: Into<std::ffi::OsString> + Clone,
     {
-        let cmd = Self::augment_args(clap::Command::new("views").no_binary_name(true));
-        cmd.try_get_matches_from(flags).and_then(|m| Self::from_arg_matches(&m)).map_err(|e| one_line(&e))
+        parse("views", flags)
     }
 
     /// Reads the views: the light field `(U, V, H, W, 13)`, the centre view's disparity if
@@ -176,8 +175,7 @@ impl CubeSettings {
         I: IntoIterator<Item = S>,
         S: Into<std::ffi::OsString> + Clone,
     {
-        let cmd = Self::augment_args(clap::Command::new("cube").no_binary_name(true));
-        cmd.try_get_matches_from(flags).and_then(|m| Self::from_arg_matches(&m)).map_err(|e| one_line(&e))
+        parse("cube", flags)
     }
 
     /// Reads the cube and makes its views: the light field `(U, V, H, W, 13)`, the centre

@@ -4,13 +4,13 @@
 //! flags from strings, the way the package passes its keywords).
 
 use anyhow::{Context, Result};
-use clap::{Args, FromArgMatches, ValueEnum};
+use clap::{Args, ValueEnum};
 use slf_firmware::MaskFamily;
 
 use crate::io::capture::{Capture, MaskDescription};
 use crate::io::lightfield::LightField;
 use crate::sim::camera::{CameraConfig, simulate};
-use crate::sim::flags::{one_line, positive};
+use crate::sim::flags::{parse, positive};
 use crate::sim::import::with_camera_bands;
 
 /// `--mask`: the mask family, which band each pixel sees in each snapshot.
@@ -115,8 +115,7 @@ impl SimulateSettings {
         I: IntoIterator<Item = S>,
         S: Into<std::ffi::OsString> + Clone,
     {
-        let cmd = Self::augment_args(clap::Command::new("simulate").no_binary_name(true));
-        cmd.try_get_matches_from(flags).and_then(|m| Self::from_arg_matches(&m)).map_err(|e| one_line(&e))
+        parse("simulate", flags)
     }
 
     /// The camera these settings describe.
