@@ -45,11 +45,14 @@ fn bad_gains_are_refused_with_a_message() {
     let truth =
         slf_host::sim::realistic::lookup("outdoor").unwrap().render(SceneSize { views: (5, 5), rows: 10, cols: 10 });
     let cap = simulate(&truth, &CameraConfig::pixel(3, 1)).unwrap();
-    let mut g = [1.0f32; 13];
-    g[3] = 0.0;
-    let opts = DecodeOptions { balance: Balance::Gains(g), ..DecodeOptions::disjoint() };
-    let e = decode_with(&cap, &Basis::Dct, &opts).unwrap_err().to_string();
-    assert!(e.contains("gains") && e.contains("finite and positive"), "{e}");
+    // Zero, below 1/64, above 64, not a number: each refused by the firmware's decoder.
+    for bad in [0.0, 1e-3, 1e30, f32::NAN] {
+        let mut g = [1.0f32; 13];
+        g[3] = bad;
+        let opts = DecodeOptions { balance: Balance::Gains(g), ..DecodeOptions::disjoint() };
+        let e = decode_with(&cap, &Basis::Dct, &opts).unwrap_err().to_string();
+        assert!(e.contains("gains") && e.contains("[1/64, 64]"), "{bad}: {e}");
+    }
 }
 
 /// The shipped ensemble's screened choice keeps the DCT's solution in the mean unless a

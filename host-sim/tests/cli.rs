@@ -533,3 +533,97 @@ fn evaluate_refuses_two_inputs_of_one_name() {
     assert!(e.contains("both named \"s\"") && e.contains("rename one"), "{e}");
     assert!(!p("out/table.md").exists());
 }
+
+/// Sizes and indices from the import's flags are checked before anything is allocated or
+/// read (issue 32, items 1-3): a resize to 4000 x 4000 (25 views x 16 M pixels x 13 bands,
+/// 21 GB of f32) or 65536 x 65536, a wavelength step that would give 3e32 samples, an index
+/// base that would wrap the view numbers; each one error line, no output, no abort.
+#[test]
+fn import_sizes_and_indices_are_checked_before_allocating() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    std::fs::create_dir(p("views")).unwrap();
+    for r in 0..9 {
+        for c in 0..9 {
+            let img = image::RgbImage::from_pixel(8, 8, image::Rgb([100, 120, 140]));
+            img.save(p("views").join(format!("input_Cam{:03}.png", r * 9 + c))).unwrap();
+            img.save(p("views").join(format!("lf_{r:02}_{c:02}.png"))).unwrap();
+        }
+    }
+    let e = failure(
+        slf().args(["import", "views"]).arg(p("views")).args(["--resize", "4000,4000", "-o"]).arg(p("big.npy")),
+    );
+    assert!(e.contains("more than the 1073741824 (4 GiB) a light field may hold"), "{e}");
+    let body: Vec<u8> = (0..6 * 7 * 31).flat_map(|_| 0.5f32.to_le_bytes()).collect();
+    let header = "{'descr': '<f4', 'fortran_order': False, 'shape': (6, 7, 31), }";
+    std::fs::write(p("cube.npy"), common::npy_bytes(1, header, &body)).unwrap();
+    let e = failure(
+        slf()
+            .args(["import", "cube"])
+            .arg(p("cube.npy"))
+            .args(["--wavelengths", "400:700:10", "--resize", "65536,65536", "-o"])
+            .arg(p("big.npy")),
+    );
+    assert!(e.contains("4 GiB") && e.contains("65536 x 65536 pixels"), "{e}");
+    let e = failure(
+        slf().args(["import", "cube"]).arg(p("cube.npy")).args(["--wavelengths", "400:700:1e-30", "-o"]).arg(p("w.npy")),
+    );
+    assert!(e.contains("samples is more than 100000"), "{e}");
+    let e = failure(
+        slf()
+            .args(["import", "views"])
+            .arg(p("views"))
+            .args(["--pattern", "lf_{row:02}_{col:02}.png", "--index-base", "18446744073709551615", "-o"])
+            .arg(p("wrap.npy")),
+    );
+    assert!(e.contains("index base 18446744073709551615") && e.contains("past the largest index"), "{e}");
+    for f in ["big.npy", "w.npy", "wrap.npy"] {
+        assert!(!p(f).exists(), "{f} written");
+    }
+    // The same folder and cube within the limits import.
+    stdout(slf().args(["import", "views"]).arg(p("views")).args(["--resize", "20,20", "-o"]).arg(p("ok.npy")));
+    stdout(
+        slf()
+            .args(["import", "views"])
+            .arg(p("views"))
+            .args(["--pattern", "lf_{row:02}_{col:02}.png", "--index-base", "0", "-o"])
+            .arg(p("ok2.npy")),
+    );
+}
+
+/// Interpolated patches are counted apart from solved ones, in the summary and the member
+/// map (issue 32, item 8): a kronecker capture at k = 3 interpolates the patches that see
+/// fewer than 5 bands; the pixel mask solves every patch.
+#[test]
+fn interpolated_patches_are_counted_and_mapped_apart() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    stdout(slf().args(["scene", "smooth", "--size", "15", "-o"]).arg(p("s.npy")));
+    let count = |line: &str, what: &str| -> u32 {
+        let i = line.find(what).unwrap_or_else(|| panic!("no {what:?} in {line}"));
+        line[..i].trim_end().rsplit([' ', '(']).next().unwrap().parse().unwrap()
+    };
+    for (mask, k, interpolates) in [("kronecker", "3", true), ("pixel", "1", false)] {
+        let cap = p(&format!("cap-{mask}"));
+        stdout(slf().arg("simulate").arg(p("s.npy")).args(["--mask", mask, "-s", k, "-o"]).arg(&cap));
+        let map = p(&format!("{mask}.csv"));
+        let out = stdout(
+            slf().arg("decode").arg(&cap).args(["--stride", "5", "-o"]).arg(p("x.npy")).arg("--member-map").arg(&map),
+        );
+        let line = out.lines().find(|l| l.starts_with("decoded ")).unwrap();
+        let (decoded, solved, interpolated) =
+            (count(line, " patches"), count(line, " solved"), count(line, " interpolated from fewer than 5 bands"));
+        let csv = std::fs::read_to_string(&map).unwrap();
+        let rows: Vec<&str> = csv.lines().skip(1).collect();
+        let in_map = |d: &str| rows.iter().filter(|r| r.split(',').nth(5) == Some(d)).count() as u32;
+        assert_eq!(rows.len() as u32, decoded, "{line}");
+        assert_eq!(in_map("interpolated"), interpolated, "{line}");
+        assert_eq!(in_map("member") + in_map("dictionary"), solved, "{line}");
+        assert_eq!(decoded, solved + interpolated + in_map("flat"), "{line}");
+        if interpolates {
+            assert!(interpolated > 0 && interpolated < decoded, "{line}");
+        } else {
+            assert_eq!(interpolated, 0, "{line}");
+        }
+    }
+}

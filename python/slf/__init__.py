@@ -274,7 +274,8 @@ def decode(
     """Decodes a capture (or a capture folder's path) as ``slf decode`` does, bit for bit.
 
     Returns the light field ``(U, V, H, W, 13)`` float32, or with ``report=True`` the pair
-    ``(light field, report)``: a dict of patches decoded / flagged / failed, tiles, solves,
+    ``(light field, report)``: a dict of patches decoded / flagged / failed, of the decoded
+    those solved / interpolated (fewer than ``min_bands`` bands measured) / flat, tiles, solves,
     steps, band gains, seconds, the per-lenslet disparity map (``report["disparity"]``, an
     array, or None when no disparity was searched) and a ``warning`` when over 1 % of the
     patches failed or were flagged.

@@ -77,6 +77,9 @@ pub fn decode<'py>(
             report.set_item("decoded", r.patches.decoded)?;
             report.set_item("flagged", r.patches.flagged)?;
             report.set_item("failed", r.patches.failed)?;
+            report.set_item("solved", r.patches.solved())?;
+            report.set_item("interpolated", r.patches.interpolated)?;
+            report.set_item("flat", r.patches.flat)?;
             report.set_item("tiles", r.tiles)?;
             report.set_item("failed_tiles", r.failed_tiles)?;
             report.set_item("solves", r.solves)?;

@@ -90,6 +90,10 @@ def test_a_broken_capture_is_named(tmp_path, capture):
         ({"adaptive": 2.0, "stride": 5}, "--adaptive needs a stride below 5"),
         ({"blob": "e.slfd", "dictionary": "dct"}, "--blob names an ensemble"),
         ({"sigma_f": 1.5}, r"--sigma-f 1.5: must be in \(0, 1\)"),
+        ({"mu": 5.0}, r"--mu 5: must be in \(0, 2\]"),
+        ({"sigma_min": 1e30}, r"--sigma-min 1e30: must be in \(0, 1\]"),
+        ({"noise": 1e30}, r"--noise 1e30: must be in \[0, 1\]"),
+        ({"gains": [1.0] * 12 + [1e30]}, r"--gains: gain 13 is 1e30"),
     ],
 )
 def test_bad_decode_settings(capture, kwargs, message):

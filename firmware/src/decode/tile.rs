@@ -31,7 +31,7 @@ use crate::sensor::raw::{Invalid, RawFormat};
 use crate::solver::choice::{ModelOutcome, PatchModel};
 use crate::solver::fractional::{MAX_GRID, to_sensor};
 use crate::solver::interpolate::{bands_measured, interpolate_bands};
-use crate::solver::sl0::{Outcome, Sl0Config, SolveError};
+use crate::solver::sl0::{Ended, Outcome, Sl0Config, SolveError};
 use crate::solver::workspace::Workspace;
 
 /// The source trait lives with the raw frames (the sensor layer); named here too, where the
@@ -204,6 +204,13 @@ pub struct TileReport {
     pub flagged: u32,
     /// Patches that could not be decoded (rejected to the sink).
     pub failed: u32,
+    /// Of the decoded, patches that measured fewer than [`Sl0Config::min_bands`] bands and
+    /// were interpolated per pixel ([`Ended::Interpolated`]), not solved: a user reads
+    /// which decoder made their pixels.
+    pub interpolated: u32,
+    /// Of the decoded, patches flat within [`Sl0Config::flat`], each band its mean
+    /// ([`Ended::Flat`]), not solved.
+    pub flat: u32,
 }
 
 impl TileReport {
@@ -211,6 +218,13 @@ impl TileReport {
         self.decoded += o.decoded;
         self.flagged += o.flagged;
         self.failed += o.failed;
+        self.interpolated += o.interpolated;
+        self.flat += o.flat;
+    }
+
+    /// Patches solved by SL0: the decoded less the interpolated and the flat.
+    pub fn solved(&self) -> u32 {
+        self.decoded.saturating_sub(self.interpolated).saturating_sub(self.flat)
     }
 }
 
@@ -232,7 +246,7 @@ pub enum ConfigError {
     Solver(SolveError),
     /// An overlap stride outside `1..=` the patch's size.
     Stride,
-    /// Band gains that are not finite and positive.
+    /// Band gains outside `[1 / MAX_RATIO, MAX_RATIO]`.
     Gains,
 }
 
@@ -246,7 +260,7 @@ impl fmt::Display for ConfigError {
             Self::RawFormat => f.write_str("raw format: need finite levels with white > black"),
             Self::Solver(e) => write!(f, "solver: {e}"),
             Self::Stride => f.write_str("overlap stride must be in 1..=patch size per axis"),
-            Self::Gains => f.write_str("band gains must be finite and positive"),
+            Self::Gains => f.write_str("band gains must each be in [1/64, 64]"),
         }
     }
 }
@@ -382,7 +396,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     /// are the plain decode, bit for bit.
     ///
     /// # Errors
-    /// [`ConfigError::Gains`] for a gain that is not finite and positive.
+    /// [`ConfigError::Gains`] for a gain outside `[1 / MAX_RATIO, MAX_RATIO]` ([`crate::sensor::gains::valid`]).
     pub fn with_gains(self, gains: &[f32; B]) -> Result<Self, ConfigError> {
         if !crate::sensor::gains::valid(gains) {
             return Err(ConfigError::Gains);
@@ -533,7 +547,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let k = c.mask.snapshots();
         let m = ws.measurements_mut();
         m.clear();
-        // Checked finite and positive by `with_gains`; `B <= MAX_BANDS` by `PatchShape`.
+        // Checked within [1/64, 64] by `with_gains`; `B <= MAX_BANDS` by `PatchShape`.
         let _ = m.set_gains(&self.gains);
         let mut flags = PatchFlags::default();
         let mut excluded = 0u16;
@@ -789,6 +803,11 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                 if !flags.is_empty() {
                     report.flagged += 1;
                     log!(warn, "patch flagged: {} samples left out", excluded);
+                }
+                match done.outcome.ended {
+                    Ended::Interpolated => report.interpolated += 1,
+                    Ended::Flat => report.flat += 1,
+                    _ => {}
                 }
                 report.decoded += 1;
                 sink.accept(origin, ws.patch(), &r).map_err(TileError::Sink)

@@ -68,7 +68,10 @@ pub fn gains_from_sums<const B: usize>(sums: &[f32; B], counts: &[u32; B]) -> [f
     means
 }
 
-/// Whether `gains` can balance a decode: finite and positive.
+/// Whether `gains` can balance a decode: each in `[1 / MAX_RATIO, MAX_RATIO]`. The
+/// solver's thresholds are in normalised units, so gains far from 1 would move the whole
+/// balanced signal out of their scale; [`gains_from_sums`]' gains average 1 and lie within
+/// `[1 / MAX_RATIO, 13]`.
 pub fn valid(gains: &[f32]) -> bool {
-    gains.iter().all(|g| g.is_finite() && *g > 0.0)
+    gains.iter().all(|g| (1.0 / MAX_RATIO..=MAX_RATIO).contains(g))
 }

@@ -44,21 +44,22 @@ pub struct Sl0Config {
     pub sigma_f: f32,
     /// `L`: steepest-ascent + projection steps per sigma level, >= 1.
     pub steps: u16,
-    /// `mu`: step size, > 0 (2 as in Mohimani et al.'s reference code).
+    /// `mu`: step size, in (0, 2] (2 as in Mohimani et al.'s reference code; above 2 the
+    /// ascent grows small coefficients).
     pub mu: f32,
-    /// `sigma_min`: the last sigma, > 0, in normalised units (white = 1).
+    /// `sigma_min`: the last sigma, in (0, 1], in normalised units (white = 1).
     pub sigma_min: f32,
     /// Hard bound on steps (ascent + projection) per solve, >= 1.
     pub max_iterations: u32,
-    /// Noise standard deviation per measurement (normalised units), >= 0: read and
+    /// Noise standard deviation per measurement (normalised units), in [0, 1]: read and
     /// quantisation noise. With `shot` 0 too, the solution equals the measurements.
     pub noise: f32,
-    /// Shot noise: a measurement's variance per unit of its value (normalised units), >= 0;
+    /// Shot noise: a measurement's variance per unit of its value (normalised units), in [0, 1];
     /// `1 / electrons at white` for a sensor whose white level collects that many
     /// electrons. A measurement `y` has variance `noise^2 + shot * max(y, 0)`.
     pub shot: f32,
     /// Early stop: the solve ends once a whole sigma level moves the patch by less than
-    /// this, as an RMS per value (normalised units), >= 0; 0 never stops early.
+    /// this, as an RMS per value (normalised units), in [0, 1]; 0 never stops early.
     pub tolerance: f32,
     /// Where a solve starts from another dictionary's patch ([`solve_warm`]: the ensemble's
     /// second solve), sigma starts at `warm_start * max |S|`, in (0, 1]; 1 is a cold start.
@@ -77,7 +78,7 @@ pub struct Sl0Config {
     /// higher than the minimum-norm start).
     pub cold_start: f32,
     /// The short path: a patch whose measurements of each band all lie within `flat` of
-    /// each other (normalised units, >= 0) is flat in space and view, and is decoded as
+    /// each other (normalised units, in [0, 1]) is flat in space and view, and is decoded as
     /// each band's mean with no solve. Dark patches are flat (their spread is at most their
     /// brightness); with 0 only exactly flat patches (black, clipped) take it.
     pub flat: f32,
@@ -126,22 +127,27 @@ impl Sl0Config {
         if self.steps == 0 {
             return bad("steps");
         }
-        if !(self.mu > 0.0 && self.mu.is_finite()) {
+        // Above 2 the ascent's step `s -> s (1 - mu e^(-s^2 / 2 sigma^2))` grows a small
+        // coefficient instead of shrinking it (2 reflects it): the solve diverges.
+        if !(self.mu > 0.0 && self.mu <= 2.0) {
             return bad("mu");
         }
-        if !(self.sigma_min > 0.0 && self.sigma_min.is_finite()) {
+        // Values are in normalised units (white = 1): a sigma, a noise, a tolerance or a
+        // flatness above 1 is larger than the signal, and the solve would return its start.
+        if !(self.sigma_min > 0.0 && self.sigma_min <= 1.0) {
             return bad("sigma_min");
         }
         if self.max_iterations == 0 {
             return bad("max_iterations");
         }
-        if !(self.noise >= 0.0 && self.noise.is_finite()) {
+        if !(self.noise >= 0.0 && self.noise <= 1.0) {
             return bad("noise");
         }
-        if !(self.shot >= 0.0 && self.shot.is_finite()) {
+        // `1 / electrons at white`: a sensor collects at least one electron at white.
+        if !(self.shot >= 0.0 && self.shot <= 1.0) {
             return bad("shot");
         }
-        if !(self.tolerance >= 0.0 && self.tolerance.is_finite()) {
+        if !(self.tolerance >= 0.0 && self.tolerance <= 1.0) {
             return bad("tolerance");
         }
         if !(self.warm_start > 0.0 && self.warm_start <= 1.0) {
@@ -156,7 +162,7 @@ impl Sl0Config {
         if !(self.cold_start > 0.0 && self.cold_start <= 1.0) {
             return bad("cold_start");
         }
-        if !(self.flat >= 0.0 && self.flat.is_finite()) {
+        if !(self.flat >= 0.0 && self.flat <= 1.0) {
             return bad("flat");
         }
         Ok(())

@@ -16,7 +16,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use slf_firmware::disparity::Disparity;
 use slf_firmware::{
-    Dictionary, DisparityRange, FrameSource, PaperShape, PaperWorkspace, PatchModel, PatchOrigin, PatchReport,
+    Dictionary, DisparityRange, Ended, FrameSource, PaperShape, PaperWorkspace, PatchModel, PatchOrigin, PatchReport,
     PatchSink, Sl0Config, SolveError, Tile, TileDecoder, TileReport,
 };
 
@@ -239,7 +239,7 @@ impl DecodeOptions {
 /// (estimated from the frame for [`Balance::GreyWorld`], as the device does).
 ///
 /// # Errors
-/// A capture the decoder cannot take, or gains that are not finite and positive.
+/// A capture the decoder cannot take, or gains outside `[1/64, 64]`.
 pub fn tile_decoder<'a>(capture: &'a Capture, opts: &DecodeOptions) -> Result<TileDecoder<'a, 5, 5, 4, 4, 13, 5200>> {
     let decoder = capture.decoder(opts.solver_config(capture))?;
     let gains = match opts.balance {
@@ -287,6 +287,41 @@ pub fn shifted_tiles(lenslets: (usize, usize), stride: (u8, u8), per: (u16, u16)
     tiles
 }
 
+/// Which decoder made a patch: a row of [`DecodeReport::member_map`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PatchDecoder {
+    /// SL0 with this ensemble member (the last solve's).
+    Member(u16),
+    /// SL0 with the single dictionary (the DCT, or a one-member basis).
+    Dictionary,
+    /// Per-pixel spectral interpolation: the patch measured fewer than `min_bands` bands.
+    Interpolated,
+    /// The flat short path: each band its mean, no solve.
+    Flat,
+}
+
+impl PatchDecoder {
+    /// The decoder of a patch from its report.
+    pub fn of(report: &PatchReport) -> Self {
+        match (report.outcome.ended, report.member) {
+            (Ended::Interpolated, _) => Self::Interpolated,
+            (Ended::Flat, _) => Self::Flat,
+            (_, Some(m)) => Self::Member(m),
+            (_, None) => Self::Dictionary,
+        }
+    }
+
+    /// Its name in the member map's `decoder` column.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Member(_) => "member",
+            Self::Dictionary => "dictionary",
+            Self::Interpolated => "interpolated",
+            Self::Flat => "flat",
+        }
+    }
+}
+
 /// What a decode did.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct DecodeReport {
@@ -297,9 +332,9 @@ pub struct DecodeReport {
     pub steps: u64,
     /// Solves over all patches (more than one per patch with an ensemble).
     pub solves: u64,
-    /// The ensemble member each decoded patch used, by patch origin (empty for a single
-    /// dictionary).
-    pub member_map: Vec<(PatchOrigin, u16)>,
+    /// Which decoder made each decoded patch, by patch origin: the ensemble member, the
+    /// single dictionary, interpolation or the flat short path.
+    pub member_map: Vec<(PatchOrigin, PatchDecoder)>,
     /// Light-field values no decoded patch covered (left at 0).
     pub uncovered: usize,
     /// Values of a view no (sheared) patch covered, taken from the lenslet's other views.
@@ -324,7 +359,7 @@ struct TileSums {
     weight: Vec<f32>,
     steps: u64,
     solves: u64,
-    members: Vec<(PatchOrigin, u16)>,
+    members: Vec<(PatchOrigin, PatchDecoder)>,
     disparities: Vec<(PatchOrigin, Disparity)>,
 }
 
@@ -364,9 +399,7 @@ impl PatchSink<5200> for TileSums {
     fn accept(&mut self, o: PatchOrigin, patch: &[f32; 5200], report: &PatchReport) -> Result<(), Self::Error> {
         self.steps += u64::from(report.outcome.iterations);
         self.solves += u64::from(report.solves);
-        if let Some(m) = report.member {
-            self.members.push((o, m));
-        }
+        self.members.push((o, PatchDecoder::of(report)));
         if (o.view_row, o.view_col) == (0, 0) && self.halo > 0 && !report.fallback {
             self.disparities.push((o, o.disparity));
         }
@@ -512,6 +545,8 @@ fn aggregate(
                 report.patches.decoded += t.decoded;
                 report.patches.flagged += t.flagged;
                 report.patches.failed += t.failed;
+                report.patches.interpolated += t.interpolated;
+                report.patches.flat += t.flat;
             }
             Err(_) => report.failed_tiles += 1,
         }

@@ -258,19 +258,19 @@ impl SolverSettings {
             Ok(()) => Ok(c),
             Err(SolveError::InvalidConfig { field }) => {
                 let value = match field {
-                    "sigma_f" => c.sigma_f.to_string(),
+                    "sigma_f" => show(c.sigma_f),
                     "steps" => c.steps.to_string(),
-                    "mu" => c.mu.to_string(),
-                    "sigma_min" => c.sigma_min.to_string(),
+                    "mu" => show(c.mu),
+                    "sigma_min" => show(c.sigma_min),
                     "max_iterations" => c.max_iterations.to_string(),
-                    "noise" => c.noise.to_string(),
-                    "shot" => c.shot.to_string(),
-                    "tolerance" => c.tolerance.to_string(),
-                    "warm_start" => c.warm_start.to_string(),
-                    "warm_sigma_f" => c.warm_sigma_f.to_string(),
+                    "noise" => show(c.noise),
+                    "shot" => show(c.shot),
+                    "tolerance" => show(c.tolerance),
+                    "warm_start" => show(c.warm_start),
+                    "warm_sigma_f" => show(c.warm_sigma_f),
                     "warm_steps" => c.warm_steps.to_string(),
-                    "cold_start" => c.cold_start.to_string(),
-                    "flat" => c.flat.to_string(),
+                    "cold_start" => show(c.cold_start),
+                    "flat" => show(c.flat),
                     _ => String::from("?"),
                 };
                 bail!("--{} {value}: must be {}", field.replace('_', "-"), config_range(field))
@@ -280,14 +280,20 @@ impl SolverSettings {
     }
 }
 
+/// A flag's value as a user would write it: `1e30`, not thirty-one digits.
+fn show(v: f32) -> String {
+    if v != 0.0 && v.is_finite() && !(1e-4..1e6).contains(&v.abs()) { format!("{v:e}") } else { v.to_string() }
+}
+
 /// The range [`Sl0Config::validate`] holds `field` to, in words.
 fn config_range(field: &str) -> &'static str {
     match field {
         "sigma_f" | "warm_sigma_f" => "in (0, 1)",
         "warm_start" | "cold_start" => "in (0, 1]",
         "steps" | "warm_steps" | "max_iterations" => "at least 1",
-        "mu" | "sigma_min" => "finite and above 0",
-        _ => "finite and at or above 0",
+        "mu" => "in (0, 2] (above 2 the ascent grows small coefficients)",
+        "sigma_min" => "in (0, 1] (normalised units, white = 1)",
+        _ => "in [0, 1] (normalised units, white = 1)",
     }
 }
 
@@ -386,7 +392,15 @@ impl DecodeSettings {
             Some(g) => {
                 let g: [f32; 13] =
                     g.as_slice().try_into().map_err(|_| anyhow!("--gains: 13 values, got {}", g.len()))?;
-                ensure!(gains::valid(&g), "--gains: every gain must be finite and positive");
+                if let Some((b, bad)) = g.iter().enumerate().find(|(_, x)| !gains::valid(&[**x])) {
+                    bail!(
+                        "--gains: gain {} is {}: each must be in [1/{m}, {m}] (the decode's thresholds are in units \
+                         of white)",
+                        b + 1,
+                        show(*bad),
+                        m = gains::MAX_RATIO
+                    );
+                }
                 Balance::Gains(g)
             }
             None => self.balance.balance(),
@@ -576,7 +590,30 @@ mod tests {
         let s = DecodeSettings::from_flags(["--cold-start=0"]).unwrap();
         assert_eq!(s.resolve().unwrap_err().to_string(), "--cold-start 0: must be in (0, 1]");
         let s = DecodeSettings::from_flags(["--mu=-1"]).unwrap();
-        assert_eq!(s.resolve().unwrap_err().to_string(), "--mu -1: must be finite and above 0");
+        assert!(s.resolve().unwrap_err().to_string().starts_with("--mu -1: must be in (0, 2]"));
+        // Absurd values of every solver and noise flag (issue 32, item 4), each named with
+        // its range; the range's ends are taken.
+        for (flag, bad, good, range) in [
+            ("--mu", ["5", "10", "100", "1e30"], "2", "in (0, 2]"),
+            ("--sigma-min", ["1.5", "1e30", "0", "inf"], "1", "in (0, 1]"),
+            ("--tolerance", ["1.5", "1e30", "-1", "NaN"], "1", "in [0, 1]"),
+            ("--noise", ["1.5", "1e30", "-1", "inf"], "1", "in [0, 1]"),
+            ("--shot", ["1.5", "1e30", "-1", "inf"], "1", "in [0, 1]"),
+            ("--flat", ["1.5", "1e30", "-1", "inf"], "1", "in [0, 1]"),
+        ] {
+            for v in bad {
+                let arg = format!("{flag}={v}");
+                let e = DecodeSettings::from_flags([arg.as_str()]).unwrap().resolve().unwrap_err().to_string();
+                assert!(e.starts_with(&format!("{flag} ")) && e.contains(range) && !e.contains('\n'), "{arg}: {e}");
+            }
+            resolved(&[&format!("{flag}={good}")]);
+        }
+        for g in ["1e30", "0", "0.01", "65", "nan"] {
+            let arg = format!("--gains=1,1,1,{g},1,1,1,1,1,1,1,1,1");
+            let e = DecodeSettings::from_flags([arg.as_str()]).unwrap().resolve().unwrap_err().to_string();
+            assert!(e.starts_with("--gains: gain 4 is ") && e.contains("[1/64, 64]"), "{arg}: {e}");
+        }
+        resolved(&["--gains=64,0.015625,1,1,1,1,1,1,1,1,1,1,1"]);
         // Flags that would be ignored are refused (issue 32, items 5 and 9).
         for (flags, says) in [
             (&["--min-bands", "14"][..], "--min-bands 14: at most 13"),

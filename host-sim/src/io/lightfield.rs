@@ -28,6 +28,38 @@ pub struct LightField {
 }
 
 impl LightField {
+    /// The most values a light field made in memory may hold (a render, an import, a
+    /// resample): 2^30, 4 GiB of f32. Sizes are checked against it before anything is
+    /// allocated ([`Self::check_size`]).
+    pub const MAX_VALUES: usize = 1 << 30;
+
+    /// Checks that a `(U, V, H, W, B)` light field of these sizes has no empty axis and
+    /// stays within [`Self::MAX_VALUES`], before it is allocated.
+    ///
+    /// # Errors
+    /// The sizes, their product (or "more than 2^64") and the limit, in one line.
+    pub fn check_size(views: (usize, usize), rows: usize, cols: usize, bands: usize) -> anyhow::Result<()> {
+        anyhow::ensure!(
+            views.0 > 0 && views.1 > 0 && rows > 0 && cols > 0 && bands > 0,
+            "a light field of {} x {} views, {rows} x {cols} pixels a view and {bands} bands is empty",
+            views.0,
+            views.1
+        );
+        let n = [views.0, views.1, rows, cols, bands].iter().try_fold(1usize, |n, &d| n.checked_mul(d));
+        match n {
+            Some(n) if n <= Self::MAX_VALUES => Ok(()),
+            n => anyhow::bail!(
+                "{} x {} views of {rows} x {cols} pixels and {bands} bands is {} values ({:.1} GiB of f32), more than \
+                 the {} (4 GiB) a light field may hold",
+                views.0,
+                views.1,
+                n.map_or_else(|| "more than 2^64".to_string(), |n| n.to_string()),
+                n.map_or(f64::INFINITY, |n| n as f64 * 4.0 / f64::from(1u32 << 30)),
+                Self::MAX_VALUES
+            ),
+        }
+    }
+
     /// A light field of zeros.
     pub fn zeros(views: (usize, usize), rows: usize, cols: usize, bands: usize) -> Self {
         let n = views.0 * views.1 * rows * cols * bands;

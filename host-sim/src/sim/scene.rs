@@ -235,35 +235,21 @@ impl Default for SceneSize {
 }
 
 impl SceneSize {
-    /// The most values a rendered light field may hold: 2^30 (4 GiB of f32).
-    pub const MAX_VALUES: usize = 1 << 30;
+    /// The most values a rendered light field may hold: [`LightField::MAX_VALUES`].
+    pub const MAX_VALUES: usize = LightField::MAX_VALUES;
 
     /// Values of the light field `(U, V, H, W, 13)`, if that fits in a `usize`.
     pub fn values(&self) -> Option<usize> {
         [self.views.0, self.views.1, self.rows, self.cols, BANDS].iter().try_fold(1usize, |n, &d| n.checked_mul(d))
     }
 
-    /// Checks that no axis is empty and the light field stays within [`Self::MAX_VALUES`].
+    /// Checks that no axis is empty and the light field stays within [`Self::MAX_VALUES`]
+    /// ([`LightField::check_size`]).
     ///
     /// # Errors
     /// What is out of range, in one line.
     pub fn check(&self) -> anyhow::Result<()> {
-        anyhow::ensure!(
-            self.views.0 > 0 && self.views.1 > 0 && self.rows > 0 && self.cols > 0,
-            "a light field of {:?} views and {} x {} lenslets is empty",
-            self.views,
-            self.rows,
-            self.cols
-        );
-        match self.values() {
-            Some(n) if n <= Self::MAX_VALUES => Ok(()),
-            n => anyhow::bail!(
-                "{} values ({:.1} GiB), more than the {} (4 GiB) a rendered light field may hold",
-                n.map_or_else(|| "more than 2^64".to_string(), |n| n.to_string()),
-                n.map_or(f64::INFINITY, |n| n as f64 * 4.0 / f64::from(1u32 << 30)),
-                Self::MAX_VALUES
-            ),
-        }
+        LightField::check_size(self.views, self.rows, self.cols, BANDS)
     }
 }
 

@@ -158,8 +158,12 @@ impl Resampler {
     }
 }
 
+/// The most wavelengths a list or range may give.
+pub const MAX_SAMPLES: usize = 100_000;
+
 /// Wavelengths from a flag: `START:STOP:STEP` (inclusive, e.g. `400:700:10`) or a comma
 /// list (`450,550,650`).
+
 pub fn parse_wavelengths(s: &str) -> Result<Vec<f32>> {
     let s = s.trim();
     if let Some((start, rest)) = s.split_once(':') {
@@ -175,9 +179,17 @@ pub fn parse_wavelengths(s: &str) -> Result<Vec<f32>> {
         };
         let (a, b, d) = (num(start)?, num(stop)?, num(step)?);
         ensure!(d > 0.0 && b >= a, "wavelengths {s:?}: need STEP > 0 and STOP >= START");
-        let n = ((b - a) / d + 1e-6).floor() as usize + 1;
-        ensure!(n <= 100_000, "wavelengths {s:?}: {n} samples is more than 100000");
-        return Ok((0..n).map(|i| (a + i as f64 * d) as f32).collect());
+        // The count in f64 first: a tiny STEP would overflow a usize.
+        let n = ((b - a) / d + 1e-6).floor() + 1.0;
+        ensure!(n <= MAX_SAMPLES as f64, "wavelengths {s:?}: {n:.3e} samples is more than {MAX_SAMPLES}");
+        let n = n as usize;
+        let out: Vec<f32> = (0..n).map(|i| (a + i as f64 * d) as f32).collect();
+        // A step below f32's resolution at these wavelengths would repeat samples.
+        ensure!(
+            out.windows(2).all(|w| w[1] > w[0]),
+            "wavelengths {s:?}: STEP {d} is below the resolution of the wavelengths (f32)"
+        );
+        return Ok(out);
     }
     s.split(',')
         .map(|t| {

@@ -211,6 +211,8 @@ pub fn to_camera_bands(
 pub fn to_lightfield(image: &Plane, cfg: &CubeConfig, source: (usize, usize)) -> Result<(LightField, Option<Plane>)> {
     let (nu, nv) = cfg.views;
     ensure!((1..=16).contains(&nu) && (1..=16).contains(&nv), "views {nu} x {nv}: each in 1..=16");
+    let (rows, cols) = cfg.geometry.output_size(image.rows, image.cols)?;
+    LightField::check_size((nu, nv), rows, cols, image.channels).context("the imported light field")?;
     let img = cfg.geometry.apply(image)?;
     let map = match &cfg.depth {
         Depth::Plane(d) => {

@@ -35,9 +35,9 @@ use image::imageops::{FilterType, resize};
 /// The largest side of an image or cube read.
 pub const MAX_SIDE: usize = 16_384;
 
-/// Reads an image file (8- or 16-bit, grey or colour, values as fractions of full scale)
-/// as three channels; its size is checked against [`MAX_SIDE`] before it is decoded.
-pub fn read_rgb(path: &Path) -> Result<Plane> {
+/// The size of an image file, `(rows, cols)`, from its header alone, checked against
+/// [`MAX_SIDE`].
+pub fn image_size(path: &Path) -> Result<(usize, usize)> {
     let (w, h) = image::ImageReader::open(path)
         .and_then(|r| r.with_guessed_format())
         .with_context(|| format!("{}: cannot open", path.display()))?
@@ -49,7 +49,21 @@ pub fn read_rgb(path: &Path) -> Result<Plane> {
         "{}: {w} x {h} pixels is not within 1..={MAX_SIDE} a side",
         path.display()
     );
+    Ok((h, w))
+}
+
+/// Reads an image file (8- or 16-bit, grey or colour, values as fractions of full scale)
+/// as three channels; its size is checked against [`MAX_SIDE`] before it is decoded.
+pub fn read_rgb(path: &Path) -> Result<Plane> {
+    let (h, w) = image_size(path)?;
     let img = image::open(path).with_context(|| format!("{}: cannot decode", path.display()))?.into_rgb32f();
+    ensure!(
+        (img.height() as usize, img.width() as usize) == (h, w),
+        "{}: the header says {w} x {h} pixels, the image is {} x {}",
+        path.display(),
+        img.width(),
+        img.height()
+    );
     Ok(Plane { rows: h, cols: w, channels: 3, data: img.into_raw() })
 }
 

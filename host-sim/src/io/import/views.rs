@@ -17,12 +17,12 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Result, bail, ensure};
+use anyhow::{Context, Result, bail, ensure};
 
 use super::parallax::{Disparity, estimate, warp};
 use super::pfm::read_pfm;
 use super::rgb::{RgbLift, srgb_to_linear};
-use super::{Geometry, Plane, read_rgb};
+use super::{Geometry, Plane, image_size, read_rgb};
 use crate::io::lightfield::LightField;
 
 /// How view files are named.
@@ -104,7 +104,10 @@ pub fn view_name(cfg: &ViewsConfig, row: usize, col: usize) -> Result<String> {
         Naming::Hci => format!("input_Cam{:03}.png", row * cfg.grid.1 + col),
         Naming::Pattern(p) => {
             let mut s = p.clone();
-            for (key, value) in [("row", row + cfg.index_base), ("col", col + cfg.index_base)] {
+            for (key, index) in [("row", row), ("col", col)] {
+                let Some(value) = index.checked_add(cfg.index_base) else {
+                    bail!("pattern {p:?}: {key} {index} + index base {} is past the largest index", cfg.index_base);
+                };
                 let Some(open) = s.find(&format!("{{{key}")) else {
                     bail!("pattern {p:?} has no {{{key}}} placeholder");
                 };
@@ -150,30 +153,34 @@ pub fn import_views(folder: &Path, cfg: &ViewsConfig, lift: &RgbLift) -> Result<
         r0 + nu,
         c0 + nv
     );
+    // Sizes before anything is decoded: the views held (three channels) and the light
+    // field made, from the first present view's header.
+    let names = (0..nu * nv).map(|i| Ok(folder.join(view_name(cfg, r0 + i / nv, c0 + i % nv)?)));
+    let paths: Vec<PathBuf> = names.collect::<Result<_>>()?;
+    let first_size = paths.iter().find(|p| p.exists()).map(|p| image_size(p)).transpose()?;
+    if let Some((rows, cols)) = first_size {
+        LightField::check_size((nu, nv), rows, cols, 3).with_context(|| format!("{}: the views read", folder.display()))?;
+        let (out_rows, out_cols) = cfg.geometry.output_size(rows, cols)?;
+        LightField::check_size((nu, nv), out_rows, out_cols, lift.bands()).context("the imported light field")?;
+    }
     let mut notes = Vec::new();
     let mut views: Vec<Option<Plane>> = Vec::with_capacity(nu * nv);
     let mut missing = Vec::new();
-    for u in 0..nu {
-        for v in 0..nv {
-            let path = folder.join(view_name(cfg, r0 + u, c0 + v)?);
-            if path.exists() {
-                let p = read_view(&path, cfg.linear)?;
-                if let Some(first) = views.iter().flatten().next() {
-                    ensure!(
-                        (p.rows, p.cols) == (first.rows, first.cols),
-                        "{}: {} x {} pixels, other views {} x {}",
-                        path.display(),
-                        p.cols,
-                        p.rows,
-                        first.cols,
-                        first.rows
-                    );
-                }
-                views.push(Some(p));
-            } else {
-                missing.push((u, v, path));
-                views.push(None);
+    for (i, path) in paths.into_iter().enumerate() {
+        let (u, v) = (i / nv, i % nv);
+        if path.exists() {
+            // Each view's header against the first's before it is decoded.
+            if let (Some((rows, cols)), (r, c)) = (first_size, image_size(&path)?) {
+                ensure!(
+                    (r, c) == (rows, cols),
+                    "{}: {c} x {r} pixels, other views {cols} x {rows}",
+                    path.display(),
+                );
             }
+            views.push(Some(read_view(&path, cfg.linear)?));
+        } else {
+            missing.push((u, v, path));
+            views.push(None);
         }
     }
     let Some(first) = views.iter().flatten().next() else {

@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use slf_host::decode::cs::{Balance, NoiseSource, disparity_per_lenslet};
+use slf_host::decode::cs::{Balance, NoiseSource, PatchDecoder, disparity_per_lenslet};
 use slf_host::decode::settings::{DecodeSettings, Outcome};
 use slf_host::firmware::disparity::Disparity;
 use slf_host::io::capture::Capture;
@@ -20,8 +20,9 @@ pub struct Args {
     pub output: PathBuf,
     #[command(flatten)]
     pub settings: DecodeSettings,
-    /// Also write which ensemble member each patch used (CSV: the patch's origin, the
-    /// disparity it was sheared to, the member).
+    /// Also write which decoder made each patch (CSV: the patch's origin, the disparity it
+    /// was sheared to, the decoder: member, dictionary, interpolated or flat, and the
+    /// ensemble member).
     #[arg(long)]
     pub member_map: Option<PathBuf>,
     /// Also write the chosen disparity per lenslet (.npy, lenslet rows x cols, f32: the
@@ -74,15 +75,17 @@ pub fn run(args: Args) -> Result<()> {
         Outcome::Cs { options, report } => (options, report),
     };
     if let Some(path) = member_map {
-        let mut csv = String::from(
-            "lenslet_row,lenslet_col,view_row,view_col,disparity,member
-",
-        );
-        for (o, m) in &r.member_map {
+        let mut csv = String::from("lenslet_row,lenslet_col,view_row,view_col,disparity,decoder,member\n");
+        for (o, d) in &r.member_map {
+            let member = if let PatchDecoder::Member(m) = d { m.to_string() } else { String::new() };
             csv += &format!(
-                "{},{},{},{},{},{m}
-",
-                o.lenslet_row, o.lenslet_col, o.view_row, o.view_col, o.disparity
+                "{},{},{},{},{},{},{member}\n",
+                o.lenslet_row,
+                o.lenslet_col,
+                o.view_row,
+                o.view_col,
+                o.disparity,
+                d.name()
             );
         }
         std::fs::write(&path, csv).with_context(|| format!("cannot write {}", path.display()))?;
@@ -122,8 +125,13 @@ pub fn run(args: Args) -> Result<()> {
         );
     }
     println!(
-        "decoded {} patches ({} flagged, {} failed, {} tiles failed) in {:.2} s; wrote {}",
+        "decoded {} patches ({} solved, {} interpolated from fewer than {} bands, {} flat; {} flagged, {} failed, {} \
+         tiles failed) in {:.2} s; wrote {}",
         r.patches.decoded,
+        r.patches.solved(),
+        r.patches.interpolated,
+        opts.sl0.min_bands,
+        r.patches.flat,
         r.patches.flagged,
         r.patches.failed,
         r.failed_tiles,
