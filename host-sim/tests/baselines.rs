@@ -201,3 +201,27 @@ fn kronecker_patches_with_too_few_bands_are_interpolated() {
         }
     }
 }
+
+/// One output contract for every decode method (issue 32, item 13): values in the sensor's
+/// physical range, 0 to `(max_valid - black) / (white - black)`, as the CS decode clamps
+/// its patches. Before the baselines were clamped, the textured scene at pixel k = 1 gave
+/// the demosaic 1.91 and PPID -0.37 against [0, 1.111].
+#[test]
+fn every_method_keeps_to_the_sensors_physical_range() {
+    use slf_host::decode::baselines::Baseline;
+    use slf_host::decode::cs::{DecodeOptions, decode_with};
+    use slf_host::sim::scene::{SceneSize, named};
+    let truth = named("texture").unwrap().render(SceneSize { views: (5, 5), rows: 20, cols: 20 });
+    let cap = simulate(&truth, &CameraConfig::pixel(7, 1)).unwrap();
+    let (lo, hi) = cap.raw_format().range();
+    assert_eq!(lo, 0.0);
+    assert!((hi - 1.0 / 0.9).abs() < 1e-3, "{hi}");
+    let mut outputs: Vec<(String, LightField)> =
+        Baseline::ALL.iter().map(|b| (b.name().to_string(), b.run(&cap).unwrap().0)).collect();
+    let opts = DecodeOptions::disjoint();
+    outputs.push(("cs".into(), decode_with(&cap, &slf_host::decode::cs::Basis::Dct, &opts).unwrap().0));
+    for (name, lf) in &outputs {
+        let (min, max) = lf.data.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+        assert!(min >= lo && max <= hi, "{name}: values {min}..{max} outside {lo}..{hi}");
+    }
+}

@@ -19,6 +19,10 @@
 //! - [`ppid`]: the published multispectral demosaicking method of Mihoubi et al. (2017),
 //!   by the pseudo-panchromatic image, adapted to a random filter array spread over views.
 //!
+//! Every baseline's output is clamped to the sensor's physical range, as the CS decode's
+//! is: `0` (no light) to the brightest value a pixel can measure in normalised units
+//! ([`slf_firmware::RawFormat::range`]).
+//!
 //! A pixel with no measurement (all its samples invalid) takes, in [`interpolate`], the mean
 //! spectrum of the measured pixels of its lenslet and the lenslets around it, and in
 //! [`demosaic`] the neighbourhood's estimate; the report counts them.
@@ -95,6 +99,15 @@ pub struct BaselineReport {
     pub filled: usize,
     /// Wall time, seconds.
     pub seconds: f64,
+}
+
+/// Clamps every value to the sensor's physical range ([`slf_firmware::RawFormat::range`]):
+/// the output contract of every decode method, the one the CS decoder keeps per patch. A
+/// colour ratio or PPID's high-pass can push a value past what the sensor could have
+/// recorded, and a measurement under the black level is below no light.
+fn clamp_to_sensor(capture: &Capture, lf: &mut LightField) {
+    let (lo, hi) = capture.raw_format().range();
+    lf.data.iter_mut().for_each(|v| *v = v.clamp(lo, hi));
 }
 
 /// Every sensor position's valid measurements as `(band, value)`, in snapshot order,
@@ -309,6 +322,7 @@ pub fn interpolate(capture: &Capture) -> Result<(LightField, BaselineReport)> {
     }
     ensure!(report.measured > 0, "{}: no pixel holds a measurement (all saturated or defective)", capture.source());
     fill(&mut lf, &missing);
+    clamp_to_sensor(capture, &mut lf);
     report.seconds = start.elapsed().as_secs_f64();
     Ok((lf, report))
 }
@@ -349,6 +363,7 @@ pub fn demosaic(capture: &Capture, cfg: &DemosaicConfig) -> Result<(LightField, 
             lf.data[at + usize::from(band)] = x;
         }
     }
+    clamp_to_sensor(capture, &mut lf);
     report.seconds = start.elapsed().as_secs_f64();
     Ok((lf, report))
 }
@@ -480,6 +495,7 @@ pub fn ppid(capture: &Capture, cfg: &PpidConfig) -> Result<(LightField, Baseline
         }
     });
     let measured = positions.iter().filter(|(_, own)| !own.is_empty()).count();
+    clamp_to_sensor(capture, &mut lf);
     let report =
         BaselineReport { measured, filled: positions.len() - measured, seconds: start.elapsed().as_secs_f64() };
     Ok((lf, report))

@@ -3,8 +3,9 @@
 //! Axes are `(U, V, H, W, B)`: view row, view column, spatial row, spatial column, band,
 //! row-major with the band fastest, the layout of the public multispectral light-field
 //! dataset the paper evaluates on (Schambach and Puente Leon, 2020). Values are f32 in
-//! `[0, 1]` (1 = a white surface in the brightest band); files may also hold uint16
-//! (`0..=65535` maps to `[0, 1]`).
+//! normalised units (1 = a white surface in the brightest band; a decode's lie in the
+//! sensor's physical range, 0 to its brightest measurable value, a little above 1); files
+//! may also hold uint16 (`0..=65535` maps to `[0, 1]`).
 
 use std::fs::File;
 use std::io::BufWriter;
@@ -141,9 +142,10 @@ impl LightField {
 /// How a light field is stored in a file.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Dtype {
-    /// float32, values in `[0, 1]`.
+    /// float32, values as they are (a decode's: 0 to the sensor's brightest measurable
+    /// value, white = 1).
     F32,
-    /// uint16, `[0, 1]` scaled to `0..=65535`.
+    /// uint16, `[0, 1]` scaled to `0..=65535` (values above white clip at 65535).
     U16,
 }
 

@@ -15,7 +15,9 @@ use slf_host::io::lightfield::{Dtype, write_npy, write_npy_f32_2d};
 pub struct Args {
     /// Capture folder (capture.json and frames).
     pub capture: PathBuf,
-    /// Output .npy file.
+    /// Output .npy file: normalised units (white = 1), every method's values clamped to the
+    /// sensor's physical range, 0 to (max_valid - black) / (white - black) (1.111 for the
+    /// simulator's default sensor).
     #[arg(short, long)]
     pub output: PathBuf,
     #[command(flatten)]
