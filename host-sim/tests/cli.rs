@@ -566,7 +566,11 @@ fn import_sizes_and_indices_are_checked_before_allocating() {
     );
     assert!(e.contains("4 GiB") && e.contains("65536 x 65536 pixels"), "{e}");
     let e = failure(
-        slf().args(["import", "cube"]).arg(p("cube.npy")).args(["--wavelengths", "400:700:1e-30", "-o"]).arg(p("w.npy")),
+        slf()
+            .args(["import", "cube"])
+            .arg(p("cube.npy"))
+            .args(["--wavelengths", "400:700:1e-30", "-o"])
+            .arg(p("w.npy")),
     );
     assert!(e.contains("samples is more than 100000"), "{e}");
     let e = failure(

@@ -1,7 +1,10 @@
-//! Fuzz targets of the host's readers: the `.npy` reader and the capture loader, on
-//! arbitrary and mutated files. Each must return (a value or a one-line error) without
-//! panicking, hanging or allocating what the file cannot back, and what it returns must
-//! hold together (values match the shape; a loaded capture's frames match its geometry).
+//! Fuzz targets of the host's readers and flags: the `.npy` reader and the capture loader,
+//! on arbitrary and mutated files; `slf import views` / `cube`'s options and `slf decode`'s
+//! solver, noise and gain flags, with any values. Each must return (a value or a one-line
+//! error) without panicking, hanging or allocating what the input cannot back, and what it
+//! returns must hold together (values match the shape; a loaded capture's frames match its
+//! geometry; an accepted flag is within its stated range and decodes into the sensor's
+//! physical range).
 //!
 //! Why proptest and how to run it long: see `firmware/tests/fuzz.rs` (`SLF_FUZZ_CASES`,
 //! `SLF_FUZZ_SEED`):
@@ -192,4 +195,202 @@ fn fuzz_capture_loader() {
     let loaded = LOADED.load(Ordering::Relaxed);
     eprintln!("fuzz capture loader: {} cases ({loaded} loaded), no failure", cases());
     assert!(loaded > 0, "the generator must reach a successful load");
+}
+
+/// A number as a flag value: mostly small and plausible, sometimes anything a user could
+/// type (huge, negative, zero, not finite, not a number).
+fn flag_number() -> impl Strategy<Value = String> {
+    prop_oneof![
+        4 => (0u32..40).prop_map(|n| n.to_string()),
+        2 => (-2.0f64..3.0).prop_map(|x| format!("{x}")),
+        1 => any::<f64>().prop_map(|x| format!("{x:e}")),
+        1 => any::<u64>().prop_map(|n| n.to_string()),
+        1 => prop::sample::select(vec!["0", "-1", "1e30", "1e-30", "inf", "-inf", "NaN", "", "x", "1,2"])
+            .prop_map(String::from),
+    ]
+}
+
+/// `A,B` or `A,B,C,D` of flag numbers (sizes, windows, crops).
+fn flag_list(n: usize) -> impl Strategy<Value = String> {
+    prop::collection::vec(flag_number(), n).prop_map(|v| v.join(","))
+}
+
+/// A folder of 9 x 9 views of 8 x 8 pixels in both namings, and an `(8, 8, 31)` cube.
+fn import_inputs() -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    let views = dir.path().join("views");
+    std::fs::create_dir(&views).unwrap();
+    for r in 0..9u8 {
+        for c in 0..9u8 {
+            let img = image::RgbImage::from_fn(8, 8, |x, y| image::Rgb([20 * r, 20 * c, (8 * x + y) as u8]));
+            img.save(views.join(format!("input_Cam{:03}.png", u32::from(r) * 9 + u32::from(c)))).unwrap();
+            img.save(views.join(format!("lf_{:02}_{:02}.png", r + 1, c + 1))).unwrap();
+        }
+    }
+    let body: Vec<u8> = (0..8 * 8 * 31).flat_map(|i| (0.2 + (i % 7) as f32 * 0.1).to_le_bytes()).collect();
+    let header = "{'descr': '<f4', 'fortran_order': False, 'shape': (8, 8, 31), }";
+    std::fs::write(dir.path().join("cube.npy"), npy_bytes(1, header, &body)).unwrap();
+    dir
+}
+
+/// Imports that succeeded.
+static IMPORTED: AtomicU32 = AtomicU32::new(0);
+
+/// `slf import views` and `slf import cube` with any values of their options (issue 32's
+/// sizes, wavelengths and indices among them): a light field of the sizes asked for, within
+/// the size cap, or one error line; never a panic or an allocation the cap forbids.
+#[test]
+fn fuzz_import_options() {
+    use slf_host::io::lightfield::LightField;
+    use slf_host::sim::import::{CubeSettings, ViewsSettings};
+    let inputs = import_inputs();
+    let folder = inputs.path().join("views").display().to_string();
+    let cube = inputs.path().join("cube.npy").display().to_string();
+    let check = |result: anyhow::Result<slf_host::io::import::views::Imported>| -> Result<(), TestCaseError> {
+        match result {
+            Ok(i) => {
+                IMPORTED.fetch_add(1, Ordering::Relaxed);
+                let lf = &i.lightfield;
+                prop_assert_eq!(lf.data.len(), lf.shape().iter().product::<usize>());
+                prop_assert!(lf.data.len() <= LightField::MAX_VALUES);
+                prop_assert!(lf.data.iter().all(|v| v.is_finite()));
+            }
+            Err(e) => {
+                let text = format!("{e:#}");
+                prop_assert_eq!(text.lines().count(), 1, "not one line: {}", text);
+            }
+        }
+        Ok(())
+    };
+    let option = |name: &'static str, value: BoxedStrategy<String>| {
+        prop::option::weighted(0.4, value.prop_map(move |v| vec![format!("--{name}={v}")]))
+    };
+    let views = (
+        option("views", flag_list(2).boxed()),
+        option("grid", flag_list(2).boxed()),
+        option("start", flag_list(2).boxed()),
+        option("crop", flag_list(4).boxed()),
+        option("resize", flag_list(2).boxed()),
+        option("index-base", flag_number().boxed()),
+        any::<bool>(),
+    );
+    runner()
+        .run(&views, |(a, b, c, d, e, f, pattern)| {
+            let mut flags = vec![folder.clone()];
+            if pattern {
+                flags.push("--pattern=lf_{row:02}_{col:02}.png".into());
+            }
+            flags.extend([a, b, c, d, e, f].into_iter().flatten().flatten());
+            match ViewsSettings::from_flags(&flags) {
+                Ok(s) => check(s.run()),
+                Err(e) => {
+                    prop_assert_eq!(e.lines().count(), 1, "not one line: {}", e);
+                    Ok(())
+                }
+            }
+        })
+        .unwrap();
+    let wavelengths = prop_oneof![
+        (flag_number(), flag_number(), flag_number()).prop_map(|(a, b, c)| format!("{a}:{b}:{c}")),
+        flag_list(31),
+        Just("400:700:10".to_string()),
+    ];
+    let cubes = (
+        option("wavelengths", wavelengths.boxed()),
+        option("views", flag_list(2).boxed()),
+        option("disparity", flag_number().boxed()),
+        option("white", flag_number().boxed()),
+        option("crop", flag_list(4).boxed()),
+        option("resize", flag_list(2).boxed()),
+    );
+    runner()
+        .run(&cubes, |(a, b, c, d, e, f)| {
+            let mut flags = vec![cube.clone()];
+            flags.extend([a, b, c, d, e, f].into_iter().flatten().flatten());
+            match CubeSettings::from_flags(&flags) {
+                Ok(s) => check(s.run()),
+                Err(e) => {
+                    prop_assert_eq!(e.lines().count(), 1, "not one line: {}", e);
+                    Ok(())
+                }
+            }
+        })
+        .unwrap();
+    let imported = IMPORTED.load(Ordering::Relaxed);
+    eprintln!("fuzz import options: {} cases x 2 commands ({imported} imported), no failure", cases());
+    assert!(imported > 0, "the generators must reach a successful import");
+}
+
+/// Decodes that ran.
+static DECODED: AtomicU32 = AtomicU32::new(0);
+
+/// `slf decode`'s solver, noise and gain flags with any values (issue 32, item 4): refused
+/// in one line naming the flag, or accepted with every value within the ranges the help
+/// states, and then decoded to finite values in the sensor's physical range.
+#[test]
+fn fuzz_decode_flag_ranges() {
+    use slf_host::decode::settings::DecodeSettings;
+    let lf = slf_host::sim::scene::named("texture").unwrap().render(slf_host::sim::scene::SceneSize {
+        views: (5, 5),
+        rows: 5,
+        cols: 5,
+    });
+    let cap = simulate(&lf, &CameraConfig::pixel(3, 1)).unwrap();
+    let (lo, hi) = cap.raw_format().range();
+    let names = vec![
+        "mu",
+        "sigma-min",
+        "tolerance",
+        "noise",
+        "shot",
+        "flat",
+        "sigma-f",
+        "steps",
+        "max-iterations",
+        "warm-start",
+        "warm-sigma-f",
+        "warm-steps",
+        "cold-start",
+        "min-bands",
+        "gains",
+    ];
+    let flag = (prop::sample::select(names), flag_number(), flag_list(13));
+    runner()
+        .run(&prop::collection::vec(flag, 1..4), |flags| {
+            let args: Vec<String> = flags
+                .iter()
+                .map(|(name, one, thirteen)| format!("--{name}={}", if *name == "gains" { thirteen } else { one }))
+                .chain(["--stride=5".to_string(), "--dictionary=dct".to_string()])
+                .collect();
+            let settings = match DecodeSettings::from_flags(&args) {
+                Ok(s) => s,
+                Err(e) => {
+                    prop_assert_eq!(e.lines().count(), 1, "not one line: {}", e);
+                    return Ok(());
+                }
+            };
+            let (_, o) = match settings.resolve() {
+                Ok(r) => r,
+                Err(e) => {
+                    let text = e.to_string();
+                    prop_assert!(text.starts_with("--") && text.lines().count() == 1, "{:?}: {}", args, text);
+                    return Ok(());
+                }
+            };
+            let c = o.sl0;
+            prop_assert!(c.mu > 0.0 && c.mu <= 2.0, "{:?}", args);
+            prop_assert!(c.sigma_min > 0.0 && c.sigma_min <= 1.0, "{:?}", args);
+            for v in [c.tolerance, c.noise, c.shot, c.flat] {
+                prop_assert!((0.0..=1.0).contains(&v), "{:?}", args);
+            }
+            let Ok(decoded) = settings.run(&cap, false, &|_, _| {}) else { return Ok(()) };
+            DECODED.fetch_add(1, Ordering::Relaxed);
+            let data = &decoded.light_field.data;
+            prop_assert!(data.iter().all(|v| (lo..=hi).contains(v)), "{:?}: outside the physical range", args);
+            Ok(())
+        })
+        .unwrap();
+    let decoded = DECODED.load(Ordering::Relaxed);
+    eprintln!("fuzz decode flag ranges: {} cases ({decoded} decoded), no failure", cases());
+    assert!(decoded > 0, "the generator must reach a decode");
 }

@@ -159,7 +159,8 @@ pub fn import_views(folder: &Path, cfg: &ViewsConfig, lift: &RgbLift) -> Result<
     let paths: Vec<PathBuf> = names.collect::<Result<_>>()?;
     let first_size = paths.iter().find(|p| p.exists()).map(|p| image_size(p)).transpose()?;
     if let Some((rows, cols)) = first_size {
-        LightField::check_size((nu, nv), rows, cols, 3).with_context(|| format!("{}: the views read", folder.display()))?;
+        LightField::check_size((nu, nv), rows, cols, 3)
+            .with_context(|| format!("{}: the views read", folder.display()))?;
         let (out_rows, out_cols) = cfg.geometry.output_size(rows, cols)?;
         LightField::check_size((nu, nv), out_rows, out_cols, lift.bands()).context("the imported light field")?;
     }
@@ -171,11 +172,7 @@ pub fn import_views(folder: &Path, cfg: &ViewsConfig, lift: &RgbLift) -> Result<
         if path.exists() {
             // Each view's header against the first's before it is decoded.
             if let (Some((rows, cols)), (r, c)) = (first_size, image_size(&path)?) {
-                ensure!(
-                    (r, c) == (rows, cols),
-                    "{}: {c} x {r} pixels, other views {cols} x {rows}",
-                    path.display(),
-                );
+                ensure!((r, c) == (rows, cols), "{}: {c} x {r} pixels, other views {cols} x {rows}", path.display(),);
             }
             views.push(Some(read_view(&path, cfg.linear)?));
         } else {
