@@ -162,8 +162,7 @@ impl Resampler {
 pub const MAX_SAMPLES: usize = 100_000;
 
 /// Wavelengths from a flag: `START:STOP:STEP` (inclusive, e.g. `400:700:10`) or a comma
-/// list (`450,550,650`).
-
+/// list (`450,550,650`), at most [`MAX_SAMPLES`] of them.
 pub fn parse_wavelengths(s: &str) -> Result<Vec<f32>> {
     let s = s.trim();
     if let Some((start, rest)) = s.split_once(':') {
@@ -191,6 +190,7 @@ pub fn parse_wavelengths(s: &str) -> Result<Vec<f32>> {
         );
         return Ok(out);
     }
+    ensure!(s.split(',').count() <= MAX_SAMPLES, "wavelengths: more than {MAX_SAMPLES} in the list");
     s.split(',')
         .map(|t| {
             t.trim().parse::<f32>().ok().filter(|v| v.is_finite()).ok_or_else(|| {
