@@ -9,6 +9,12 @@
  * `bench_end` in the device binary) and passes their addresses (see scripts/budgets.sh):
  *   qemu-system-arm ... -plugin ./libwincount.so,start=0xADDR,end=0xADDR -d plugin
  *
+ * With `prof=FIRST:LAST` it also counts, per instruction address in flash, the instructions
+ * executed inside windows FIRST..=LAST (1-based), and prints each address's count at exit as
+ *   wincount: prof 0xADDR COUNT
+ * which scripts/device-profile.py adds up per function from the ELF's symbols: where a
+ * window's instructions go.
+ *
  * Counting is exact and repeatable (it does not depend on the host's load), which is why the
  * budgets use it instead of cycle timers: qemu's DWT cycle counter reads 0.
  *
@@ -54,6 +60,12 @@ static uint64_t in_window; /* instructions in the open window */
 static uint64_t windows;   /* windows closed so far */
 static int open;           /* a window is open */
 
+/* The profile: one counter per 2-byte instruction address of the 1 MiB flash. */
+#define FLASH_BASE 0x08000000u
+#define FLASH_SIZE 0x00100000u
+static uint64_t *prof;     /* NULL without prof= */
+static uint64_t prof_first, prof_last;
+
 /* One callback per executed instruction; the instruction's address is its user data. The
  * emulated Cortex-M has one vCPU, so plain counters suffice. */
 static void on_exec(unsigned int vcpu_index, void *userdata)
@@ -74,6 +86,10 @@ static void on_exec(unsigned int vcpu_index, void *userdata)
     }
     if (open) {
         in_window++;
+        if (prof && windows + 1 >= prof_first && windows + 1 <= prof_last && pc >= FLASH_BASE &&
+            pc < FLASH_BASE + FLASH_SIZE) {
+            prof[(pc - FLASH_BASE) / 2]++;
+        }
     }
 }
 
@@ -96,6 +112,14 @@ static void on_run_end(qemu_plugin_id_t id, void *userdata)
     (void)userdata;
     snprintf(line, sizeof line, "wincount: total insns=%" PRIu64 "\n", total);
     qemu_plugin_outs(line);
+    if (prof) {
+        for (uint64_t i = 0; i < FLASH_SIZE / 2; i++) {
+            if (prof[i]) {
+                snprintf(line, sizeof line, "wincount: prof 0x%08" PRIx64 " %" PRIu64 "\n", FLASH_BASE + 2 * i, prof[i]);
+                qemu_plugin_outs(line);
+            }
+        }
+    }
 }
 
 /* Parses `name=0xADDR`; a Thumb symbol's address has bit 0 set, the instruction's does not. */
@@ -115,8 +139,20 @@ __attribute__((visibility("default"))) int qemu_plugin_install(qemu_plugin_id_t 
 {
     (void)info;
     for (int i = 0; i < argc; i++) {
+        if (strncmp(argv[i], "prof=", 5) == 0) {
+            char *rest;
+            prof_first = strtoull(argv[i] + 5, &rest, 10);
+            prof_last = *rest == ':' ? strtoull(rest + 1, &rest, 10) : prof_first;
+            prof = calloc(FLASH_SIZE / 2, sizeof *prof);
+            if (*rest != '\0' || prof_first == 0 || prof_last < prof_first || !prof) {
+                fprintf(stderr, "wincount: prof=%s is not FIRST[:LAST] windows, 1-based\n", argv[i] + 5);
+                return -1;
+            }
+            continue;
+        }
         if (!parse(argv[i], "start", &start_pc) && !parse(argv[i], "end", &end_pc)) {
-            fprintf(stderr, "wincount: unknown or malformed argument %s (expected start=ADDR, end=ADDR)\n", argv[i]);
+            fprintf(stderr, "wincount: unknown or malformed argument %s (expected start=ADDR, end=ADDR, prof=N[:M])\n",
+                    argv[i]);
             return -1;
         }
     }

@@ -42,7 +42,7 @@ use crate::operators::blob::Ensemble;
 use crate::operators::dictionary::Dictionary;
 use crate::operators::shape::PatchShape;
 use crate::operators::transform::analyze_preserving;
-use crate::solver::sl0::{Ended, Outcome, Sl0Config, SolveError, solve, solve_warm};
+use crate::solver::sl0::{Ended, Outcome, Sl0Config, SolveError, max_abs, solve, solve_warm};
 use crate::solver::workspace::Workspace;
 
 /// How much sparser than the DCT's own solution a member's must score to replace it
@@ -123,7 +123,7 @@ fn residual_outside_top(s: &[f32], tau: usize) -> f32 {
     if total.is_nan() || total <= 0.0 || tau >= s.len() {
         return 0.0;
     }
-    let (mut lo, mut hi) = (0.0f32, s.iter().fold(0.0f32, |m, x| m.max(x.abs())));
+    let (mut lo, mut hi) = (0.0f32, max_abs(s));
     for _ in 0..40 {
         let mid = 0.5 * (lo + hi);
         match count_above(s, mid) {

@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Where the device's instructions go (issue 30): runs the device binary on qemu's emulated
+# Cortex-M4F with the counting plugin's profile (scripts/wincount/wincount.c, prof=) and
+# prints, per function of the device ELF, the instructions of a screened-ensemble tile and
+# of a DCT tile (4 patches each; the windows of scripts/budgets.sh).
+# Needs what budgets.sh needs: thumbv7em-none-eabihf, qemu-system-arm, gcc, llvm-nm.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+mkdir -p target
+gcc -O2 -shared -fPIC -fvisibility=hidden -o target/libwincount.so scripts/wincount/wincount.c
+cargo build --profile device -q -p slf-device --target thumbv7em-none-eabihf
+elf=target/thumbv7em-none-eabihf/device/slf-device
+addr() { local v; v=$(llvm-nm "$elf" | awk -v s="$1" '$3 == s { print $1 }'); printf '0x%x' $(( 0x$v & ~1 )); }
+begin=$(addr bench_begin); end=$(addr bench_end)
+# Windows: 1 the white balance, 2 one synthesis, 3 the first ensemble tile, then the other
+# ensemble tiles and the DCT tiles (T of each).
+run() {
+  timeout 600 qemu-system-arm -M netduinoplus2 -nographic -semihosting-config enable=on,target=native \
+    -kernel "$elf" -plugin "target/libwincount.so,start=$begin,end=$end,prof=$1:$1" -d plugin -D "$2" \
+    > target/profile-device.log
+}
+run 3 target/profile-ensemble.log
+tiles=$(grep -c '^tile ' target/profile-device.log)
+python3 scripts/device-profile.py "$elf" target/profile-ensemble.log 3 3 "screened ensemble tile (4 patches)"
+echo
+run $((3 + tiles)) target/profile-dct.log
+python3 scripts/device-profile.py "$elf" target/profile-dct.log $((3 + tiles)) $((3 + tiles)) "DCT tile (4 patches)"
