@@ -151,6 +151,14 @@ fn bad_files_and_arguments_are_one_line_errors() {
     assert_eq!(e.lines().count(), 1, "{e}");
     let e = failure(slf().arg("simulate").arg(p("junk.npy")).arg("-o").arg(p("cap")));
     assert!(e.contains("junk.npy"), "{e}");
+    // Each cause said once (issue 32, item 11): a missing file, a file that is no PNG.
+    let e = failure(slf().arg("eval").arg(p("none.npy")).arg(p("none.npy")));
+    assert_eq!(e.matches("(os error 2)").count(), 1, "{e}");
+    std::fs::create_dir(p("views")).unwrap();
+    std::fs::write(p("views").join("input_Cam020.png"), b"not a png").unwrap();
+    let e = failure(slf().args(["import", "views"]).arg(p("views")).arg("-o").arg(p("v.npy")));
+    assert!(e.contains("not an image slf reads"), "{e}");
+    assert_eq!(e.matches("Invalid PNG signature").count(), 1, "{e}");
     // Shapes that differ.
     stdout(slf().args(["scene", "smooth", "--size", "12", "-o"]).arg(p("a.npy")));
     stdout(slf().args(["scene", "smooth", "--size", "13", "-o"]).arg(p("b.npy")));

@@ -7,7 +7,7 @@ use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyValueError};
 
 /// `e` as the exception a Python user expects.
 pub fn to_py(e: &anyhow::Error) -> PyErr {
-    let message = one_line(&format!("{e:#}"));
+    let message = slf_host::io::message::one_line(e);
     let io = e.chain().find_map(|c| c.downcast_ref::<std::io::Error>());
     match io.map(std::io::Error::kind) {
         Some(std::io::ErrorKind::NotFound) => PyFileNotFoundError::new_err(message),
@@ -31,9 +31,4 @@ impl<T> OrPy<T> for anyhow::Result<T> {
     fn or_py(self) -> pyo3::PyResult<T> {
         self.map_err(|e| to_py(&e))
     }
-}
-
-/// Lines joined: a message is one line in a Python traceback.
-fn one_line(s: &str) -> String {
-    s.lines().map(str::trim).filter(|l| !l.is_empty()).collect::<Vec<_>>().join(" ")
 }

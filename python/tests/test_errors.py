@@ -120,3 +120,12 @@ def test_impossible_noise_and_no_light(capture):
     dark = slf.Capture(np.full_like(capture.frames, int(capture.description["black_level"])), capture.description)
     with pytest.raises(ValueError, match="no light was recorded"):
         slf.decode(dark)
+
+
+def test_each_cause_is_said_once(tmp_path):
+    (tmp_path / "views").mkdir()
+    (tmp_path / "views" / "input_Cam020.png").write_bytes(b"not a png")
+    with pytest.raises(ValueError) as e:
+        slf.import_views(tmp_path / "views")
+    assert "not an image slf reads" in str(e.value)
+    assert str(e.value).count("Invalid PNG signature") == 1, str(e.value)

@@ -14,6 +14,7 @@ use slf_firmware::{
 };
 
 use crate::io::lightfield::{read_npy_u16_2d, write_npy_u16_2d};
+use crate::io::message::one_line;
 
 /// The largest `capture.json` read (a long defect list fits many times over).
 pub const MAX_DESCRIPTION: u64 = 64 << 20;
@@ -287,7 +288,7 @@ impl Capture {
     /// # Errors
     /// A mask or geometry the decoder does not take, with the reason.
     pub fn decoder(&self, sl0: Sl0Config) -> Result<TileDecoder<'_, 5, 5, 4, 4, 13, 5200>> {
-        let mask = self.mask().map_err(|e| anyhow!("{}: {e:#}", self.source()))?;
+        let mask = self.mask().map_err(|e| anyhow!("{}: {}", self.source(), one_line(&e)))?;
         let config =
             DecoderConfig { sensor: self.sensor(), mask, raw: self.raw_format(), defects: self.defects(), sl0 };
         TileDecoder::new(config).map_err(|e| anyhow!("{}: the decoder does not take this capture: {e}", self.source()))
@@ -314,7 +315,7 @@ impl Capture {
     /// A message with the file and what is wrong in it.
     pub fn load(dir: &Path) -> Result<Self> {
         let desc_path = dir.join(DESCRIPTION);
-        let named = |e: anyhow::Error| anyhow!("{}: {e:#}", desc_path.display());
+        let named = |e: anyhow::Error| anyhow!("{}: {}", desc_path.display(), one_line(&e));
         let text = read_small_file(&desc_path, MAX_DESCRIPTION)?;
         let description: CaptureDescription = serde_json::from_str(&text)
             .map_err(|e| anyhow!("{}: invalid capture description: {e}", desc_path.display()))?;
@@ -327,7 +328,8 @@ impl Capture {
         );
         let mut frames = Vec::with_capacity(description.frames.len());
         for (i, name) in description.frames.iter().enumerate() {
-            let path = frame_path(dir, name).map_err(|e| anyhow!("{}: frames[{i}]: {e:#}", desc_path.display()))?;
+            let path =
+                frame_path(dir, name).map_err(|e| anyhow!("{}: frames[{i}]: {}", desc_path.display(), one_line(&e)))?;
             let frame = read_frame(&path)?;
             ensure!(
                 (frame.rows, frame.cols) == (rows, cols),

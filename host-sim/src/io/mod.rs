@@ -5,7 +5,8 @@
 //!   memory order, every size checked before anything is allocated;
 //! - [`lightfield`]: the `(U, V, H, W, B)` light field and its `.npy` files;
 //! - [`capture`]: the capture folder (frames and `capture.json`), loaded and saved;
-//! - [`import`]: views, hyperspectral cubes, HDF5 light fields and band resampling.
+//! - [`import`]: views, hyperspectral cubes, HDF5 light fields and band resampling;
+//! - [`message`]: an error as the one line a user reads.
 //!
 //! May use: nothing of this crate (the firmware crate's checked types). Used by every
 //! layer above.
@@ -13,4 +14,5 @@
 pub mod capture;
 pub mod import;
 pub mod lightfield;
+pub mod message;
 pub mod npy;

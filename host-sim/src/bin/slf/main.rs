@@ -90,7 +90,7 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", slf_host::io::message::one_line(&e));
             ExitCode::FAILURE
         }
     }

@@ -1,0 +1,56 @@
+//! An error as the one line a user reads: the context and its causes joined by `: `, each
+//! said once.
+//!
+//! anyhow's `{:#}` appends every cause to the message, and an error type that already
+//! prints its source in its own message (an `.npy` reader's "cannot read PATH: No such
+//! file", the `image` crate's decoding errors) then shows that source twice: "No such file
+//! or directory (os error 2): No such file or directory (os error 2)". Here a cause whose
+//! text the line already ends with is left out.
+
+/// `e`'s chain on one line, without repeated causes or line breaks.
+pub fn one_line(e: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        let text = text.lines().map(str::trim).filter(|l| !l.is_empty()).collect::<Vec<_>>().join(" ");
+        if text.is_empty() || line.ends_with(&text) {
+            continue;
+        }
+        if !line.is_empty() {
+            line.push_str(": ");
+        }
+        line.push_str(&text);
+    }
+    line
+}
+
+#[cfg(test)]
+mod tests {
+    use super::one_line;
+
+    #[derive(Debug)]
+    struct Repeats(std::io::Error);
+
+    impl std::fmt::Display for Repeats {
+        fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+            write!(f, "x.npy: {}", self.0)
+        }
+    }
+
+    impl std::error::Error for Repeats {
+        fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+            Some(&self.0)
+        }
+    }
+
+    #[test]
+    fn a_cause_the_message_already_says_is_said_once() {
+        let io = || std::io::Error::new(std::io::ErrorKind::NotFound, "No such file");
+        let e = anyhow::Error::new(Repeats(io()));
+        assert_eq!(format!("{e:#}"), "x.npy: No such file: No such file");
+        assert_eq!(one_line(&e), "x.npy: No such file");
+        // Context and a cause it does not repeat: both, joined; line breaks joined too.
+        let e = anyhow::Error::new(io()).context("cannot read\n  capture.json");
+        assert_eq!(one_line(&e), "cannot read capture.json: No such file");
+    }
+}
