@@ -26,7 +26,7 @@ pub fn one_line(e: &anyhow::Error) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::one_line;
+    use crate::io::message::one_line;
 
     #[derive(Debug)]
     struct Repeats(std::io::Error);
