@@ -13,13 +13,7 @@
 # 128.5 KiB.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-mkdir -p target
-gcc -O2 -shared -fPIC -fvisibility=hidden -o target/libwincount.so scripts/wincount/wincount.c
-cargo build --profile device -q -p slf-device --target thumbv7em-none-eabihf
-elf=target/thumbv7em-none-eabihf/device/slf-device
-# Thumb symbols carry bit 0; instruction addresses do not.
-addr() { local v; v=$(llvm-nm "$elf" | awk -v s="$1" '$3 == s { print $1 }'); printf '0x%x' $(( 0x$v & ~1 )); }
-begin=$(addr bench_begin); end=$(addr bench_end)
+source scripts/device-build.sh
 timeout 600 qemu-system-arm -M netduinoplus2 -nographic -semihosting-config enable=on,target=native \
   -kernel "$elf" -plugin "target/libwincount.so,start=$begin,end=$end" -d plugin -D target/wincount.log \
   > target/budget-device.log

@@ -6,12 +6,7 @@
 # Needs what budgets.sh needs: thumbv7em-none-eabihf, qemu-system-arm, gcc, llvm-nm.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-mkdir -p target
-gcc -O2 -shared -fPIC -fvisibility=hidden -o target/libwincount.so scripts/wincount/wincount.c
-cargo build --profile device -q -p slf-device --target thumbv7em-none-eabihf
-elf=target/thumbv7em-none-eabihf/device/slf-device
-addr() { local v; v=$(llvm-nm "$elf" | awk -v s="$1" '$3 == s { print $1 }'); printf '0x%x' $(( 0x$v & ~1 )); }
-begin=$(addr bench_begin); end=$(addr bench_end)
+source scripts/device-build.sh
 # Windows: 1 the white balance, 2 one synthesis, 3 the first ensemble tile, then the other
 # ensemble tiles and the DCT tiles (T of each).
 run() {

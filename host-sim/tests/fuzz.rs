@@ -262,6 +262,14 @@ fn fuzz_import_options() {
         }
         Ok(())
     };
+    // A parser's refusal is one line; what it accepts imports or fails as `check` says.
+    let parsed = |r: Result<anyhow::Result<slf_host::io::import::views::Imported>, String>| match r {
+        Ok(imported) => check(imported),
+        Err(e) => {
+            prop_assert_eq!(e.lines().count(), 1, "not one line: {}", e);
+            Ok(())
+        }
+    };
     let option = |name: &'static str, value: BoxedStrategy<String>| {
         prop::option::weighted(0.4, value.prop_map(move |v| vec![format!("--{name}={v}")]))
     };
@@ -281,13 +289,7 @@ fn fuzz_import_options() {
                 flags.push("--pattern=lf_{row:02}_{col:02}.png".into());
             }
             flags.extend([a, b, c, d, e, f].into_iter().flatten().flatten());
-            match ViewsSettings::from_flags(&flags) {
-                Ok(s) => check(s.run()),
-                Err(e) => {
-                    prop_assert_eq!(e.lines().count(), 1, "not one line: {}", e);
-                    Ok(())
-                }
-            }
+            parsed(ViewsSettings::from_flags(&flags).map(|s| s.run()))
         })
         .unwrap();
     let wavelengths = prop_oneof![
@@ -307,13 +309,7 @@ fn fuzz_import_options() {
         .run(&cubes, |(a, b, c, d, e, f)| {
             let mut flags = vec![cube.clone()];
             flags.extend([a, b, c, d, e, f].into_iter().flatten().flatten());
-            match CubeSettings::from_flags(&flags) {
-                Ok(s) => check(s.run()),
-                Err(e) => {
-                    prop_assert_eq!(e.lines().count(), 1, "not one line: {}", e);
-                    Ok(())
-                }
-            }
+            parsed(CubeSettings::from_flags(&flags).map(|s| s.run()))
         })
         .unwrap();
     let imported = IMPORTED.load(Ordering::Relaxed);
