@@ -51,7 +51,7 @@ fn scene_simulate_decode_eval_round_trip() {
     // 20 x 20 lenslets, four angular windows: 4 x 4 disjoint blocks and, at the default
     // stride 3, 4 x 3 + 3 x 4 + 3 x 3 patches at shifted origins: (16 + 33) x 4 (unsheared:
     // a block sheared at the frame's edge adds its unsheared fallback).
-    assert!(out.contains("decoded 196 patches (0 flagged, 0 failed, 0 tiles failed)"), "{out}");
+    assert!(out.contains("decoded 196 patches (196 solved, 0 interpolated from fewer than 5 bands, 0 flat; 0 flagged, 0 failed, 0 tiles failed)"), "{out}");
     // The capture's noise by default (2 DN read noise, 20,000 electrons at white); exact
     // or a given noise on request, not both.
     assert!(out.contains("projection: the capture's noise (sd 5.57e-4 + shot 5.00e-5 per unit)"), "{out}");
@@ -96,7 +96,7 @@ fn scene_simulate_decode_eval_round_trip() {
     assert!(out.contains("decoded 196 patches"), "{out}");
     stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("e.npy")).arg("--member-map").arg(p("map.csv")).arg("-q"));
     let map = std::fs::read_to_string(p("map.csv")).unwrap();
-    assert_eq!(map.lines().next(), Some("lenslet_row,lenslet_col,view_row,view_col,disparity,member"));
+    assert_eq!(map.lines().next(), Some("lenslet_row,lenslet_col,view_row,view_col,disparity,decoder,member"));
     // Every patch (with the default disparity search, the 196 of the grid and the unsheared
     // fallbacks of the blocks sheared at the frame's edge), the grid's each once.
     let grid: std::collections::HashSet<String> =
@@ -107,7 +107,14 @@ fn scene_simulate_decode_eval_round_trip() {
         map.lines().count() - 1,
         grid.len()
     );
-    assert!(map.lines().skip(1).all(|l| l.rsplit(',').next().unwrap().parse::<u16>().unwrap() < 8));
+    // A member's row names it (the shipped ensemble's 8); any other decoder's names none.
+    assert!(map.lines().skip(1).all(|l| {
+        let f: Vec<&str> = l.split(',').collect();
+        match f[5] {
+            "member" => f[6].parse::<u16>().is_ok_and(|m| m < 8),
+            _ => f[6].is_empty(),
+        }
+    }));
     // A tiny training run writes a blob the decoder takes.
     let out = stdout(slf().arg("train").arg("-o").arg(p("e.slfd")).args([
         "--scenes",
