@@ -8,7 +8,7 @@
 //! light field with its window's weight. The solver's noise ball comes from the capture's
 //! noise description unless told otherwise ([`NoiseSource`]).
 
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::Instant;
 
 use anyhow::{Result, anyhow, ensure};
@@ -488,6 +488,9 @@ pub fn decode_observed<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
                 .unwrap_or_else(|_| ProgressStyle::default_bar()),
         );
         let shown = AtomicBool::new(false);
+        // Tiles done, counted here: the bar's position read after its increment could be
+        // another thread's too, and an observer then saw one count twice.
+        let done = AtomicUsize::new(0);
         let out = tiles
             .par_iter()
             .map_init(
@@ -497,7 +500,7 @@ pub fn decode_observed<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
                     let mut source = FrameSource::new(&raw);
                     let r = decoder.decode_tile(model, tile, &mut source, &mut sums, ws).map_err(|e| e.to_string());
                     bar.inc(1);
-                    observer(bar.position() as usize, tiles.len());
+                    observer(done.fetch_add(1, Ordering::Relaxed) + 1, tiles.len());
                     if opts.progress && start.elapsed().as_secs_f64() > 1.0 && !shown.swap(true, Ordering::Relaxed) {
                         bar.set_draw_target(ProgressDrawTarget::stderr());
                     }
