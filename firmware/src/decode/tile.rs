@@ -214,7 +214,8 @@ pub struct TileReport {
 }
 
 impl TileReport {
-    pub(crate) fn add(&mut self, o: &Self) {
+    /// Adds another tile's counts (a frame's report is its tiles' sum).
+    pub fn add(&mut self, o: &Self) {
         self.decoded += o.decoded;
         self.flagged += o.flagged;
         self.failed += o.failed;

@@ -73,5 +73,10 @@ pub fn gains_from_sums<const B: usize>(sums: &[f32; B], counts: &[u32; B]) -> [f
 /// balanced signal out of their scale; [`gains_from_sums`]' gains average 1 and lie within
 /// `[1 / MAX_RATIO, 13]`.
 pub fn valid(gains: &[f32]) -> bool {
-    gains.iter().all(|g| (1.0 / MAX_RATIO..=MAX_RATIO).contains(g))
+    gains.iter().all(|&g| valid_gain(g))
+}
+
+/// Whether one gain is in `[1 / MAX_RATIO, MAX_RATIO]` (see [`valid`]).
+pub fn valid_gain(g: f32) -> bool {
+    (1.0 / MAX_RATIO..=MAX_RATIO).contains(&g)
 }

@@ -549,13 +549,7 @@ fn aggregate(
     let mut report = DecodeReport { tiles, ..DecodeReport::default() };
     for (sums, r) in results {
         match r {
-            Ok(t) => {
-                report.patches.decoded += t.decoded;
-                report.patches.flagged += t.flagged;
-                report.patches.failed += t.failed;
-                report.patches.interpolated += t.interpolated;
-                report.patches.flat += t.flat;
-            }
+            Ok(t) => report.patches.add(t),
             Err(_) => report.failed_tiles += 1,
         }
         report.steps += sums.steps;

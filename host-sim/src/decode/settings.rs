@@ -392,7 +392,7 @@ impl DecodeSettings {
             Some(g) => {
                 let g: [f32; 13] =
                     g.as_slice().try_into().map_err(|_| anyhow!("--gains: 13 values, got {}", g.len()))?;
-                if let Some((b, bad)) = g.iter().enumerate().find(|(_, x)| !gains::valid(&[**x])) {
+                if let Some((b, bad)) = g.iter().enumerate().find(|(_, x)| !gains::valid_gain(**x)) {
                     bail!(
                         "--gains: gain {} is {}: each must be in [1/{m}, {m}] (the decode's thresholds are in units \
                          of white)",

@@ -238,11 +238,6 @@ impl SceneSize {
     /// The most values a rendered light field may hold: [`LightField::MAX_VALUES`].
     pub const MAX_VALUES: usize = LightField::MAX_VALUES;
 
-    /// Values of the light field `(U, V, H, W, 13)`, if that fits in a `usize`.
-    pub fn values(&self) -> Option<usize> {
-        [self.views.0, self.views.1, self.rows, self.cols, BANDS].iter().try_fold(1usize, |n, &d| n.checked_mul(d))
-    }
-
     /// Checks that no axis is empty and the light field stays within [`Self::MAX_VALUES`]
     /// ([`LightField::check_size`]).
     ///
