@@ -29,7 +29,7 @@ use crate::sensor::defects::DefectList;
 use crate::sensor::mask::{LensletSize, Mask, MaskFamily};
 use crate::sensor::raw::{Invalid, RawFormat};
 use crate::solver::choice::{ModelOutcome, PatchModel};
-use crate::solver::fractional::{MAX_GRID, to_sensor};
+use crate::solver::fractional::{MAX_GRID, from_sensor, to_sensor};
 use crate::solver::interpolate::{bands_measured, interpolate_bands};
 use crate::solver::sl0::{Ended, Outcome, Sl0Config, SolveError};
 use crate::solver::workspace::Workspace;
@@ -56,6 +56,27 @@ pub trait PatchSink<const N: usize> {
     fn reject(&mut self, origin: PatchOrigin, error: SolveError) -> Result<(), Self::Error> {
         let _ = (origin, error);
         Ok(())
+    }
+}
+
+/// Where a seeded decode ([`TileDecoder::decode_tile_seeded`]) finds its start: an
+/// estimate of a patch from its overlapping neighbours' decode (the running sums of the
+/// host's frame, or of the device's strip).
+pub trait PatchSeed<const N: usize> {
+    /// Writes the estimate of the patch at `origin` into `patch`, in the layout a
+    /// [`PatchSink`] receives (sensor units, each value at the pixel
+    /// [`PatchOrigin::lenslet`] names; a value it names none of is not read); `false` if
+    /// there is none (the patch is then decoded from nothing).
+    fn seed(&mut self, origin: PatchOrigin, patch: &mut [f32; N]) -> bool;
+}
+
+/// No estimate anywhere: every patch decodes from nothing.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NoSeed;
+
+impl<const N: usize> PatchSeed<N> for NoSeed {
+    fn seed(&mut self, _: PatchOrigin, _: &mut [f32; N]) -> bool {
+        false
     }
 }
 
@@ -714,6 +735,24 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         sink: &mut K,
         ws: &mut Workspace<PS, PT, PU, PV, B, N>,
     ) -> Result<TileReport, TileError<S::Error, K::Error>> {
+        self.decode_tile_seeded(model, tile, source, &mut NoSeed, sink, ws)
+    }
+
+    /// [`decode_tile`](Self::decode_tile), each patch `seed` has an estimate of decoded
+    /// from it ([`PatchModel::decode_seeded`]: one warm solve instead of a cold one and a
+    /// warm one).
+    ///
+    /// # Errors
+    /// As [`decode_tile`](Self::decode_tile).
+    pub fn decode_tile_seeded<M: PatchModel<PS, PT, PU, PV, B, N>, S: TileSource, Q: PatchSeed<N>, K: PatchSink<N>>(
+        &self,
+        model: &M,
+        tile: Tile,
+        source: &mut S,
+        seed: &mut Q,
+        sink: &mut K,
+        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ) -> Result<TileReport, TileError<S::Error, K::Error>> {
         if !self.check_tile(&tile) {
             return Err(TileError::Geometry);
         }
@@ -724,7 +763,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                 let disparity = self.choose_disparity(row as usize, col as usize, source).map_err(TileError::Source)?;
                 for (view_row, view_col) in self.windows() {
                     let origin = PatchOrigin { lenslet_row: row, lenslet_col: col, view_row, view_col, disparity };
-                    self.decode_patch(model, origin, false, source, sink, ws, &mut report)?;
+                    self.decode_patch(model, origin, false, source, seed, sink, ws, &mut report)?;
                 }
                 // A block sheared at the frame's edge leaves some views of the edge's
                 // lenslets to no patch (their points lie outside the other views): an
@@ -742,7 +781,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                             view_col,
                             disparity: Disparity::ZERO,
                         };
-                        self.decode_patch(model, origin, true, source, sink, ws, &mut report)?;
+                        self.decode_patch(model, origin, true, source, seed, sink, ws, &mut report)?;
                     }
                 }
             }
@@ -762,12 +801,13 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     /// Reads, decodes and sends the patch at `origin` (a fallback: see
     /// [`PatchReport::fallback`]), counting it in `report`.
     #[allow(clippy::too_many_arguments)]
-    fn decode_patch<M: PatchModel<PS, PT, PU, PV, B, N>, S: TileSource, K: PatchSink<N>>(
+    fn decode_patch<M: PatchModel<PS, PT, PU, PV, B, N>, S: TileSource, Q: PatchSeed<N>, K: PatchSink<N>>(
         &self,
         model: &M,
         origin: PatchOrigin,
         fallback: bool,
         source: &mut S,
+        seed: &mut Q,
         sink: &mut K,
         ws: &mut Workspace<PS, PT, PU, PV, B, N>,
         report: &mut TileReport,
@@ -781,6 +821,13 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             let Workspace { signal, measurements, .. } = ws;
             interpolate_bands::<B, N>(measurements, signal);
             Ok(ModelOutcome { outcome: Outcome::interpolated(), member: None, solves: 0 })
+        } else if seed.seed(origin, &mut ws.signal) {
+            let half = ws.measurements().half_views();
+            if !half.is_none() {
+                from_sensor::<PS, PT, PU, PV, B, N>(half, &mut ws.signal);
+            }
+            ws.balance_patch(&self.gains);
+            model.decode_seeded(cfg, ws)
         } else {
             model.decode(cfg, ws)
         };

@@ -42,7 +42,7 @@ use crate::operators::blob::Ensemble;
 use crate::operators::dictionary::Dictionary;
 use crate::operators::shape::PatchShape;
 use crate::operators::transform::analyze_preserving;
-use crate::solver::sl0::{Ended, Outcome, Sl0Config, SolveError, max_abs, solve, solve_warm};
+use crate::solver::sl0::{Ended, Outcome, Sl0Config, SolveError, max_abs, seed, solve, solve_seeded, solve_warm};
 use crate::solver::workspace::Workspace;
 
 /// How much sparser than the DCT's own solution a member's must score to replace it
@@ -179,6 +179,21 @@ pub trait PatchModel<const PS: usize, const PT: usize, const PU: usize, const PV
     /// # Errors
     /// As [`solve`].
     fn decode(&self, cfg: &Sl0Config, ws: &mut Workspace<PS, PT, PU, PV, B, N>) -> Result<ModelOutcome, SolveError>;
+
+    /// Decodes the patch whose measurements are in `ws`, starting from the estimate of it
+    /// in `ws.patch()` (its overlapping neighbours' decode, in the solve's balanced units):
+    /// one seeded solve ([`seed`], [`solve_seeded`]) where [`decode`](Self::decode) starts
+    /// cold. A model without a seeded path decodes from nothing.
+    ///
+    /// # Errors
+    /// As [`solve`].
+    fn decode_seeded(
+        &self,
+        cfg: &Sl0Config,
+        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ) -> Result<ModelOutcome, SolveError> {
+        self.decode(cfg, ws)
+    }
 }
 
 impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
@@ -186,6 +201,18 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
 {
     fn decode(&self, cfg: &Sl0Config, ws: &mut Workspace<PS, PT, PU, PV, B, N>) -> Result<ModelOutcome, SolveError> {
         let outcome = solve(self, cfg, ws)?;
+        Ok(ModelOutcome { outcome, member: None, solves: 1 })
+    }
+
+    fn decode_seeded(
+        &self,
+        cfg: &Sl0Config,
+        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ) -> Result<ModelOutcome, SolveError> {
+        if let Some(outcome) = seed(self, cfg, ws)? {
+            return Ok(ModelOutcome { outcome, member: None, solves: 0 });
+        }
+        let outcome = solve_seeded(self, cfg, ws)?;
         Ok(ModelOutcome { outcome, member: None, solves: 1 })
     }
 }
@@ -336,6 +363,54 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         }
         Ok(ModelOutcome { outcome, member: Some(chosen), solves: 2 })
     }
+
+    /// Seeded: [`Self::screened`] with the estimate in `ws.patch()` (its overlapping
+    /// neighbours' decode, moved onto the measurements by [`seed`]) in place of the DCT's
+    /// cold solution: scored in every member, the best solved from it
+    /// ([`solve_seeded`]), and unless the member's solution scores [`DCT_MARGIN`] times
+    /// sparser than the estimate does in the DCT, the patch is the two's weighted mean as
+    /// in the screened choice. One solve where the screened choice takes two, the first
+    /// cold. Interpolating measurements (half-pixel shears) keep the member's solution:
+    /// the stash holds unmeasured entries only.
+    fn seeded<const N: usize>(
+        &self,
+        rule: &ChoiceRule,
+        cfg: &Sl0Config,
+        ws: &mut Ws<PS, PT, PU, PV, B, N>,
+    ) -> Result<ModelOutcome, SolveError> {
+        if let Some(outcome) = seed(&self.screen, cfg, ws)? {
+            return Ok(ModelOutcome { outcome, member: self.screen_member, solves: 0 });
+        }
+        let dct_score = self.score(&self.screen, rule, ws);
+        let mut best = (f32::INFINITY, None);
+        for k in (0..self.ensemble.len() as u16).filter(|&k| Some(k) != self.screen_member) {
+            let s = self.score(&self.member(k)?, rule, ws);
+            if s < best.0 || best.1.is_none() {
+                best = (s, Some(k));
+            }
+        }
+        let (Some(chosen), Some(dct)) = (best.1, self.screen_member) else {
+            let k = best.1.or(self.screen_member).unwrap_or(0);
+            let outcome = solve_seeded(&self.member(k)?, cfg, ws)?;
+            return Ok(ModelOutcome { outcome, member: Some(k), solves: 1 });
+        };
+        let member = self.member(chosen)?;
+        let selection = ws.measurements.half.is_none();
+        if !selection {
+            let outcome = solve_seeded(&member, cfg, ws)?;
+            return Ok(ModelOutcome { outcome, member: Some(chosen), solves: 1 });
+        }
+        ws.measurements.stash(&ws.signal);
+        let solved = solve_seeded(&member, cfg, ws).map(|outcome| (outcome, self.score(&member, rule, ws)));
+        let (outcome, member_score) = solved.inspect_err(|_| ws.measurements.drop_stash())?;
+        if dct_score < DCT_MARGIN * member_score {
+            let Workspace { signal, measurements, .. } = ws;
+            measurements.blend_stash(signal, member_score / (member_score + dct_score));
+            return Ok(ModelOutcome { outcome, member: Some(dct), solves: 1 });
+        }
+        ws.measurements.drop_stash();
+        Ok(ModelOutcome { outcome, member: Some(chosen), solves: 1 })
+    }
 }
 
 impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
@@ -350,5 +425,17 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
             MemberChoice::ScreenedResolve(rule) => (rule, true),
         };
         self.screened(&rule, cfg, ws, resolve)
+    }
+
+    fn decode_seeded(
+        &self,
+        cfg: &Sl0Config,
+        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ) -> Result<ModelOutcome, SolveError> {
+        let rule = match self.choice {
+            MemberChoice::Exhaustive(rule) => return self.exhaustive(&rule, cfg, ws),
+            MemberChoice::Screened(rule) | MemberChoice::ScreenedResolve(rule) => rule,
+        };
+        self.seeded(&rule, cfg, ws)
     }
 }

@@ -309,3 +309,60 @@ pub fn to_sensor<const PS: usize, const PT: usize, const PU: usize, const PV: us
         }
     }
 }
+
+/// The reverse of [`to_sensor`], for a start: a half-pixel patch estimated from the sensor
+/// pixels its grid positions name (`patch` in [`to_sensor`]'s layout; the last position of
+/// a half axis names no pixel and is not read). Along every half axis, position `s`
+/// between pixels `s - 1` and `s` becomes their mean, and the end positions their one
+/// neighbour: linear interpolation, exact for a patch linear along the axis. In place.
+pub fn from_sensor<
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+    const N: usize,
+>(
+    half: crate::operators::disparity::HalfViews,
+    patch: &mut [f32; N],
+) {
+    const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
+    let index = PatchShape::<PS, PT, PU, PV, B, N>::index;
+    let get = |p: &[f32; N], i: usize| p.get(i).copied().unwrap_or(0.0);
+    for u in 0..PU {
+        for v in 0..PV {
+            let (hs, ht) = (half.row(u), half.col(v));
+            for b in 0..B {
+                if hs && PS > 1 {
+                    for t in 0..PT {
+                        // From the far end, each position from its two pixels before they change.
+                        let last = get(patch, index(PS - 2, t, u, v, b));
+                        for s in (1..PS - 1).rev() {
+                            let x = 0.5 * (get(patch, index(s - 1, t, u, v, b)) + get(patch, index(s, t, u, v, b)));
+                            if let Some(y) = patch.get_mut(index(s, t, u, v, b)) {
+                                *y = x;
+                            }
+                        }
+                        if let Some(y) = patch.get_mut(index(PS - 1, t, u, v, b)) {
+                            *y = last;
+                        }
+                    }
+                }
+                if ht && PT > 1 {
+                    for s in 0..PS {
+                        let last = get(patch, index(s, PT - 2, u, v, b));
+                        for t in (1..PT - 1).rev() {
+                            let x = 0.5 * (get(patch, index(s, t - 1, u, v, b)) + get(patch, index(s, t, u, v, b)));
+                            if let Some(y) = patch.get_mut(index(s, t, u, v, b)) {
+                                *y = x;
+                            }
+                        }
+                        if let Some(y) = patch.get_mut(index(s, PT - 1, u, v, b)) {
+                            *y = last;
+                        }
+                    }
+                }
+            }
+        }
+    }
+}

@@ -70,6 +70,13 @@ pub struct Sl0Config {
     pub warm_sigma_f: f32,
     /// `L` of a warm solve, >= 1.
     pub warm_steps: u16,
+    /// `sigma_f` of a seeded solve ([`solve_seeded`]: a patch started from its
+    /// overlapping neighbours' decode), in (0, 1). It starts where a warm solve does but
+    /// from an estimate, not a solution: slower than the warm fall, so it reworks what the
+    /// estimate carries from the neighbours' borders (measured: at 0.85 the realistic set
+    /// lost 0.1-0.2 dB against a cold decode of the same patches, at 0.9 it gains up to
+    /// 0.2 dB, `docs/bench/README.md`).
+    pub seed_sigma_f: f32,
     /// Where a cold solve starts, in (0, 1]. 1: the paper's minimum-norm solution (the
     /// measurements, zeros elsewhere) at `sigma0 = max |S0|`. Below 1: the band-gain fill
     /// ([`crate::solver::fill`]) at `cold_start * max |S|` of its coefficients (the fill's
@@ -110,6 +117,7 @@ impl Sl0Config {
         warm_start: 1e-2,
         warm_sigma_f: 0.85,
         warm_steps: 1,
+        seed_sigma_f: 0.9,
         cold_start: 1.0,
         flat: 0.0,
         min_bands: 5,
@@ -158,6 +166,9 @@ impl Sl0Config {
         }
         if self.warm_steps == 0 {
             return bad("warm_steps");
+        }
+        if !(self.seed_sigma_f > 0.0 && self.seed_sigma_f < 1.0) {
+            return bad("seed_sigma_f");
         }
         if !(self.cold_start > 0.0 && self.cold_start <= 1.0) {
             return bad("cold_start");
@@ -376,6 +387,14 @@ fn short_path<const PS: usize, const PT: usize, const PU: usize, const PV: usize
     ws: &mut Workspace<PS, PT, PU, PV, B, N>,
 ) -> Option<Outcome> {
     let Workspace { signal, measurements: m, .. } = ws;
+    let mean = short_path_check::<B, N>(cfg, m)?;
+    fill_flat::<B, N>(&mean, signal, m);
+    Some(Outcome { iterations: 0, levels: 0, sigma0: 0.0, residual: 0.0, ended: Ended::Flat })
+}
+
+/// Each band's mean if the patch takes the short path (every band measured, each within
+/// `cfg.flat`), else `None`.
+fn short_path_check<const B: usize, const N: usize>(cfg: &Sl0Config, m: &Measurements<N>) -> Option<[f32; B]> {
     let (mut lo, mut hi, mut sum, mut count) = ([f32::INFINITY; B], [f32::NEG_INFINITY; B], [0.0f32; B], [0u32; B]);
     // The band is the last (contiguous) axis of the patch layout.
     for (values, measured) in m.values.as_chunks::<B>().0.iter().zip(m.measured.as_chunks::<B>().0) {
@@ -393,6 +412,11 @@ fn short_path<const PS: usize, const PT: usize, const PU: usize, const PV: usize
     if mean.iter().any(|v| !v.is_finite()) {
         return None; // a sum past f32's range: the solve reports it
     }
+    Some(mean)
+}
+
+/// The short path's patch: measured entries their values, the rest their band's `mean`.
+fn fill_flat<const B: usize, const N: usize>(mean: &[f32; B], signal: &mut [f32; N], m: &Measurements<N>) {
     for ((x, values), measured) in
         signal.as_chunks_mut::<B>().0.iter_mut().zip(m.values.as_chunks::<B>().0).zip(m.measured.as_chunks::<B>().0)
     {
@@ -400,7 +424,6 @@ fn short_path<const PS: usize, const PT: usize, const PU: usize, const PV: usize
             x[b] = if measured[b] { values[b] } else { mean[b] };
         }
     }
-    Some(Outcome { iterations: 0, levels: 0, sigma0: 0.0, residual: 0.0, ended: Ended::Flat })
 }
 
 /// Decodes the patch again with `dict`, starting from the patch now in `ws.patch()`
@@ -432,6 +455,63 @@ pub fn solve_warm<
     let ball = start::<B, N>(cfg, &ws.measurements)?;
     let warm = Sl0Config { sigma_f: cfg.warm_sigma_f, steps: cfg.warm_steps, ..*cfg };
     descend(dict, &warm, ws, &ball, cfg.warm_start)
+}
+
+/// Decodes the patch from the estimate in `ws.patch()` ([`seed`] must have prepared it):
+/// [`solve_warm`]'s start (`cfg.warm_start * max |S|`) and steps per level, falling by
+/// `cfg.seed_sigma_f`.
+///
+/// # Errors
+/// As [`solve`].
+pub fn solve_seeded<
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+    const N: usize,
+>(
+    dict: &Dictionary<PS, PT, PU, PV, B>,
+    cfg: &Sl0Config,
+    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+) -> Result<Outcome, SolveError> {
+    let ball = start::<B, N>(cfg, &ws.measurements)?;
+    let seeded = Sl0Config { sigma_f: cfg.seed_sigma_f, steps: cfg.warm_steps, ..*cfg };
+    descend(dict, &seeded, ws, &ball, cfg.warm_start)
+}
+
+/// Prepares a seeded solve: the patch in `ws.signal` is an estimate of the patch (its
+/// overlapping neighbours' decode, [`crate::decode::tile::PatchSeed`]), not a solution.
+/// A flat patch is decoded by the short path as [`solve`] does (`Some`); otherwise the
+/// estimate is moved onto the measurements exactly (measured entries take their values;
+/// interpolating measurements: the exact projection) and `None` says a warm solve
+/// ([`solve_seeded`]) may start from it.
+///
+/// # Errors
+/// As [`solve`].
+pub fn seed<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
+    dict: &Dictionary<PS, PT, PU, PV, B>,
+    cfg: &Sl0Config,
+    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+) -> Result<Option<Outcome>, SolveError> {
+    start::<B, N>(cfg, &ws.measurements)?;
+    let Workspace { coeffs, signal, measurements: m } = ws;
+    if !m.half.is_none() {
+        analyze(dict, signal, coeffs);
+        project_fractional(dict, coeffs, signal, m, &Ball::new(0.0, 0.0, m.count, 0));
+        synthesize(dict, coeffs, signal);
+        return Ok(None);
+    }
+    if let Some(mean) = short_path_check::<B, N>(cfg, m) {
+        fill_flat::<B, N>(&mean, signal, m);
+        return Ok(Some(Outcome { iterations: 0, levels: 0, sigma0: 0.0, residual: 0.0, ended: Ended::Flat }));
+    }
+    for ((x, &y), &k) in signal.iter_mut().zip(&m.values).zip(&m.measured) {
+        if k {
+            *x = y;
+        }
+    }
+    Ok(None)
 }
 
 /// The schedule from the patch in `ws.signal`, from `sigma0 = scale * max |S|`, projecting

@@ -221,6 +221,19 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
         }
     }
 
+    /// Divides each band of the patch by its gain: an estimate in the sensor's units into
+    /// the white-balanced units the solve works in ([`Self::unbalance_patch`]'s reverse).
+    pub(crate) fn balance_patch(&mut self, gains: &[f32; B]) {
+        if gains.iter().all(|&g| g == 1.0) {
+            return;
+        }
+        for pixel in self.signal.as_chunks_mut::<B>().0 {
+            for (x, g) in pixel.iter_mut().zip(gains) {
+                *x /= g;
+            }
+        }
+    }
+
     /// Limits the decoded patch to `[lo, hi]` (the sensor's physical range).
     pub(crate) fn clamp_patch(&mut self, lo: f32, hi: f32) {
         // Comparisons, not `f32::clamp` (it asserts `lo <= hi`: a panic site) nor

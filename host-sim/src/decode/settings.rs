@@ -205,6 +205,10 @@ pub struct SolverSettings {
     /// The warm solve's steps per sigma level.
     #[arg(long, default_value_t = Sl0Config::DEFAULT.warm_steps)]
     pub warm_steps: u16,
+    /// A seeded solve's (a shifted patch started from the disjoint grid's decode) sigma
+    /// decrease factor per level, in (0, 1); it starts at --warm-start.
+    #[arg(long, default_value_t = Sl0Config::DEFAULT.seed_sigma_f)]
+    pub seed_sigma_f: f32,
     /// Where a cold solve starts, in (0, 1]: 1 the minimum-norm solution at its largest
     /// coefficient; below 1 the band-gain fill (each pixel's gain times each band's mean
     /// over the patch) at that fraction of its largest coefficient, fewer sigma levels
@@ -250,6 +254,7 @@ impl SolverSettings {
             warm_start: self.warm_start,
             warm_sigma_f: self.warm_sigma_f,
             warm_steps: self.warm_steps,
+            seed_sigma_f: self.seed_sigma_f,
             cold_start: self.cold_start.unwrap_or(base.cold_start),
             flat: self.flat,
             min_bands: self.min_bands,
@@ -269,6 +274,7 @@ impl SolverSettings {
                     "warm_start" => show(c.warm_start),
                     "warm_sigma_f" => show(c.warm_sigma_f),
                     "warm_steps" => c.warm_steps.to_string(),
+                    "seed_sigma_f" => show(c.seed_sigma_f),
                     "cold_start" => show(c.cold_start),
                     "flat" => show(c.flat),
                     _ => String::from("?"),
@@ -288,7 +294,7 @@ fn show(v: f32) -> String {
 /// The range [`Sl0Config::validate`] holds `field` to, in words.
 fn config_range(field: &str) -> &'static str {
     match field {
-        "sigma_f" | "warm_sigma_f" => "in (0, 1)",
+        "sigma_f" | "warm_sigma_f" | "seed_sigma_f" => "in (0, 1)",
         "warm_start" | "cold_start" => "in (0, 1]",
         "steps" | "warm_steps" | "max_iterations" => "at least 1",
         "mu" => "in (0, 2] (above 2 the ascent grows small coefficients)",
@@ -346,6 +352,11 @@ pub struct DecodeSettings {
     /// [default: true; false with --preset preview].
     #[arg(long, value_name = "BOOL")]
     pub edge_fallback: Option<bool>,
+    /// With a stride below 5: decode the disjoint grid first and start each shifted patch
+    /// from its decode, one solve a patch instead of two (false: every patch from
+    /// nothing, the decode before 2026-11-25) [default: true].
+    #[arg(long, value_name = "BOOL")]
+    pub seeded: Option<bool>,
 }
 
 /// A decode's light field and what it reports.
@@ -417,6 +428,7 @@ impl DecodeSettings {
             balance,
             disparities: self.disparities.or(base.disparities),
             edge_fallback: self.edge_fallback.unwrap_or(base.edge_fallback),
+            seeded: self.seeded.unwrap_or(base.seeded),
             ..base
         };
         // Flags the decode would otherwise ignore in silence.
@@ -430,6 +442,11 @@ impl DecodeSettings {
         ensure!(
             self.adaptive.is_none() || options.stride != (5, 5),
             "--adaptive needs a stride below 5: on the disjoint grid there are no shifted patches to choose"
+        );
+        ensure!(
+            self.seeded != Some(true) || (options.stride != (5, 5) && self.adaptive.is_none()),
+            "--seeded true needs a stride below 5 and no --adaptive: it seeds the shifted patches from the disjoint \
+             grid's decode"
         );
         let basis = self.basis.basis_for(self.preset)?;
         ensure!(
@@ -566,8 +583,9 @@ mod tests {
             ((2, 2), p.window, 0.002, p.sl0.cold_start)
         );
         assert_eq!(o.disparities, DisparityRange::new(-2, 2).map(|r| r.with_halves(true)));
-        let (_, o) = resolved(&["--exact", "--balance", "off", "--edge-fallback", "false"]);
-        assert_eq!((o.noise, o.balance, o.edge_fallback), (NoiseSource::Config, Balance::Off, false));
+        let (_, o) = resolved(&["--exact", "--balance", "off", "--edge-fallback", "false", "--seeded", "false"]);
+        assert_eq!((o.noise, o.balance, o.edge_fallback, o.seeded), (NoiseSource::Config, Balance::Off, false, false));
+        assert!(resolved(&[]).1.seeded);
     }
 
     #[test]
@@ -600,6 +618,7 @@ mod tests {
             ("--noise", ["1.5", "1e30", "-1", "inf"], "1", "in [0, 1]"),
             ("--shot", ["1.5", "1e30", "-1", "inf"], "1", "in [0, 1]"),
             ("--flat", ["1.5", "1e30", "-1", "inf"], "1", "in [0, 1]"),
+            ("--seed-sigma-f", ["1", "0", "1e30", "NaN"], "0.5", "in (0, 1)"),
         ] {
             for v in bad {
                 let arg = format!("{flag}={v}");
@@ -619,6 +638,8 @@ mod tests {
             (&["--min-bands", "14"][..], "--min-bands 14: at most 13"),
             (&["--adaptive", "2", "--stride", "5"][..], "--adaptive needs a stride below 5"),
             (&["--adaptive", "2", "--preset", "preview"][..], "--adaptive needs a stride below 5"),
+            (&["--seeded", "true", "--preset", "preview"][..], "--seeded true needs a stride below 5"),
+            (&["--seeded", "true", "--adaptive", "2"][..], "--seeded true needs a stride below 5 and no --adaptive"),
             (
                 &["--blob", "e.slfd", "--dictionary", "dct"][..],
                 "--blob names an ensemble, but this decode uses the DCT (--dictionary dct)",
