@@ -2,6 +2,7 @@
 //! (a one-patch tile each), then averaged with the window's weights in f64.
 
 use slf_host::decode::cs::{Basis, DecodeOptions, Window, decode_with, tile_decoder};
+use slf_host::firmware::tile::PatchSeed;
 use slf_host::firmware::{
     Dictionary, DisparityRange, FrameSource, Overlap, OverlapDecoder, PaperShape, PaperWorkspace, PatchOrigin,
     PatchReport, PatchSink, SolveError, Tile,
@@ -42,7 +43,24 @@ fn unsheared() -> DecodeOptions {
     DecodeOptions { disparities: Some(DisparityRange::OFF), ..DecodeOptions::default() }
 }
 
-fn reference(truth: &LightField, k: u8, stride: usize, window: Window) -> Vec<f32> {
+/// The seed of a patch written out: the first pass's light field at the patch's own
+/// lenslets and views (unsheared), as the decode's sink receives a patch.
+struct FirstPass<'a>(&'a LightField, &'a [f32]);
+
+impl PatchSeed<5200> for FirstPass<'_> {
+    fn seed(&mut self, o: PatchOrigin, patch: &mut [f32; 5200]) -> bool {
+        for (i, x) in patch.iter_mut().enumerate() {
+            let [s, t, u, v, b] = PaperShape::coordinates(i);
+            let (r, c) = (o.lenslet_row as usize + s, o.lenslet_col as usize + t);
+            *x = self.1[self.0.index(o.view_row as usize + u, o.view_col as usize + v, r, c, b)];
+        }
+        true
+    }
+}
+
+/// Every patch decoded on its own and averaged in f64; `seeded`: the disjoint grid first,
+/// averaged alone, and every shifted patch started from that average.
+fn reference(truth: &LightField, k: u8, stride: usize, window: Window, seeded: bool) -> Vec<f32> {
     let capture = simulate(truth, &CameraConfig::pixel(3, k)).unwrap();
     // The solver config `decode_with` uses: the capture's noise ball, and the white balance
     // (the gains are the frame's; a patch decoded alone uses the same ones).
@@ -53,6 +71,7 @@ fn reference(truth: &LightField, k: u8, stride: usize, window: Window) -> Vec<f3
     let (rows, cols) = (truth.rows, truth.cols);
     let mut sum = vec![0.0f64; truth.data.len()];
     let mut weight = vec![0.0f64; truth.data.len()];
+    let mut first: Option<Vec<f32>> = None;
     for dy in (0..5).step_by(stride) {
         for dx in (0..5).step_by(stride) {
             // The unshifted grid's edge patch exists per axis only with offset 0 on that axis.
@@ -70,7 +89,15 @@ fn reference(truth: &LightField, k: u8, stride: usize, window: Window) -> Vec<f3
                 for &c in &cs {
                     let tile = Tile { lenslet_row: r as u16, lenslet_col: c as u16, lenslet_rows: 5, lenslet_cols: 5 };
                     let mut kept = Kept(Vec::new());
-                    decoder.decode_tile(&dct, tile, &mut FrameSource::new(&raw), &mut kept, &mut ws).unwrap();
+                    let mut source = FrameSource::new(&raw);
+                    match (&first, (dy, dx)) {
+                        (Some(lf), (dy, dx)) if (dy, dx) != (0, 0) => {
+                            let mut seed = FirstPass(truth, lf);
+                            decoder.decode_tile_seeded(&dct, tile, &mut source, &mut seed, &mut kept, &mut ws)
+                        }
+                        _ => decoder.decode_tile(&dct, tile, &mut source, &mut kept, &mut ws),
+                    }
+                    .unwrap();
                     assert_eq!(kept.0.len(), 4, "4 angular windows of 4 x 4 in 5 x 5 views");
                     for (o, patch) in &kept.0 {
                         for (i, &x) in patch.iter().enumerate() {
@@ -88,6 +115,9 @@ fn reference(truth: &LightField, k: u8, stride: usize, window: Window) -> Vec<f3
                     }
                 }
             }
+            if seeded && (dy, dx) == (0, 0) {
+                first = Some(sum.iter().zip(&weight).map(|(s, w)| (s / w) as f32).collect());
+            }
         }
     }
     sum.iter().zip(&weight).map(|(s, w)| (s / w) as f32).collect()
@@ -102,10 +132,10 @@ fn overlapping_patches_average_as_every_patch_decoded_alone() {
         [(5, Window::Uniform, 1), (2, Window::Uniform, 1), (3, Window::Tapered, 3), (1, Window::Tapered, 1)]
     {
         let capture = simulate(&truth, &CameraConfig::pixel(3, k)).unwrap();
-        let opts = DecodeOptions { stride: (stride as u8, stride as u8), window, ..unsheared() };
+        let opts = DecodeOptions { stride: (stride as u8, stride as u8), window, seeded: false, ..unsheared() };
         let (fast, report) = decode_with(&capture, &Basis::Dct, &opts).unwrap();
         assert_eq!(report.uncovered, 0);
-        let slow = reference(&truth, k, stride, window);
+        let slow = reference(&truth, k, stride, window, false);
         let worst = fast.data.iter().zip(&slow).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
         assert!(worst <= 1e-6, "stride {stride}, {window:?}, k = {k}: off by {worst}");
         // The device's strip walks the same patches: the same light field, in bands of 4
@@ -121,6 +151,29 @@ fn overlapping_patches_average_as_every_patch_decoded_alone() {
         assert_eq!((r.bands, r.uncovered), (3, 0));
         let worst = fast.data.iter().zip(&rows.0.data).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
         assert!(worst <= 1e-6, "strip, stride {stride}, {window:?}, k = {k}: off by {worst}");
+    }
+}
+
+#[test]
+fn seeded_patches_start_from_the_disjoint_grids_average() {
+    // The seeded decode (the default) against the reference written out: the disjoint grid
+    // decoded and averaged alone, each shifted patch's seed read from that average at its
+    // own lenslets, every estimate averaged in f64.
+    let truth = common::small_smooth(5).window(0, 0, 12, 11);
+    for (stride, window, k) in [(3, Window::Tapered, 1), (2, Window::Uniform, 3)] {
+        let capture = simulate(&truth, &CameraConfig::pixel(3, k)).unwrap();
+        let opts = DecodeOptions { stride: (stride as u8, stride as u8), window, ..unsheared() };
+        assert!(opts.seeded);
+        let (fast, report) = decode_with(&capture, &Basis::Dct, &opts).unwrap();
+        let slow = reference(&truth, k, stride, window, true);
+        let worst = fast.data.iter().zip(&slow).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+        assert!(worst <= 1e-5, "stride {stride}, {window:?}, k = {k}: off by {worst}");
+        // And it is not the unseeded decode: the seeds changed the shifted patches.
+        let cold = reference(&truth, k, stride, window, false);
+        let apart = fast.data.iter().zip(&cold).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+        assert!(apart > 1e-3, "stride {stride}: seeded within {apart} of the cold decode");
+        // One solve a patch either way with the DCT; the seeded ones take fewer steps.
+        assert_eq!(report.solves, u64::from(report.patches.decoded));
     }
 }
 
@@ -225,6 +278,12 @@ fn adaptive_overlap_decodes_shifted_patches_only_at_seams() {
     assert_eq!(r_all.patches.decoded, r_full.patches.decoded);
     let worst = all.data.iter().zip(&full.data).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
     assert!(worst <= 1e-6, "adaptive 0 vs every shifted patch: {worst}");
+    // Unseeded alike: every shifted patch from nothing.
+    let cold = |adaptive| DecodeOptions { seeded: false, ..opts(3, adaptive) };
+    let (all, _) = decode_with(&capture, &Basis::Dct, &cold(Some(0.0))).unwrap();
+    let (full, _) = decode_with(&capture, &Basis::Dct, &cold(None)).unwrap();
+    let worst = all.data.iter().zip(&full.data).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+    assert!(worst <= 1e-6, "unseeded: adaptive 0 vs every shifted patch: {worst}");
     // Steps of 0.01 between lenslet columns, 0.05 across column 4|5, none between rows. A
     // patch from column 3 crosses that seam once per row (steps into columns 4..7: 0.01,
     // 0.05, 0.01, 0.01); its other steps are 3 of 0.01 per row and 4 of 0 per column, so

@@ -246,6 +246,7 @@ def decode(
     window: Optional[str] = None,
     disparities: Union[None, str, Sequence[float]] = None,
     edge_fallback: Optional[bool] = None,
+    seeded: Optional[bool] = None,
     dictionary: Optional[str] = None,
     choice: Optional[str] = None,
     blob: Optional[PathLike] = None,
@@ -264,6 +265,7 @@ def decode(
     warm_start: Optional[float] = None,
     warm_sigma_f: Optional[float] = None,
     warm_steps: Optional[int] = None,
+    seed_sigma_f: Optional[float] = None,
     cold_start: Optional[float] = None,
     flat: Optional[float] = None,
     min_bands: Optional[int] = None,
@@ -277,14 +279,16 @@ def decode(
     ``(light field, report)``: a dict of patches decoded / flagged / failed, of the decoded
     those solved / interpolated (fewer than ``min_bands`` bands measured) / flat, tiles, solves,
     steps, band gains, seconds, the per-lenslet disparity map (``report["disparity"]``, an
-    array, or None when no disparity was searched) and a ``warning`` when over 1 % of the
+    array, or None when no disparity was searched), ``stride``, ``seeded`` (whether the shifted
+    patches started from the disjoint grid's decode) and a ``warning`` when over 1 % of the
     patches failed or were flagged.
 
     ``method``: cs (compressed sensing), interpolate, demosaic or ppid (baselines).
     ``preset``: preview (fast), default or best; any keyword below overrides the preset's
     value. The keywords are ``slf decode``'s flags (see ``slf decode --help``):
     ``stride`` 1..=5, ``window`` uniform or tapered, ``disparities`` ``"MIN:MAX[:STEP]"``
-    or ``(min, max[, step])``, ``edge_fallback``, ``dictionary`` dct or ensemble,
+    or ``(min, max[, step])``, ``edge_fallback``, ``seeded`` (shifted patches started from
+    the disjoint grid's decode), ``dictionary`` dct or ensemble,
     ``choice``, ``blob`` (an ensemble file), ``balance`` grey or off, ``gains`` (13),
     ``adaptive`` and the solver's ``sigma_f`` ... ``min_bands``.
 
@@ -297,6 +301,8 @@ def decode(
         disparities = ":".join(f"{d:g}" for d in disparities)
     if edge_fallback is not None:
         edge_fallback = "true" if edge_fallback else "false"  # type: ignore[assignment]
+    if seeded is not None:
+        seeded = "true" if seeded else "false"  # type: ignore[assignment]
     if blob is not None:
         blob = os.fspath(blob)
     args = _flags(
@@ -306,6 +312,7 @@ def decode(
         window=window,
         disparities=disparities,
         edge_fallback=edge_fallback,
+        seeded=seeded,
         dictionary=dictionary,
         choice=choice,
         blob=blob,
@@ -324,6 +331,7 @@ def decode(
         warm_start=warm_start,
         warm_sigma_f=warm_sigma_f,
         warm_steps=warm_steps,
+        seed_sigma_f=seed_sigma_f,
         cold_start=cold_start,
         flat=flat,
         min_bands=min_bands,

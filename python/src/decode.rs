@@ -88,6 +88,7 @@ pub fn decode<'py>(
             report.set_item("gains", r.gains.to_vec())?;
             report.set_item("seconds", r.seconds)?;
             report.set_item("stride", options.stride.0)?;
+            report.set_item("seeded", options.seeds())?;
             if options.disparities_for(&capture).is_off() {
                 report.set_item("disparity", py.None())?;
             } else {

@@ -19,6 +19,7 @@ def test_report(capture, depth):
     lf, report = slf.decode(capture, preset="preview", report=True)
     assert report["method"] == "cs" and report["preset"] == "preview"
     assert report["decoded"] > 0 and report["failed"] == 0 and report["stride"] == 5
+    assert report["seeded"] is False  # the disjoint grid has no shifted patch to seed
     assert report["solved"] + report["interpolated"] + report["flat"] == report["decoded"]
     assert report["interpolated"] == 0  # the pixel mask measures every band in a patch
     assert len(report["gains"]) == 13 and report["seconds"] > 0

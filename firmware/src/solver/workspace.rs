@@ -208,6 +208,13 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
         &self.signal
     }
 
+    /// The patch buffer, to write an estimate of the patch into before a seeded decode
+    /// ([`crate::solver::choice::PatchModel::decode_seeded`], in the solve's units: divided
+    /// by the band gains). The tile decoder fills it from its [`crate::decode::tile::PatchSeed`].
+    pub fn patch_mut(&mut self) -> &mut [f32; N] {
+        &mut self.signal
+    }
+
     /// Multiplies each band of the decoded patch by its gain: a white-balanced decode back
     /// in the sensor's units. Gains of 1 leave it as it is (and cost nothing).
     pub(crate) fn unbalance_patch(&mut self, gains: &[f32; B]) {

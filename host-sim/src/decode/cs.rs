@@ -190,8 +190,8 @@ pub struct DecodeOptions {
     /// ([`TileDecoder::with_edge_fallback`]); off, the views no sheared patch reached are
     /// filled from their lenslet's other views. On by default.
     pub edge_fallback: bool,
-    /// With a stride below 5 (and no adaptive rule): decode the disjoint grid first, then
-    /// start every shifted patch from that decode ([`slf_firmware::tile::PatchSeed`],
+    /// With a stride below 5: decode the disjoint grid first, then start every shifted
+    /// patch (those the adaptive rule asks for) from that decode ([`slf_firmware::tile::PatchSeed`],
     /// [`slf_firmware::PatchModel::decode_seeded`]): one seeded solve a shifted patch
     /// where a cold one takes the DCT's cold solve and the member's warm one. On by
     /// default: the realistic set decodes as well or better in about two thirds of the
@@ -230,6 +230,12 @@ impl DecodeOptions {
     pub fn disparities_for(&self, capture: &Capture) -> DisparityRange {
         let snapshots = u8::try_from(capture.description.frames.len()).unwrap_or(u8::MAX);
         self.disparities.unwrap_or(DisparityRange::for_snapshots(snapshots))
+    }
+
+    /// Whether the decode seeds its shifted patches: [`Self::seeded`] with a stride below 5
+    /// (the disjoint grid alone has no shifted patch).
+    pub fn seeds(&self) -> bool {
+        self.seeded && self.stride != (5, 5)
     }
 
     /// The solver's config for `capture`: [`Self::sl0`] with the noise ball from
@@ -534,13 +540,14 @@ pub fn decode_observed<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
     // Every patch in one parallel pass; with the adaptive rule, the disjoint grid first and
     // then the shifted patches its seams ask for.
     let mut tiles = base;
-    // Seeded: the disjoint grid first, then the shifted patches from its decode.
-    let seeded = opts.seeded && opts.adaptive.is_none() && opts.stride != (5, 5);
+    // Seeded: the disjoint grid first, then the shifted patches (those the adaptive rule
+    // asks for, or all) from its decode.
+    let seeded = opts.seeds();
     if opts.adaptive.is_none() && !seeded {
         tiles.extend(shifted_tiles(lenslets, opts.stride, opts.tile_patches));
     }
     let mut results = run(&tiles, None);
-    if seeded {
+    if seeded && opts.adaptive.is_none() {
         let (first, _) = aggregate(&results, views, lenslets, tiles.len(), range);
         let shifted = shifted_tiles(lenslets, opts.stride, opts.tile_patches);
         results.extend(run(&shifted, Some(&first)));
@@ -553,7 +560,7 @@ pub fn decode_observed<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
             .into_iter()
             .filter(|t| seams.score(t.lenslet_row as usize, t.lenslet_col as usize) > threshold)
             .collect();
-        results.extend(run(&chosen, None));
+        results.extend(run(&chosen, seeded.then_some(&first)));
         tiles.extend(chosen);
     }
     let (lf, mut report) = aggregate(&results, views, lenslets, tiles.len(), range);

@@ -444,9 +444,8 @@ impl DecodeSettings {
             "--adaptive needs a stride below 5: on the disjoint grid there are no shifted patches to choose"
         );
         ensure!(
-            self.seeded != Some(true) || (options.stride != (5, 5) && self.adaptive.is_none()),
-            "--seeded true needs a stride below 5 and no --adaptive: it seeds the shifted patches from the disjoint \
-             grid's decode"
+            self.seeded != Some(true) || options.stride != (5, 5),
+            "--seeded true needs a stride below 5: it seeds the shifted patches from the disjoint grid's decode"
         );
         let basis = self.basis.basis_for(self.preset)?;
         ensure!(
@@ -639,7 +638,6 @@ mod tests {
             (&["--adaptive", "2", "--stride", "5"][..], "--adaptive needs a stride below 5"),
             (&["--adaptive", "2", "--preset", "preview"][..], "--adaptive needs a stride below 5"),
             (&["--seeded", "true", "--preset", "preview"][..], "--seeded true needs a stride below 5"),
-            (&["--seeded", "true", "--adaptive", "2"][..], "--seeded true needs a stride below 5 and no --adaptive"),
             (
                 &["--blob", "e.slfd", "--dictionary", "dct"][..],
                 "--blob names an ensemble, but this decode uses the DCT (--dictionary dct)",
