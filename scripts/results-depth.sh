@@ -32,7 +32,8 @@ all="demosaic=--method,demosaic ppid=--method,ppid dct=--dictionary,dct,--dispar
 dct+depth=--dictionary,dct,--disparities=-1:1 dct+halves=--dictionary,dct,--disparities=-1:1:0.5
 ensemble=--disparities=0:0 ensemble+depth=--disparities=-1:1 ensemble+depth2=--disparities=-2:2
 ensemble+halves=--disparities=-1:1:0.5
-preview=--preset,preview default=--preset,default best=--preset,best"
+preview=--preset,preview default=--preset,default best=--preset,best
+default-unseeded=--preset,default,--seeded,false best-unseeded=--preset,best,--seeded,false"
 models=""
 for m in $all; do
   case " ${SLF_MODELS:-${m%%=*}} " in *" ${m%%=*} "*) models="$models $m" ;; esac
