@@ -200,7 +200,10 @@ fn f32_decoder_within_005_db_of_the_f64_reference_on_the_test_scenes() {
     for name in scene::NAMES {
         let truth = scene::named(name).unwrap().render(SIZE);
         let cap = simulate(&truth, &CameraConfig::pixel(9, 3)).unwrap();
-        let opts = DecodeOptions::default();
+        // Exact projection for both: the f64 reference has no noise ball (with the capture's
+        // noise model the f32 decode moves onto a ball the reference does not, which the
+        // seeded shifted patches carry on: dark 56.665 against 56.606 dB).
+        let opts = DecodeOptions { noise: NoiseSource::Config, ..DecodeOptions::default() };
         let (f32r, _) = decode(&cap, &Dictionary::dct(), &opts).unwrap();
         let (f64r, _) = decode(&cap, &F64Dct::default(), &opts).unwrap();
         let (a, b) = (peak_psnr(&truth, &f32r), peak_psnr(&truth, &f64r));

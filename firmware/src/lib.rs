@@ -31,10 +31,12 @@
 //!   orthonormal fast path and its cold start from the band-gain fill, the
 //!   noise ball a projection moves onto, the projection of half-pixel sheared patches (whose
 //!   measurements interpolate them), the paper's general pseudo-inverse path for kronecker
-//!   masks, the choice of an ensemble member per patch (exhaustive or screened), and
-//!   per-pixel spectral interpolation for patches that measure too few distinct bands.
+//!   masks, the choice of an ensemble member per patch (exhaustive or screened, or seeded:
+//!   one solve from an estimate of the patch), and per-pixel spectral interpolation for
+//!   patches that measure too few distinct bands.
 //! - **decode** ([`decode`]: [`tile`], [`overlap`]): a rectangle of the raw frame, patch by
-//!   patch, from a [`TileSource`] to a [`PatchSink`], into a caller-owned [`Workspace`]; and
+//!   patch, from a [`TileSource`] to a [`PatchSink`], into a caller-owned [`Workspace`]
+//!   (each patch from nothing, or from a [`PatchSeed`]'s estimate); and
 //!   patches at a stride below the patch size, averaged with a [`Window`] into a
 //!   caller-owned strip of lenslet rows, finished rows to a [`RowSink`].
 //!
@@ -121,8 +123,8 @@ pub mod prelude;
 // `blob::write_blob`, `pinv::solve_pinv`, `sl0::solve_warm`, ...) stay in their modules.
 pub use decode::overlap::{Overlap, OverlapDecoder, OverlapError, OverlapReport, RowSink, Window};
 pub use decode::tile::{
-    ConfigError, DecoderConfig, FrameReport, PatchFlags, PatchOrigin, PatchReport, PatchSink, SensorGeometry, Tile,
-    TileDecoder, TileError, TileReport,
+    ConfigError, DecoderConfig, FrameReport, NoSeed, PatchFlags, PatchOrigin, PatchReport, PatchSeed, PatchSink,
+    SensorGeometry, Tile, TileDecoder, TileError, TileReport,
 };
 pub use operators::blob::{DEFAULT_ENSEMBLE, Ensemble};
 pub use operators::dictionary::{Dictionary, DictionaryError};

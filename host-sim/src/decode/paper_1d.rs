@@ -246,6 +246,42 @@ pub fn solve_5d<T: Real>(factors: &Factors<T>, measured: &[Option<T>], cfg: &Sl0
     (x, iterations)
 }
 
+/// [`solve_5d`] started from the estimate `start` (its measured entries replaced by the
+/// measurements) at `cfg.warm_start` of its largest coefficient, falling by
+/// `cfg.seed_sigma_f` with `cfg.warm_steps` steps a level: the seeded solve
+/// (`slf_firmware::sl0::solve_seeded`) in `T`.
+pub fn solve_5d_seeded<T: Real>(
+    factors: &Factors<T>,
+    measured: &[Option<T>],
+    start: &[T],
+    cfg: &Sl0Config,
+) -> (Vec<T>, u32) {
+    let f = &factors.0;
+    let project = |x: &mut [T]| {
+        for (x, y) in x.iter_mut().zip(measured) {
+            if let Some(y) = y {
+                *x = *y;
+            }
+        }
+    };
+    let mut x = start.to_vec();
+    project(&mut x);
+    let mut s = modes(f, &x, true);
+    let mu = T::from(cfg.mu);
+    let seeded = Sl0Config { sigma_f: cfg.seed_sigma_f, steps: cfg.warm_steps, ..*cfg };
+    let sigma0 = T::from(cfg.warm_start) * max_abs(&s);
+    let (iterations, _) = schedule(&seeded, sigma0, x.len(), |inv| {
+        ascend(&mut s, mu, inv);
+        let before = std::mem::replace(&mut x, modes(f, &s, false));
+        project(&mut x);
+        s = modes(f, &x, true);
+        distance(&before, &x)
+    });
+    x = modes(f, &s, false);
+    project(&mut x);
+    (x, iterations)
+}
+
 /// `slf baseline`: the 5D decoder against the 1D method on `patches` patches of the
 /// texture scene (4 x 4 views): time, memory and the largest difference, printed.
 ///

@@ -26,7 +26,7 @@ use slf_firmware::{
 
 use crate::decode::baselines::Baseline;
 use crate::decode::cs::{Basis, DecodeOptions, NoiseSource, Window, decode, decode_with, patch_count};
-use crate::decode::paper_1d::{Factors, analyze_5d, solve_5d};
+use crate::decode::paper_1d::{Factors, analyze_5d, solve_5d, solve_5d_seeded};
 use crate::decode::preset::Preset;
 use crate::eval::metrics::evaluate;
 use crate::io::capture::MaskDescription;
@@ -59,15 +59,38 @@ impl PatchModel<5, 5, 4, 4, 13, 5200> for F64Dct {
         }
         let meas: Vec<Option<f64>> = (0..5200).map(|i| m.get(i).map(f64::from)).collect();
         let (x, iterations) = solve_5d::<f64>(&self.factors, &meas, cfg);
-        // Write the f64 patch back: its DCT coefficients (f64 analysis with the f32 tables),
-        // then one f32 synthesis (rounding ~1e-7, far below the f32-vs-f64 differences).
-        let s = analyze_5d(&self.widened, &x);
+        Ok(self.write_back(&x, iterations, ws))
+    }
+
+    fn decode_seeded(
+        &self,
+        cfg: &Sl0Config,
+        ws: &mut Workspace<5, 5, 4, 4, 13, 5200>,
+    ) -> Result<ModelOutcome, SolveError> {
+        cfg.validate()?;
+        let m = ws.measurements();
+        if m.count() == 0 {
+            return Err(SolveError::NoMeasurements);
+        }
+        let meas: Vec<Option<f64>> = (0..5200).map(|i| m.get(i).map(f64::from)).collect();
+        let start: Vec<f64> = ws.patch().iter().map(|&x| f64::from(x)).collect();
+        let (x, iterations) = solve_5d_seeded::<f64>(&self.factors, &meas, &start, cfg);
+        Ok(self.write_back(&x, iterations, ws))
+    }
+}
+
+impl F64Dct {
+    /// Writes the f64 patch `x` back: its DCT coefficients (f64 analysis with the f32
+    /// tables), then one f32 synthesis (rounding ~1e-7, far below the f32-vs-f64
+    /// differences).
+    fn write_back(&self, x: &[f64], iterations: u32, ws: &mut Workspace<5, 5, 4, 4, 13, 5200>) -> ModelOutcome {
+        let s = analyze_5d(&self.widened, x);
         for (dst, v) in ws.coefficients_mut().iter_mut().zip(&s) {
             *dst = *v as f32;
         }
         ws.synthesize(&self.dict);
         let outcome = Outcome { iterations, levels: 0, sigma0: 0.0, residual: 0.0, ended: Ended::SigmaMin };
-        Ok(ModelOutcome { outcome, member: None, solves: 1 })
+        ModelOutcome { outcome, member: None, solves: 1 }
     }
 }
 
