@@ -381,3 +381,70 @@ fn tiles_cover_every_lenslet_of_any_sensor() {
         }
     }
 }
+
+/// Seeds from the truth, as a frame's first pass would give them (sensor units).
+struct TruthSeed<'a>(&'a [f32], bool);
+
+impl PatchSeed<5200> for TruthSeed<'_> {
+    fn seed(&mut self, origin: PatchOrigin, patch: &mut [f32; 5200]) -> bool {
+        patch.copy_from_slice(&truth_patch(self.0, origin));
+        if self.1 {
+            patch[17] = f32::NAN;
+        }
+        true
+    }
+}
+
+/// A seeded tile decode is the model's seeded decode of each patch from its seed divided
+/// by the band gains (written out here), multiplied back and clamped; a seed with a NaN is
+/// no seed (the decode from nothing, bit for bit), and so is [`NoSeed`].
+#[test]
+fn a_seeded_tile_decode_starts_each_patch_from_its_balanced_seed() {
+    let l = light_field();
+    let dict = Dictionary::dct();
+    let mask = Mask::pixel(3, 1, 13, L5).unwrap();
+    let gains: [f32; 13] = core::array::from_fn(|b| 0.6 + 0.07 * b as f32);
+    let dec = Decoder::new(config(mask)).unwrap().with_gains(&gains).unwrap();
+    let frames = capture(&l, &mask);
+    let raw: Vec<RawFrame<f32>> = frames.iter().map(|f| RawFrame::new(f, 50, 75).unwrap()).collect();
+    let tile = Tile { lenslet_row: 0, lenslet_col: 5, lenslet_rows: 5, lenslet_cols: 5 };
+    let mut ws = Box::new(PaperWorkspace::new());
+    // One tile into a sink of its own, from nothing (`None`) or seeded by `seed`.
+    let run = |seed: Option<&mut dyn PatchSeed<5200>>| {
+        let (mut sink, mut ws) = (Collect::default(), Box::new(PaperWorkspace::new()));
+        let mut src = FrameSource::new(&raw);
+        match seed {
+            None => dec.decode_tile(&dict, tile, &mut src, &mut sink, &mut ws),
+            Some(q) => dec.decode_tile_seeded(&dict, tile, &mut src, q, &mut sink, &mut ws),
+        }
+        .unwrap();
+        sink
+    };
+    let cold = run(None);
+    let none = run(Some(&mut NoSeed));
+    let nan = run(Some(&mut TruthSeed(&l, true)));
+    let seeded = run(Some(&mut TruthSeed(&l, false)));
+    assert_eq!(cold.accepted.len(), 4);
+    for (a, b) in cold.accepted.iter().zip(&none.accepted) {
+        assert_eq!((a.0, &a.1, a.2), (b.0, &b.1, b.2), "NoSeed");
+    }
+    for (a, b) in cold.accepted.iter().zip(&nan.accepted) {
+        assert_eq!((a.0, &a.1, a.2), (b.0, &b.1, b.2), "a NaN seed");
+    }
+    for ((origin, patch, report), (_, cold_patch, cold_report)) in seeded.accepted.iter().zip(&cold.accepted) {
+        let truth = truth_patch(&l, *origin);
+        // By hand: the measurements read as the decoder reads them, the seed balanced.
+        dec.read_patch(*origin, &mut FrameSource::new(&raw), &mut ws).unwrap();
+        for (i, x) in ws.patch_mut().iter_mut().enumerate() {
+            *x = truth[i] / gains[i % 13];
+        }
+        let out = dict.decode_seeded(&dec.config().sl0, &mut ws).unwrap();
+        let expected: Vec<f32> =
+            ws.patch().iter().enumerate().map(|(i, x)| (x * gains[i % 13]).clamp(0.0, 1.0)).collect();
+        assert_eq!(&expected[..], &patch[..], "{origin:?}");
+        assert_eq!((out.outcome, out.solves), (report.outcome, 1));
+        assert!(report.outcome.iterations < cold_report.outcome.iterations);
+        let (es, ec) = (rel_err32(patch, &truth), rel_err32(cold_patch, &truth));
+        assert!(es < ec, "{origin:?}: seeded from the truth {es}, cold {ec}");
+    }
+}

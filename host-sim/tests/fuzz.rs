@@ -346,6 +346,7 @@ fn fuzz_decode_flag_ranges() {
         "warm-start",
         "warm-sigma-f",
         "warm-steps",
+        "seed-sigma-f",
         "cold-start",
         "min-bands",
         "gains",
@@ -376,6 +377,7 @@ fn fuzz_decode_flag_ranges() {
             let c = o.sl0;
             prop_assert!(c.mu > 0.0 && c.mu <= 2.0, "{:?}", args);
             prop_assert!(c.sigma_min > 0.0 && c.sigma_min <= 1.0, "{:?}", args);
+            prop_assert!(c.seed_sigma_f > 0.0 && c.seed_sigma_f < 1.0, "{:?}", args);
             for v in [c.tolerance, c.noise, c.shot, c.flat] {
                 prop_assert!((0.0..=1.0).contains(&v), "{:?}", args);
             }

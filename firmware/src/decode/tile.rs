@@ -66,7 +66,8 @@ pub trait PatchSeed<const N: usize> {
     /// Writes the estimate of the patch at `origin` into `patch`, in the layout a
     /// [`PatchSink`] receives (sensor units, each value at the pixel
     /// [`PatchOrigin::lenslet`] names; a value it names none of is not read); `false` if
-    /// there is none (the patch is then decoded from nothing).
+    /// there is none. A patch without an estimate, or with a NaN or an infinity in it, is
+    /// decoded from nothing.
     fn seed(&mut self, origin: PatchOrigin, patch: &mut [f32; N]) -> bool;
 }
 
@@ -744,7 +745,12 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     ///
     /// # Errors
     /// As [`decode_tile`](Self::decode_tile).
-    pub fn decode_tile_seeded<M: PatchModel<PS, PT, PU, PV, B, N>, S: TileSource, Q: PatchSeed<N>, K: PatchSink<N>>(
+    pub fn decode_tile_seeded<
+        M: PatchModel<PS, PT, PU, PV, B, N>,
+        S: TileSource,
+        Q: PatchSeed<N> + ?Sized,
+        K: PatchSink<N>,
+    >(
         &self,
         model: &M,
         tile: Tile,
@@ -801,7 +807,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     /// Reads, decodes and sends the patch at `origin` (a fallback: see
     /// [`PatchReport::fallback`]), counting it in `report`.
     #[allow(clippy::too_many_arguments)]
-    fn decode_patch<M: PatchModel<PS, PT, PU, PV, B, N>, S: TileSource, Q: PatchSeed<N>, K: PatchSink<N>>(
+    fn decode_patch<M: PatchModel<PS, PT, PU, PV, B, N>, S: TileSource, Q: PatchSeed<N> + ?Sized, K: PatchSink<N>>(
         &self,
         model: &M,
         origin: PatchOrigin,
@@ -821,7 +827,8 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             let Workspace { signal, measurements, .. } = ws;
             interpolate_bands::<B, N>(measurements, signal);
             Ok(ModelOutcome { outcome: Outcome::interpolated(), member: None, solves: 0 })
-        } else if seed.seed(origin, &mut ws.signal) {
+        } else if seed.seed(origin, &mut ws.signal) && ws.signal.iter().all(|x| x.is_finite()) {
+            // (A seed with a NaN or an infinity is no estimate: the patch decodes from nothing.)
             let half = ws.measurements().half_views();
             if !half.is_none() {
                 from_sensor::<PS, PT, PU, PV, B, N>(half, &mut ws.signal);
