@@ -5,9 +5,8 @@ mod common;
 
 use common::*;
 use rand::Rng;
-use slf_firmware::blob::write_blob;
 use slf_firmware::sl0::solve_warm;
-use slf_firmware::transform::{analyze_preserving, synthesize};
+use slf_firmware::transform::analyze_preserving;
 use slf_firmware::*;
 
 const L5: LensletSize = LensletSize { rows: 5, cols: 5 };
@@ -37,24 +36,6 @@ fn rules_match_slow_references() {
         assert_eq!(ChoiceRule::Count { threshold: 0.3 }.score(&s), count);
     }
     assert_eq!(ChoiceRule::Residual { tau: 10 }.score(&[0.0; 100]), 0.0);
-}
-
-fn blob(members: &[Dictionary<5, 5, 4, 4, 13>]) -> &'static [u8] {
-    let mut out = vec![0u8; blob::blob_len([5, 5, 4, 4, 13], members.len())];
-    write_blob(members, &mut out).unwrap();
-    Box::leak(out.into_boxed_slice())
-}
-
-/// A patch of a few atoms of `dict` plus a DC level.
-fn sparse_in(dict: &Dictionary<5, 5, 4, 4, 13>, seed: u64) -> Vec<f32> {
-    let mut r = rng(seed);
-    let mut s = Box::new([0.0f32; 5200]);
-    for _ in 0..15 {
-        s[r.random_range(0..5200)] = r.random_range(1.0f32..3.0) * if r.random_bool(0.5) { 1.0 } else { -1.0 };
-    }
-    let mut x = Box::new([0.0f32; 5200]);
-    synthesize(dict, &mut s, &mut x);
-    x.to_vec()
 }
 
 /// With a cold second solve (`warm_start` 1) both choices find the member an exactly

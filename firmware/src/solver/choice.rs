@@ -283,6 +283,23 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         rule.score(&ws.coeffs)
     }
 
+    /// The member other than the DCT whose analysis of `ws.patch()` scores sparsest by
+    /// `rule`, with its score (`None`: the ensemble has no other member).
+    fn screen_members<const N: usize>(
+        &self,
+        rule: &ChoiceRule,
+        ws: &mut Ws<PS, PT, PU, PV, B, N>,
+    ) -> Result<(f32, Option<u16>), SolveError> {
+        let mut best = (f32::INFINITY, None);
+        for k in (0..self.ensemble.len() as u16).filter(|&k| Some(k) != self.screen_member) {
+            let s = self.score(&self.member(k)?, rule, ws);
+            if s < best.0 || best.1.is_none() {
+                best = (s, Some(k));
+            }
+        }
+        Ok(best)
+    }
+
     fn member(&self, k: u16) -> Result<Dictionary<PS, PT, PU, PV, B>, SolveError> {
         self.ensemble.member(k as usize).map_err(|_| SolveError::NoSuchMember)
     }
@@ -327,13 +344,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             return Ok(ModelOutcome { outcome: first, member: self.screen_member, solves: 1 });
         }
         let dct_score = self.score(&self.screen, rule, ws);
-        let mut best = (f32::INFINITY, None);
-        for k in (0..self.ensemble.len() as u16).filter(|&k| Some(k) != self.screen_member) {
-            let s = self.score(&self.member(k)?, rule, ws);
-            if s < best.0 || best.1.is_none() {
-                best = (s, Some(k));
-            }
-        }
+        let best = self.screen_members(rule, ws)?;
         let (Some(chosen), Some(dct)) = (best.1, self.screen_member) else {
             // No other member, or no DCT member to compete: solve with the screen's pick.
             let k = best.1.or(self.screen_member).unwrap_or(0);
@@ -382,13 +393,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             return Ok(ModelOutcome { outcome, member: self.screen_member, solves: 0 });
         }
         let dct_score = self.score(&self.screen, rule, ws);
-        let mut best = (f32::INFINITY, None);
-        for k in (0..self.ensemble.len() as u16).filter(|&k| Some(k) != self.screen_member) {
-            let s = self.score(&self.member(k)?, rule, ws);
-            if s < best.0 || best.1.is_none() {
-                best = (s, Some(k));
-            }
-        }
+        let best = self.screen_members(rule, ws)?;
         let (Some(chosen), Some(dct)) = (best.1, self.screen_member) else {
             let k = best.1.or(self.screen_member).unwrap_or(0);
             let outcome = solve_seeded(&self.member(k)?, cfg, ws)?;

@@ -452,9 +452,20 @@ pub fn solve_warm<
     cfg: &Sl0Config,
     ws: &mut Workspace<PS, PT, PU, PV, B, N>,
 ) -> Result<Outcome, SolveError> {
+    descend_from(dict, cfg, cfg.warm_sigma_f, ws)
+}
+
+/// The schedule from the patch in `ws.patch()` at `cfg.warm_start * max |S|`, falling by
+/// `sigma_f` with `cfg.warm_steps` steps a level: [`solve_warm`] and [`solve_seeded`].
+fn descend_from<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
+    dict: &Dictionary<PS, PT, PU, PV, B>,
+    cfg: &Sl0Config,
+    sigma_f: f32,
+    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+) -> Result<Outcome, SolveError> {
     let ball = start::<B, N>(cfg, &ws.measurements)?;
-    let warm = Sl0Config { sigma_f: cfg.warm_sigma_f, steps: cfg.warm_steps, ..*cfg };
-    descend(dict, &warm, ws, &ball, cfg.warm_start)
+    let from = Sl0Config { sigma_f, steps: cfg.warm_steps, ..*cfg };
+    descend(dict, &from, ws, &ball, cfg.warm_start)
 }
 
 /// Decodes the patch from the estimate in `ws.patch()` ([`seed`] must have prepared it):
@@ -475,9 +486,7 @@ pub fn solve_seeded<
     cfg: &Sl0Config,
     ws: &mut Workspace<PS, PT, PU, PV, B, N>,
 ) -> Result<Outcome, SolveError> {
-    let ball = start::<B, N>(cfg, &ws.measurements)?;
-    let seeded = Sl0Config { sigma_f: cfg.seed_sigma_f, steps: cfg.warm_steps, ..*cfg };
-    descend(dict, &seeded, ws, &ball, cfg.warm_start)
+    descend_from(dict, cfg, cfg.seed_sigma_f, ws)
 }
 
 /// Prepares a seeded solve: the patch in `ws.signal` is an estimate of the patch (its

@@ -209,3 +209,23 @@ pub fn small_decoder(mask: Mask<'static>) -> Small<'static> {
     })
     .unwrap()
 }
+
+/// An ensemble blob of `members`, leaked for the `'static` an [`slf_firmware::Ensemble`]
+/// borrows.
+pub fn blob(members: &[Dictionary<5, 5, 4, 4, 13>]) -> &'static [u8] {
+    let mut out = vec![0u8; slf_firmware::blob::blob_len([5, 5, 4, 4, 13], members.len())];
+    slf_firmware::blob::write_blob(members, &mut out).unwrap();
+    Box::leak(out.into_boxed_slice())
+}
+
+/// A patch of 15 atoms of `dict` (a member's exactly sparse patch).
+pub fn sparse_in(dict: &Dictionary<5, 5, 4, 4, 13>, seed: u64) -> Vec<f32> {
+    let mut r = rng(seed);
+    let mut s = Box::new([0.0f32; 5200]);
+    for _ in 0..15 {
+        s[r.random_range(0..5200)] = r.random_range(1.0f32..3.0) * if r.random_bool(0.5) { 1.0 } else { -1.0 };
+    }
+    let mut x = Box::new([0.0f32; 5200]);
+    slf_firmware::transform::synthesize(dict, &mut s, &mut x);
+    x.to_vec()
+}

@@ -223,6 +223,22 @@ pub fn analyze_5d<T: Real>(factors: &Factors<T>, x: &[T]) -> Vec<T> {
 /// 5D SL0 (fast path) in `T`: the reference for the firmware's f32 decoder and for the
 /// 1D method. `measured[i]` is `Some(y)` for a measured entry.
 pub fn solve_5d<T: Real>(factors: &Factors<T>, measured: &[Option<T>], cfg: &Sl0Config) -> (Vec<T>, u32) {
+    let x: Vec<T> = measured.iter().map(|y| y.unwrap_or(T::zero())).collect();
+    let s = modes(&factors.0, &x, true);
+    let sigma0 = max_abs(&s);
+    descend_5d(factors, measured, x, s, cfg, sigma0)
+}
+
+/// Algorithm 1's schedule from the patch `x` (meeting the measurements) and its
+/// coefficients `s`, from `sigma0`: the patch and the steps taken.
+fn descend_5d<T: Real>(
+    factors: &Factors<T>,
+    measured: &[Option<T>],
+    mut x: Vec<T>,
+    mut s: Vec<T>,
+    cfg: &Sl0Config,
+    sigma0: T,
+) -> (Vec<T>, u32) {
     let f = &factors.0;
     let project = |x: &mut [T]| {
         for (x, y) in x.iter_mut().zip(measured) {
@@ -231,10 +247,8 @@ pub fn solve_5d<T: Real>(factors: &Factors<T>, measured: &[Option<T>], cfg: &Sl0
             }
         }
     };
-    let mut x: Vec<T> = measured.iter().map(|y| y.unwrap_or(T::zero())).collect();
-    let mut s = modes(f, &x, true);
     let mu = T::from(cfg.mu);
-    let (iterations, _) = schedule(cfg, max_abs(&s), x.len(), |inv| {
+    let (iterations, _) = schedule(cfg, sigma0, x.len(), |inv| {
         ascend(&mut s, mu, inv);
         let before = std::mem::replace(&mut x, modes(f, &s, false));
         project(&mut x);
@@ -256,30 +270,11 @@ pub fn solve_5d_seeded<T: Real>(
     start: &[T],
     cfg: &Sl0Config,
 ) -> (Vec<T>, u32) {
-    let f = &factors.0;
-    let project = |x: &mut [T]| {
-        for (x, y) in x.iter_mut().zip(measured) {
-            if let Some(y) = y {
-                *x = *y;
-            }
-        }
-    };
-    let mut x = start.to_vec();
-    project(&mut x);
-    let mut s = modes(f, &x, true);
-    let mu = T::from(cfg.mu);
-    let seeded = Sl0Config { sigma_f: cfg.seed_sigma_f, steps: cfg.warm_steps, ..*cfg };
+    let x: Vec<T> = start.iter().zip(measured).map(|(&x, y)| y.unwrap_or(x)).collect();
+    let s = modes(&factors.0, &x, true);
     let sigma0 = T::from(cfg.warm_start) * max_abs(&s);
-    let (iterations, _) = schedule(&seeded, sigma0, x.len(), |inv| {
-        ascend(&mut s, mu, inv);
-        let before = std::mem::replace(&mut x, modes(f, &s, false));
-        project(&mut x);
-        s = modes(f, &x, true);
-        distance(&before, &x)
-    });
-    x = modes(f, &s, false);
-    project(&mut x);
-    (x, iterations)
+    let seeded = Sl0Config { sigma_f: cfg.seed_sigma_f, steps: cfg.warm_steps, ..*cfg };
+    descend_5d(factors, measured, x, s, &seeded, sigma0)
 }
 
 /// `slf baseline`: the 5D decoder against the 1D method on `patches` patches of the
