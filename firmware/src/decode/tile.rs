@@ -60,8 +60,9 @@ pub trait PatchSink<const N: usize> {
 }
 
 /// Where a seeded decode ([`TileDecoder::decode_tile_seeded`]) finds its start: an
-/// estimate of a patch from its overlapping neighbours' decode (the running sums of the
-/// host's frame, or of the device's strip).
+/// estimate of a patch from its overlapping neighbours' decode (on the host, the disjoint
+/// grid's averaged decode of the frame; the device's strip does not seed, see
+/// `docs/bench/README.md`).
 pub trait PatchSeed<const N: usize> {
     /// Writes the estimate of the patch at `origin` into `patch`, in the layout a
     /// [`PatchSink`] receives (sensor units, each value at the pixel
@@ -740,8 +741,8 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     }
 
     /// [`decode_tile`](Self::decode_tile), each patch `seed` has an estimate of decoded
-    /// from it ([`PatchModel::decode_seeded`]: one warm solve instead of a cold one and a
-    /// warm one).
+    /// from it ([`PatchModel::decode_seeded`]: one seeded solve where the screened
+    /// ensemble takes a cold one and a warm one).
     ///
     /// # Errors
     /// As [`decode_tile`](Self::decode_tile).
