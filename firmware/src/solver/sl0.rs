@@ -490,7 +490,7 @@ pub fn solve_seeded<
 }
 
 /// Prepares a seeded solve: the patch in `ws.signal` is an estimate of the patch (its
-/// overlapping neighbours' decode, [`crate::decode::tile::PatchSeed`]), not a solution.
+/// overlapping neighbours' decode, as the tile decoder's seed gives it), not a solution.
 /// A flat patch is decoded by the short path as [`solve`] does (`Some`); otherwise the
 /// estimate is moved onto the measurements exactly (measured entries take their values;
 /// interpolating measurements: the exact projection) and `None` says a warm solve

@@ -210,7 +210,7 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
 
     /// The patch buffer, to write an estimate of the patch into before a seeded decode
     /// ([`crate::solver::choice::PatchModel::decode_seeded`], in the solve's units: divided
-    /// by the band gains). The tile decoder fills it from its [`crate::decode::tile::PatchSeed`].
+    /// by the band gains). The tile decoder fills it from its seed.
     pub fn patch_mut(&mut self) -> &mut [f32; N] {
         &mut self.signal
     }
