@@ -193,9 +193,9 @@ pub struct DecodeOptions {
     /// With a stride below 5: decode the disjoint grid first, then start every shifted
     /// patch (those the adaptive rule asks for) from that decode ([`slf_firmware::tile::PatchSeed`],
     /// [`slf_firmware::PatchModel::decode_seeded`]): one seeded solve a shifted patch
-    /// where a cold one takes the DCT's cold solve and the member's warm one. On by
-    /// default: the realistic set decodes as well or better in about two thirds of the
-    /// time (`docs/bench/README.md`).
+    /// where an unseeded one takes the DCT's cold solve and the member's warm one. On by
+    /// default: the realistic set decodes as well or better in 0.71 of the time
+    /// (`docs/bench/README.md`).
     pub seeded: bool,
 }
 
@@ -537,11 +537,10 @@ pub fn decode_observed<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
         bar.finish_and_clear();
         out
     };
-    // Every patch in one parallel pass; with the adaptive rule, the disjoint grid first and
-    // then the shifted patches its seams ask for.
+    // Unseeded, every patch in one parallel pass. Seeded, or with the adaptive rule, the
+    // disjoint grid first, then the shifted patches (all, or those its seams ask for),
+    // seeded from its decode unless told not to.
     let mut tiles = base;
-    // Seeded: the disjoint grid first, then the shifted patches (those the adaptive rule
-    // asks for, or all) from its decode.
     let seeded = opts.seeds();
     if opts.adaptive.is_none() && !seeded {
         tiles.extend(shifted_tiles(lenslets, opts.stride, opts.tile_patches));
