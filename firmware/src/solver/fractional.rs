@@ -328,41 +328,42 @@ pub fn from_sensor<
 ) {
     const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
     let index = PatchShape::<PS, PT, PU, PV, B, N>::index;
-    let get = |p: &[f32; N], i: usize| p.get(i).copied().unwrap_or(0.0);
     for u in 0..PU {
         for v in 0..PV {
             let (hs, ht) = (half.row(u), half.col(v));
             for b in 0..B {
-                if hs && PS > 1 {
+                if hs {
                     for t in 0..PT {
-                        // From the far end, each position from its two pixels before they change.
-                        let last = get(patch, index(PS - 2, t, u, v, b));
-                        for s in (1..PS - 1).rev() {
-                            let x = 0.5 * (get(patch, index(s - 1, t, u, v, b)) + get(patch, index(s, t, u, v, b)));
-                            if let Some(y) = patch.get_mut(index(s, t, u, v, b)) {
-                                *y = x;
-                            }
-                        }
-                        if let Some(y) = patch.get_mut(index(PS - 1, t, u, v, b)) {
-                            *y = last;
-                        }
+                        back_along(patch, PS, |s| index(s, t, u, v, b));
                     }
                 }
-                if ht && PT > 1 {
+                if ht {
                     for s in 0..PS {
-                        let last = get(patch, index(s, PT - 2, u, v, b));
-                        for t in (1..PT - 1).rev() {
-                            let x = 0.5 * (get(patch, index(s, t - 1, u, v, b)) + get(patch, index(s, t, u, v, b)));
-                            if let Some(y) = patch.get_mut(index(s, t, u, v, b)) {
-                                *y = x;
-                            }
-                        }
-                        if let Some(y) = patch.get_mut(index(s, PT - 1, u, v, b)) {
-                            *y = last;
-                        }
+                        back_along(patch, PT, |t| index(s, t, u, v, b));
                     }
                 }
             }
         }
+    }
+}
+
+/// [`from_sensor`] along one half axis of `len` positions, position `i` at `at(i)`: from
+/// the far end, each position the mean of its two pixels before they change, the last
+/// position its one neighbour's (the first keeps its pixel).
+#[inline(always)]
+fn back_along<const N: usize>(patch: &mut [f32; N], len: usize, at: impl Fn(usize) -> usize) {
+    if len < 2 {
+        return;
+    }
+    let get = |p: &[f32; N], i: usize| p.get(at(i)).copied().unwrap_or(0.0);
+    let last = get(patch, len - 2);
+    for i in (1..len - 1).rev() {
+        let x = 0.5 * (get(patch, i - 1) + get(patch, i));
+        if let Some(y) = patch.get_mut(at(i)) {
+            *y = x;
+        }
+    }
+    if let Some(y) = patch.get_mut(at(len - 1)) {
+        *y = last;
     }
 }

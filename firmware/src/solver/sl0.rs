@@ -382,19 +382,12 @@ pub fn solve<const PS: usize, const PT: usize, const PU: usize, const PV: usize,
 /// The short path for a flat patch: if every band is measured and each band's
 /// measurements lie within `cfg.flat` of each other, `ws.patch()` becomes each band's
 /// mean (measured entries keep their values, so the patch meets the measurements).
+/// Otherwise `ws.patch()` is left as it was.
 fn short_path<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
     cfg: &Sl0Config,
     ws: &mut Workspace<PS, PT, PU, PV, B, N>,
 ) -> Option<Outcome> {
     let Workspace { signal, measurements: m, .. } = ws;
-    let mean = short_path_check::<B, N>(cfg, m)?;
-    fill_flat::<B, N>(&mean, signal, m);
-    Some(Outcome { iterations: 0, levels: 0, sigma0: 0.0, residual: 0.0, ended: Ended::Flat })
-}
-
-/// Each band's mean if the patch takes the short path (every band measured, each within
-/// `cfg.flat`), else `None`.
-fn short_path_check<const B: usize, const N: usize>(cfg: &Sl0Config, m: &Measurements<N>) -> Option<[f32; B]> {
     let (mut lo, mut hi, mut sum, mut count) = ([f32::INFINITY; B], [f32::NEG_INFINITY; B], [0.0f32; B], [0u32; B]);
     // The band is the last (contiguous) axis of the patch layout.
     for (values, measured) in m.values.as_chunks::<B>().0.iter().zip(m.measured.as_chunks::<B>().0) {
@@ -412,11 +405,6 @@ fn short_path_check<const B: usize, const N: usize>(cfg: &Sl0Config, m: &Measure
     if mean.iter().any(|v| !v.is_finite()) {
         return None; // a sum past f32's range: the solve reports it
     }
-    Some(mean)
-}
-
-/// The short path's patch: measured entries their values, the rest their band's `mean`.
-fn fill_flat<const B: usize, const N: usize>(mean: &[f32; B], signal: &mut [f32; N], m: &Measurements<N>) {
     for ((x, values), measured) in
         signal.as_chunks_mut::<B>().0.iter_mut().zip(m.values.as_chunks::<B>().0).zip(m.measured.as_chunks::<B>().0)
     {
@@ -424,6 +412,7 @@ fn fill_flat<const B: usize, const N: usize>(mean: &[f32; B], signal: &mut [f32;
             x[b] = if measured[b] { values[b] } else { mean[b] };
         }
     }
+    Some(Outcome { iterations: 0, levels: 0, sigma0: 0.0, residual: 0.0, ended: Ended::Flat })
 }
 
 /// Decodes the patch again with `dict`, starting from the patch now in `ws.patch()`
@@ -504,22 +493,18 @@ pub fn seed<const PS: usize, const PT: usize, const PU: usize, const PV: usize, 
     ws: &mut Workspace<PS, PT, PU, PV, B, N>,
 ) -> Result<Option<Outcome>, SolveError> {
     start::<B, N>(cfg, &ws.measurements)?;
-    let Workspace { coeffs, signal, measurements: m } = ws;
-    if !m.half.is_none() {
+    let exact = Ball::new(0.0, 0.0, ws.measurements.count, 0);
+    if !ws.measurements.half.is_none() {
+        let Workspace { coeffs, signal, measurements: m } = ws;
         analyze(dict, signal, coeffs);
-        project_fractional(dict, coeffs, signal, m, &Ball::new(0.0, 0.0, m.count, 0));
+        project_fractional(dict, coeffs, signal, m, &exact);
         synthesize(dict, coeffs, signal);
         return Ok(None);
     }
-    if let Some(mean) = short_path_check::<B, N>(cfg, m) {
-        fill_flat::<B, N>(&mean, signal, m);
-        return Ok(Some(Outcome { iterations: 0, levels: 0, sigma0: 0.0, residual: 0.0, ended: Ended::Flat }));
+    if let Some(outcome) = short_path(cfg, ws) {
+        return Ok(Some(outcome));
     }
-    for ((x, &y), &k) in signal.iter_mut().zip(&m.values).zip(&m.measured) {
-        if k {
-            *x = y;
-        }
-    }
+    project::<B, N>(&mut ws.signal, &ws.measurements, &exact);
     Ok(None)
 }
 

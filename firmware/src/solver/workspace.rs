@@ -218,25 +218,25 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
     /// Multiplies each band of the decoded patch by its gain: a white-balanced decode back
     /// in the sensor's units. Gains of 1 leave it as it is (and cost nothing).
     pub(crate) fn unbalance_patch(&mut self, gains: &[f32; B]) {
-        if gains.iter().all(|&g| g == 1.0) {
-            return;
-        }
-        for pixel in self.signal.as_chunks_mut::<B>().0 {
-            for (x, g) in pixel.iter_mut().zip(gains) {
-                *x *= g;
-            }
-        }
+        self.per_band(gains, |x, g| x * g);
     }
 
     /// Divides each band of the patch by its gain: an estimate in the sensor's units into
     /// the white-balanced units the solve works in ([`Self::unbalance_patch`]'s reverse).
     pub(crate) fn balance_patch(&mut self, gains: &[f32; B]) {
+        self.per_band(gains, |x, g| x / g);
+    }
+
+    /// Each value `x` of the patch becomes `f(x, its band's gain)`; nothing at all when
+    /// every gain is 1.
+    #[inline(always)]
+    fn per_band(&mut self, gains: &[f32; B], f: impl Fn(f32, f32) -> f32) {
         if gains.iter().all(|&g| g == 1.0) {
             return;
         }
         for pixel in self.signal.as_chunks_mut::<B>().0 {
-            for (x, g) in pixel.iter_mut().zip(gains) {
-                *x /= g;
+            for (x, &g) in pixel.iter_mut().zip(gains) {
+                *x = f(*x, g);
             }
         }
     }
