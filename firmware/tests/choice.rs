@@ -38,6 +38,41 @@ fn rules_match_slow_references() {
     assert_eq!(ChoiceRule::Residual { tau: 10 }.score(&[0.0; 100]), 0.0);
 }
 
+/// The residual's bisection must drop the same set as sorting: every magnitude at or below
+/// the `tau + 1`-th largest, ties with it included (where no threshold leaves exactly `tau`
+/// above it). Checked in f64 on coarse values (many ties), sparse ones (mostly zeros) and
+/// short inputs (the counts' 32 lanes and their tail).
+#[test]
+fn the_residual_drops_what_sorting_drops_ties_included() {
+    let dropped = |s: &[f32], tau: usize| {
+        let mut mags: Vec<f32> = s.iter().map(|x| x.abs()).collect();
+        mags.sort_by(|a, b| b.total_cmp(a));
+        let t = mags[tau];
+        let sq = |x: &f32| f64::from(*x) * f64::from(*x);
+        let total: f64 = s.iter().map(sq).sum();
+        s.iter().filter(|x| x.abs() <= t).map(sq).sum::<f64>() / total
+    };
+    let mut r = rng(2);
+    for case in 0..60 {
+        let len = [5200usize, 5200, 63, 64, 65, 200][case % 6];
+        let s: Vec<f32> = (0..len)
+            .map(|_| match case % 3 {
+                0 => (r.random_range(-1.0f32..1.0).powi(3) * 8.0).round() / 8.0,
+                1 if r.random_range(0.0f32..1.0) < 0.9 => 0.0,
+                _ => r.random_range(-1.0f32..1.0).powi(5),
+            })
+            .collect();
+        if s.iter().all(|&x| x == 0.0) {
+            continue;
+        }
+        for tau in [1usize, 20, 62, 100, len - 1].into_iter().filter(|&t| t < len) {
+            let fast = f64::from(ChoiceRule::Residual { tau: tau as u16 }.score(&s));
+            let slow = dropped(&s, tau);
+            assert!((fast - slow).abs() <= 1e-5 * slow.max(1e-3), "case {case}, tau {tau}: {fast} vs {slow}");
+        }
+    }
+}
+
 /// With a cold second solve (`warm_start` 1) both choices find the member an exactly
 /// sparse patch is made of. The default warm start (1e-2, +1.2 dB on real scenes at k = 1)
 /// does not: from a DCT solution that is wrong everywhere (relative error ~1, as only

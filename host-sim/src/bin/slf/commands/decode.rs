@@ -65,7 +65,7 @@ pub fn run(args: Args) -> Result<()> {
         Outcome::Baseline { method, report: r } => {
             write_npy(&output, lf, dtype)?;
             println!(
-                "{:?}: {} sensor positions measured, {} filled from their neighbours, in {:.2} s; wrote {}",
+                "{:?}: {} sensor positions measured, {} filled from their neighbours, in {:.3} s; wrote {}",
                 method,
                 r.measured,
                 r.filled,
@@ -128,7 +128,7 @@ pub fn run(args: Args) -> Result<()> {
     }
     println!(
         "decoded {} patches ({} solved, {} interpolated from fewer than {} bands, {} flat; {} flagged, {} failed, {} \
-         tiles failed) in {:.2} s; wrote {}",
+         tiles failed) in {:.3} s; wrote {}",
         r.patches.decoded,
         r.patches.solved(),
         r.patches.interpolated,
