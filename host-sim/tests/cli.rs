@@ -646,3 +646,43 @@ fn interpolated_patches_are_counted_and_mapped_apart() {
         }
     }
 }
+
+/// `slf bench --from CSV --device CSV` draws a sweep's table again with the device's frame
+/// figure after it (seconds = solves x instructions / clock), without sweeping; a bad
+/// device file is one error line naming its line, and nothing is written.
+#[test]
+fn bench_adds_the_devices_frame_figure_to_a_sweeps_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let sweep = dir.path().join("sweep.csv");
+    std::fs::write(
+        &sweep,
+        "mask,k,setting,psnr_db,ssim,sa_deg,ms_per_patch_1_thread,ms_per_patch_all_threads,solves_per_patch,frame_512_s_1_thread,pareto\n\
+         pixel,1,preset default,29.9800,0.94060,4.4100,4.2600,2.1700,6.20,177.40,true\n\
+         pixel,1,preset preview,24.4500,0.80860,7.9100,0.4800,0.2500,1.00,19.80,true\n",
+    )
+    .unwrap();
+    let device = dir.path().join("device.csv");
+    std::fs::write(
+        &device,
+        "decode,patch_solves,instructions_per_solve,clock_mhz\n\"default kind\",6080,93587147,480\npreview kind,1600,52521593,480\n",
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    slf().arg("bench").arg("--from").arg(&sweep).arg("--device").arg(&device).arg("--out").arg(&out).assert().success();
+    let md = std::fs::read_to_string(out.join("bench.md")).unwrap();
+    assert!(
+        md.contains("| pixel | 1 | preset default | 29.98 | 0.9406 | 4.41 | 4.26 | 2.17 | 6.2 | 177.4 | yes |"),
+        "{md}"
+    );
+    assert!(md.contains("## The device's frame figure"), "{md}");
+    assert!(md.contains("| default kind | 6080 | 93.6 M | 480 | 1185 |"), "{md}");
+    assert!(md.contains("| preview kind | 1600 | 52.5 M | 480 | 175 |"), "{md}");
+    assert!(out.join("bench.png").is_file());
+
+    std::fs::write(&device, "decode,patch_solves,instructions_per_solve,clock_mhz\nx,6080,-1,480\n").unwrap();
+    let bad = dir.path().join("bad");
+    let err = failure(slf().arg("bench").arg("--from").arg(&sweep).arg("--device").arg(&device).arg("--out").arg(&bad));
+    assert!(err.contains("line 2: instructions_per_solve is -1"), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(!bad.exists());
+}

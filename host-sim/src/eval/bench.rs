@@ -11,12 +11,13 @@
 //!
 //! Each point also gives a frame figure: the seconds a 512 x 512-pixel-per-view frame
 //! (the paper's scale, 5 x 5 views) takes on one core at that point's time per patch of
-//! the disjoint grid.
+//! the disjoint grid; with the device's counts ([`crate::eval::device_frame`]) the table
+//! also gives the projected seconds of a 100 x 100-lenslet frame on the device.
 
 use std::path::Path;
 use std::time::Instant;
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use plotters::prelude::*;
 use slf_firmware::{
@@ -28,6 +29,7 @@ use crate::decode::baselines::Baseline;
 use crate::decode::cs::{Basis, DecodeOptions, NoiseSource, Window, decode, decode_with, patch_count};
 use crate::decode::paper_1d::{Factors, analyze_5d, solve_5d, solve_5d_seeded};
 use crate::decode::preset::Preset;
+use crate::eval::device_frame::{self, DeviceFrame};
 use crate::eval::metrics::evaluate;
 use crate::io::capture::MaskDescription;
 use crate::io::lightfield::LightField;
@@ -421,11 +423,12 @@ pub fn mark_pareto(points: &mut [Point]) {
     }
 }
 
-/// Writes `bench.csv`, `bench.md` and `bench.png` into `dir`.
+/// Writes `bench.csv`, `bench.md` and `bench.png` into `dir`; `bench.md` ends with the
+/// device's frame figure when `device` holds any rows.
 ///
 /// # Errors
 /// I/O and drawing errors.
-pub fn write(points: &[Point], dir: &Path) -> Result<()> {
+pub fn write(points: &[Point], device: &[DeviceFrame], dir: &Path) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     // Setting names hold commas ("ensemble screened, tolerance 1e-3, ..."): the csv crate
     // quotes them.
@@ -475,9 +478,52 @@ pub fn write(points: &[Point], dir: &Path) -> Result<()> {
             if p.pareto { "yes" } else { "" }
         );
     }
+    if !device.is_empty() {
+        md += &device_frame::markdown(device);
+    }
     std::fs::write(dir.join("bench.csv"), csv.into_inner().context("csv buffer")?)?;
     std::fs::write(dir.join("bench.md"), md)?;
     plot(points, &dir.join("bench.png"))
+}
+
+/// The points of a `bench.csv` that [`write`] wrote, to draw its table and plot again
+/// (with the device's figure, say) without sweeping again. Values are as the CSV rounds
+/// them (four decimals).
+///
+/// # Errors
+/// A file that cannot be read, is larger than 16 MiB, or has a row that is not a point
+/// (its line is named).
+pub fn read_points(path: &Path) -> Result<Vec<Point>> {
+    const MAX_BYTES: u64 = 16 << 20;
+    let len = std::fs::metadata(path).with_context(|| format!("cannot read {}", path.display()))?.len();
+    if len > MAX_BYTES {
+        bail!("{}: {len} bytes, more than a bench table's {MAX_BYTES}", path.display());
+    }
+    let mut r = csv::Reader::from_path(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let mut points = Vec::new();
+    for (i, row) in r.records().enumerate() {
+        let line = i + 2;
+        let row = row.with_context(|| format!("{} line {line}", path.display()))?;
+        let at = |j: usize| row.get(j).with_context(|| format!("{} line {line}: {} fields", path.display(), row.len()));
+        let number = |j: usize| -> Result<f64> {
+            let x = at(j)?;
+            x.parse().with_context(|| format!("{} line {line}: field {} {x:?} is not a number", path.display(), j + 1))
+        };
+        points.push(Point {
+            mask: at(0)?.to_owned(),
+            k: at(1)?.parse().with_context(|| format!("{} line {line}: k", path.display()))?,
+            setting: at(2)?.to_owned(),
+            psnr: number(3)?,
+            ssim: number(4)?,
+            sa: number(5)?,
+            ms_one: number(6)?,
+            ms_all: number(7)?,
+            solves: number(8)?,
+            frame_s: number(9)?,
+            pareto: at(10)? == "true",
+        });
+    }
+    Ok(points)
 }
 
 fn plot(points: &[Point], path: &Path) -> Result<()> {
@@ -617,7 +663,8 @@ mod tests {
             pareto: true,
         };
         let dir = tempfile::tempdir().unwrap();
-        write(&[point("DCT default"), point("ensemble screened, tolerance 1e-3, flat 4e-3")], dir.path()).unwrap();
+        let points = [point("DCT default"), point("ensemble screened, tolerance 1e-3, flat 4e-3")];
+        write(&points, &[], dir.path()).unwrap();
         let mut r = csv::Reader::from_path(dir.path().join("bench.csv")).unwrap();
         let rows: Vec<csv::StringRecord> = r.records().map(|x| x.unwrap()).collect();
         assert_eq!(r.headers().unwrap().len(), 11);
@@ -626,5 +673,23 @@ mod tests {
         assert_eq!(&rows[0][9], "12.50");
         assert_eq!(&rows[1][2], "ensemble screened, tolerance 1e-3, flat 4e-3");
         assert_eq!(&rows[1][3], "31.5000");
+        // Read back, the points draw the same table; with the device's rows it gains their
+        // figure after it.
+        let md = std::fs::read_to_string(dir.path().join("bench.md")).unwrap();
+        let again = read_points(&dir.path().join("bench.csv")).unwrap();
+        assert_eq!(again.len(), 2);
+        assert_eq!(again[1].setting, points[1].setting);
+        assert_eq!((again[1].psnr, again[1].solves, again[1].frame_s, again[1].pareto), (31.5, 2.25, 12.5, true));
+        let device =
+            device_frame::parse("decode,patch_solves,instructions_per_solve,clock_mhz\nDCT,1600,5e7,480\n").unwrap();
+        let other = tempfile::tempdir().unwrap();
+        write(&again, &device, other.path()).unwrap();
+        let md2 = std::fs::read_to_string(other.path().join("bench.md")).unwrap();
+        assert_eq!(md2, md.clone() + &device_frame::markdown(&device));
+        assert!(md2.contains("| DCT | 1600 | 50.0 M | 480 | 167 |"), "{md2}");
+        // A row that is not a point is refused with its line.
+        let bad = dir.path().join("bad.csv");
+        std::fs::write(&bad, "mask,k,setting\npixel,three,x\n").unwrap();
+        assert!(format!("{:#}", read_points(&bad).unwrap_err()).contains("line 2"));
     }
 }

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use slf_host::eval::bench::{self, BenchOptions};
+use slf_host::eval::device_frame;
 
 use crate::args::Family;
 
@@ -26,6 +27,14 @@ pub struct Args {
     /// Mask families to sweep (default: all three).
     #[arg(long, value_delimiter = ',')]
     pub masks: Vec<Family>,
+    /// The device's frame figure to add to bench.md: the CSV `scripts/budgets.sh` writes
+    /// (target/device-frame.csv), projected seconds for a 100 x 100-lenslet frame.
+    #[arg(long, value_name = "CSV")]
+    pub device: Option<PathBuf>,
+    /// Instead of sweeping: draw bench.md and bench.png again from a bench.csv this command
+    /// wrote (e.g. with `--device`).
+    #[arg(long, value_name = "CSV")]
+    pub from: Option<PathBuf>,
 }
 
 pub fn run(args: Args) -> Result<()> {
@@ -33,10 +42,16 @@ pub fn run(args: Args) -> Result<()> {
         println!("{}", bench::paper_scale()?);
         return Ok(());
     }
-    let masks = args.masks.iter().map(|m| m.family()).collect();
-    let opts = BenchOptions { quick: args.quick, progress: true, only: args.only, masks };
-    let points = bench::run(&opts)?;
-    bench::write(&points, &args.out)?;
+    // The device's file is read before the sweep, so a bad one costs no sweep.
+    let device = args.device.as_deref().map(device_frame::read).transpose()?.unwrap_or_default();
+    let points = if let Some(csv) = &args.from {
+        bench::read_points(csv)?
+    } else {
+        let masks = args.masks.iter().map(|m| m.family()).collect();
+        let opts = BenchOptions { quick: args.quick, progress: true, only: args.only, masks };
+        bench::run(&opts)?
+    };
+    bench::write(&points, &device, &args.out)?;
     println!("{} points; wrote {}/bench.csv, bench.md, bench.png", points.len(), args.out.display());
     Ok(())
 }
