@@ -17,7 +17,7 @@
 use std::path::Path;
 use std::time::Instant;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use plotters::prelude::*;
 use slf_firmware::{
@@ -32,6 +32,7 @@ use crate::decode::preset::Preset;
 use crate::eval::device_frame::{self, DeviceFrame};
 use crate::eval::metrics::evaluate;
 use crate::io::capture::MaskDescription;
+use crate::io::capture::regular_file;
 use crate::io::lightfield::LightField;
 use crate::sim::camera::{CameraConfig, simulate};
 use crate::sim::scene::{self, SceneSize};
@@ -491,27 +492,28 @@ pub fn write(points: &[Point], device: &[DeviceFrame], dir: &Path) -> Result<()>
 /// them (four decimals).
 ///
 /// # Errors
-/// A file that cannot be read, is larger than 16 MiB, or has a row that is not a point
-/// (its line is named).
+/// A file that cannot be read, is not a regular file or is larger than 16 MiB, or has a
+/// row that is not a point (its line is named).
 pub fn read_points(path: &Path) -> Result<Vec<Point>> {
-    const MAX_BYTES: u64 = 16 << 20;
-    let len = std::fs::metadata(path).with_context(|| format!("cannot read {}", path.display()))?.len();
-    if len > MAX_BYTES {
-        bail!("{}: {len} bytes, more than a bench table's {MAX_BYTES}", path.display());
-    }
-    let mut r = csv::Reader::from_path(path).with_context(|| format!("cannot read {}", path.display()))?;
+    regular_file(path, 16 << 20, "a bench table holds")?;
+    let r = csv::Reader::from_path(path).with_context(|| format!("cannot read {}", path.display()))?;
+    points_of(r).with_context(|| path.display().to_string())
+}
+
+/// The rows of a `bench.csv` reader as points; a fault names its line.
+fn points_of<R: std::io::Read>(mut r: csv::Reader<R>) -> Result<Vec<Point>> {
     let mut points = Vec::new();
     for (i, row) in r.records().enumerate() {
         let line = i + 2;
-        let row = row.with_context(|| format!("{} line {line}", path.display()))?;
-        let at = |j: usize| row.get(j).with_context(|| format!("{} line {line}: {} fields", path.display(), row.len()));
+        let row = row.with_context(|| format!("line {line}"))?;
+        let at = |j: usize| row.get(j).with_context(|| format!("line {line}: {} fields", row.len()));
         let number = |j: usize| -> Result<f64> {
             let x = at(j)?;
-            x.parse().with_context(|| format!("{} line {line}: field {} {x:?} is not a number", path.display(), j + 1))
+            x.parse().with_context(|| format!("line {line}: field {} {x:?} is not a number", j + 1))
         };
         points.push(Point {
             mask: at(0)?.to_owned(),
-            k: at(1)?.parse().with_context(|| format!("{} line {line}: k", path.display()))?,
+            k: at(1)?.parse().with_context(|| format!("line {line}: k"))?,
             setting: at(2)?.to_owned(),
             psnr: number(3)?,
             ssim: number(4)?,

@@ -8,12 +8,15 @@
 //! frame figure (`bench.md`), so one page shows both: the host's seconds measured, the
 //! device's projected from counts (one instruction a cycle; a Cortex-M7 issues up to two).
 //!
-//! The file is checked before anything is kept: at most [`MAX_BYTES`] and [`MAX_ROWS`],
+//! The file is checked before anything is kept: a regular file (`io::capture::regular_file`)
+//! of at most [`MAX_BYTES`], at most [`MAX_ROWS`] rows,
 //! every number finite and positive, each fault named with its line.
 
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
+
+use crate::io::capture::regular_file;
 
 /// The largest device-frame file read: a few rows of text.
 pub const MAX_BYTES: u64 = 64 * 1024;
@@ -46,14 +49,11 @@ impl DeviceFrame {
 /// Reads the device-frame table at `path` (the CSV `scripts/budgets.sh` writes).
 ///
 /// # Errors
-/// A file that cannot be read, is larger than [`MAX_BYTES`], lacks the [`HEADER`], or has
+/// A file that cannot be read, is not a regular file or is larger than [`MAX_BYTES`], lacks the [`HEADER`], or has
 /// a row that is not a name and three finite positive numbers (the line is named), or
 /// more than [`MAX_ROWS`] rows.
 pub fn read(path: &Path) -> Result<Vec<DeviceFrame>> {
-    let len = std::fs::metadata(path).with_context(|| format!("cannot read {}", path.display()))?.len();
-    if len > MAX_BYTES {
-        bail!("{}: {len} bytes, more than a device-frame table's {MAX_BYTES}", path.display());
-    }
+    regular_file(path, MAX_BYTES, "a device-frame table holds")?;
     let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
     parse(&text).with_context(|| format!("{}", path.display()))
 }
@@ -160,6 +160,6 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let big = dir.path().join("big.csv");
         std::fs::write(&big, vec![b'x'; MAX_BYTES as usize + 1]).unwrap();
-        assert!(format!("{:#}", read(&big).unwrap_err()).contains("more than a device-frame table's"));
+        assert!(format!("{:#}", read(&big).unwrap_err()).contains("more than the 65536 a device-frame table holds"));
     }
 }
