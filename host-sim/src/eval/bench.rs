@@ -487,7 +487,7 @@ pub fn write(points: &[Point], device: &[DeviceFrame], dir: &Path) -> Result<()>
     plot(points, &dir.join("bench.png"))
 }
 
-/// The points of a `bench.csv` that [`write`] wrote, to draw its table and plot again
+/// The points of a `bench.csv` that [`write()`] wrote, to draw its table and plot again
 /// (with the device's figure, say) without sweeping again. Values are as the CSV rounds
 /// them (four decimals).
 ///
