@@ -11,6 +11,8 @@
 #   SLF_MODELS="ensemble ensemble+halves" bash scripts/results-depth.sh OUT_DIR  # some rows
 #   SLF_SETTINGS="pixel:1" SLF_MODELS="demosaic ppid preview default best" \
 #     RAYON_NUM_THREADS=1 bash scripts/results-depth.sh OUT_DIR  # the presets, one thread
+#   SLF_MODELS="preview-4 preview-5 default-4 default-5" RAYON_NUM_THREADS=1 \
+#     bash scripts/results-depth.sh OUT_DIR  # the paper's patch against the full-view one
 #
 # The real light fields are scripts/real-eval.sh's 128 x 128 crops, in $SLF_REAL (default
 # /tmp/hci/real); their licence allows evaluation only.
@@ -33,7 +35,9 @@ dct+depth=--dictionary,dct,--disparities=-1:1 dct+halves=--dictionary,dct,--disp
 ensemble=--disparities=0:0 ensemble+depth=--disparities=-1:1 ensemble+depth2=--disparities=-2:2
 ensemble+halves=--disparities=-1:1:0.5
 preview=--preset,preview default=--preset,default best=--preset,best
-default-unseeded=--preset,default,--seeded,false best-unseeded=--preset,best,--seeded,false"
+default-unseeded=--preset,default,--seeded,false best-unseeded=--preset,best,--seeded,false
+preview-4=--preset,preview,--patch-views,4 default-4=--preset,default,--patch-views,4 best-4=--preset,best,--patch-views,4
+preview-5=--preset,preview,--patch-views,5 default-5=--preset,default,--patch-views,5 best-5=--preset,best,--patch-views,5"
 models=""
 for m in $all; do
   case " ${SLF_MODELS:-${m%%=*}} " in *" ${m%%=*} "*) models="$models $m" ;; esac
@@ -43,27 +47,32 @@ table() {
   shift
   local header="| model | setting |" rule="| --- | --- |"
   for lf in "$@"; do header="$header $(basename "$lf" .npy) |"; rule="$rule --- |"; done
-  echo "$header mean PSNR | mean SSIM | mean SA | seconds |"
-  echo "$rule --- | --- | --- | --- |"
+  echo "$header mean PSNR | mean SSIM | mean SA | seconds | patches | steps a patch |"
+  echo "$rule --- | --- | --- | --- | --- | --- |"
   for s in ${SLF_SETTINGS:-pixel:1 pixel:3 lenslet:3}; do
     mask=${s%:*}; k=${s#*:}
     for m in $models; do
       name=${m%%=*}; args=${m#*=}; args=${args//,/ }
-      row="| $name | $mask k=$k |"; sp=0; ss=0; sa=0; secs=0; n=0
+      row="| $name | $mask k=$k |"; sp=0; ss=0; sa=0; secs=0; n=0; patches=0; steps=0
       for lf in "$@"; do
         base=$(basename "$lf" .npy)
         cap="$dir/cap-$base-$mask-$k"
         [ -d "$cap" ] || "$slf" simulate "$lf" -o "$cap" --mask "$mask" -s "$k" --seed 3 > /dev/null
         rec="$dir/rec.npy"
         # shellcheck disable=SC2086
-        t=$("$slf" decode "$cap" -o "$rec" --quiet $args | awk '/ in [0-9.]+ s/ { for (i = 1; i < NF; i++) if ($i == "in") print $(i + 1) }')
+        log=$("$slf" decode "$cap" -o "$rec" --quiet $args)
+        t=$(echo "$log" | awk '/ in [0-9.]+ s/ { for (i = 1; i < NF; i++) if ($i == "in") print $(i + 1) }')
+        # Patches and SL0 steps (the CS methods' `sl0:` line; none for a baseline).
+        read -r np ns < <(echo "$log" | awk '/^decoded / { p = $2 } /^sl0: / { s = $4 } END { print p + 0, s + 0 }')
+        patches=$((patches + np)); steps=$((steps + ns))
         read -r p q a < <("$slf" eval "$lf" "$rec" | awk '/^PSNR/ { p = $2 } /^SSIM/ { q = $2 } /^SA/ { a = $2 } END { print p, q, a }')
         row="$row $p |"
         sp=$(echo "$sp + $p" | bc -l); ss=$(echo "$ss + $q" | bc -l); sa=$(echo "$sa + $a" | bc -l)
         secs=$(echo "$secs + ${t:-0}" | bc -l); n=$((n + 1))
       done
-      printf '%s %.2f | %.4f | %.2f | %.2f |\n' "$row" "$(echo "$sp / $n" | bc -l)" "$(echo "$ss / $n" | bc -l)" \
-        "$(echo "$sa / $n" | bc -l)" "$secs"
+      if [ "$steps" -gt 0 ]; then per=$(echo "$steps / $patches" | bc -l); else per=0; fi
+      printf '%s %.2f | %.4f | %.2f | %.2f | %d | %.1f |\n' "$row" "$(echo "$sp / $n" | bc -l)" \
+        "$(echo "$ss / $n" | bc -l)" "$(echo "$sa / $n" | bc -l)" "$secs" "$patches" "$per"
     done
   done
 }

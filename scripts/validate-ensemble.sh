@@ -12,6 +12,12 @@
 # candidates (the realistic named scenes use seeds below 1000; `slf train` renders seeds
 # from 1000 up). Real light fields (e.g. the HCI crops of scripts/real-eval.sh) are
 # for validation only: their licence forbids training what we ship.
+#
+# SLF_PATCH_VIEWS=4|5 decodes every CS model with that patch (`--patch-views`; a blob of the
+# other patch is refused); unset, the DCT uses the decode's default and a blob its own patch:
+#
+#   SLF_PATCH_VIEWS=5 bash scripts/validate-ensemble.sh OUT \
+#     "dct=dct fullview8=firmware/dictionaries/fullview8.slfd" LF.npy ...
 set -euo pipefail
 out=${1:?usage: validate-ensemble.sh OUT_DIR "name=BLOB ..." LF.npy ...}
 models=${2:?models}
@@ -33,6 +39,7 @@ psnr() { "$slf" eval "$1" "$2" | awk '/PSNR/ { for (i = 1; i <= NF; i++) if ($i 
 for m in $models; do
   name=${m%%=*}; blob=${m#*=}; extra=""
   case "$blob" in *:off) blob=${blob%:off}; extra="--balance off" ;; esac
+  if [ -n "${SLF_PATCH_VIEWS:-}" ]; then extra="$extra --patch-views $SLF_PATCH_VIEWS"; fi
   row="| $name |"
   for s in $settings; do
     mask=${s%:*}; k=${s#*:}; sum=0; n=0

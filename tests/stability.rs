@@ -2,7 +2,7 @@
 //! case asserts: no NaN or infinity in the output, the iteration bound honoured, and an
 //! error bound or a typed error. Error bounds were set from measurement (noted per case).
 
-use slf_host::decode::cs::{Basis, DecodeOptions, DecodeReport, NoiseSource, decode, decode_with};
+use slf_host::decode::cs::{Basis, DecodeOptions, DecodeReport, NoiseSource, PatchViews, decode, decode_with};
 use slf_host::eval::bench::F64Dct;
 use slf_host::eval::metrics::psnr;
 use slf_host::firmware::{Dictionary, Sl0Config};
@@ -72,7 +72,9 @@ fn all_saturated_is_a_typed_error_per_patch_and_nothing_is_invented() {
     let cap = simulate(&truth, &CameraConfig::pixel(1, 3).noiseless()).unwrap();
     let (recon, report) = checked(&cap, &ensemble(), Sl0Config::DEFAULT);
     assert_eq!(report.patches.decoded, 0);
-    assert_eq!(report.patches.failed, 16, "every patch: no valid measurement");
+    // 10 x 10 lenslets: 2 x 2 blocks, one full-view patch each (the default patch).
+    assert_eq!(report.patch_views, Some(PatchViews::Five));
+    assert_eq!(report.patches.failed, 4, "every patch: no valid measurement");
     assert_eq!(report.uncovered, recon.data.len());
     assert!(recon.data.iter().all(|&x| x == 0.0));
 }
@@ -136,8 +138,9 @@ fn patches_with_few_valid_pixels_and_bad_raw_values() {
     cap.frames[2][40 * 50 + 9] = 4095;
     let cap = Capture::new(d, cap.frames).unwrap();
     let (recon, report) = checked(&cap, &ensemble(), Sl0Config::DEFAULT);
-    assert_eq!(report.patches.failed, 4, "block (1, 1): a typed error per window");
-    assert!(report.patches.flagged >= 4);
+    assert_eq!(report.patches.failed, 1, "block (1, 1): a typed error for its full-view patch");
+    // Block (0, 0) (its defects) and block (1, 0) (both out-of-range values) are flagged.
+    assert!(report.patches.flagged >= 2, "{} flagged", report.patches.flagged);
     let max = recon.data.iter().fold(0.0f32, |m, x| m.max(x.abs()));
     assert!(max <= 1.5, "output up to {max}");
 }
@@ -204,9 +207,14 @@ fn f32_decoder_within_005_db_of_the_f64_reference_on_the_test_scenes() {
         // noise model the f32 decode moves onto a ball the reference does not, which the
         // seeded shifted patches carry on: dark 56.665 against 56.606 dB).
         let opts = DecodeOptions { noise: NoiseSource::Config, ..DecodeOptions::default() };
-        let (f32r, _) = decode(&cap, &Dictionary::dct(), &opts).unwrap();
-        let (f64r, _) = decode(&cap, &F64Dct::default(), &opts).unwrap();
+        // Both patches: the paper's and the full-view one.
+        let (f32r, _) = decode::<4, 4, 5200, _>(&cap, &Dictionary::dct(), &opts).unwrap();
+        let (f64r, _) = decode::<4, 4, 5200, _>(&cap, &F64Dct::<4, 4>::default(), &opts).unwrap();
         let (a, b) = (peak_psnr(&truth, &f32r), peak_psnr(&truth, &f64r));
-        assert!((a - b).abs() <= 0.05, "{name}: f32 {a:.3} dB vs f64 {b:.3} dB");
+        assert!((a - b).abs() <= 0.05, "{name}, 4 views: f32 {a:.3} dB vs f64 {b:.3} dB");
+        let (f32r, _) = decode::<5, 5, 8125, _>(&cap, &Dictionary::dct(), &opts).unwrap();
+        let (f64r, _) = decode::<5, 5, 8125, _>(&cap, &F64Dct::<5, 5>::default(), &opts).unwrap();
+        let (a, b) = (peak_psnr(&truth, &f32r), peak_psnr(&truth, &f64r));
+        assert!((a - b).abs() <= 0.05, "{name}, 5 views: f32 {a:.3} dB vs f64 {b:.3} dB");
     }
 }

@@ -126,7 +126,7 @@ pub use decode::tile::{
     ConfigError, DecoderConfig, FrameReport, NoSeed, PatchFlags, PatchOrigin, PatchReport, PatchSeed, PatchSink,
     SensorGeometry, Tile, TileDecoder, TileError, TileReport,
 };
-pub use operators::blob::{DEFAULT_ENSEMBLE, Ensemble};
+pub use operators::blob::{DEFAULT_ENSEMBLE, DEFAULT_FULL_VIEW_ENSEMBLE, Ensemble};
 pub use operators::dictionary::{Dictionary, DictionaryError};
 pub use operators::disparity::{Disparity, DisparityRange};
 pub use operators::shape::{FullViewShape, PaperShape, PatchShape};

@@ -17,7 +17,7 @@ pub use crate::decode::tile::{
     ConfigError, DecoderConfig, FrameReport, PatchOrigin, PatchReport, PatchSink, SensorGeometry, Tile, TileDecoder,
     TileError, TileReport, TileSource,
 };
-pub use crate::operators::blob::{DEFAULT_ENSEMBLE, Ensemble};
+pub use crate::operators::blob::{DEFAULT_ENSEMBLE, DEFAULT_FULL_VIEW_ENSEMBLE, Ensemble};
 pub use crate::operators::dictionary::{Dictionary, DictionaryError};
 pub use crate::operators::disparity::{Disparity, DisparityRange};
 pub use crate::sensor::defects::{DefectList, Pixel};

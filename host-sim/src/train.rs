@@ -1,6 +1,7 @@
 //! Training a learned 5D dictionary ensemble (AMDE-style) from light-field patches.
 //!
-//! K members, each five orthonormal matrices (5x5, 5x5, 4x4, 4x4, 13x13):
+//! K members, each five orthonormal matrices (5x5, 5x5, PUxPU, PVxPV, 13x13), for the paper's
+//! patch (4 x 4 views) or the full-view patch (5 x 5; `slf train --patch-views`):
 //!
 //! 1. **Initialise** each member from the HOSVD of a small random group of patches (a few
 //!    dozen): per mode, the eigenvectors of the summed mode-unfolding Gram matrix. Small
@@ -30,15 +31,15 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use slf_firmware::dictionary::Factors;
 use slf_firmware::transform::analyze;
-use slf_firmware::{Dictionary, PaperShape};
+use slf_firmware::{Dictionary, PatchShape};
 
-use crate::decode::cs::PaperDictionary;
+use crate::decode::cs::PatchViews;
 use crate::io::lightfield::LightField;
 
-/// Values of one patch.
-pub const N: usize = 5200;
 /// The patch's mode sizes.
-pub const DIMS: [usize; 5] = [5, 5, 4, 4, 13];
+const fn dims<const PU: usize, const PV: usize>() -> [usize; 5] {
+    [5, 5, PU, PV, 13]
+}
 const CHUNK: usize = 64;
 
 /// Training parameters.
@@ -74,17 +75,21 @@ pub struct IterationReport {
     pub members: usize,
 }
 
-/// Patches sampled uniformly from light fields: `count` patches of 5 x 5 lenslets x 4 x 4
+/// Patches sampled uniformly from light fields: `count` patches of 5 x 5 lenslets x `PU x PV`
 /// views x 13 bands at random positions and angular windows, flat in the patch layout.
-pub fn sample_patches(fields: &[LightField], count: usize, seed: u64) -> Vec<f32> {
+pub fn sample_patches<const PU: usize, const PV: usize, const N: usize>(
+    fields: &[LightField],
+    count: usize,
+    seed: u64,
+) -> Vec<f32> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut out = Vec::with_capacity(count * N);
     for _ in 0..count {
         let lf = &fields[rng.random_range(0..fields.len())];
         let (r, c) = (rng.random_range(0..=lf.rows - 5), rng.random_range(0..=lf.cols - 5));
-        let (u0, v0) = (rng.random_range(0..=lf.views.0 - 4), rng.random_range(0..=lf.views.1 - 4));
+        let (u0, v0) = (rng.random_range(0..=lf.views.0 - PU), rng.random_range(0..=lf.views.1 - PV));
         for i in 0..N {
-            let [s, t, u, v, b] = PaperShape::coordinates(i);
+            let [s, t, u, v, b] = PatchShape::<5, 5, PU, PV, 13, N>::coordinates(i);
             out.push(lf.get(u0 + u, v0 + v, r + s, c + t, b));
         }
     }
@@ -97,15 +102,15 @@ pub struct Member(pub [Vec<f64>; 5]);
 
 impl Member {
     /// The f32 dictionary (checked orthonormal by the firmware).
-    pub fn dictionary(&self) -> PaperDictionary {
+    pub fn dictionary<const PU: usize, const PV: usize>(&self) -> Dictionary<5, 5, PU, PV, 13> {
         fn m<const D: usize>(v: &[f64]) -> [[f32; D]; D] {
             core::array::from_fn(|i| core::array::from_fn(|j| v[i * D + j] as f32))
         }
         let f = Factors {
             m1: m::<5>(&self.0[0]),
             m2: m::<5>(&self.0[1]),
-            m3: m::<4>(&self.0[2]),
-            m4: m::<4>(&self.0[3]),
+            m3: m::<PU>(&self.0[2]),
+            m4: m::<PV>(&self.0[3]),
             m5: m::<13>(&self.0[4]),
         };
         // Procrustes and eigenvectors are orthonormal to ~1e-15 in f64; f32 rounding keeps
@@ -115,14 +120,14 @@ impl Member {
 }
 
 /// Index stride of mode `n` in the patch layout.
-fn stride(n: usize) -> usize {
-    DIMS[n + 1..].iter().product()
+fn stride<const PU: usize, const PV: usize>(n: usize) -> usize {
+    dims::<PU, PV>()[n + 1..].iter().product()
 }
 
 /// `buf x_n R` for a `d x d` matrix `R` (row-major), in place.
-fn mode_product(buf: &mut [f32], n: usize, r: &[f64]) {
-    let d = DIMS[n];
-    let st = stride(n);
+fn mode_product<const PU: usize, const PV: usize, const N: usize>(buf: &mut [f32], n: usize, r: &[f64]) {
+    let d = dims::<PU, PV>()[n];
+    let st = stride::<PU, PV>(n);
     let outer = N / (d * st);
     let mut fibre = vec![0.0f64; d];
     for o in 0..outer {
@@ -139,9 +144,9 @@ fn mode_product(buf: &mut [f32], n: usize, r: &[f64]) {
 }
 
 /// The HOSVD of a group of patches: per mode, eigenvectors of the summed unfolding Gram.
-fn hosvd(patches: &[f32], group: &[usize]) -> Member {
+fn hosvd<const PU: usize, const PV: usize, const N: usize>(patches: &[f32], group: &[usize]) -> Member {
     Member(core::array::from_fn(|n| {
-        let (d, st) = (DIMS[n], stride(n));
+        let (d, st) = (dims::<PU, PV>()[n], stride::<PU, PV>(n));
         let mut gram = DMatrix::<f64>::zeros(d, d);
         for &p in group {
             let x = &patches[p * N..(p + 1) * N];
@@ -188,7 +193,11 @@ pub fn top_tau(s: &[f32], tau: usize) -> (f64, Vec<u16>) {
 }
 
 /// Coefficients of patch `p` in `dict`.
-fn coefficients(patches: &[f32], p: usize, dict: &PaperDictionary) -> Box<[f32; N]> {
+fn coefficients<const PU: usize, const PV: usize, const N: usize>(
+    patches: &[f32],
+    p: usize,
+    dict: &Dictionary<5, 5, PU, PV, 13>,
+) -> Box<[f32; N]> {
     let mut x: Box<[f32; N]> = Box::new([0.0; N]);
     x.copy_from_slice(&patches[p * N..(p + 1) * N]);
     let mut s = Box::new([0.0; N]);
@@ -197,62 +206,91 @@ fn coefficients(patches: &[f32], p: usize, dict: &PaperDictionary) -> Box<[f32; 
 }
 
 /// Mean relative coding error of every patch in `dict` at `tau`.
-pub fn coding_error(patches: &[f32], dict: &PaperDictionary, tau: usize) -> f64 {
+pub fn coding_error<const PU: usize, const PV: usize, const N: usize>(
+    patches: &[f32],
+    dict: &Dictionary<5, 5, PU, PV, 13>,
+    tau: usize,
+) -> f64 {
     let count = patches.len() / N;
-    let sum: f64 = (0..count).into_par_iter().map(|p| top_tau(&coefficients(patches, p, dict)[..], tau).0).sum();
+    let sum: f64 =
+        (0..count).into_par_iter().map(|p| top_tau(&coefficients::<PU, PV, N>(patches, p, dict)[..], tau).0).sum();
     sum / count as f64
 }
 
 /// Mean relative coding error with each patch in its best member: the ensemble's error.
-pub fn ensemble_error(patches: &[f32], members: &[PaperDictionary], tau: usize) -> f64 {
+pub fn ensemble_error<const PU: usize, const PV: usize, const N: usize>(
+    patches: &[f32],
+    members: &[Dictionary<5, 5, PU, PV, 13>],
+    tau: usize,
+) -> f64 {
     let count = patches.len() / N;
     let sum: f64 = (0..count)
         .into_par_iter()
-        .map(|p| members.iter().map(|d| top_tau(&coefficients(patches, p, d)[..], tau).0).fold(f64::INFINITY, f64::min))
+        .map(|p| {
+            members
+                .iter()
+                .map(|d| top_tau(&coefficients::<PU, PV, N>(patches, p, d)[..], tau).0)
+                .fold(f64::INFINITY, f64::min)
+        })
         .sum();
     sum / count as f64
 }
 
 /// Each patch's best member and its error.
-pub fn assign(patches: &[f32], members: &[PaperDictionary], tau: usize) -> Vec<(usize, f64)> {
+pub fn assign<const PU: usize, const PV: usize, const N: usize>(
+    patches: &[f32],
+    members: &[Dictionary<5, 5, PU, PV, 13>],
+    tau: usize,
+) -> Vec<(usize, f64)> {
     (0..patches.len() / N)
         .into_par_iter()
         .map(|p| {
             members
                 .iter()
                 .enumerate()
-                .map(|(k, d)| (k, top_tau(&coefficients(patches, p, d)[..], tau).0))
+                .map(|(k, d)| (k, top_tau(&coefficients::<PU, PV, N>(patches, p, d)[..], tau).0))
                 .fold((0, f64::INFINITY), |best, c| if c.1 < best.1 { c } else { best })
         })
         .collect()
 }
 
 /// Mean coding error of the patches assigned to `k` (`assignment[p] == k`) in `member`.
-pub fn member_error(patches: &[f32], member: &Member, which: &[usize], tau: usize) -> f64 {
-    let d = member.dictionary();
-    which.iter().map(|&p| top_tau(&coefficients(patches, p, &d)[..], tau).0).sum::<f64>() / which.len().max(1) as f64
+pub fn member_error<const PU: usize, const PV: usize, const N: usize>(
+    patches: &[f32],
+    member: &Member,
+    which: &[usize],
+    tau: usize,
+) -> f64 {
+    let d = member.dictionary::<PU, PV>();
+    which.iter().map(|&p| top_tau(&coefficients::<PU, PV, N>(patches, p, &d)[..], tau).0).sum::<f64>()
+        / which.len().max(1) as f64
 }
 
 /// A patch's full coefficients in a member and its fixed sparse code `(index, value)`.
-type PatchCode = (Box<[f32; N]>, Vec<(u16, f32)>);
+type PatchCode<const N: usize> = (Box<[f32; N]>, Vec<(u16, f32)>);
 
 /// One Procrustes update of every mode of `member` on its patches `which`, codes fixed
 /// at the start (the `tau` largest coefficients in the current member).
-pub fn update_member(patches: &[f32], member: &Member, which: &[usize], tau: usize) -> Member {
-    let dict = member.dictionary();
+pub fn update_member<const PU: usize, const PV: usize, const N: usize>(
+    patches: &[f32],
+    member: &Member,
+    which: &[usize],
+    tau: usize,
+) -> Member {
+    let dict = member.dictionary::<PU, PV>();
     // Per patch: the full coefficients (kept current as modes change) and the fixed code.
-    let mut state: Vec<PatchCode> = which
+    let mut state: Vec<PatchCode<N>> = which
         .par_iter()
         .map(|&p| {
-            let s = coefficients(patches, p, &dict);
+            let s = coefficients::<PU, PV, N>(patches, p, &dict);
             let (_, idx) = top_tau(&s[..], tau);
             let code = idx.iter().map(|&i| (i, s[i as usize])).collect();
             (s, code)
         })
         .collect();
     let mut next = member.clone();
-    for (n, &d) in DIMS.iter().enumerate() {
-        let st = stride(n);
+    for (n, &d) in dims::<PU, PV>().iter().enumerate() {
+        let st = stride::<PU, PV>(n);
         // G = sum_p S_full(n) S_sparse(n)^T, in fixed chunks summed in order.
         let parts: Vec<Vec<f64>> = state
             .par_chunks(CHUNK)
@@ -289,7 +327,7 @@ pub fn update_member(patches: &[f32], member: &Member, which: &[usize], tau: usi
         // Keep S_full current: S <- S x_n (U_new^T U_cur).
         let r = u_new.transpose() * &u_cur;
         let r_rows: Vec<f64> = (0..d * d).map(|k| r[(k / d, k % d)]).collect();
-        state.par_iter_mut().for_each(|(full, _)| mode_product(&mut full[..], n, &r_rows));
+        state.par_iter_mut().for_each(|(full, _)| mode_product::<PU, PV, N>(&mut full[..], n, &r_rows));
         next.0[n] = (0..d * d).map(|k| u_new[(k / d, k % d)]).collect();
     }
     next
@@ -297,28 +335,35 @@ pub fn update_member(patches: &[f32], member: &Member, which: &[usize], tau: usi
 
 /// The starting members: the fixed DCT (with `dct_member`), then the HOSVD of a random
 /// group of `group` patches each.
-pub fn init_members(patches: &[f32], cfg: &TrainConfig) -> Vec<Member> {
+pub fn init_members<const PU: usize, const PV: usize, const N: usize>(
+    patches: &[f32],
+    cfg: &TrainConfig,
+) -> Vec<Member> {
     let count = patches.len() / N;
     let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed);
     let fixed = usize::from(cfg.dct_member && cfg.members > 0);
     let mut members: Vec<Member> = Vec::with_capacity(cfg.members);
     if fixed == 1 {
-        let dct: Vec<Vec<f64>> = crate::decode::paper_1d::Factors::dct_f64().0.into_iter().map(|(_, m)| m).collect();
+        let dct: Vec<Vec<f64>> =
+            crate::decode::paper_1d::Factors::dct_f64_of(dims::<PU, PV>()).0.into_iter().map(|(_, m)| m).collect();
         members.push(Member(dct.try_into().unwrap_or_else(|_| unreachable!("five modes"))));
     }
     while members.len() < cfg.members {
-        members.push(hosvd(patches, &sample(&mut rng, count, cfg.group.min(count)).into_vec()));
+        members.push(hosvd::<PU, PV, N>(patches, &sample(&mut rng, count, cfg.group.min(count)).into_vec()));
     }
     members
 }
 
 /// Trains an ensemble on `patches`; returns its members (empty ones dropped) and the
 /// coding error per iteration against the DCT's.
-pub fn train(patches: &[f32], cfg: &TrainConfig) -> (Vec<PaperDictionary>, Vec<IterationReport>) {
+pub fn train<const PU: usize, const PV: usize, const N: usize>(
+    patches: &[f32],
+    cfg: &TrainConfig,
+) -> (Vec<Dictionary<5, 5, PU, PV, 13>>, Vec<IterationReport>) {
     let count = patches.len() / N;
     let fixed = usize::from(cfg.dct_member && cfg.members > 0);
-    let mut members = init_members(patches, cfg);
-    let dct_error = coding_error(patches, &Dictionary::dct(), cfg.tau);
+    let mut members = init_members::<PU, PV, N>(patches, cfg);
+    let dct_error = coding_error::<PU, PV, N>(patches, &Dictionary::dct(), cfg.tau);
     let bar = ProgressBar::with_draw_target(Some(cfg.iterations as u64), ProgressDrawTarget::hidden());
     if cfg.progress {
         bar.set_draw_target(ProgressDrawTarget::stderr());
@@ -329,8 +374,8 @@ pub fn train(patches: &[f32], cfg: &TrainConfig) -> (Vec<PaperDictionary>, Vec<I
     }
     let mut reports = Vec::new();
     for _ in 0..cfg.iterations {
-        let dicts: Vec<PaperDictionary> = members.iter().map(Member::dictionary).collect();
-        let assignment = assign(patches, &dicts, cfg.tau);
+        let dicts: Vec<Dictionary<5, 5, PU, PV, 13>> = members.iter().map(Member::dictionary).collect();
+        let assignment = assign::<PU, PV, N>(patches, &dicts, cfg.tau);
         let ensemble_error = assignment.iter().map(|a| a.1).sum::<f64>() / count as f64;
         let groups: Vec<Vec<usize>> =
             (0..members.len()).map(|k| (0..count).filter(|&p| assignment[p].0 == k).collect()).collect();
@@ -344,13 +389,17 @@ pub fn train(patches: &[f32], cfg: &TrainConfig) -> (Vec<PaperDictionary>, Vec<I
             .collect();
         reports.push(IterationReport { ensemble_error, dct_error, members: kept.len() });
         bar.set_message(format!("ensemble {ensemble_error:.4} vs DCT {dct_error:.4}"));
-        members = kept
-            .iter()
-            .enumerate()
-            .map(
-                |(k, (m, g))| if k < fixed || g.is_empty() { m.clone() } else { update_member(patches, m, g, cfg.tau) },
-            )
-            .collect();
+        members =
+            kept.iter()
+                .enumerate()
+                .map(|(k, (m, g))| {
+                    if k < fixed || g.is_empty() {
+                        m.clone()
+                    } else {
+                        update_member::<PU, PV, N>(patches, m, g, cfg.tau)
+                    }
+                })
+                .collect();
         bar.inc(1);
     }
     bar.finish_and_clear();
@@ -404,12 +453,25 @@ pub fn training_fields(count: usize, size: usize, seed: u64, generator: Generato
         .collect()
 }
 
-/// `slf train`: samples `patches` patches from `fields`, trains, prints the coding error per
-/// iteration as a markdown table, and writes the ensemble as a blob to `output`.
+/// `slf train`: samples `patches` patches of `views` from `fields`, trains, prints the coding
+/// error per iteration as a markdown table, and writes the ensemble as a blob to `output`.
 ///
 /// # Errors
-/// A light field too small for 5x5x4x4x13 patches, or an unwritable `output`.
+/// A light field too small for the patch, or an unwritable `output`.
 pub fn train_blob(
+    fields: &[LightField],
+    patches: usize,
+    views: PatchViews,
+    cfg: &TrainConfig,
+    output: &std::path::Path,
+) -> anyhow::Result<()> {
+    match views {
+        PatchViews::Four => train_blob_of::<4, 4, 5200>(fields, patches, cfg, output),
+        PatchViews::Five => train_blob_of::<5, 5, 8125>(fields, patches, cfg, output),
+    }
+}
+
+fn train_blob_of<const PU: usize, const PV: usize, const N: usize>(
     fields: &[LightField],
     patches: usize,
     cfg: &TrainConfig,
@@ -419,25 +481,26 @@ pub fn train_blob(
     let start = std::time::Instant::now();
     for (i, f) in fields.iter().enumerate() {
         anyhow::ensure!(
-            f.bands == 13 && f.views.0 >= 4 && f.views.1 >= 4 && f.rows >= 5 && f.cols >= 5,
-            "training light field {i} is too small for 5x5x4x4x13 patches: {:?}",
+            f.bands == 13 && f.views.0 >= PU && f.views.1 >= PV && f.rows >= 5 && f.cols >= 5,
+            "training light field {i} is too small for 5x5x{PU}x{PV}x13 patches: {:?}",
             f.shape()
         );
     }
-    let data = sample_patches(fields, patches, cfg.seed);
-    let (dicts, reports) = train(&data, cfg);
+    anyhow::ensure!(cfg.tau <= N, "--tau {}: at most {N}, the values of a 5x5x{PU}x{PV}x13 patch", cfg.tau);
+    let data = sample_patches::<PU, PV, N>(fields, patches, cfg.seed);
+    let (dicts, reports) = train::<PU, PV, N>(&data, cfg);
     println!("| iteration | members | ensemble coding error | DCT coding error |\n| --- | --- | --- | --- |");
     for (i, r) in reports.iter().enumerate() {
         println!("| {} | {} | {:.5} | {:.5} |", i + 1, r.members, r.ensemble_error, r.dct_error);
     }
     let tau = cfg.tau;
-    let final_err = ensemble_error(&data, &dicts, tau);
+    let final_err = ensemble_error::<PU, PV, N>(&data, &dicts, tau);
     println!(
         "final: {} members, coding error {final_err:.5} vs DCT {:.5} (tau {tau}, relative energy)",
         dicts.len(),
         reports.first().map_or(0.0, |r| r.dct_error)
     );
-    let mut blob = vec![0u8; slf_firmware::blob::blob_len(PaperShape::DIMS, dicts.len())];
+    let mut blob = vec![0u8; slf_firmware::blob::blob_len(dims::<PU, PV>(), dicts.len())];
     slf_firmware::blob::write_blob(&dicts, &mut blob).map_err(|e| anyhow::anyhow!("{e}"))?;
     std::fs::write(output, &blob).with_context(|| format!("cannot write {}", output.display()))?;
     println!("wrote {} ({} bytes) in {:.1} s", output.display(), blob.len(), start.elapsed().as_secs_f64());

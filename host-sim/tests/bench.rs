@@ -62,7 +62,7 @@ fn the_frame_figure_counts_the_frames_disjoint_patches() {
         cols: 20,
     });
     let cap = slf_host::sim::camera::simulate(&truth, &slf_host::sim::camera::CameraConfig::pixel(7, 1)).unwrap();
-    let n = slf_host::decode::cs::patch_count(&cap).unwrap();
+    let n = slf_host::decode::cs::patch_count(&cap, slf_host::decode::cs::PatchViews::Four).unwrap();
     assert_eq!(n, 4 * 4 * 4);
     assert_eq!(frame_patches(n / 16), 4 * 102 * 102);
 }

@@ -48,10 +48,11 @@ fn scene_simulate_decode_eval_round_trip() {
         "--disparities",
         "0:0",
     ]));
-    // 20 x 20 lenslets, four angular windows: 4 x 4 disjoint blocks and, at the default
-    // stride 3, 4 x 3 + 3 x 4 + 3 x 3 patches at shifted origins: (16 + 33) x 4 (unsheared:
-    // a block sheared at the frame's edge adds its unsheared fallback).
-    assert!(out.contains("decoded 196 patches (196 solved, 0 interpolated from fewer than 5 bands, 0 flat; 0 flagged, 0 failed, 0 tiles failed)"), "{out}");
+    // 20 x 20 lenslets, the full-view patch (one angular window): 4 x 4 disjoint blocks
+    // and, at the default stride 2, the grids at offsets 0, 2 and 4 on each axis (4, 3 and
+    // 3 whole patches a row) but (0, 0): (4 + 3 + 3)^2 - 16 = 84 (unsheared: a block
+    // sheared at the frame's edge adds its unsheared fallback).
+    assert!(out.contains("decoded 100 patches (100 solved, 0 interpolated from fewer than 5 bands, 0 flat; 0 flagged, 0 failed, 0 tiles failed)"), "{out}");
     // The capture's noise by default (2 DN read noise, 20,000 electrons at white); exact
     // or a given noise on request, not both.
     assert!(out.contains("projection: the capture's noise (sd 5.57e-4 + shot 5.00e-5 per unit)"), "{out}");
@@ -93,16 +94,16 @@ fn scene_simulate_decode_eval_round_trip() {
         "-q",
         "--disparities=0:0",
     ]));
-    assert!(out.contains("decoded 196 patches"), "{out}");
+    assert!(out.contains("decoded 100 patches"), "{out}");
     stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("e.npy")).arg("--member-map").arg(p("map.csv")).arg("-q"));
     let map = std::fs::read_to_string(p("map.csv")).unwrap();
     assert_eq!(map.lines().next(), Some("lenslet_row,lenslet_col,view_row,view_col,disparity,decoder,member"));
-    // Every patch (with the default disparity search, the 196 of the grid and the unsheared
+    // Every patch (with the default disparity search, the 100 of the grids and the unsheared
     // fallbacks of the blocks sheared at the frame's edge), the grid's each once.
     let grid: std::collections::HashSet<String> =
         map.lines().skip(1).map(|l| l.split(',').take(4).collect::<Vec<_>>().join(",")).collect();
     assert!(
-        grid.len() == 196 && map.lines().count() > 196,
+        grid.len() == 100 && map.lines().count() > 100,
         "{} patches, {} origins",
         map.lines().count() - 1,
         grid.len()
@@ -252,9 +253,10 @@ fn nothing_decoded_is_a_failure_and_many_flagged_patches_a_warning() {
     let e = failure(
         slf().arg("decode").arg(p("cap")).arg("-o").arg(p("out.npy")).arg("-q").arg("--member-map").arg(p("m.csv")),
     );
-    // 12 x 12 lenslets, four angular windows: 3 x 3 disjoint blocks (with the edge strip)
-    // and, at the default stride 3, 2 + 2 + 1 patches at shifted origins: (9 + 5) x 4.
-    assert!(e.contains("no patch decoded (56 failed"), "{e}");
+    // 12 x 12 lenslets, the full-view patch (one angular window): 3 x 3 disjoint blocks
+    // (with the edge strip) and, at the default stride 2, the grids at offsets 0, 2 and 4
+    // on each axis (2, 2 and 1 whole patches a row) but (0, 0): (2 + 2 + 1)^2 - 4 = 21.
+    assert!(e.contains("no patch decoded (30 failed"), "{e}");
     assert!(!p("out.npy").exists() && !p("m.csv").exists(), "nothing written");
     // Half the pixels defective: every patch flagged, decoded, and a warning with the count.
     stdout(slf().arg("simulate").arg(p("lf.npy")).arg("-o").arg(p("cap2")).arg("--defects=0.5"));
@@ -267,7 +269,7 @@ fn nothing_decoded_is_a_failure_and_many_flagged_patches_a_warning() {
         .assert()
         .success();
     let err = String::from_utf8(out.get_output().stderr.clone()).unwrap();
-    assert!(err.contains("warning") && err.contains("56 were flagged"), "{err}");
+    assert!(err.contains("warning") && err.contains("30 were flagged"), "{err}");
     // No warning on a clean capture.
     stdout(slf().arg("simulate").arg(p("lf.npy")).arg("-o").arg(p("cap3")));
     let err = stderr_of_success(slf().arg("decode").arg(p("cap3")).arg("-o").arg(p("out3.npy")).arg("-q"));
@@ -685,4 +687,87 @@ fn bench_adds_the_devices_frame_figure_to_a_sweeps_table() {
     assert!(err.contains("line 2: instructions_per_solve is -1"), "{err}");
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(!bad.exists());
+}
+
+/// The patch is a decode setting (issue 40): `--patch-views 4` the paper's patch in four
+/// angular windows, `5` the full-view patch in one; unset, the one that fits the capture's
+/// lenslets (or a given blob's own); what does not fit is one line naming both.
+#[test]
+fn patch_views_are_a_decode_setting_that_fits_the_capture() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    stdout(slf().args(["scene", "depth", "--size", "10", "-o"]).arg(p("five.npy")));
+    stdout(slf().args(["scene", "depth", "--size", "10", "--views", "4", "-o"]).arg(p("four.npy")));
+    for lf in ["five", "four"] {
+        stdout(slf().arg("simulate").arg(p(&format!("{lf}.npy"))).arg("-o").arg(p(&format!("cap-{lf}"))));
+    }
+    let decode = |cap: &str, out: &str, args: &[&str]| {
+        let text = stdout(
+            slf()
+                .arg("decode")
+                .arg(p(cap))
+                .arg("-o")
+                .arg(p(out))
+                .args(["-q", "--stride", "5", "--member-map"])
+                .arg(p(&format!("{out}.csv")))
+                .args(args),
+        );
+        let patch = text.lines().find(|l| l.starts_with("patch: ")).unwrap_or_default().to_string();
+        let csv = std::fs::read_to_string(p(&format!("{out}.csv"))).unwrap();
+        // The angular windows' origins (view_row, view_col) the member map names.
+        let mut windows: Vec<(String, String)> = csv
+            .lines()
+            .skip(1)
+            .map(|l| {
+                let f: Vec<&str> = l.split(',').collect();
+                (f[2].to_string(), f[3].to_string())
+            })
+            .collect();
+        windows.sort();
+        windows.dedup();
+        (std::fs::read(p(out)).unwrap(), patch, windows)
+    };
+    let w = |v: &[(&str, &str)]| -> Vec<(String, String)> {
+        v.iter().map(|(a, b)| (a.to_string(), b.to_string())).collect()
+    };
+    // 5 x 5 views: four windows of the paper's patch (origins 0 and 1 per axis), one of
+    // the full-view patch; unset is the full-view patch, bit for bit.
+    let (four, patch4, windows4) = decode("cap-five", "four.npy", &["--patch-views", "4"]);
+    assert_eq!(patch4, "patch: 5 x 5 x 4 x 4 x 13 (--patch-views 4)");
+    assert_eq!(windows4, w(&[("0", "0"), ("0", "1"), ("1", "0"), ("1", "1")]));
+    let (five, patch5, windows5) = decode("cap-five", "five.npy", &["--patch-views", "5"]);
+    assert_eq!(patch5, "patch: 5 x 5 x 5 x 5 x 13 (--patch-views 5)");
+    assert_eq!(windows5, w(&[("0", "0")]));
+    assert!(four != five, "the two patches decode alike");
+    let (unset, patch, _) = decode("cap-five", "unset.npy", &[]);
+    assert!(unset == five && patch == patch5, "unset is not the full-view patch: {patch}");
+    // The DCT too, and a 4-view ensemble blob decodes with its own patch.
+    let (_, patch, _) = decode("cap-five", "dct.npy", &["--dictionary", "dct", "--patch-views", "5"]);
+    assert_eq!(patch, patch5);
+    std::fs::write(p("four.slfd"), slf_host::firmware::DEFAULT_ENSEMBLE).unwrap();
+    let blob = p("four.slfd").display().to_string();
+    let (with_blob, patch, _) = decode("cap-five", "blob.npy", &["--blob", &blob]);
+    assert!(with_blob == four && patch == patch4, "a 4-view blob's own patch: {patch}");
+    let e = failure(slf().arg("decode").arg(p("cap-five")).arg("-o").arg(p("x.npy")).args([
+        "--blob",
+        &blob,
+        "--patch-views",
+        "5",
+    ]));
+    assert!(
+        e.contains("the ensemble blob is for 5 x 5 x 4 x 4 x 13 patches, this decode's patch is 5 x 5 x 5 x 5 x 13")
+            && e.trim().lines().count() == 1,
+        "{e}"
+    );
+    // 4 x 4 views: the paper's patch fits (one window), the full-view patch does not.
+    let (_, patch, windows) = decode("cap-four", "four4.npy", &[]);
+    assert_eq!((patch.as_str(), windows), ("patch: 5 x 5 x 4 x 4 x 13 (--patch-views 4)", w(&[("0", "0")])));
+    let e = failure(slf().arg("decode").arg(p("cap-four")).arg("-o").arg(p("x.npy")).args(["--patch-views", "5"]));
+    assert!(
+        e.contains("--patch-views 5: the capture's lenslets have 4 x 4 views") && e.contains("--patch-views 4"),
+        "{e}"
+    );
+    assert_eq!(e.trim().lines().count(), 1, "{e}");
+    let e = failure(slf().arg("decode").arg(p("cap-five")).arg("-o").arg(p("x.npy")).args(["--patch-views", "6"]));
+    assert!(e.contains("--patch-views") && e.contains("4 (the paper's 4 x 4-view patch) or 5"), "{e}");
 }

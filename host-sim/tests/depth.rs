@@ -4,10 +4,10 @@
 //! overlap ring, and the command line.
 
 use assert_cmd::Command;
-use slf_host::decode::cs::{Basis, DecodeOptions, decode_with, disparity_per_lenslet, tile_decoder};
+use slf_host::decode::cs::{Basis, DecodeOptions, PatchViews, decode_with, disparity_per_lenslet, tile_decoder};
 use slf_host::eval::metrics::psnr;
 use slf_host::firmware::disparity::Disparity;
-use slf_host::firmware::{Dictionary, DisparityRange, FrameSource, Overlap, OverlapDecoder, PaperWorkspace};
+use slf_host::firmware::{Dictionary, DisparityRange, FrameSource, Overlap, OverlapDecoder, Workspace};
 use slf_host::io::lightfield::{Dtype, LightField, write_npy};
 use slf_host::sim::camera::{CameraConfig, simulate};
 use slf_host::sim::scene::{Layer, Scene, SceneSize, Shape, Texture};
@@ -99,27 +99,41 @@ fn two_planes_each_get_their_own_disparity() {
     assert!(inside >= 1 && outside >= 20, "{inside} blocks on the square, {outside} on the background");
 }
 
-#[test]
-fn the_device_ring_decodes_sheared_patches_as_the_host_does() {
+/// The ring of one patch shape against the host's decode of the same shape.
+fn ring_matches_the_host<const PU: usize, const PV: usize, const N: usize>(views: PatchViews) {
     // Two depths, so blocks shear both ways, edges need fallbacks and the blocks between
     // leave views to fill; 17 x 16 lenslets, decoded by the ring in bands of 6 columns.
     let square = Shape::Rect { y0: 0.25, x0: 0.3, y1: 0.75, x1: 0.8 };
     let truth = planes(&[(-1.0, Shape::Everywhere), (1.0, square)], 20).window(0, 0, 17, 16);
     let capture = simulate(&truth, &CameraConfig::pixel(5, 1)).unwrap();
     // The ring decodes every patch from nothing (not seeded).
-    let opts = DecodeOptions { disparities: range(-1, 1), seeded: false, ..DecodeOptions::default() };
+    let opts = DecodeOptions {
+        disparities: range(-1, 1),
+        seeded: false,
+        patch_views: Some(views),
+        stride: Overlap::DEFAULT.stride,
+        window: Overlap::DEFAULT.window,
+        ..DecodeOptions::default()
+    };
     let (host, report) = decode_with(&capture, &Basis::Dct, &opts).unwrap();
     let sheared = report.disparity_map.iter().filter(|(_, d)| *d != Disparity::ZERO).count();
-    assert!(sheared > 10, "{sheared} sheared blocks");
-    let od = OverlapDecoder::new(tile_decoder(&capture, &opts).unwrap(), Overlap::DEFAULT).unwrap();
+    assert!(sheared > 10, "{views} views: {sheared} sheared blocks");
+    let od = OverlapDecoder::new(tile_decoder::<PU, PV, N>(&capture, &opts).unwrap(), Overlap::DEFAULT).unwrap();
     let mut strip = vec![0.0f32; od.strip_per_column() * 6];
     let mut rows = Rows(LightField::zeros(truth.views, truth.rows, truth.cols, 13));
     let raw = capture.raw_frames().unwrap();
-    let mut ws = Box::new(PaperWorkspace::new());
-    let r = od.decode_frame(&Dictionary::dct(), &mut FrameSource::new(&raw), &mut strip, &mut rows, &mut ws).unwrap();
-    assert_eq!((r.bands, r.uncovered, r.filled as usize), (3, 0, report.filled));
+    let mut ws = Box::new(Workspace::<5, 5, PU, PV, 13, N>::new());
+    let dct = Dictionary::<5, 5, PU, PV, 13>::dct();
+    let r = od.decode_frame(&dct, &mut FrameSource::new(&raw), &mut strip, &mut rows, &mut ws).unwrap();
+    assert_eq!((r.bands, r.uncovered, r.filled as usize), (3, 0, report.filled), "{views} views");
     let worst = host.data.iter().zip(&rows.0.data).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
-    assert!(worst <= 1e-6, "ring against host: off by {worst}");
+    assert!(worst <= 1e-6, "{views} views: ring against host: off by {worst}");
+}
+
+#[test]
+fn the_device_ring_decodes_sheared_patches_as_the_host_does() {
+    ring_matches_the_host::<4, 4, 5200>(PatchViews::Four);
+    ring_matches_the_host::<5, 5, 8125>(PatchViews::Five);
 }
 
 #[test]

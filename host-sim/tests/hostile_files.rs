@@ -389,6 +389,10 @@ fn a_capture_the_decoder_refuses_names_its_description() {
     let opts = slf_host::decode::cs::DecodeOptions::default();
     let e =
         format!("{:#}", slf_host::decode::cs::decode_with(&cap, &slf_host::decode::cs::Basis::Dct, &opts).unwrap_err());
+    assert!(e.contains("capture's lenslets have 3 x 3 views") && e.contains("at least 4 x 4"), "{e}");
+    assert_eq!(e.lines().count(), 1, "{e}");
+    // The tile decoder's own refusal of a patch larger than the lenslet names the file.
+    let e = format!("{:#}", cap.decoder::<4, 4, 5200>(slf_host::firmware::Sl0Config::DEFAULT).unwrap_err());
     assert!(e.contains("capture.json") && e.contains("more views than a lenslet"), "{e}");
     assert_eq!(e.lines().count(), 1, "{e}");
 }

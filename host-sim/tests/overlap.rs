@@ -1,11 +1,12 @@
 //! Overlapping patches against the slow obvious reference: every patch decoded on its own
-//! (a one-patch tile each), then averaged with the window's weights in f64.
+//! (a one-patch tile each), then averaged with the window's weights in f64; for the paper's
+//! patch (four angular windows a block) and the full-view patch (one).
 
-use slf_host::decode::cs::{Basis, DecodeOptions, Window, decode_with, tile_decoder};
+use slf_host::decode::cs::{Basis, DecodeOptions, PatchViews, Window, decode_with, tile_decoder};
 use slf_host::firmware::tile::PatchSeed;
 use slf_host::firmware::{
-    Dictionary, DisparityRange, FrameSource, Overlap, OverlapDecoder, PaperShape, PaperWorkspace, PatchOrigin,
-    PatchReport, PatchSink, SolveError, Tile,
+    Dictionary, DisparityRange, FrameSource, Overlap, OverlapDecoder, PatchOrigin, PatchReport, PatchShape, PatchSink,
+    SolveError, Tile, Workspace,
 };
 use slf_host::io::lightfield::LightField;
 use slf_host::sim::camera::{CameraConfig, simulate};
@@ -16,9 +17,9 @@ use common::Rows;
 /// Keeps the patches a one-patch tile sends (one per angular window).
 struct Kept(Vec<(PatchOrigin, Vec<f32>)>);
 
-impl PatchSink<5200> for Kept {
+impl<const N: usize> PatchSink<N> for Kept {
     type Error = core::convert::Infallible;
-    fn accept(&mut self, o: PatchOrigin, patch: &[f32; 5200], _: &PatchReport) -> Result<(), Self::Error> {
+    fn accept(&mut self, o: PatchOrigin, patch: &[f32; N], _: &PatchReport) -> Result<(), Self::Error> {
         self.0.push((o, patch.to_vec()));
         Ok(())
     }
@@ -45,12 +46,12 @@ fn unsheared() -> DecodeOptions {
 
 /// The seed of a patch written out: the first pass's light field at the patch's own
 /// lenslets and views (unsheared), as the decode's sink receives a patch.
-struct FirstPass<'a>(&'a LightField, &'a [f32]);
+struct FirstPass<'a, const PU: usize, const PV: usize>(&'a LightField, &'a [f32]);
 
-impl PatchSeed<5200> for FirstPass<'_> {
-    fn seed(&mut self, o: PatchOrigin, patch: &mut [f32; 5200]) -> bool {
+impl<const PU: usize, const PV: usize, const N: usize> PatchSeed<N> for FirstPass<'_, PU, PV> {
+    fn seed(&mut self, o: PatchOrigin, patch: &mut [f32; N]) -> bool {
         for (i, x) in patch.iter_mut().enumerate() {
-            let [s, t, u, v, b] = PaperShape::coordinates(i);
+            let [s, t, u, v, b] = PatchShape::<5, 5, PU, PV, 13, N>::coordinates(i);
             let (r, c) = (o.lenslet_row as usize + s, o.lenslet_col as usize + t);
             *x = self.1[self.0.index(o.view_row as usize + u, o.view_col as usize + v, r, c, b)];
         }
@@ -58,16 +59,22 @@ impl PatchSeed<5200> for FirstPass<'_> {
     }
 }
 
-/// Every patch decoded on its own and averaged in f64; `seeded`: the disjoint grid first,
-/// averaged alone, and every shifted patch started from that average.
-fn reference(truth: &LightField, k: u8, stride: usize, window: Window, seeded: bool) -> Vec<f32> {
+/// Every `5 x 5 x PU x PV x 13` patch decoded on its own and averaged in f64; `seeded`: the
+/// disjoint grid first, averaged alone, and every shifted patch started from that average.
+fn reference<const PU: usize, const PV: usize, const N: usize>(
+    truth: &LightField,
+    k: u8,
+    stride: usize,
+    window: Window,
+    seeded: bool,
+) -> Vec<f32> {
     let capture = simulate(truth, &CameraConfig::pixel(3, k)).unwrap();
     // The solver config `decode_with` uses: the capture's noise ball, and the white balance
     // (the gains are the frame's; a patch decoded alone uses the same ones).
-    let decoder = tile_decoder(&capture, &unsheared()).unwrap();
+    let decoder = tile_decoder::<PU, PV, N>(&capture, &unsheared()).unwrap();
     let raw = capture.raw_frames().unwrap();
-    let dct = Dictionary::dct();
-    let mut ws = Box::new(PaperWorkspace::new());
+    let dct = Dictionary::<5, 5, PU, PV, 13>::dct();
+    let mut ws = Box::new(Workspace::<5, 5, PU, PV, 13, N>::new());
     let (rows, cols) = (truth.rows, truth.cols);
     let mut sum = vec![0.0f64; truth.data.len()];
     let mut weight = vec![0.0f64; truth.data.len()];
@@ -92,16 +99,17 @@ fn reference(truth: &LightField, k: u8, stride: usize, window: Window, seeded: b
                     let mut source = FrameSource::new(&raw);
                     match (&first, (dy, dx)) {
                         (Some(lf), (dy, dx)) if (dy, dx) != (0, 0) => {
-                            let mut seed = FirstPass(truth, lf);
+                            let mut seed = FirstPass::<PU, PV>(truth, lf);
                             decoder.decode_tile_seeded(&dct, tile, &mut source, &mut seed, &mut kept, &mut ws)
                         }
                         _ => decoder.decode_tile(&dct, tile, &mut source, &mut kept, &mut ws),
                     }
                     .unwrap();
-                    assert_eq!(kept.0.len(), 4, "4 angular windows of 4 x 4 in 5 x 5 views");
+                    // 4 angular windows of 4 x 4 in 5 x 5 views, 1 of 5 x 5.
+                    assert_eq!(kept.0.len(), 5usize.div_ceil(PU) * 5usize.div_ceil(PV), "angular windows");
                     for (o, patch) in &kept.0 {
                         for (i, &x) in patch.iter().enumerate() {
-                            let [s, t, u, v, b] = PaperShape::coordinates(i);
+                            let [s, t, u, v, b] = PatchShape::<5, 5, PU, PV, 13, N>::coordinates(i);
                             // The taper written out: 1, 2, 3, 2, 1 per axis.
                             const TAPER: [f64; 5] = [1.0, 2.0, 3.0, 2.0, 1.0];
                             let w = match window {
@@ -123,8 +131,8 @@ fn reference(truth: &LightField, k: u8, stride: usize, window: Window, seeded: b
     sum.iter().zip(&weight).map(|(s, w)| (s / w) as f32).collect()
 }
 
-#[test]
-fn overlapping_patches_average_as_every_patch_decoded_alone() {
+/// The overlapped decode of one patch shape against the reference and the device's strip.
+fn overlap_matches_the_reference<const PU: usize, const PV: usize, const N: usize>(views: PatchViews) {
     // 12 x 11 lenslets: edge strips on both axes, shifted grids that stop short, and
     // axes that differ.
     let truth = common::small_smooth(5).window(0, 0, 12, 11);
@@ -132,25 +140,59 @@ fn overlapping_patches_average_as_every_patch_decoded_alone() {
         [(5, Window::Uniform, 1), (2, Window::Uniform, 1), (3, Window::Tapered, 3), (1, Window::Tapered, 1)]
     {
         let capture = simulate(&truth, &CameraConfig::pixel(3, k)).unwrap();
-        let opts = DecodeOptions { stride: (stride as u8, stride as u8), window, seeded: false, ..unsheared() };
+        let opts = DecodeOptions {
+            stride: (stride as u8, stride as u8),
+            window,
+            seeded: false,
+            patch_views: Some(views),
+            ..unsheared()
+        };
         let (fast, report) = decode_with(&capture, &Basis::Dct, &opts).unwrap();
         assert_eq!(report.uncovered, 0);
-        let slow = reference(&truth, k, stride, window, false);
+        assert_eq!(report.patch_views, Some(views));
+        let slow = reference::<PU, PV, N>(&truth, k, stride, window, false);
         let worst = fast.data.iter().zip(&slow).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
-        assert!(worst <= 1e-6, "stride {stride}, {window:?}, k = {k}: off by {worst}");
+        assert!(worst <= 1e-6, "{views} views, stride {stride}, {window:?}, k = {k}: off by {worst}");
         // The device's strip walks the same patches: the same light field, in bands of 4
         // lenslet columns (patches straddling a band border decoded twice).
         let overlap = Overlap { stride: (stride as u8, stride as u8), window };
-        let od = OverlapDecoder::new(tile_decoder(&capture, &opts).unwrap(), overlap).unwrap();
+        let od = OverlapDecoder::new(tile_decoder::<PU, PV, N>(&capture, &opts).unwrap(), overlap).unwrap();
         let mut strip = vec![0.0f32; od.strip_per_column() * 4];
         let mut rows = Rows(LightField::zeros(truth.views, truth.rows, truth.cols, 13));
         let raw = capture.raw_frames().unwrap();
-        let mut ws = Box::new(PaperWorkspace::new());
-        let r =
-            od.decode_frame(&Dictionary::dct(), &mut FrameSource::new(&raw), &mut strip, &mut rows, &mut ws).unwrap();
+        let mut ws = Box::new(Workspace::<5, 5, PU, PV, 13, N>::new());
+        let dct = Dictionary::<5, 5, PU, PV, 13>::dct();
+        let r = od.decode_frame(&dct, &mut FrameSource::new(&raw), &mut strip, &mut rows, &mut ws).unwrap();
         assert_eq!((r.bands, r.uncovered), (3, 0));
         let worst = fast.data.iter().zip(&rows.0.data).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
-        assert!(worst <= 1e-6, "strip, stride {stride}, {window:?}, k = {k}: off by {worst}");
+        assert!(worst <= 1e-6, "{views} views, strip, stride {stride}, {window:?}, k = {k}: off by {worst}");
+    }
+}
+
+#[test]
+fn overlapping_patches_average_as_every_patch_decoded_alone() {
+    overlap_matches_the_reference::<4, 4, 5200>(PatchViews::Four);
+    overlap_matches_the_reference::<5, 5, 8125>(PatchViews::Five);
+}
+
+/// The seeded decode of one patch shape against the reference.
+fn seeded_matches_the_reference<const PU: usize, const PV: usize, const N: usize>(views: PatchViews) {
+    let truth = common::small_smooth(5).window(0, 0, 12, 11);
+    for (stride, window, k) in [(3, Window::Tapered, 1), (2, Window::Uniform, 3)] {
+        let capture = simulate(&truth, &CameraConfig::pixel(3, k)).unwrap();
+        let opts =
+            DecodeOptions { stride: (stride as u8, stride as u8), window, patch_views: Some(views), ..unsheared() };
+        assert!(opts.seeded);
+        let (fast, report) = decode_with(&capture, &Basis::Dct, &opts).unwrap();
+        let slow = reference::<PU, PV, N>(&truth, k, stride, window, true);
+        let worst = fast.data.iter().zip(&slow).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+        assert!(worst <= 1e-5, "{views} views, stride {stride}, {window:?}, k = {k}: off by {worst}");
+        // And it is not the unseeded decode: the seeds changed the shifted patches.
+        let cold = reference::<PU, PV, N>(&truth, k, stride, window, false);
+        let apart = fast.data.iter().zip(&cold).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+        assert!(apart > 1e-3, "{views} views, stride {stride}: seeded within {apart} of the cold decode");
+        // One solve a patch either way with the DCT; the seeded ones take fewer steps.
+        assert_eq!(report.solves, u64::from(report.patches.decoded));
     }
 }
 
@@ -159,22 +201,8 @@ fn seeded_patches_start_from_the_disjoint_grids_average() {
     // The seeded decode (the default) against the reference written out: the disjoint grid
     // decoded and averaged alone, each shifted patch's seed read from that average at its
     // own lenslets, every estimate averaged in f64.
-    let truth = common::small_smooth(5).window(0, 0, 12, 11);
-    for (stride, window, k) in [(3, Window::Tapered, 1), (2, Window::Uniform, 3)] {
-        let capture = simulate(&truth, &CameraConfig::pixel(3, k)).unwrap();
-        let opts = DecodeOptions { stride: (stride as u8, stride as u8), window, ..unsheared() };
-        assert!(opts.seeded);
-        let (fast, report) = decode_with(&capture, &Basis::Dct, &opts).unwrap();
-        let slow = reference(&truth, k, stride, window, true);
-        let worst = fast.data.iter().zip(&slow).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
-        assert!(worst <= 1e-5, "stride {stride}, {window:?}, k = {k}: off by {worst}");
-        // And it is not the unseeded decode: the seeds changed the shifted patches.
-        let cold = reference(&truth, k, stride, window, false);
-        let apart = fast.data.iter().zip(&cold).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
-        assert!(apart > 1e-3, "stride {stride}: seeded within {apart} of the cold decode");
-        // One solve a patch either way with the DCT; the seeded ones take fewer steps.
-        assert_eq!(report.solves, u64::from(report.patches.decoded));
-    }
+    seeded_matches_the_reference::<4, 4, 5200>(PatchViews::Four);
+    seeded_matches_the_reference::<5, 5, 8125>(PatchViews::Five);
 }
 
 #[test]
@@ -189,9 +217,12 @@ fn stride_five_is_todays_decode_and_bad_strides_are_refused() {
     assert!(differ > 0 && differ < a.data.len() / 2, "{differ}");
     let three = DecodeOptions { stride: (3, 3), ..unsheared() };
     let (_, r3) = decode_with(&capture, &Basis::Dct, &three).unwrap();
-    // 12 x 12 lenslets, 4 angular windows: rows and columns {0, 5, 7} give 9 patches a
-    // window; stride 3 adds the grids at offsets (0, 3), (3, 0), (3, 3): 2 + 2 + 1.
-    assert_eq!((ra.patches.decoded, r3.patches.decoded), (9 * 4, 14 * 4));
+    // 12 x 12 lenslets, the full-view patch: rows and columns {0, 5, 7} give 9 patches;
+    // stride 3 adds the grids at offsets (0, 3), (3, 0), (3, 3): 2 + 2 + 1. The paper's
+    // patch decodes each in 4 angular windows.
+    assert_eq!((ra.patches.decoded, r3.patches.decoded), (9, 14));
+    let four = DecodeOptions { patch_views: Some(PatchViews::Four), ..three };
+    assert_eq!(decode_with(&capture, &Basis::Dct, &four).unwrap().1.patches.decoded, 14 * 4);
     for bad in [(0, 5), (5, 6)] {
         let e =
             decode_with(&capture, &Basis::Dct, &DecodeOptions { stride: bad, ..DecodeOptions::default() }).unwrap_err();

@@ -247,6 +247,7 @@ def decode(
     disparities: Union[None, str, Sequence[float]] = None,
     edge_fallback: Optional[bool] = None,
     seeded: Optional[bool] = None,
+    patch_views: Optional[int] = None,
     dictionary: Optional[str] = None,
     choice: Optional[str] = None,
     blob: Optional[PathLike] = None,
@@ -280,15 +281,17 @@ def decode(
     those solved / interpolated (fewer than ``min_bands`` bands measured) / flat, tiles, solves,
     steps, band gains, seconds, the per-lenslet disparity map (``report["disparity"]``, an
     array, or None when no disparity was searched), ``stride``, ``seeded`` (whether the shifted
-    patches started from the disjoint grid's decode) and a ``warning`` when over 1 % of the
-    patches failed or were flagged.
+    patches started from the disjoint grid's decode), ``patch_views`` (4 or 5: the views per
+    axis of the patch it decoded with) and a ``warning`` when over 1 % of the patches failed or
+    were flagged.
 
     ``method``: cs (compressed sensing), interpolate, demosaic or ppid (baselines).
     ``preset``: preview (fast), default or best; any keyword below overrides the preset's
     value. The keywords are ``slf decode``'s flags (see ``slf decode --help``):
     ``stride`` 1..=5, ``window`` uniform or tapered, ``disparities`` ``"MIN:MAX[:STEP]"``
     or ``(min, max[, step])``, ``edge_fallback``, ``seeded`` (shifted patches started from
-    the disjoint grid's decode), ``dictionary`` dct or ensemble,
+    the disjoint grid's decode), ``patch_views`` 4 or 5 (the paper's 4 x 4-view patch or the
+    full-view patch; default 5 for lenslets of 5 x 5 views), ``dictionary`` dct or ensemble,
     ``choice``, ``blob`` (an ensemble file), ``balance`` grey or off, ``gains`` (13),
     ``adaptive`` and the solver's ``sigma_f`` ... ``min_bands``.
 
@@ -313,6 +316,7 @@ def decode(
         disparities=disparities,
         edge_fallback=edge_fallback,
         seeded=seeded,
+        patch_views=patch_views,
         dictionary=dictionary,
         choice=choice,
         blob=blob,

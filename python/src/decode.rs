@@ -7,7 +7,7 @@ use numpy::{PyArrayDyn, PyReadonlyArrayDyn};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use slf_host::decode::cs::disparity_per_lenslet;
+use slf_host::decode::cs::{PatchViews, disparity_per_lenslet};
 use slf_host::decode::settings::{DecodeSettings, Outcome};
 
 use crate::arrays::{plane, to_array};
@@ -89,6 +89,7 @@ pub fn decode<'py>(
             report.set_item("seconds", r.seconds)?;
             report.set_item("stride", options.stride.0)?;
             report.set_item("seeded", options.seeds())?;
+            report.set_item("patch_views", r.patch_views.map(PatchViews::count))?;
             if options.disparities_for(&capture).is_off() {
                 report.set_item("disparity", py.None())?;
             } else {

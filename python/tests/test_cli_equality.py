@@ -39,6 +39,8 @@ def test_simulate_equals_cli_and_round_trips(tmp_path, slf_bin, depth):
         (["--stride", "5", "--disparities", "-1:1", "--dictionary", "dct"], {"stride": 5, "disparities": (-1, 1), "dictionary": "dct"}),
         (["--seeded", "false", "--dictionary", "dct"], {"seeded": False, "dictionary": "dct"}),
         (["--seed-sigma-f", "0.8", "--dictionary", "dct"], {"seed_sigma_f": 0.8, "dictionary": "dct"}),
+        (["--patch-views", "4"], {"patch_views": 4}),
+        (["--patch-views", "5", "--preset", "preview"], {"patch_views": 5, "preset": "preview"}),
         (["--method", "demosaic"], {"method": "demosaic"}),
         (["--method", "ppid"], {"method": "ppid"}),
     ],

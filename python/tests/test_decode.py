@@ -29,6 +29,21 @@ def test_report(capture, depth):
     assert slf.evaluate(depth, lf)["psnr"] > 20
 
 
+def test_patch_views_keyword_and_report(capture):
+    # The full-view patch by default on 5 x 5 views (one window a block), the paper's on
+    # request (four); a patch larger than the lenslet is a ValueError naming the flag.
+    _, five = slf.decode(capture, preset="preview", report=True)
+    _, four = slf.decode(capture, preset="preview", patch_views=4, report=True)
+    assert five["patch_views"] == 5 and four["patch_views"] == 4
+    assert four["decoded"] > five["decoded"]
+    small = slf.simulate(slf.scene("depth", size=10, views=4), k=1)
+    assert slf.decode(small, preset="preview", report=True)[1]["patch_views"] == 4
+    with pytest.raises(ValueError, match="--patch-views 5: the capture's lenslets have 4 x 4 views"):
+        slf.decode(small, patch_views=5)
+    with pytest.raises(ValueError, match="patch-views"):
+        slf.decode(capture, patch_views=6)
+
+
 def test_progress_callback(capture):
     calls = []
     slf.decode(capture, preset="preview", progress=lambda done, total: calls.append((done, total)))

@@ -66,7 +66,8 @@ pub struct Overlap {
 }
 
 impl Overlap {
-    /// The host's default (`DecodeOptions::default`): stride 3, tapered window.
+    /// The device's strip: stride 3, tapered window (the host's default with the paper's
+    /// patch; the host's full-view default is stride 2).
     pub const DEFAULT: Self = Self { stride: (3, 3), window: Window::Tapered };
 }
 

@@ -31,6 +31,13 @@ use crate::operators::dictionary::{Dictionary, DictionaryError, Factors, Matrix}
 /// `Ensemble::<5, 5, 4, 4, 13>::new(DEFAULT_ENSEMBLE)` validates it.
 pub static DEFAULT_ENSEMBLE: &[u8] = include_bytes!("../../dictionaries/ensemble8.slfd");
 
+/// The shipped default ensemble for the full-view patch (5 x 5 x 5 x 5 x 13): 8 members
+/// trained by `cargo run --release -p slf-host -- train --patch-views 5 -o
+/// firmware/dictionaries/fullview8.slfd` (the same defaults and training scenes as
+/// [`DEFAULT_ENSEMBLE`]). `Ensemble::<5, 5, 5, 5, 13>::new(DEFAULT_FULL_VIEW_ENSEMBLE)`
+/// validates it.
+pub static DEFAULT_FULL_VIEW_ENSEMBLE: &[u8] = include_bytes!("../../dictionaries/fullview8.slfd");
+
 /// The magic bytes at the start of a blob.
 pub const BLOB_MAGIC: [u8; 4] = *b"SLFD";
 /// The format version this decoder reads and writes.

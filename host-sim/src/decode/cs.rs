@@ -1,7 +1,10 @@
 //! Decoding a capture on the workstation with the firmware's own tile decoder, in parallel
-//! over tiles (rayon), one [`PaperWorkspace`] per worker thread.
+//! over tiles (rayon), one [`Workspace`] per worker thread.
 //!
-//! Where a patch has fewer views than a lenslet, the decoder's overlapping angular windows
+//! The patch is 5 x 5 lenslets x `PU x PV` views x 13 bands, a decode setting
+//! ([`PatchViews`]): the paper's 4 x 4-view window, or the full-view patch, every view of a
+//! 5 x 5-view lenslet. Where a patch has fewer views than a lenslet, the decoder's
+//! overlapping angular windows
 //! each give an estimate of the shared views; so do the end-aligned edge tiles for the
 //! lenslets they share with the grid, and (by default) the patch grids shifted by the
 //! stride ([`DEFAULT_STRIDE`], [`Window::Tapered`]). Every estimate is averaged into the
@@ -11,30 +14,101 @@
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::Instant;
 
-use anyhow::{Result, anyhow, ensure};
+use anyhow::{Result, anyhow, bail, ensure};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use slf_firmware::disparity::Disparity;
 use slf_firmware::tile::PatchSeed;
 use slf_firmware::{
-    Dictionary, DisparityRange, Ended, FrameSource, PaperShape, PaperWorkspace, PatchModel, PatchOrigin, PatchReport,
-    PatchSink, Sl0Config, SolveError, Tile, TileDecoder, TileReport,
+    Dictionary, DisparityRange, Ended, FrameSource, PatchModel, PatchOrigin, PatchReport, PatchShape, PatchSink,
+    Sl0Config, SolveError, Tile, TileDecoder, TileReport, Workspace,
 };
 
 use crate::io::capture::Capture;
 use crate::io::lightfield::LightField;
 
-/// The decoder's patch: the paper's 5 x 5 lenslets x 4 x 4 views x 13 bands.
+/// A dictionary of the paper's patch: 5 x 5 lenslets x 4 x 4 views x 13 bands.
 pub type PaperDictionary = Dictionary<5, 5, 4, 4, 13>;
+/// A dictionary of the full-view patch: 5 x 5 lenslets x 5 x 5 views x 13 bands.
+pub type FullViewDictionary = Dictionary<5, 5, 5, 5, 13>;
+
+/// How many of a lenslet's views a patch holds per axis (`slf decode --patch-views`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum PatchViews {
+    /// The paper's patch, 5 x 5 x 4 x 4 x 13 (N = 5,200): a 5 x 5-view lenslet is covered
+    /// by four overlapping angular windows, averaged.
+    Four,
+    /// The full-view patch, 5 x 5 x 5 x 5 x 13 (N = 8,125): every view of a 5 x 5-view
+    /// lenslet in one patch, one solve a patch position.
+    Five,
+}
+
+impl PatchViews {
+    /// Both, the paper's first.
+    pub const ALL: [Self; 2] = [Self::Four, Self::Five];
+
+    /// Views per axis.
+    pub fn count(self) -> usize {
+        match self {
+            Self::Four => 4,
+            Self::Five => 5,
+        }
+    }
+
+    /// The patch's dimensions `[PS, PT, PU, PV, B]`.
+    pub fn dims(self) -> [usize; 5] {
+        let v = self.count();
+        [5, 5, v, v, 13]
+    }
+
+    /// The patch a capture with lenslets of `views` (rows, cols) views decodes with when
+    /// not told: the full-view patch where a lenslet has at least 5 x 5 views, the paper's
+    /// where it has 4 x 4; `None` for smaller lenslets, which no patch fits.
+    pub fn fitting(views: (usize, usize)) -> Option<Self> {
+        match views.0.min(views.1) {
+            5.. => Some(Self::Five),
+            4 => Some(Self::Four),
+            _ => None,
+        }
+    }
+
+    /// The patch a dictionary blob was made for (its header's dimensions); `None` for a
+    /// blob too short to have a header or of another shape.
+    pub fn of_blob(blob: &[u8]) -> Option<Self> {
+        let dim = |i: usize| blob.get(8 + 2 * i..10 + 2 * i).map(|b| usize::from(u16::from_le_bytes([b[0], b[1]])));
+        let dims = [dim(0)?, dim(1)?, dim(2)?, dim(3)?, dim(4)?];
+        Self::ALL.into_iter().find(|v| v.dims() == dims)
+    }
+
+    /// The shipped ensemble of this patch.
+    pub fn shipped_ensemble(self) -> &'static [u8] {
+        match self {
+            Self::Four => slf_firmware::DEFAULT_ENSEMBLE,
+            Self::Five => slf_firmware::DEFAULT_FULL_VIEW_ENSEMBLE,
+        }
+    }
+
+    /// `5 x 5 x 4 x 4 x 13`, as messages name a patch.
+    pub fn shape_name(self) -> String {
+        let v = self.count();
+        format!("5 x 5 x {v} x {v} x 13")
+    }
+}
+
+impl core::fmt::Display for PatchViews {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "{}", self.count())
+    }
+}
 
 /// Which basis decodes: the 5D DCT, or an ensemble with a member choice.
 #[derive(Clone, Debug)]
 pub enum Basis {
     Dct,
-    /// A blob (the shipped [`slf_firmware::DEFAULT_ENSEMBLE`] unless told otherwise) and how
-    /// members are chosen.
+    /// A blob and how members are chosen. `blob: None` is the shipped ensemble of the
+    /// decode's patch ([`PatchViews::shipped_ensemble`]).
     Ensemble {
-        blob: Vec<u8>,
+        blob: Option<Vec<u8>>,
         choice: slf_firmware::MemberChoice,
     },
 }
@@ -42,9 +116,15 @@ pub enum Basis {
 impl Basis {
     /// The shipped ensemble with screened member choice: the default.
     pub fn default_ensemble() -> Self {
-        Self::Ensemble {
-            blob: slf_firmware::DEFAULT_ENSEMBLE.to_vec(),
-            choice: slf_firmware::MemberChoice::Screened(slf_firmware::ChoiceRule::DEFAULT),
+        Self::Ensemble { blob: None, choice: slf_firmware::MemberChoice::Screened(slf_firmware::ChoiceRule::DEFAULT) }
+    }
+
+    /// The patch a given blob was made for; `None` for the DCT and the shipped ensembles,
+    /// which exist for every patch.
+    pub fn blob_views(&self) -> Option<PatchViews> {
+        match self {
+            Self::Ensemble { blob: Some(b), .. } => PatchViews::of_blob(b),
+            _ => None,
         }
     }
 
@@ -61,11 +141,12 @@ impl Basis {
     }
 }
 
-/// The largest dictionary blob of the decoder's patch: 65,535 members, the format's limit.
-pub const MAX_BLOB: usize = slf_firmware::blob::blob_len([5, 5, 4, 4, 13], u16::MAX as usize);
+/// The largest dictionary blob of a decoder's patch: 65,535 members of the full-view
+/// patch, the format's limit.
+pub const MAX_BLOB: usize = slf_firmware::blob::blob_len([5, 5, 5, 5, 13], u16::MAX as usize);
 
-/// Reads and validates a dictionary blob file; a file larger than [`MAX_BLOB`], a FIFO or a
-/// device is refused before reading.
+/// Reads and validates a dictionary blob file, of either patch ([`PatchViews`]); a file
+/// larger than [`MAX_BLOB`], a FIFO or a device is refused before reading.
 ///
 /// # Errors
 /// A message with the file and what is wrong.
@@ -73,10 +154,15 @@ pub fn read_blob(path: &std::path::Path) -> Result<Vec<u8>> {
     crate::io::capture::regular_file(
         path,
         MAX_BLOB as u64,
-        "of the largest dictionary blob of the decoder's patch (65,535 members)",
+        "of the largest dictionary blob of a decoder's patch (65,535 members)",
     )?;
     let blob = std::fs::read(path).map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
-    slf_firmware::Ensemble::<5, 5, 4, 4, 13>::new(&blob).map_err(|e| anyhow!("{}: {e}", path.display()))?;
+    let checked = match PatchViews::of_blob(&blob) {
+        Some(PatchViews::Five) => slf_firmware::Ensemble::<5, 5, 5, 5, 13>::new(&blob).map(|_| ()),
+        // The paper's patch also reports a blob of neither shape (its dimension check).
+        _ => slf_firmware::Ensemble::<5, 5, 4, 4, 13>::new(&blob).map(|_| ()),
+    };
+    checked.map_err(|e| anyhow!("{}: {e}", path.display()))?;
     Ok(blob)
 }
 
@@ -98,24 +184,66 @@ pub fn decode_with_observer(
     opts: &DecodeOptions,
     observer: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<(LightField, DecodeReport)> {
+    match opts.patch_views_for(capture, basis)? {
+        PatchViews::Four => decode_basis::<4, 4, 5200>(capture, basis, opts, observer),
+        PatchViews::Five => decode_basis::<5, 5, 8125>(capture, basis, opts, observer),
+    }
+}
+
+/// [`decode_with_observer`] for one patch shape.
+fn decode_basis<const PU: usize, const PV: usize, const N: usize>(
+    capture: &Capture,
+    basis: &Basis,
+    opts: &DecodeOptions,
+    observer: &(dyn Fn(usize, usize) + Sync),
+) -> Result<(LightField, DecodeReport)> {
     match basis {
-        Basis::Dct => decode_observed(capture, &Dictionary::dct(), opts, observer),
+        Basis::Dct => decode_observed::<PU, PV, N, _>(capture, &Dictionary::<5, 5, PU, PV, 13>::dct(), opts, observer),
         Basis::Ensemble { blob, choice } => {
-            let ensemble = slf_firmware::Ensemble::<5, 5, 4, 4, 13>::new(blob).map_err(|e| anyhow!("{e}"))?;
-            decode_observed(capture, &slf_firmware::EnsembleModel::new(ensemble, *choice), opts, observer)
+            let ensemble = ensemble::<PU, PV>(blob.as_deref())?;
+            let model = slf_firmware::EnsembleModel::new(ensemble, *choice);
+            decode_observed::<PU, PV, N, _>(capture, &model, opts, observer)
         }
     }
 }
 
-/// Patches the CS decoder decodes in `capture` (every tile's patches in every angular
-/// window): the unit that times per patch are given in, also for methods without patches.
+/// The ensemble of `blob` (the shipped one of the patch for `None`) for `5 x 5 x PU x PV x
+/// 13` patches.
+///
+/// # Errors
+/// A blob that does not validate, or of the other patch (named, with the flag to change).
+pub fn ensemble<const PU: usize, const PV: usize>(
+    blob: Option<&[u8]>,
+) -> Result<slf_firmware::Ensemble<'_, 5, 5, PU, PV, 13>> {
+    let views = if PU == 5 { PatchViews::Five } else { PatchViews::Four };
+    let bytes = blob.unwrap_or(views.shipped_ensemble());
+    if let Some(made) = PatchViews::of_blob(bytes).filter(|&m| m != views) {
+        bail!(
+            "the ensemble blob is for {} patches, this decode's patch is {} (--patch-views {views}): pass \
+             --patch-views {made}, or train a blob for it with slf train --patch-views {views}",
+            made.shape_name(),
+            views.shape_name()
+        );
+    }
+    slf_firmware::Ensemble::<5, 5, PU, PV, 13>::new(bytes).map_err(|e| anyhow!("ensemble blob: {e}"))
+}
+
+/// Patches the CS decoder decodes in `capture` with `views`-view patches (every tile's
+/// patches in every angular window): the unit that times per patch are given in, also for
+/// methods without patches.
 ///
 /// # Errors
 /// A capture the decoder does not take.
-pub fn patch_count(capture: &Capture) -> Result<u64> {
-    let decoder = capture.decoder(Sl0Config::DEFAULT)?;
-    let windows = decoder.windows().count() as u64;
-    Ok(decoder.tiles((2, 2)).map(|t| u64::from(t.lenslet_rows / 5) * u64::from(t.lenslet_cols / 5) * windows).sum())
+pub fn patch_count(capture: &Capture, views: PatchViews) -> Result<u64> {
+    fn count<const PU: usize, const PV: usize, const N: usize>(capture: &Capture) -> Result<u64> {
+        let decoder = capture.decoder::<PU, PV, N>(Sl0Config::DEFAULT)?;
+        let windows = decoder.windows().count() as u64;
+        Ok(decoder.tiles((2, 2)).map(|t| u64::from(t.lenslet_rows / 5) * u64::from(t.lenslet_cols / 5) * windows).sum())
+    }
+    match views {
+        PatchViews::Four => count::<4, 4, 5200>(capture),
+        PatchViews::Five => count::<5, 5, 8125>(capture),
+    }
 }
 
 /// How overlapping patches are averaged where they meet: the firmware's window, so the
@@ -133,15 +261,19 @@ pub enum NoiseSource {
     Config,
 }
 
-/// The default stride: 3 lenslets, with [`Window::Tapered`]. Chosen on the speed-against-
-/// error plot (`docs/results-real.md`, `docs/bench`): on three real scenes (HCI, 128 x 128)
-/// stride 3 tapered gains 1.2 / 1.4 / 2.1 dB over disjoint patches at pixel k = 1 / 3 and
-/// lenslet k = 3 for 3.8 times the patches, stride 2 another 0.2-0.4 dB for 8.2 times; on a
-/// smooth ramp the error's step across the disjoint grid's borders falls from 1.9 times the
-/// inside step to 1.0 (1.18 with the uniform window), so no grid shows. The seam-driven
+/// The default stride: 2 lenslets, with [`Window::Tapered`], for the default full-view
+/// patch ([`PatchViews::Five`]). With the paper's patch the default was 3 (chosen on the
+/// speed-against-error plot, `docs/results-real.md`: on three real scenes stride 3 tapered
+/// gained 1.2 / 1.4 / 2.1 dB over disjoint patches at pixel k = 1 / 3 and lenslet k = 3, and
+/// no grid shows). A full-view patch position costs about a quarter of the four angular
+/// windows it replaces but gives one estimate of a view where they gave up to four: at
+/// stride 3 it decodes the realistic set in half the time with +0.19 dB at pixel k = 1 but
+/// -0.19 dB at pixel k = 3 and a worse spectral angle (`docs/results-depth.md`, issue 40), at
+/// stride 2 better in every measure and setting in about the same time as the paper's patch
+/// at stride 3 (`--patch-views 4 --stride 3` is the decode before issue 40). The seam-driven
 /// adaptive rule ([`DecodeOptions::adaptive`]) lands on the uniform strides' curve, not
 /// above it, so it is off by default.
-pub const DEFAULT_STRIDE: (u8, u8) = (3, 3);
+pub const DEFAULT_STRIDE: (u8, u8) = (2, 2);
 
 /// The white balance of a decode ([`slf_firmware::gains`]): each band's measurements divided
 /// by a gain before the solve and the decoded patch multiplied back.
@@ -197,6 +329,9 @@ pub struct DecodeOptions {
     /// default: the realistic set decodes as well or better in 0.71 of the time
     /// (`docs/bench/README.md`).
     pub seeded: bool,
+    /// The patch's views per axis; `None` (the default): [`PatchViews::fitting`] the
+    /// capture's lenslets, or the patch a given ensemble blob was made for.
+    pub patch_views: Option<PatchViews>,
 }
 
 impl Default for DecodeOptions {
@@ -213,6 +348,7 @@ impl Default for DecodeOptions {
             disparities: None,
             edge_fallback: true,
             seeded: true,
+            patch_views: None,
         }
     }
 }
@@ -230,6 +366,31 @@ impl DecodeOptions {
     pub fn disparities_for(&self, capture: &Capture) -> DisparityRange {
         let snapshots = u8::try_from(capture.description.frames.len()).unwrap_or(u8::MAX);
         self.disparities.unwrap_or(DisparityRange::for_snapshots(snapshots))
+    }
+
+    /// The patch a decode of `capture` with `basis` uses: [`Self::patch_views`], else the
+    /// patch a given blob was made for, else the one [`PatchViews::fitting`] the capture.
+    ///
+    /// # Errors
+    /// Lenslets with fewer views than the patch, or than any patch (4 x 4), in one line.
+    pub fn patch_views_for(&self, capture: &Capture, basis: &Basis) -> Result<PatchViews> {
+        let views = (capture.description.views[0], capture.description.views[1]);
+        let Some(fits) = PatchViews::fitting(views) else {
+            bail!(
+                "the capture's lenslets have {} x {} views: the decoder's patches need at least 4 x 4",
+                views.0,
+                views.1
+            );
+        };
+        let chosen = self.patch_views.or(basis.blob_views()).unwrap_or(fits);
+        ensure!(
+            chosen.count() <= views.0.min(views.1),
+            "--patch-views {chosen}: the capture's lenslets have {} x {} views, fewer than the patch's {chosen} x \
+             {chosen}: pass --patch-views {fits}",
+            views.0,
+            views.1
+        );
+        Ok(chosen)
     }
 
     /// Whether the decode seeds its shifted patches: [`Self::seeded`] with a stride below 5
@@ -255,8 +416,11 @@ impl DecodeOptions {
 ///
 /// # Errors
 /// A capture the decoder cannot take, or gains outside `[1/64, 64]`.
-pub fn tile_decoder<'a>(capture: &'a Capture, opts: &DecodeOptions) -> Result<TileDecoder<'a, 5, 5, 4, 4, 13, 5200>> {
-    let decoder = capture.decoder(opts.solver_config(capture))?;
+pub fn tile_decoder<'a, const PU: usize, const PV: usize, const N: usize>(
+    capture: &'a Capture,
+    opts: &DecodeOptions,
+) -> Result<TileDecoder<'a, 5, 5, PU, PV, 13, N>> {
+    let decoder = capture.decoder::<PU, PV, N>(opts.solver_config(capture))?;
     let gains = match opts.balance {
         Balance::Off => [1.0; 13],
         Balance::GreyWorld => {
@@ -361,11 +525,13 @@ pub struct DecodeReport {
     pub seconds: f64,
     /// The band gains the decode used (1 without white balance).
     pub gains: [f32; 13],
+    /// The patch it decoded with (`None` only in a report made by hand).
+    pub patch_views: Option<PatchViews>,
 }
 
 /// Weighted sums of the patch estimates over one tile's lenslets and the halo a sheared
 /// patch reaches beyond them (`halo` lenslets on every side), all views and bands.
-struct TileSums {
+struct TileSums<const PU: usize, const PV: usize> {
     tile: Tile,
     views: (usize, usize),
     window: Window,
@@ -378,7 +544,7 @@ struct TileSums {
     disparities: Vec<(PatchOrigin, Disparity)>,
 }
 
-impl TileSums {
+impl<const PU: usize, const PV: usize> TileSums<PU, PV> {
     fn new(tile: Tile, views: (usize, usize), window: Window, halo: usize) -> Self {
         let (rows, cols) = (tile.lenslet_rows as usize + 2 * halo, tile.lenslet_cols as usize + 2 * halo);
         let n = rows * cols * views.0 * views.1 * 13;
@@ -408,10 +574,10 @@ impl TileSums {
     }
 }
 
-impl PatchSink<5200> for TileSums {
+impl<const PU: usize, const PV: usize, const N: usize> PatchSink<N> for TileSums<PU, PV> {
     type Error = core::convert::Infallible;
 
-    fn accept(&mut self, o: PatchOrigin, patch: &[f32; 5200], report: &PatchReport) -> Result<(), Self::Error> {
+    fn accept(&mut self, o: PatchOrigin, patch: &[f32; N], report: &PatchReport) -> Result<(), Self::Error> {
         self.steps += u64::from(report.outcome.iterations);
         self.solves += u64::from(report.solves);
         self.members.push((o, PatchDecoder::of(report)));
@@ -427,7 +593,7 @@ impl PatchSink<5200> for TileSums {
         // share the pixel's position and weight, found once instead of once a value (7 % of a
         // preview's one-thread time when they were, 1.6 % now; `perf record`, cotton_128).
         for (p, bands) in patch.as_chunks::<13>().0.iter().enumerate() {
-            let [s, t, u, v, _] = PaperShape::coordinates(p * 13);
+            let [s, t, u, v, _] = PatchShape::<5, 5, PU, PV, 13, N>::coordinates(p * 13);
             // The pixel the value was read from (sheared patches: shifted per view).
             let Some((r, c)) = o.lenslet::<5, 5>(s, t, u, v, self.views) else { continue };
             let (Ok(r), Ok(c)) = (usize::try_from(r - r0), usize::try_from(c - c0)) else { continue };
@@ -454,7 +620,7 @@ impl PatchSink<5200> for TileSums {
 ///
 /// # Errors
 /// A capture the decoder cannot take (band count, views, mask), with the reason.
-pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
+pub fn decode<const PU: usize, const PV: usize, const N: usize, M: PatchModel<5, 5, PU, PV, 13, N> + Sync>(
     capture: &Capture,
     model: &M,
     opts: &DecodeOptions,
@@ -468,7 +634,7 @@ pub fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
 ///
 /// # Errors
 /// As [`decode`].
-pub fn decode_observed<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
+pub fn decode_observed<const PU: usize, const PV: usize, const N: usize, M: PatchModel<5, 5, PU, PV, 13, N> + Sync>(
     capture: &Capture,
     model: &M,
     opts: &DecodeOptions,
@@ -477,7 +643,19 @@ pub fn decode_observed<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
     let start = Instant::now();
     let d = &capture.description;
     ensure!(d.bands_nm.len() == 13, "the decoder's patch has 13 bands, the capture {}", d.bands_nm.len());
-    let decoder = tile_decoder(capture, opts)?;
+    if let Some(asked) = opts.patch_views {
+        ensure!(
+            asked.count() == PU && asked.count() == PV,
+            "--patch-views {asked}: this decoder's patch has {PU} x {PV} views"
+        );
+    }
+    ensure!(
+        PU <= d.views[0] && PV <= d.views[1],
+        "--patch-views {PU}: the capture's lenslets have {} x {} views, fewer than the patch's {PU} x {PV}",
+        d.views[0],
+        d.views[1]
+    );
+    let decoder = tile_decoder::<PU, PV, N>(capture, opts)?;
     let gains = *decoder.gains();
     let raw = capture.raw_frames()?;
     ensure!(
@@ -496,7 +674,7 @@ pub fn decode_observed<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
     let views = (d.views[0], d.views[1]);
     let range = decoder.config().raw.range();
     let halo = decoder.disparities().halo(views.0.max(views.1));
-    let run = |tiles: &[Tile], prior: Option<&LightField>| -> Vec<(TileSums, Result<TileReport, String>)> {
+    let run = |tiles: &[Tile], prior: Option<&LightField>| -> Vec<(TileSums<PU, PV>, Result<TileReport, String>)> {
         let bar = ProgressBar::with_draw_target(Some(tiles.len() as u64), ProgressDrawTarget::hidden());
         bar.set_style(
             ProgressStyle::with_template("decoding {bar:40} {pos}/{len} tiles, {elapsed} elapsed, {eta} left")
@@ -509,7 +687,7 @@ pub fn decode_observed<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
         let out = tiles
             .par_iter()
             .map_init(
-                || Box::new(PaperWorkspace::new()),
+                || Box::new(Workspace::<5, 5, PU, PV, 13, N>::new()),
                 |ws, &tile| {
                     let mut sums = TileSums::new(tile, views, opts.window, halo);
                     let mut source = FrameSource::new(&raw);
@@ -518,7 +696,7 @@ pub fn decode_observed<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
                             model,
                             tile,
                             &mut source,
-                            &mut FrameSeed { lf, views },
+                            &mut FrameSeed::<PU, PV> { lf, views },
                             &mut sums,
                             ws,
                         ),
@@ -565,20 +743,21 @@ pub fn decode_observed<M: PatchModel<5, 5, 4, 4, 13, 5200> + Sync>(
     let (lf, mut report) = aggregate(&results, views, lenslets, tiles.len(), range);
     report.seconds = start.elapsed().as_secs_f64();
     report.gains = gains;
+    report.patch_views = PatchViews::ALL.into_iter().find(|v| v.count() == PU && PU == PV);
     Ok((lf, report))
 }
 
 /// A frame's decode as the start of the patches that overlap it ([`PatchSeed`]).
-struct FrameSeed<'a> {
+struct FrameSeed<'a, const PU: usize, const PV: usize> {
     lf: &'a LightField,
     views: (usize, usize),
 }
 
-impl PatchSeed<5200> for FrameSeed<'_> {
-    fn seed(&mut self, o: PatchOrigin, patch: &mut [f32; 5200]) -> bool {
+impl<const PU: usize, const PV: usize, const N: usize> PatchSeed<N> for FrameSeed<'_, PU, PV> {
+    fn seed(&mut self, o: PatchOrigin, patch: &mut [f32; N]) -> bool {
         let (rows, cols) = (self.lf.rows as isize, self.lf.cols as isize);
         for (p, bands) in patch.as_chunks_mut::<13>().0.iter_mut().enumerate() {
-            let [s, t, u, v, _] = PaperShape::coordinates(p * 13);
+            let [s, t, u, v, _] = PatchShape::<5, 5, PU, PV, 13, N>::coordinates(p * 13);
             let Some((r, c)) = o.lenslet::<5, 5>(s, t, u, v, self.views) else { continue };
             // A sheared patch reaches past the sensor: its nearest lenslet's value.
             let (r, c) = (r.clamp(0, rows - 1) as usize, c.clamp(0, cols - 1) as usize);
@@ -590,8 +769,8 @@ impl PatchSeed<5200> for FrameSeed<'_> {
 
 /// The light field and the report from every tile's sums: each value the weighted mean of
 /// the patch estimates that cover it.
-fn aggregate(
-    results: &[(TileSums, Result<TileReport, String>)],
+fn aggregate<const PU: usize, const PV: usize>(
+    results: &[(TileSums<PU, PV>, Result<TileReport, String>)],
     views: (usize, usize),
     lenslets: (usize, usize),
     tiles: usize,

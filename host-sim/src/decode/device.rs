@@ -169,7 +169,7 @@ pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
     // its overlapped frame shears (checked in `check_rows`).
     let unsheared =
         crate::decode::cs::DecodeOptions { disparities: Some(slf_firmware::DisparityRange::OFF), ..Default::default() };
-    let decoder = crate::decode::cs::tile_decoder(&capture, &unsheared)?;
+    let decoder = crate::decode::cs::tile_decoder::<4, 4, 5200>(&capture, &unsheared)?;
     let raw = capture.raw_frames()?;
     let host_gains = *decoder.gains();
     ensure!(gains.len() == 13, "the device printed {} gains, not 13", gains.len());
@@ -215,8 +215,15 @@ fn check_rows(
     // The device's strip decodes every patch from nothing: the seeded decode needs the
     // disjoint grid's sums kept apart from the rest, rows ahead of the walk and columns
     // beyond a band (`docs/bench/README.md`), more than the emulated part's RAM.
-    let opts = crate::decode::cs::DecodeOptions { seeded: false, ..Default::default() };
-    let (lf, _) = crate::decode::cs::decode(capture, model, &opts)?;
+    // The device's strip: the paper's patch at stride 3, tapered (`Overlap::DEFAULT`).
+    let opts = crate::decode::cs::DecodeOptions {
+        seeded: false,
+        stride: slf_firmware::Overlap::DEFAULT.stride,
+        window: slf_firmware::Overlap::DEFAULT.window,
+        patch_views: Some(crate::decode::cs::PatchViews::Four),
+        ..Default::default()
+    };
+    let (lf, _) = crate::decode::cs::decode::<4, 4, 5200, _>(capture, model, &opts)?;
     let per_col = lf.views.0 * lf.views.1 * lf.bands;
     let mut covered = vec![false; lf.rows * lf.cols];
     let scale = lf.data.iter().fold(0.0f32, |m, x| m.max(x.abs())).max(f32::MIN_POSITIVE);

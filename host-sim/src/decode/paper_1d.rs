@@ -52,20 +52,21 @@ pub fn matvec<T: Real>(m: &DMatrix<T>, x: &[T]) -> Vec<T> {
     acc.into_iter().map(<T as Real>::from_f64).collect()
 }
 
-/// The five synthesis matrices of a patch `5 x 5 x 4 x 4 x 13`, row-major, in `T`.
+/// The five synthesis matrices of a patch (`5 x 5 x 4 x 4 x 13`, or another shape), row-major,
+/// in `T`.
 #[derive(Clone, Debug)]
 pub struct Factors<T: Real>(pub Vec<(usize, Vec<T>)>);
 
 impl<T: Real> Factors<T> {
     /// A firmware dictionary's matrices (f32 values, widened to `T`).
-    pub fn from_dictionary(dict: &Dictionary<5, 5, 4, 4, 13>) -> Self {
+    pub fn from_dictionary<const PU: usize, const PV: usize>(dict: &Dictionary<5, 5, PU, PV, 13>) -> Self {
         let d = dict.synthesis();
         let conv = |m: &[f32], n: usize| (n, m.iter().map(|&x| T::from(x)).collect());
         Self(vec![
             conv(d.m1.as_flattened(), 5),
             conv(d.m2.as_flattened(), 5),
-            conv(d.m3.as_flattened(), 4),
-            conv(d.m4.as_flattened(), 4),
+            conv(d.m3.as_flattened(), PU),
+            conv(d.m4.as_flattened(), PV),
             conv(d.m5.as_flattened(), 13),
         ])
     }
@@ -75,6 +76,11 @@ impl Factors<f64> {
     /// The 5D DCT computed in f64, orthonormal to f64 precision (the f32 tables are
     /// orthonormal only to about 1e-7, which an f64 comparison would see).
     pub fn dct_f64() -> Self {
+        Self::dct_f64_of([5, 5, 4, 4, 13])
+    }
+
+    /// [`Self::dct_f64`] for a patch of `dims` (e.g. the full-view patch's `[5, 5, 5, 5, 13]`).
+    pub fn dct_f64_of(dims: [usize; 5]) -> Self {
         let dct = |n: usize| -> (usize, Vec<f64>) {
             let mut m = vec![0.0; n * n];
             for k in 0..n {
@@ -86,7 +92,7 @@ impl Factors<f64> {
             }
             (n, m)
         };
-        Self(vec![dct(5), dct(5), dct(4), dct(4), dct(13)])
+        Self(dims.iter().map(|&n| dct(n)).collect())
     }
 }
 

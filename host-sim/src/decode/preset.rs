@@ -7,10 +7,14 @@
 //!   its largest coefficient down to `sigma_min = 3e-3`: one solve a patch of about 50
 //!   steps, a quarter of the default's patches, no half-pixel shears (their projection
 //!   costs about 1.5 times a whole one's).
-//! - [`Preset::Default`]: the screened ensemble at stride 3 with the tapered window, the
-//!   capture's disparities (half pixels at one snapshot): what `slf decode` does unless told.
-//! - [`Preset::Best`]: the default at stride 2, where every lenslet is covered by more
-//!   patches: `(5 / 2)^2` instead of `(5 / 3)^2` times the disjoint grid's patches.
+//! - [`Preset::Default`]: the screened ensemble on full-view patches at stride 2 with the
+//!   tapered window, the capture's disparities (half pixels at one snapshot): what `slf
+//!   decode` does unless told.
+//! - [`Preset::Best`]: the default at stride 1, where every lenslet is covered by every
+//!   patch that holds it: 25 instead of 9 times the disjoint grid's patches.
+//!
+//! Every preset decodes with the patch that fits the capture (the full-view patch on 5 x 5
+//! views) unless `--patch-views` says otherwise.
 //!
 //! What each costs and gains is measured, not assumed: `slf bench` plots the presets as
 //! named points, and `docs/bench/README.md` gives their table (PSNR, SSIM, SA and time on
@@ -28,9 +32,9 @@ pub enum Preset {
     /// whole-pixel shears without the edge fallback, SL0 from the band-gain fill at 0.03
     /// of its largest coefficient to sigma 3e-3.
     Preview,
-    /// The screened ensemble at stride 3 with the capture's disparities.
+    /// The screened ensemble at stride 2 with the capture's disparities.
     Default,
-    /// The default at stride 2: slower, measured to gain.
+    /// The default at stride 1: slower, measured to gain.
     Best,
 }
 
@@ -59,13 +63,14 @@ impl Preset {
                 ..DecodeOptions::default()
             },
             Self::Default => DecodeOptions::default(),
-            Self::Best => DecodeOptions { stride: (2, 2), ..DecodeOptions::default() },
+            Self::Best => DecodeOptions { stride: (1, 1), ..DecodeOptions::default() },
         }
     }
 
-    /// The basis: the 5D DCT for the preview, the shipped ensemble (screened) otherwise.
+    /// The basis: the 5D DCT for the preview, the shipped ensemble of the decode's patch
+    /// (screened) otherwise.
     pub fn basis(self) -> Basis {
-        self.basis_with(slf_firmware::DEFAULT_ENSEMBLE)
+        self.basis_with(None)
     }
 
     /// Whether the preset decodes with the 5D DCT (else with an ensemble).
@@ -73,13 +78,14 @@ impl Preset {
         self == Self::Preview
     }
 
-    /// [`Self::basis`] with the ensemble `blob` in place of the shipped one.
-    pub fn basis_with(self, blob: &[u8]) -> Basis {
+    /// [`Self::basis`] with the ensemble `blob` in place of the shipped one (`None`: the
+    /// shipped one).
+    pub fn basis_with(self, blob: Option<&[u8]>) -> Basis {
         if self.uses_dct() {
             return Basis::Dct;
         }
         Basis::Ensemble {
-            blob: blob.to_vec(),
+            blob: blob.map(<[u8]>::to_vec),
             choice: slf_firmware::MemberChoice::Screened(slf_firmware::ChoiceRule::DEFAULT),
         }
     }

@@ -14,11 +14,11 @@ use std::path::PathBuf;
 use anyhow::{Result, anyhow, bail, ensure};
 use clap::{Args, ValueEnum};
 use slf_firmware::disparity::MAX_DISPARITY;
-use slf_firmware::{ChoiceRule, DEFAULT_ENSEMBLE, DisparityRange, MemberChoice, Sl0Config, SolveError, gains};
+use slf_firmware::{ChoiceRule, DisparityRange, MemberChoice, Sl0Config, SolveError, gains};
 
 use crate::decode::baselines::{Baseline, BaselineReport};
 use crate::decode::cs::{
-    Balance, Basis, DecodeOptions, DecodeReport, NoiseSource, Window, decode_with_observer, read_blob,
+    Balance, Basis, DecodeOptions, DecodeReport, NoiseSource, PatchViews, Window, decode_with_observer, read_blob,
 };
 use crate::decode::preset::Preset;
 use crate::io::capture::Capture;
@@ -121,9 +121,23 @@ pub struct BasisSettings {
     /// How an ensemble member is chosen per patch.
     #[arg(long, value_enum, default_value_t = Choice::Screened)]
     pub choice: Choice,
-    /// Ensemble blob (default: the shipped 8-member ensemble).
+    /// Ensemble blob (default: the shipped 8-member ensemble of the patch).
     #[arg(long)]
     pub blob: Option<PathBuf>,
+    /// Views per axis a patch holds, 4 or 5: 4 the paper's 5 x 5 x 4 x 4 x 13 patch (a 5 x
+    /// 5-view lenslet in four overlapping angular windows), 5 the full-view 5 x 5 x 5 x 5 x 13
+    /// patch [default: 5 for lenslets of 5 x 5 views or more, 4 for 4 x 4; a --blob's own].
+    #[arg(long, value_parser = patch_views, value_name = "4|5")]
+    pub patch_views: Option<PatchViews>,
+}
+
+/// `--patch-views`: 4 or 5.
+pub fn patch_views(s: &str) -> Result<PatchViews, String> {
+    match s.trim() {
+        "4" => Ok(PatchViews::Four),
+        "5" => Ok(PatchViews::Five),
+        _ => Err(format!("{s:?}: 4 (the paper's 4 x 4-view patch) or 5 (the full-view patch)")),
+    }
 }
 
 impl BasisSettings {
@@ -145,8 +159,8 @@ impl BasisSettings {
             DictionaryKind::Dct => Basis::Dct,
             DictionaryKind::Ensemble => {
                 let blob = match &self.blob {
-                    Some(p) => read_blob(p)?,
-                    None => DEFAULT_ENSEMBLE.to_vec(),
+                    Some(p) => Some(read_blob(p)?),
+                    None => None,
                 };
                 let rule = ChoiceRule::DEFAULT;
                 let choice = match self.choice {
@@ -320,7 +334,7 @@ pub struct DecodeSettings {
     pub basis: BasisSettings,
     /// Lenslets between patch origins, 1..=5 (5: disjoint patches, which show their
     /// grid; smaller strides decode (5 / stride)^2 times the patches and average them)
-    /// [default: 3; preview 5, best 2].
+    /// [default: 2; preview 5, best 1; 3 was the default with the paper's patch].
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=5))]
     pub stride: Option<u8>,
     /// How overlapping patches are averaged [default: tapered; preview uniform].
@@ -429,6 +443,7 @@ impl DecodeSettings {
             disparities: self.disparities.or(base.disparities),
             edge_fallback: self.edge_fallback.unwrap_or(base.edge_fallback),
             seeded: self.seeded.unwrap_or(base.seeded),
+            patch_views: self.basis.patch_views.or(base.patch_views),
             ..base
         };
         // Flags the decode would otherwise ignore in silence.

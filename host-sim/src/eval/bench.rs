@@ -21,12 +21,12 @@ use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use plotters::prelude::*;
 use slf_firmware::{
-    ChoiceRule, DEFAULT_ENSEMBLE, Dictionary, DisparityRange, Ended, MaskFamily, MemberChoice, ModelOutcome, Outcome,
-    PatchModel, Sl0Config, SolveError, Workspace,
+    ChoiceRule, Dictionary, DisparityRange, Ended, MaskFamily, MemberChoice, ModelOutcome, Outcome, PatchModel,
+    Sl0Config, SolveError, Workspace,
 };
 
 use crate::decode::baselines::Baseline;
-use crate::decode::cs::{Basis, DecodeOptions, NoiseSource, Window, decode, decode_with, patch_count};
+use crate::decode::cs::{Basis, DecodeOptions, NoiseSource, PatchViews, Window, decode, decode_with, patch_count};
 use crate::decode::paper_1d::{Factors, analyze_5d, solve_5d, solve_5d_seeded};
 use crate::decode::preset::Preset;
 use crate::eval::device_frame::{self, DeviceFrame};
@@ -38,29 +38,30 @@ use crate::sim::camera::{CameraConfig, simulate};
 use crate::sim::scene::{self, SceneSize};
 
 /// The f64 reference: SL0 with the DCT in f64 (the host's 5D reference), written back
-/// through the workspace so it runs in the same tile pipeline as the f32 decoder.
-pub struct F64Dct {
+/// through the workspace so it runs in the same tile pipeline as the f32 decoder; for
+/// `5 x 5 x PU x PV x 13` patches.
+pub struct F64Dct<const PU: usize, const PV: usize> {
     factors: Factors<f64>,
     /// The f32 DCT tables widened to f64, for writing the result back through them.
     widened: Factors<f64>,
-    dict: Dictionary<5, 5, 4, 4, 13>,
+    dict: Dictionary<5, 5, PU, PV, 13>,
 }
 
-impl Default for F64Dct {
+impl<const PU: usize, const PV: usize> Default for F64Dct<PU, PV> {
     fn default() -> Self {
         let dict = Dictionary::dct();
-        Self { factors: Factors::dct_f64(), widened: Factors::from_dictionary(&dict), dict }
+        Self { factors: Factors::dct_f64_of([5, 5, PU, PV, 13]), widened: Factors::from_dictionary(&dict), dict }
     }
 }
 
-impl PatchModel<5, 5, 4, 4, 13, 5200> for F64Dct {
-    fn decode(&self, cfg: &Sl0Config, ws: &mut Workspace<5, 5, 4, 4, 13, 5200>) -> Result<ModelOutcome, SolveError> {
+impl<const PU: usize, const PV: usize, const N: usize> PatchModel<5, 5, PU, PV, 13, N> for F64Dct<PU, PV> {
+    fn decode(&self, cfg: &Sl0Config, ws: &mut Workspace<5, 5, PU, PV, 13, N>) -> Result<ModelOutcome, SolveError> {
         cfg.validate()?;
         let m = ws.measurements();
         if m.count() == 0 {
             return Err(SolveError::NoMeasurements);
         }
-        let meas: Vec<Option<f64>> = (0..5200).map(|i| m.get(i).map(f64::from)).collect();
+        let meas: Vec<Option<f64>> = (0..N).map(|i| m.get(i).map(f64::from)).collect();
         let (x, iterations) = solve_5d::<f64>(&self.factors, &meas, cfg);
         Ok(self.write_back(&x, iterations, ws))
     }
@@ -68,25 +69,30 @@ impl PatchModel<5, 5, 4, 4, 13, 5200> for F64Dct {
     fn decode_seeded(
         &self,
         cfg: &Sl0Config,
-        ws: &mut Workspace<5, 5, 4, 4, 13, 5200>,
+        ws: &mut Workspace<5, 5, PU, PV, 13, N>,
     ) -> Result<ModelOutcome, SolveError> {
         cfg.validate()?;
         let m = ws.measurements();
         if m.count() == 0 {
             return Err(SolveError::NoMeasurements);
         }
-        let meas: Vec<Option<f64>> = (0..5200).map(|i| m.get(i).map(f64::from)).collect();
+        let meas: Vec<Option<f64>> = (0..N).map(|i| m.get(i).map(f64::from)).collect();
         let start: Vec<f64> = ws.patch().iter().map(|&x| f64::from(x)).collect();
         let (x, iterations) = solve_5d_seeded::<f64>(&self.factors, &meas, &start, cfg);
         Ok(self.write_back(&x, iterations, ws))
     }
 }
 
-impl F64Dct {
+impl<const PU: usize, const PV: usize> F64Dct<PU, PV> {
     /// Writes the f64 patch `x` back: its DCT coefficients (f64 analysis with the f32
     /// tables), then one f32 synthesis (rounding ~1e-7, far below the f32-vs-f64
     /// differences).
-    fn write_back(&self, x: &[f64], iterations: u32, ws: &mut Workspace<5, 5, 4, 4, 13, 5200>) -> ModelOutcome {
+    fn write_back<const N: usize>(
+        &self,
+        x: &[f64],
+        iterations: u32,
+        ws: &mut Workspace<5, 5, PU, PV, 13, N>,
+    ) -> ModelOutcome {
         let s = analyze_5d(&self.widened, x);
         for (dst, v) in ws.coefficients_mut().iter_mut().zip(&s) {
             *dst = *v as f32;
@@ -183,7 +189,7 @@ fn settings(quick: bool) -> Vec<(String, Decoder, DecodeOptions)> {
     let halves = DisparityRange::DEFAULT.with_halves(true);
     let d = Sl0Config::DEFAULT;
     let dct = || Decoder::Basis(Basis::Dct);
-    let ens = |choice| Decoder::Basis(Basis::Ensemble { blob: DEFAULT_ENSEMBLE.to_vec(), choice });
+    let ens = |choice| Decoder::Basis(Basis::Ensemble { blob: None, choice });
     let screened = || ens(MemberChoice::Screened(ChoiceRule::DEFAULT));
     let mut s = vec![
         ("DCT default".to_string(), dct(), d),
@@ -293,8 +299,14 @@ fn settings(quick: bool) -> Vec<(String, Decoder, DecodeOptions)> {
         ));
     }
     // The presets, as `slf decode --preset` runs them (the best only in the full sweep).
-    let presets = Preset::ALL.into_iter().filter(|&p| !quick || p != Preset::Best);
-    decode_points.extend(presets.map(|p| (format!("preset {}", p.name()), Decoder::Basis(p.basis()), p.options())));
+    let presets = || Preset::ALL.into_iter().filter(|&p| !quick || p != Preset::Best);
+    decode_points.extend(presets().map(|p| (format!("preset {}", p.name()), Decoder::Basis(p.basis()), p.options())));
+    // Each preset with the paper's patch (4 x 4 views in four angular windows) beside it:
+    // the presets before the full-view patch (issue 40).
+    decode_points.extend(presets().map(|p| {
+        let opts = DecodeOptions { patch_views: Some(PatchViews::Four), ..p.options() };
+        (format!("preset {} (4-view patch)", p.name()), Decoder::Basis(p.basis()), opts)
+    }));
     points.splice(decode_points_at..decode_points_at, decode_points);
     points
 }
@@ -306,11 +318,14 @@ fn run_decoder(
 ) -> Result<(LightField, crate::decode::cs::DecodeReport)> {
     match dec {
         Decoder::Basis(b) => decode_with(capture, b, opts),
-        Decoder::F64 => decode(capture, &F64Dct::default(), opts),
+        Decoder::F64 => match opts.patch_views_for(capture, &Basis::Dct)? {
+            PatchViews::Four => decode::<4, 4, 5200, _>(capture, &F64Dct::<4, 4>::default(), opts),
+            PatchViews::Five => decode::<5, 5, 8125, _>(capture, &F64Dct::<5, 5>::default(), opts),
+        },
         Decoder::Baseline(m) => {
             let (lf, _) = m.run(capture)?;
             let mut report = crate::decode::cs::DecodeReport::default();
-            report.patches.decoded = u32::try_from(patch_count(capture)?).unwrap_or(u32::MAX);
+            report.patches.decoded = u32::try_from(patch_count(capture, PatchViews::Four)?).unwrap_or(u32::MAX);
             Ok((lf, report))
         }
     }
@@ -371,7 +386,8 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Point>> {
                     solves += report.solves;
                     // Per patch of the disjoint grid: a frame's cost, also for overlapping
                     // patches (which decode more of them) and baselines (which have none).
-                    let n = patch_count(capture)?;
+                    // (Patches of the paper's shape, 4 x 4 views: one unit for both shapes.)
+                    let n = patch_count(capture, PatchViews::Four)?;
                     patches += n;
                     // The same capture's angular windows at the frame's size.
                     let blocks =

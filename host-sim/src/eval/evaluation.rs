@@ -20,7 +20,7 @@ use anyhow::{Context, Result};
 use slf_firmware::{ChoiceRule, MaskFamily, MemberChoice};
 
 use crate::decode::baselines::Baseline;
-use crate::decode::cs::{Basis, DecodeOptions, Window, decode_with, patch_count};
+use crate::decode::cs::{Basis, DecodeOptions, PatchViews, Window, decode_with, patch_count};
 use crate::decode::preset::Preset;
 use crate::eval::metrics::{Metrics, evaluate};
 use crate::eval::preview::write_comparison;
@@ -58,10 +58,12 @@ type Method = (String, Option<Baseline>, Option<(Basis, DecodeOptions)>);
 /// The methods compared: the baselines, then CS with the DCT and with `blob` screened on
 /// disjoint patches, both again at each of `strides`, then the presets (`blob` for the
 /// ensemble's).
-fn methods(blob: &[u8], strides: &[(u8, u8)], window: Window) -> Vec<Method> {
+fn methods(blob: Option<&[u8]>, strides: &[(u8, u8)], window: Window, views: Option<PatchViews>) -> Vec<Method> {
     let mut m: Vec<Method> = Baseline::ALL.iter().map(|b| (b.name().to_string(), Some(*b), None)).collect();
-    let bases =
-        [Basis::Dct, Basis::Ensemble { blob: blob.to_vec(), choice: MemberChoice::Screened(ChoiceRule::DEFAULT) }];
+    let bases = [
+        Basis::Dct,
+        Basis::Ensemble { blob: blob.map(<[u8]>::to_vec), choice: MemberChoice::Screened(ChoiceRule::DEFAULT) },
+    ];
     for &stride in std::iter::once(&(5, 5)).chain(strides) {
         for basis in &bases {
             let name = if stride == (5, 5) {
@@ -69,12 +71,13 @@ fn methods(blob: &[u8], strides: &[(u8, u8)], window: Window) -> Vec<Method> {
             } else {
                 format!("{}, stride {}, {}", basis.name(), stride.0, format!("{window:?}").to_lowercase())
             };
-            let opts = DecodeOptions { stride, window, ..DecodeOptions::default() };
+            let opts = DecodeOptions { stride, window, patch_views: views, ..DecodeOptions::default() };
             m.push((name, None, Some((basis.clone(), opts))));
         }
     }
     for preset in Preset::ALL {
-        m.push((format!("preset {}", preset.name()), None, Some((preset.basis_with(blob), preset.options()))));
+        let opts = DecodeOptions { patch_views: views, ..preset.options() };
+        m.push((format!("preset {}", preset.name()), None, Some((preset.basis_with(blob), opts))));
     }
     m
 }
@@ -98,9 +101,10 @@ fn slug(s: &str) -> String {
 pub fn evaluate_set(
     scenes: &[(String, LightField)],
     settings: &[Setting],
-    blob: &[u8],
+    blob: Option<&[u8]>,
     strides: &[(u8, u8)],
     window: Window,
+    views: Option<PatchViews>,
     out: &Path,
 ) -> Result<Vec<Row>> {
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
@@ -111,8 +115,10 @@ pub fn evaluate_set(
         let cam = CameraConfig::pixel(7, k).with_mask(MaskDescription::seeded(family, 7, k));
         for (name, truth) in scenes {
             let capture = simulate(truth, &cam).with_context(|| name.clone())?;
-            let patches = patch_count(&capture)? as f64;
-            for (method, baseline, basis) in methods(blob, strides, window) {
+            // Times are per patch of the paper's shape (a 4 x 4-view window), one unit for
+            // every method and patch.
+            let patches = patch_count(&capture, PatchViews::Four)? as f64;
+            for (method, baseline, basis) in methods(blob, strides, window, views) {
                 let (recon, ms) = match (baseline, &basis) {
                     (Some(b), _) => {
                         let (recon, r) = one.install(|| b.run(&capture))?;
@@ -189,7 +195,7 @@ mod tests {
     #[test]
     fn methods_are_the_baselines_the_bases_per_stride_and_the_presets() {
         let names = |strides: &[(u8, u8)]| -> Vec<String> {
-            methods(slf_firmware::DEFAULT_ENSEMBLE, strides, Window::Tapered).into_iter().map(|m| m.0).collect()
+            methods(None, strides, Window::Tapered, None).into_iter().map(|m| m.0).collect()
         };
         let plain = names(&[]);
         assert_eq!(plain.len(), Baseline::ALL.len() + 2 + Preset::ALL.len());
@@ -199,12 +205,12 @@ mod tests {
         assert!(strided.contains(&"DCT, stride 3, tapered".to_string()), "{strided:?}");
         assert!(strided.contains(&"ensemble screened, stride 3, tapered".to_string()), "{strided:?}");
         // The presets' options are the presets'.
-        let all = methods(slf_firmware::DEFAULT_ENSEMBLE, &[], Window::Tapered);
+        let all = methods(None, &[], Window::Tapered, None);
         let (_, _, Some((basis, opts))) = &all[all.len() - 3] else { panic!("the preview is a CS method") };
         assert!(matches!(basis, Basis::Dct));
         assert_eq!(opts.stride, Preset::Preview.options().stride);
         assert!(!opts.edge_fallback);
         let (_, _, Some((_, best))) = &all[all.len() - 1] else { panic!("best is a CS method") };
-        assert_eq!(best.stride, (2, 2));
+        assert_eq!(best.stride, Preset::Best.options().stride);
     }
 }

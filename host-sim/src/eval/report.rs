@@ -5,10 +5,10 @@ use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use slf_firmware::{ChoiceRule, DEFAULT_ENSEMBLE, MaskFamily, MemberChoice};
+use slf_firmware::{ChoiceRule, MaskFamily, MemberChoice};
 
 use crate::decode::baselines::Baseline;
-use crate::decode::cs::{Basis, DecodeOptions, DecodeReport, decode_with};
+use crate::decode::cs::{Basis, DecodeOptions, DecodeReport, PatchViews, decode_with};
 use crate::eval::metrics::{Metrics, evaluate};
 use crate::eval::preview::write_comparison;
 use crate::io::capture::MaskDescription;
@@ -27,10 +27,11 @@ fn run_one(
     truth: &LightField,
     cam: &CameraConfig,
     basis: &Basis,
+    views: Option<PatchViews>,
     progress: bool,
 ) -> Result<(LightField, Metrics, DecodeReport)> {
     let capture = simulate(truth, cam)?;
-    let opts = DecodeOptions { progress, ..DecodeOptions::default() };
+    let opts = DecodeOptions { progress, patch_views: views, ..DecodeOptions::default() };
     let (recon, report) = decode_with(&capture, basis, &opts)?;
     if report.failed_tiles > 0 || report.uncovered > 0 {
         bail!("decode lost {} tiles, {} values uncovered", report.failed_tiles, report.uncovered);
@@ -44,7 +45,7 @@ fn run_one(
 ///
 /// # Errors
 /// An unknown scene, a failed decode, or a file that cannot be written.
-pub fn demo(out: &Path, name: &str, size: usize, basis: &Basis) -> Result<()> {
+pub fn demo(out: &Path, name: &str, size: usize, basis: &Basis, views: Option<PatchViews>) -> Result<()> {
     let start = Instant::now();
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let s = scene::named(name).with_context(|| format!("unknown scene {name:?}: one of {:?}", scene::NAMES))?;
@@ -58,7 +59,7 @@ pub fn demo(out: &Path, name: &str, size: usize, basis: &Basis) -> Result<()> {
     println!("{HEADER}");
     for k in [1u8, 3] {
         let cam = CameraConfig::pixel(7, k);
-        let (recon, m, r) = run_one(&truth, &cam, basis, true)?;
+        let (recon, m, r) = run_one(&truth, &cam, basis, views, true)?;
         println!("{}", row(name, "pixel", k, &m, r.seconds));
         write_npy(&out.join(format!("recon_k{k}.npy")), &recon, Dtype::F32)?;
         let label = format!("{}, pixel k = {k}", basis.name());
@@ -77,7 +78,7 @@ pub fn demo(out: &Path, name: &str, size: usize, basis: &Basis) -> Result<()> {
 ///
 /// # Errors
 /// A failed decode or an unwritable `output`.
-pub fn sweep(size: usize, ks: &[u8], output: Option<&Path>, basis: &Basis) -> Result<()> {
+pub fn sweep(size: usize, ks: &[u8], output: Option<&Path>, basis: &Basis, views: Option<PatchViews>) -> Result<()> {
     let k_list: Vec<String> = ks.iter().map(u8::to_string).collect();
     let flags = match basis {
         Basis::Dct => "--dictionary dct".to_string(),
@@ -113,7 +114,7 @@ pub fn sweep(size: usize, ks: &[u8], output: Option<&Path>, basis: &Basis) -> Re
         for family in [MaskFamily::Pixel, MaskFamily::Lenslet, MaskFamily::Kronecker] {
             for &k in ks {
                 let cam = CameraConfig::pixel(7, k).with_mask(MaskDescription::seeded(family, 7, k));
-                let (_, m, r) = run_one(&truth, &cam, basis, false)?;
+                let (_, m, r) = run_one(&truth, &cam, basis, views, false)?;
                 let fam = format!("{family:?}").to_lowercase();
                 let line = row(name, &fam, k, &m, r.seconds);
                 println!("{line}");
@@ -139,11 +140,9 @@ pub fn compare(
     blob: Option<&Path>,
     masks: &[MaskFamily],
     rule: ChoiceRule,
+    views: Option<PatchViews>,
 ) -> Result<()> {
-    let blob = match blob {
-        Some(p) => crate::decode::cs::read_blob(p)?,
-        None => DEFAULT_ENSEMBLE.to_vec(),
-    };
+    let blob = blob.map(crate::decode::cs::read_blob).transpose()?;
     let bases = [
         Basis::Dct,
         Basis::Ensemble { blob: blob.clone(), choice: MemberChoice::Exhaustive(rule) },
@@ -173,7 +172,7 @@ pub fn compare(
                 let cam = CameraConfig::pixel(7, k).with_mask(MaskDescription::seeded(family, 7, k));
                 let (mut p, mut s, mut a, mut secs, mut solves, mut patches) = (0.0, 0.0, 0.0, 0.0, 0u64, 0u64);
                 for truth in &truths {
-                    let (_, m, r) = run_one(truth, &cam, basis, false)?;
+                    let (_, m, r) = run_one(truth, &cam, basis, views, false)?;
                     p += m.psnr;
                     s += m.ssim;
                     a += m.sa;

@@ -283,11 +283,14 @@ impl Capture {
         Some((floor.sqrt() as f32, (1.0 / f64::from(n.full_well_electrons)) as f32))
     }
 
-    /// The firmware's tile decoder for this capture (the paper's 5 x 5 x 4 x 4 x 13 patch).
+    /// The firmware's tile decoder for this capture, for `5 x 5 x PU x PV x 13` patches.
     ///
     /// # Errors
     /// A mask or geometry the decoder does not take, with the reason.
-    pub fn decoder(&self, sl0: Sl0Config) -> Result<TileDecoder<'_, 5, 5, 4, 4, 13, 5200>> {
+    pub fn decoder<const PU: usize, const PV: usize, const N: usize>(
+        &self,
+        sl0: Sl0Config,
+    ) -> Result<TileDecoder<'_, 5, 5, PU, PV, 13, N>> {
         let mask = self.mask().map_err(|e| anyhow!("{}: {}", self.source(), one_line(&e)))?;
         let config =
             DecoderConfig { sensor: self.sensor(), mask, raw: self.raw_format(), defects: self.defects(), sl0 };

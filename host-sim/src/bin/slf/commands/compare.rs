@@ -6,6 +6,8 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::ValueEnum;
+use slf_host::decode::cs::PatchViews;
+use slf_host::decode::settings::patch_views;
 use slf_host::eval::report;
 use slf_host::firmware::{ChoiceRule, MaskFamily};
 
@@ -34,6 +36,10 @@ pub struct Args {
     /// Coefficients kept by the residual rule.
     #[arg(long, default_value_t = 100)]
     pub rule_tau: u16,
+    /// Views per axis a patch holds, 4 or 5 [default: 5, the full-view patch; a --blob's
+    /// own].
+    #[arg(long, value_parser = patch_views, value_name = "4|5")]
+    pub patch_views: Option<PatchViews>,
 }
 
 pub fn run(args: Args) -> Result<()> {
@@ -45,6 +51,7 @@ pub fn run(args: Args) -> Result<()> {
         args.blob.as_deref(),
         &masks,
         args.rule.rule(args.rule_tau),
+        args.patch_views,
     )
 }
 

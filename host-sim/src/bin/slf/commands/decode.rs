@@ -106,6 +106,9 @@ pub fn run(args: Args) -> Result<()> {
         }
         (NoiseSource::Config, true) => format!("noise sd {:.2e} + shot {:.2e} per unit", used.noise, used.shot),
     };
+    if let Some(v) = r.patch_views {
+        println!("patch: {} (--patch-views {v})", v.shape_name());
+    }
     println!("projection: {ball}");
     let gains: Vec<String> = r.gains.iter().map(|g| format!("{g:.3}")).collect();
     match opts.balance {
@@ -126,6 +129,14 @@ pub fn run(args: Args) -> Result<()> {
             r.filled
         );
     }
+    let per = |n: u64| n as f64 / f64::from(r.patches.decoded.max(1));
+    println!(
+        "sl0: {} solves, {} steps ({:.2} solves and {:.1} steps a patch, the last solve's steps counted)",
+        r.solves,
+        r.steps,
+        per(r.solves),
+        per(r.steps)
+    );
     println!(
         "decoded {} patches ({} solved, {} interpolated from fewer than {} bands, {} flat; {} flagged, {} failed, {} \
          tiles failed) in {:.3} s; wrote {}",

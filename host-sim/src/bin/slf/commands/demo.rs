@@ -25,5 +25,5 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    report::demo(&args.out, &args.scene, args.size, &args.basis.basis()?)
+    report::demo(&args.out, &args.scene, args.size, &args.basis.basis()?, args.basis.patch_views)
 }

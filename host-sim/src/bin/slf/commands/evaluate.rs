@@ -5,9 +5,9 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use slf_host::decode::cs::read_blob;
+use slf_host::decode::cs::{PatchViews, read_blob};
+use slf_host::decode::settings::patch_views;
 use slf_host::eval::evaluation::{SETTINGS, evaluate_set, table};
-use slf_host::firmware::DEFAULT_ENSEMBLE;
 use slf_host::io::lightfield::read_npy;
 
 use super::import::camera_bands;
@@ -33,14 +33,15 @@ pub struct Args {
     /// How overlapping patches are averaged in those rows.
     #[arg(long, value_enum, default_value_t = WindowKind::Tapered)]
     pub window: WindowKind,
+    /// Views per axis of every CS row's patch, 4 or 5 [default: the decode's, 5 for 5 x
+    /// 5-view lenslets; a --blob's own].
+    #[arg(long, value_parser = patch_views, value_name = "4|5")]
+    pub patch_views: Option<PatchViews>,
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let Args { inputs, out, blob, stride, window } = args;
-    let blob = match blob {
-        Some(p) => read_blob(&p)?,
-        None => DEFAULT_ENSEMBLE.to_vec(),
-    };
+    let Args { inputs, out, blob, stride, window, patch_views } = args;
+    let blob = blob.map(|p| read_blob(&p)).transpose()?;
     let mut scenes: Vec<(String, _)> = Vec::new();
     for (i, p) in inputs.iter().enumerate() {
         let name = p.file_stem().map_or("scene".into(), |s| s.to_string_lossy().into_owned());
@@ -55,7 +56,7 @@ pub fn run(args: Args) -> Result<()> {
         scenes.push((name, camera_bands(read_npy(p)?, None, p)?));
     }
     let strides: Vec<(u8, u8)> = stride.iter().map(|&s| (s as u8, s as u8)).collect();
-    let rows = evaluate_set(&scenes, &SETTINGS, &blob, &strides, window.window(), &out)?;
+    let rows = evaluate_set(&scenes, &SETTINGS, blob.as_deref(), &strides, window.window(), patch_views, &out)?;
     let t = table(&rows, &SETTINGS);
     let path = out.join("table.md");
     std::fs::write(&path, &t).with_context(|| format!("cannot write {}", path.display()))?;

@@ -25,5 +25,5 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    report::sweep(args.size, &args.k, args.output.as_deref(), &args.basis.basis()?)
+    report::sweep(args.size, &args.k, args.output.as_deref(), &args.basis.basis()?, args.basis.patch_views)
 }

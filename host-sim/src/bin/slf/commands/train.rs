@@ -9,7 +9,8 @@ use slf_host::io::lightfield::read_npy;
 use slf_host::train;
 
 use crate::args::ranged;
-use slf_host::decode::settings::WhiteBalance;
+use slf_host::decode::cs::PatchViews;
+use slf_host::decode::settings::{WhiteBalance, patch_views};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -31,9 +32,13 @@ pub struct Args {
     /// Members K, 1..=256.
     #[arg(long, default_value_t = 8, value_parser = ranged::<1, 256>)]
     pub members: usize,
-    /// Coefficients kept per patch when coding, 1..=5200.
-    #[arg(long, default_value_t = 100, value_parser = ranged::<1, 5200>)]
+    /// Coefficients kept per patch when coding, 1..=5200 (8125 for the full-view patch).
+    #[arg(long, default_value_t = 100, value_parser = ranged::<1, 8125>)]
     pub tau: usize,
+    /// Views per axis of the patch the ensemble is for, 4 or 5: the paper's 5 x 5 x 4 x 4 x
+    /// 13 patch, or the full-view 5 x 5 x 5 x 5 x 13 one.
+    #[arg(long, value_parser = patch_views, value_name = "4|5", default_value = "4")]
+    pub patch_views: PatchViews,
     /// Training iterations (assign patches to members, update each member), 0..=1000.
     #[arg(long, default_value_t = 10, value_parser = ranged::<0, 1000>)]
     pub iterations: usize,
@@ -72,6 +77,7 @@ pub fn run(args: Args) -> Result<()> {
         no_dct_member,
         generator,
         balance,
+        patch_views,
     } = args;
     let cfg = train::TrainConfig { members, tau, iterations, group, seed, dct_member: !no_dct_member, progress: true };
     let fields = if input.is_empty() {
@@ -87,7 +93,7 @@ pub fn run(args: Args) -> Result<()> {
         WhiteBalance::Grey => fields.iter().map(train::white_balanced).collect(),
         WhiteBalance::Off => fields,
     };
-    train::train_blob(&fields, patches, &cfg, &output)
+    train::train_blob(&fields, patches, patch_views, &cfg, &output)
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
