@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Where the device's instructions go (issue 30): runs the device binary on qemu's emulated
-# Cortex-M4F with the counting plugin's profile (scripts/wincount/wincount.c, prof=) and
+# Cortex-M7 (mps2-an500) with the counting plugin's profile (scripts/wincount/wincount.c, prof=) and
 # prints, per function of the device ELF, the instructions of a screened-ensemble tile and
-# of a DCT tile (4 patches each; the windows of scripts/budgets.sh).
+# of a DCT tile (one full-view patch each; the windows of scripts/budgets.sh).
 # Needs what budgets.sh needs: thumbv7em-none-eabihf, qemu-system-arm, gcc, llvm-nm.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -10,7 +10,7 @@ source scripts/device-build.sh
 # Windows: 1 the white balance, 2 one synthesis, 3 the first ensemble tile, then the other
 # ensemble tiles and the DCT tiles (T of each).
 run() {
-  timeout 600 qemu-system-arm -M netduinoplus2 -nographic -semihosting-config enable=on,target=native \
+  timeout 600 qemu-system-arm -M mps2-an500 -nographic -semihosting-config enable=on,target=native \
     -kernel "$elf" -plugin "target/libwincount.so,start=$begin,end=$end,prof=$1:$1" -d plugin -D "$2" \
     > target/profile-device.log
 }

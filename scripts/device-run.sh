@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Runs the device binary on qemu's emulated Cortex-M4F and checks its decoded patches
+# Runs the device binary on qemu's emulated Cortex-M7 (mps2-an500) and checks its decoded patches
 # against the host's decode of the same tiles (fails above 1e-5 relative difference).
 # Needs: rustup target add thumbv7em-none-eabihf; apt-get install qemu-system-arm.
 set -euo pipefail

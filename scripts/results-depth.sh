@@ -11,8 +11,11 @@
 #   SLF_MODELS="ensemble ensemble+halves" bash scripts/results-depth.sh OUT_DIR  # some rows
 #   SLF_SETTINGS="pixel:1" SLF_MODELS="demosaic ppid preview default best" \
 #     RAYON_NUM_THREADS=1 bash scripts/results-depth.sh OUT_DIR  # the presets, one thread
-#   SLF_MODELS="preview-4 preview-5 default-4 default-5" RAYON_NUM_THREADS=1 \
-#     bash scripts/results-depth.sh OUT_DIR  # the paper's patch against the full-view one
+#   SLF_MODELS="demosaic ppid preview preview-before default default-before default-stride3 best best-before" \
+#     RAYON_NUM_THREADS=1 bash scripts/results-depth.sh OUT_DIR  # the presets before and after issue 40
+#
+# The `-before` rows are the presets with the paper's patch as they were before issue 40 (4 x 4
+# views, default stride 3, best stride 2); `default-stride3` the full-view patch at stride 3.
 #
 # The real light fields are scripts/real-eval.sh's 128 x 128 crops, in $SLF_REAL (default
 # /tmp/hci/real); their licence allows evaluation only.
@@ -36,8 +39,8 @@ ensemble=--disparities=0:0 ensemble+depth=--disparities=-1:1 ensemble+depth2=--d
 ensemble+halves=--disparities=-1:1:0.5
 preview=--preset,preview default=--preset,default best=--preset,best
 default-unseeded=--preset,default,--seeded,false best-unseeded=--preset,best,--seeded,false
-preview-4=--preset,preview,--patch-views,4 default-4=--preset,default,--patch-views,4 best-4=--preset,best,--patch-views,4
-preview-5=--preset,preview,--patch-views,5 default-5=--preset,default,--patch-views,5 best-5=--preset,best,--patch-views,5"
+preview-before=--preset,preview,--patch-views,4 default-before=--preset,default,--patch-views,4,--stride,3
+best-before=--preset,best,--patch-views,4,--stride,2 default-stride3=--preset,default,--stride,3"
 models=""
 for m in $all; do
   case " ${SLF_MODELS:-${m%%=*}} " in *" ${m%%=*} "*) models="$models $m" ;; esac

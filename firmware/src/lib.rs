@@ -82,7 +82,8 @@
 //! Configuration (dictionaries, masks, defect lists, solver parameters) is immutable and
 //! can live in flash; all mutable state is one caller-owned [`Workspace`], whose size is the
 //! decoder's whole RAM need besides the stack: three patch buffers, a flag per value and a
-//! gain per band, 67,744 bytes for the paper's 5 x 5 x 4 x 4 x 13 patch. Overlapping patches
+//! gain per band, 67,744 bytes for the paper's 5 x 5 x 4 x 4 x 13 patch and 105,768 for the
+//! full-view 5 x 5 x 5 x 5 x 13 patch ([`FullViewWorkspace`], the device's). Overlapping patches
 //! ([`OverlapDecoder`]) add a caller-owned strip of lenslet rows, 7,000 bytes per lenslet
 //! column of 5 x 5 views, or 12,600 with sheared patches ([`disparity`]: the default range
 //! -1..=1 reaches 2 rows beyond a patch); a strip narrower than the sensor decodes it in
@@ -138,4 +139,4 @@ pub use sensor::source::TileSource;
 pub use sensor::spi::{SpiFrameBuffer, SpiSourceError};
 pub use solver::choice::{ChoiceRule, EnsembleModel, MemberChoice, ModelOutcome, PatchModel};
 pub use solver::sl0::{Ended, Outcome, Sl0Config, SolveError, solve};
-pub use solver::workspace::{Measurements, PaperWorkspace, Workspace};
+pub use solver::workspace::{FullViewWorkspace, Measurements, PaperWorkspace, Workspace};

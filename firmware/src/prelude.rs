@@ -26,7 +26,7 @@ pub use crate::sensor::raw::{FrameSource, LeU16Frame, RawFormat, RawFrame};
 pub use crate::sensor::spi::{SpiFrameBuffer, SpiSourceError};
 pub use crate::solver::choice::{ChoiceRule, EnsembleModel, MemberChoice, PatchModel};
 pub use crate::solver::sl0::{Ended, Outcome, Sl0Config, SolveError};
-pub use crate::solver::workspace::{PaperWorkspace, Workspace};
+pub use crate::solver::workspace::{FullViewWorkspace, PaperWorkspace, Workspace};
 
 /// Values in the paper's patch: 5 x 5 x 4 x 4 x 13.
 pub const PAPER_N: usize = 5200;
@@ -46,8 +46,30 @@ pub type PaperDictionary = Dictionary<5, 5, 4, 4, 13>;
 /// An ensemble blob of the paper's patch, validated.
 pub type PaperEnsemble<'a> = Ensemble<'a, 5, 5, 4, 4, 13>;
 
-/// An ensemble with its member choice, the decoder's default model.
+/// An ensemble with its member choice, for the paper's patch.
 pub type PaperEnsembleModel<'a> = EnsembleModel<'a, 5, 5, 4, 4, 13>;
+
+/// Values in the full-view patch: 5 x 5 x 5 x 5 x 13, every view of a 5 x 5-view lenslet.
+pub const FULL_VIEW_N: usize = 8125;
+
+/// One decoded full-view patch, in `(s, t, u, v, band)` order, band fastest.
+pub type FullViewPatch = [f32; FULL_VIEW_N];
+
+/// The tile decoder for the full-view patch.
+pub type FullViewDecoder<'a> = TileDecoder<'a, 5, 5, 5, 5, 13, FULL_VIEW_N>;
+
+/// The overlapped decoder for the full-view patch.
+pub type FullViewOverlapDecoder<'a> = OverlapDecoder<'a, 5, 5, 5, 5, 13, FULL_VIEW_N>;
+
+/// A dictionary (one member, or the 5D DCT) of the full-view patch.
+pub type FullViewDictionary = Dictionary<5, 5, 5, 5, 13>;
+
+/// An ensemble blob of the full-view patch, validated
+/// ([`crate::DEFAULT_FULL_VIEW_ENSEMBLE`] is the shipped one).
+pub type FullViewEnsemble<'a> = Ensemble<'a, 5, 5, 5, 5, 13>;
+
+/// An ensemble with its member choice, for the full-view patch: the device's default model.
+pub type FullViewEnsembleModel<'a> = EnsembleModel<'a, 5, 5, 5, 5, 13>;
 
 /// What can go wrong while setting a decoder up, so that set-up code can use `?` across
 /// layers. Decoding itself reports per tile and per patch ([`TileError`], [`TileReport`]).

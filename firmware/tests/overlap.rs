@@ -296,14 +296,37 @@ fn tapered_weights_are_one_two_three_two_one() {
 
 #[test]
 fn the_devices_overlapped_decode_fits_its_part() {
-    // The device binary (`firmware/device`) decodes its 5 x 10-lenslet capture through a
-    // strip of 5 lenslet columns: the workspace, the strip and 24 KiB for the stack
-    // (measured peak 17.5 KiB, `scripts/budgets.sh`) fit the part's 128 KiB; the full
-    // width (10 columns, one band) would not, which is why the strip is cut into bands.
-    let od = Overlapped::new(decoder(Mask::pixel(5, 2, 13, L5).unwrap()), Overlap::DEFAULT).unwrap();
-    let column = 4 * od.strip_per_column();
-    assert_eq!(column, 7_000);
-    let ws = core::mem::size_of::<PaperWorkspace>();
-    assert!(ws + 5 * column + 24 * 1024 <= 128 * 1024, "{ws} + 5 x {column}");
-    assert!(ws + 10 * column + 24 * 1024 > 128 * 1024);
+    // The device (`memory.x`: the stack in the 128 KiB DTCM, statics in 512 KiB of RAM)
+    // decodes its 5 x 10-lenslet capture in full-view patches through one band of the
+    // sheared strip (12,600 B a column): the workspace and the whole width fit the RAM,
+    // where in the 128 KiB of the M4F part before issue 40 they did not.
+    let full = |lenslets: (u16, u16)| {
+        let config = DecoderConfig {
+            sensor: SensorGeometry { lenslets, lenslet: L5 },
+            mask: Mask::pixel(5, 2, 13, L5).unwrap(),
+            raw: RawFormat::NORMALISED,
+            defects: DefectList::EMPTY,
+            sl0: Sl0Config::DEFAULT,
+        };
+        let tiles = TileDecoder::<5, 5, 5, 5, 13, 8125>::new(config).unwrap();
+        OverlapDecoder::new(tiles.with_disparities(DisparityRange::DEFAULT), Overlap::DEFAULT).unwrap()
+    };
+    let ws = core::mem::size_of::<FullViewWorkspace>();
+    let device = full((5, 10));
+    assert_eq!(device.strip_per_column() * 4, 12_600);
+    assert!(ws + 10 * 12_600 <= 512 * 1024, "{ws} + the full width");
+    // A camera-sized sensor, 100 x 100 lenslets, sheared: the RAM beside the workspace holds
+    // a band of 33 columns (416 KB), so the frame is decoded in 4 bands; the patch solves
+    // that costs against the full width's (`scripts/budgets.sh` projects the frame with it).
+    let camera = full((100, 100));
+    let band = (512 * 1024 - ws) / (4 * camera.strip_per_column());
+    assert_eq!(band, 33);
+    let (banded, whole) = (camera.patch_decodes(band), camera.patch_decodes(100));
+    let disjoint = 20 * 20;
+    eprintln!(
+        "100 x 100, full-view: {banded} patch solves in bands of {band} ({:.3} x the disjoint grid), {whole} at full width ({:.3} x)",
+        banded as f64 / disjoint as f64,
+        whole as f64 / disjoint as f64
+    );
+    assert!(banded > whole && banded < whole + whole / 4, "{banded} against {whole}");
 }

@@ -7,8 +7,8 @@ use common::*;
 use rand::Rng;
 use slf_firmware::pinv::{PinvOperator, solve_pinv};
 use slf_firmware::{
-    Dictionary, Ended, LensletSize, Mask, MaskFamily, PaperWorkspace, PatchShape, Sl0Config, SolveError, Workspace,
-    solve,
+    Dictionary, Ended, FullViewWorkspace, LensletSize, Mask, MaskFamily, PaperWorkspace, PatchShape, Sl0Config,
+    SolveError, Workspace, solve,
 };
 
 const L5: LensletSize = LensletSize { rows: 5, cols: 5 };
@@ -27,6 +27,11 @@ fn workspace_fits_the_ram_budget() {
     // The exact figure the README, the crate docs and the device's log give: a change to the
     // workspace shows here first.
     assert_eq!(size, 67_744, "the README and firmware/src/lib.rs say 67,744 B");
+    // The full-view patch's, the device's (`scripts/budgets.sh` checks its log against it):
+    // the same parts for 8,125 values, in the part's 512 KiB of RAM.
+    let full = core::mem::size_of::<FullViewWorkspace>();
+    assert!(full <= 3 * 4 * 8125 + 8125 + 4 * 32 + 16, "full-view workspace is {full} bytes");
+    assert_eq!(full, 105_768, "the README, firmware/src/lib.rs and scripts/budgets.sh say 105,768 B");
 }
 
 fn masks(k: u8) -> [Mask<'static>; 3] {

@@ -1,8 +1,9 @@
 //! `slf-device`: the decoder on a Cortex-M core.
 //!
 //! Decodes every tile of the capture in `firmware/device/capture` (written by
-//! `slf device-capture`, included in flash at build time) with the shipped 8-member
-//! ensemble and screened member choice, and prints over semihosting every decoded patch
+//! `slf device-capture`, included in flash at build time) in full-view patches (5 x 5
+//! lenslets x all 5 x 5 views x 13 bands) with the shipped 8-member full-view ensemble and
+//! screened member choice, and prints over semihosting every decoded patch
 //! (f32 bit patterns) for `slf device-check` to compare with the host's decode. Then it
 //! decodes the same tiles with the 5D DCT, and last the whole frame with overlapping
 //! patches (stride 3, tapered window) through a strip of lenslet rows, printing each
@@ -12,8 +13,10 @@
 //! `scripts/wincount/wincount.c` counts instructions per transform and per patch. The
 //! stack is painted at start and scanned at the end for its peak depth.
 //!
-//! Run: `cargo run --profile device -p slf-device --target thumbv7em-none-eabihf` (qemu is the
-//! runner, see `.cargo/config.toml`). On the host this file builds to a stub that says so.
+//! Run: `cargo run --profile device -p slf-device --target thumbv7em-none-eabihf` (qemu's
+//! Cortex-M7 board `mps2-an500` is the runner, see `.cargo/config.toml`; the memory map is
+//! the top-level `memory.x`: the stack in the 128 KiB DTCM, the workspace and the strip in the
+//! 512 KiB RAM). On the host this file builds to a stub that says so.
 #![cfg_attr(target_os = "none", no_std, no_main)]
 
 /// Instruction-count window markers: never inlined, distinct bodies, addresses found by
@@ -40,10 +43,10 @@ mod device {
     use defmt_semihosting as _;
     use panic_semihosting as _;
     use slf_firmware::{
-        ChoiceRule, DEFAULT_ENSEMBLE, DecoderConfig, DefectList, Dictionary, Disparity, DisparityRange, Ensemble,
-        EnsembleModel, FrameSource, LeU16Frame, LensletSize, Mask, MemberChoice, Overlap, OverlapDecoder, PaperShape,
-        PaperWorkspace, PatchModel, PatchOrigin, PatchReport, PatchSink, RawFormat, RowSink, SensorGeometry, Sl0Config,
-        TileDecoder,
+        ChoiceRule, DEFAULT_FULL_VIEW_ENSEMBLE, DecoderConfig, DefectList, Dictionary, Disparity, DisparityRange,
+        Ensemble, EnsembleModel, FrameSource, FullViewShape, FullViewWorkspace, LeU16Frame, LensletSize, Mask,
+        MemberChoice, Overlap, OverlapDecoder, PatchModel, PatchOrigin, PatchReport, PatchSink, RawFormat, RowSink,
+        SensorGeometry, Sl0Config, TileDecoder,
     };
 
     use super::{bench_begin, bench_end};
@@ -89,9 +92,9 @@ mod device {
         print: bool,
     }
 
-    impl PatchSink<5200> for Print {
+    impl PatchSink<8125> for Print {
         type Error = core::convert::Infallible;
-        fn accept(&mut self, o: PatchOrigin, p: &[f32; 5200], r: &PatchReport) -> Result<(), Self::Error> {
+        fn accept(&mut self, o: PatchOrigin, p: &[f32; 8125], r: &PatchReport) -> Result<(), Self::Error> {
             self.patches += 1;
             fold(&mut self.checksum, p);
             if self.print {
@@ -114,10 +117,12 @@ mod device {
     /// Lenslet columns of the overlapped decode's strip: with the default disparities
     /// (-1..=1, sheared patches reach 2 lenslet rows beyond their own) the ring is 9 lenslet
     /// rows x 25 views x (13 sums + 1 weight) f32, 12,600 B a column, so the capture's 10
-    /// columns are decoded as four bands of at most 3 (37,800 B), the most that fits beside
-    /// the workspace and the stack in the emulated part's 128 KiB (see README, "Overlap on
-    /// the device").
-    const STRIP_COLUMNS: usize = 3;
+    /// columns take 126,000 B: one band, in the part's 512 KiB RAM beside the workspace (in
+    /// the 128 KiB of the emulated M4F it took four bands of 3; see README, "Overlap on the
+    /// device").
+    const STRIP_COLUMNS: usize = 10;
+    /// The part's RAM for statics (`memory.x`: 512 KiB), for the camera-sized frame's band.
+    const RAM_BYTES: usize = 512 * 1024;
     const STRIP_LEN: usize = STRIP_COLUMNS * 9 * 25 * 14;
 
     /// Prints each finished row of the overlapped decode, folds it into a checksum.
@@ -141,8 +146,8 @@ mod device {
     /// dictionaries `EnsembleModel::new` compares (2 KB each) leave the stack with it
     /// instead of staying in `run`'s frame for the whole decode.
     #[inline(never)]
-    fn model() -> Option<EnsembleModel<'static, 5, 5, 4, 4, 13>> {
-        let ensemble = Ensemble::<5, 5, 4, 4, 13>::new(DEFAULT_ENSEMBLE).ok()?;
+    fn model() -> Option<EnsembleModel<'static, 5, 5, 5, 5, 13>> {
+        let ensemble = Ensemble::<5, 5, 5, 5, 13>::new(DEFAULT_FULL_VIEW_ENSEMBLE).ok()?;
         Some(EnsembleModel::new(ensemble, MemberChoice::Screened(ChoiceRule::DEFAULT)))
     }
 
@@ -156,7 +161,7 @@ mod device {
     }
 
     fn run() -> debug::ExitStatus {
-        let Some(ws) = cortex_m::singleton!(: PaperWorkspace = PaperWorkspace::new()) else {
+        let Some(ws) = cortex_m::singleton!(: FullViewWorkspace = FullViewWorkspace::new()) else {
             return debug::EXIT_FAILURE;
         };
         let (rows, cols) = (LENSLETS.0 as usize * VIEWS.0 as usize, LENSLETS.1 as usize * VIEWS.1 as usize);
@@ -180,7 +185,7 @@ mod device {
             defects: DefectList::EMPTY,
             sl0: Sl0Config { noise: NOISE, shot: SHOT, ..Sl0Config::DEFAULT },
         };
-        let Ok(decoder) = TileDecoder::<5, 5, 4, 4, 13, 5200>::new(config) else {
+        let Ok(decoder) = TileDecoder::<5, 5, 5, 5, 13, 8125>::new(config) else {
             hprintln!("error: decoder config rejected");
             return debug::EXIT_FAILURE;
         };
@@ -202,15 +207,15 @@ mod device {
             return debug::EXIT_FAILURE;
         };
         // In flash: a `const` table, not 2 KB of the stack.
-        static DCT: Dictionary<5, 5, 4, 4, 13> = Dictionary::dct();
+        static DCT: Dictionary<5, 5, 5, 5, 13> = Dictionary::dct();
         let dct = &DCT;
 
-        // Window 0: one synthesis (PaperShape::TRANSFORM_MACS multiply-adds).
+        // Window 0: one synthesis (FullViewShape::TRANSFORM_MACS multiply-adds).
         ws.coefficients_mut().fill(0.5);
         bench_begin(0);
         ws.synthesize(dct);
         bench_end(0);
-        hprintln!("transform macs {}", PaperShape::TRANSFORM_MACS);
+        hprintln!("transform macs {}", FullViewShape::TRANSFORM_MACS);
 
         let mut out = Print { checksum: 0, patches: 0, print: true };
         let mut failed = 0u32;
@@ -275,6 +280,23 @@ mod device {
             }
             Err(_) => failed += 1,
         }
+        // The patch solves of a camera-sized frame (100 x 100 lenslets, the capture's mask
+        // and sheared overlap) through the strip this part's RAM holds beside the workspace:
+        // `scripts/budgets.sh` projects the frame's time from them.
+        let camera = SensorGeometry { lenslets: (100, 100), lenslet };
+        let ram_left = RAM_BYTES.saturating_sub(core::mem::size_of::<FullViewWorkspace>());
+        if let Ok(camera) = TileDecoder::<5, 5, 5, 5, 13, 8125>::new(DecoderConfig { sensor: camera, ..config })
+            .map(|d| d.with_disparities(DisparityRange::for_snapshots(SNAPSHOTS)))
+            .and_then(|d| OverlapDecoder::new(d, Overlap::DEFAULT))
+        {
+            let band = ram_left / (4 * camera.strip_per_column()).max(1);
+            hprintln!(
+                "camera frame 100 x 100 band {} patch-solves {} full-width {}",
+                band,
+                camera.patch_decodes(band.max(1)),
+                camera.patch_decodes(100)
+            );
+        }
         bench_begin(5);
         let chosen = depth.choose_disparity(2, 3, &mut FrameSource::new(&frames));
         bench_end(5);
@@ -315,7 +337,7 @@ mod device {
         hprintln!("sheared stack peak bytes {}", crate::stack::peak());
         hprintln!("strip bytes {}", core::mem::size_of::<[f32; STRIP_LEN]>());
         hprintln!("disjoint stack peak bytes {}", disjoint_stack);
-        hprintln!("workspace bytes {}", core::mem::size_of::<PaperWorkspace>());
+        hprintln!("workspace bytes {}", core::mem::size_of::<FullViewWorkspace>());
         hprintln!("stack peak bytes {}", stack);
         #[cfg(feature = "defmt")]
         defmt::println!(
@@ -349,13 +371,14 @@ mod stack {
     unsafe extern "C" {
         /// cortex-m-rt: the top of the stack (initial SP).
         static _stack_start: u32;
-        /// cortex-m-rt: the end of `.uninit`, where free RAM (and the stack's floor) starts.
-        static __sheap: u32;
+        /// cortex-m-rt: the stack's floor (`memory.x`: the bottom of the DTCM, which holds
+        /// the stack alone).
+        static _stack_end: u32;
     }
 
     fn bounds() -> (usize, usize) {
         // Only the addresses of the linker symbols are taken, never their values.
-        (core::ptr::addr_of!(__sheap) as usize, core::ptr::addr_of!(_stack_start) as usize)
+        (core::ptr::addr_of!(_stack_end) as usize, core::ptr::addr_of!(_stack_start) as usize)
     }
 
     /// Paints from the stack's floor up to 256 bytes below the current stack pointer.
@@ -365,7 +388,7 @@ mod stack {
         let mut p = floor;
         while p + 4 <= sp.saturating_sub(256) {
             // SAFETY: [floor, sp - 256) is RAM below the live stack and above every static;
-            // nothing owns it yet. Word-aligned: cortex-m-rt aligns __sheap to 4.
+            // nothing owns it yet. Word-aligned: cortex-m-rt asserts _stack_end % 4 == 0.
             unsafe { core::ptr::write_volatile(p as *mut u32, PAINT) };
             p += 4;
         }

@@ -267,3 +267,6 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
 
 /// The workspace of the paper's patch.
 pub type PaperWorkspace = Workspace<5, 5, 4, 4, 13, 5200>;
+
+/// The workspace of the full-view patch ([`crate::FullViewShape`], 5 x 5 x 5 x 5 x 13).
+pub type FullViewWorkspace = Workspace<5, 5, 5, 5, 13, 8125>;

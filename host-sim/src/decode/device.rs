@@ -16,8 +16,8 @@ use std::path::Path;
 
 use anyhow::{Context, Result, bail, ensure};
 use slf_firmware::{
-    ChoiceRule, DEFAULT_ENSEMBLE, Ensemble, EnsembleModel, FrameSource, MemberChoice, PatchOrigin, PatchReport,
-    PatchSink,
+    ChoiceRule, DEFAULT_FULL_VIEW_ENSEMBLE, Ensemble, EnsembleModel, FrameSource, MemberChoice, PatchOrigin,
+    PatchReport, PatchSink,
 };
 
 use crate::io::capture::Capture;
@@ -146,9 +146,9 @@ fn parse(log: &str) -> Result<DeviceLog> {
 
 struct Collect(HashMap<PatchOrigin, (u16, Vec<f32>)>);
 
-impl PatchSink<5200> for Collect {
+impl PatchSink<8125> for Collect {
     type Error = core::convert::Infallible;
-    fn accept(&mut self, o: PatchOrigin, p: &[f32; 5200], r: &PatchReport) -> Result<(), Self::Error> {
+    fn accept(&mut self, o: PatchOrigin, p: &[f32; 8125], r: &PatchReport) -> Result<(), Self::Error> {
         self.0.insert(o, (r.member.unwrap_or(u16::MAX), p.to_vec()));
         Ok(())
     }
@@ -162,14 +162,15 @@ pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
     let text = std::fs::read_to_string(log).with_context(|| format!("cannot read {}", log.display()))?;
     let DeviceLog { patches: device, rows, count, gains } = parse(&text)?;
     let capture = Capture::load(capture_dir)?;
-    let ensemble = Ensemble::<5, 5, 4, 4, 13>::new(DEFAULT_ENSEMBLE).map_err(|e| anyhow::anyhow!("{e}"))?;
+    // The device decodes full-view patches with the shipped full-view ensemble.
+    let ensemble = Ensemble::<5, 5, 5, 5, 13>::new(DEFAULT_FULL_VIEW_ENSEMBLE).map_err(|e| anyhow::anyhow!("{e}"))?;
     let model = EnsembleModel::new(ensemble, MemberChoice::Screened(ChoiceRule::DEFAULT));
     // The config the device takes from `capture.rs` (the capture's noise ball) and its white
     // balance: the host's default. The device's tiles are its per-patch benchmark, unsheared;
     // its overlapped frame shears (checked in `check_rows`).
     let unsheared =
         crate::decode::cs::DecodeOptions { disparities: Some(slf_firmware::DisparityRange::OFF), ..Default::default() };
-    let decoder = crate::decode::cs::tile_decoder::<4, 4, 5200>(&capture, &unsheared)?;
+    let decoder = crate::decode::cs::tile_decoder::<5, 5, 8125>(&capture, &unsheared)?;
     let raw = capture.raw_frames()?;
     let host_gains = *decoder.gains();
     ensure!(gains.len() == 13, "the device printed {} gains, not 13", gains.len());
@@ -177,7 +178,7 @@ pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
     println!("device vs host: white balance gains differ by {worst_gain:.2e} relative (limit 1e-5)");
     ensure!(worst_gain <= 1e-5, "the device's gains {gains:?} differ from the host's {host_gains:?}");
     let mut host = Collect(HashMap::new());
-    let mut ws = Box::new(slf_firmware::PaperWorkspace::new());
+    let mut ws = Box::new(slf_firmware::FullViewWorkspace::new());
     for tile in decoder.tiles((1, 1)) {
         decoder
             .decode_tile(&model, tile, &mut FrameSource::new(&raw), &mut host, &mut ws)
@@ -210,20 +211,20 @@ pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
 fn check_rows(
     rows: &HashMap<(usize, usize), Vec<f32>>,
     capture: &Capture,
-    model: &EnsembleModel<'_, 5, 5, 4, 4, 13>,
+    model: &EnsembleModel<'_, 5, 5, 5, 5, 13>,
 ) -> Result<()> {
     // The device's strip decodes every patch from nothing: the seeded decode needs the
     // disjoint grid's sums kept apart from the rest, rows ahead of the walk and columns
     // beyond a band (`docs/bench/README.md`), more than the emulated part's RAM.
-    // The device's strip: the paper's patch at stride 3, tapered (`Overlap::DEFAULT`).
+    // The device's strip: full-view patches at stride 3, tapered (`Overlap::DEFAULT`).
     let opts = crate::decode::cs::DecodeOptions {
         seeded: false,
         stride: slf_firmware::Overlap::DEFAULT.stride,
         window: slf_firmware::Overlap::DEFAULT.window,
-        patch_views: Some(crate::decode::cs::PatchViews::Four),
+        patch_views: Some(crate::decode::cs::PatchViews::Five),
         ..Default::default()
     };
-    let (lf, _) = crate::decode::cs::decode::<4, 4, 5200, _>(capture, model, &opts)?;
+    let (lf, _) = crate::decode::cs::decode::<5, 5, 8125, _>(capture, model, &opts)?;
     let per_col = lf.views.0 * lf.views.1 * lf.bands;
     let mut covered = vec![false; lf.rows * lf.cols];
     let scale = lf.data.iter().fold(0.0f32, |m, x| m.max(x.abs())).max(f32::MIN_POSITIVE);

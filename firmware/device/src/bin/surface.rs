@@ -63,9 +63,9 @@ mod device {
     /// Counts what it is given.
     #[derive(Default)]
     struct Count(u32, u32);
-    impl PatchSink<PAPER_N> for Count {
+    impl<const N: usize> PatchSink<N> for Count {
         type Error = Infallible;
-        fn accept(&mut self, _: PatchOrigin, p: &PaperPatch, _: &PatchReport) -> Result<(), Infallible> {
+        fn accept(&mut self, _: PatchOrigin, p: &[f32; N], _: &PatchReport) -> Result<(), Infallible> {
             self.0 += u32::from(p.iter().all(|x| x.is_finite()));
             Ok(())
         }
@@ -74,6 +74,20 @@ mod device {
             Ok(())
         }
     }
+
+    /// Counts the finished rows of an overlapped decode.
+    #[derive(Default)]
+    struct Rows(u32);
+    impl RowSink for Rows {
+        type Error = Infallible;
+        fn row(&mut self, _: u16, _: u16, values: &[f32]) -> Result<(), Infallible> {
+            self.0 += u32::from(values.iter().all(|x| x.is_finite()));
+            Ok(())
+        }
+    }
+
+    /// Ring columns of the full-view overlapped decode below: 4 of the sensor's 10 (bands).
+    const STRIP: usize = 4 * 9 * 25 * 14;
 
     static TILE: [u8; 2 * 3 * 4] = [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10];
     static DEFECTS: [Pixel; 2] = [Pixel { row: 3, col: 4 }, Pixel { row: 20, col: 31 }];
@@ -161,6 +175,50 @@ mod device {
             let mut spi = SpiFrameBuffer::new(FakeSpi, Ready, ROWS, COLS, 2);
             let _ = decoder.decode_tile(&dct, tile, &mut spi, &mut sink, ws);
             done += sink.0 + sink.1;
+        }
+
+        // The full-view patch (every view of a lenslet): the DCT and the shipped full-view
+        // ensemble, tile by tile, sheared to half pixels, and overlapped through a strip of
+        // 4 columns (3 bands), seeded with nothing.
+        let full_ws = cortex_m::singleton!(: FullViewWorkspace = FullViewWorkspace::new());
+        let strip = cortex_m::singleton!(: [f32; STRIP] = [0.0; STRIP]);
+        if let (Some(full_ws), Some(strip), Ok(mask), [Ok(a), Ok(b)]) = (full_ws, strip, masks[0], &frames_u16) {
+            let config = DecoderConfig {
+                sensor: SensorGeometry { lenslets: (10, 10), lenslet: LENSLET },
+                mask,
+                raw,
+                defects,
+                sl0: noisy,
+            };
+            let full_dct = FullViewDictionary::dct();
+            let halves = DisparityRange::DEFAULT.with_halves(black_box(true));
+            if let Ok(decoder) = FullViewDecoder::new(config).map(|d| d.with_disparities(halves)) {
+                let mut sink = Count::default();
+                let frames = [*a, *b];
+                let source = &mut FrameSource::new(&frames);
+                if let Some(tile) = decoder.tiles((1, 1)).next() {
+                    let _ = decoder.decode_tile(&full_dct, tile, source, &mut sink, full_ws);
+                    if let Ok(e) = FullViewEnsemble::new(DEFAULT_FULL_VIEW_ENSEMBLE) {
+                        let model = FullViewEnsembleModel::new(e, choices[0]);
+                        let _ = decoder.decode_tile(&model, tile, source, &mut sink, full_ws);
+                        let _ = decoder.decode_tile_seeded(
+                            &model,
+                            tile,
+                            source,
+                            &mut slf_firmware::NoSeed,
+                            &mut sink,
+                            full_ws,
+                        );
+                    }
+                }
+                let overlap = Overlap { stride: (black_box(3), 3), window: Window::Tapered };
+                if let Ok(od) = FullViewOverlapDecoder::new(decoder, overlap) {
+                    let mut rows = Rows::default();
+                    let _ = od.decode_frame(&full_dct, &mut FrameSource::new(&[*a, *b]), strip, &mut rows, full_ws);
+                    done += rows.0;
+                }
+                done += sink.0 + sink.1;
+            }
         }
 
         // One patch by hand: solve, a warm solve with a learned member, a blob written.
