@@ -91,6 +91,22 @@ fn blob_round_trip() {
     assert_eq!(Dict::from_blob(&one).unwrap(), m[1]);
 }
 
+#[test]
+fn a_blobs_header_names_its_patch_before_it_is_validated() {
+    use slf_firmware::blob::dims;
+    assert_eq!(dims(&blob_of(&members())), Some(DIMS));
+    assert_eq!(dims(slf_firmware::DEFAULT_ENSEMBLE), Some([5, 5, 4, 4, 13]));
+    assert_eq!(dims(slf_firmware::DEFAULT_FULL_VIEW_ENSEMBLE), Some([5, 5, 5, 5, 13]));
+    // A header that states another shape is read as stated (the checked constructor then
+    // refuses it for the wrong type); too short or without the magic: nothing.
+    let mut other = blob_of(&members());
+    other[8..10].copy_from_slice(&7u16.to_le_bytes());
+    assert_eq!(dims(&other), Some([7, 5, 4, 4, 13]));
+    assert_eq!(dims(&other[..HEADER_LEN - 1]), None);
+    assert_eq!(dims(b"NOPE and some more bytes than a header"), None);
+    assert_eq!(dims(&[]), None);
+}
+
 /// Recomputes the trailing CRC so a corruption reaches the checks after it.
 fn reseal(blob: &mut [u8]) {
     let body = blob.len() - 4;

@@ -73,6 +73,20 @@ fn u16_at(b: &[u8], at: usize) -> u16 {
     }
 }
 
+/// The patch dimensions `[PS, PT, PU, PV, B]` a blob's header states, read without
+/// validating the rest (so a caller can pick the [`Ensemble`] type to check it with);
+/// `None` for a blob too short to hold a header or without the magic bytes.
+pub fn dims(blob: &[u8]) -> Option<[usize; 5]> {
+    if blob.len() < HEADER_LEN || blob.get(..4) != Some(&BLOB_MAGIC[..]) {
+        return None;
+    }
+    let mut dims = [0usize; 5];
+    for (i, d) in dims.iter_mut().enumerate() {
+        *d = usize::from(u16_at(blob, DIMS_AT + 2 * i));
+    }
+    Some(dims)
+}
+
 fn u32_at(b: &[u8], at: usize) -> u32 {
     match b.get(at..at + 4) {
         Some(&[w, x, y, z]) => u32::from_le_bytes([w, x, y, z]),

@@ -75,9 +75,14 @@ impl PatchViews {
     /// The patch a dictionary blob was made for (its header's dimensions); `None` for a
     /// blob too short to have a header or of another shape.
     pub fn of_blob(blob: &[u8]) -> Option<Self> {
-        let dim = |i: usize| blob.get(8 + 2 * i..10 + 2 * i).map(|b| usize::from(u16::from_le_bytes([b[0], b[1]])));
-        let dims = [dim(0)?, dim(1)?, dim(2)?, dim(3)?, dim(4)?];
+        let dims = slf_firmware::blob::dims(blob)?;
         Self::ALL.into_iter().find(|v| v.dims() == dims)
+    }
+
+    /// The patch of `PU x PV` views (the const parameters of a generic decode); `None` for
+    /// a shape that is neither.
+    pub fn of_views(pu: usize, pv: usize) -> Option<Self> {
+        Self::ALL.into_iter().find(|v| v.count() == pu && pu == pv)
     }
 
     /// The shipped ensemble of this patch.
@@ -215,7 +220,7 @@ fn decode_basis<const PU: usize, const PV: usize, const N: usize>(
 pub fn ensemble<const PU: usize, const PV: usize>(
     blob: Option<&[u8]>,
 ) -> Result<slf_firmware::Ensemble<'_, 5, 5, PU, PV, 13>> {
-    let views = if PU == 5 { PatchViews::Five } else { PatchViews::Four };
+    let views = PatchViews::of_views(PU, PV).ok_or_else(|| anyhow!("no patch of {PU} x {PV} views"))?;
     let bytes = blob.unwrap_or(views.shipped_ensemble());
     if let Some(made) = PatchViews::of_blob(bytes).filter(|&m| m != views) {
         bail!(
@@ -743,7 +748,7 @@ pub fn decode_observed<const PU: usize, const PV: usize, const N: usize, M: Patc
     let (lf, mut report) = aggregate(&results, views, lenslets, tiles.len(), range);
     report.seconds = start.elapsed().as_secs_f64();
     report.gains = gains;
-    report.patch_views = PatchViews::ALL.into_iter().find(|v| v.count() == PU && PU == PV);
+    report.patch_views = PatchViews::of_views(PU, PV);
     Ok((lf, report))
 }
 
