@@ -477,7 +477,6 @@ fn train_blob_of<const PU: usize, const PV: usize, const N: usize>(
     cfg: &TrainConfig,
     output: &std::path::Path,
 ) -> anyhow::Result<()> {
-    use anyhow::Context;
     let start = std::time::Instant::now();
     for (i, f) in fields.iter().enumerate() {
         anyhow::ensure!(
@@ -502,7 +501,7 @@ fn train_blob_of<const PU: usize, const PV: usize, const N: usize>(
     );
     let mut blob = vec![0u8; slf_firmware::blob::blob_len(dims::<PU, PV>(), dicts.len())];
     slf_firmware::blob::write_blob(&dicts, &mut blob).map_err(|e| anyhow::anyhow!("{e}"))?;
-    std::fs::write(output, &blob).with_context(|| format!("cannot write {}", output.display()))?;
+    crate::io::output::write_bytes(output, &blob)?;
     println!("wrote {} ({} bytes) in {:.1} s", output.display(), blob.len(), start.elapsed().as_secs_f64());
     Ok(())
 }

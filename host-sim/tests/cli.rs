@@ -771,3 +771,62 @@ fn patch_views_are_a_decode_setting_that_fits_the_capture() {
     let e = failure(slf().arg("decode").arg(p("cap-five")).arg("-o").arg(p("x.npy")).args(["--patch-views", "6"]));
     assert!(e.contains("--patch-views") && e.contains("4 (the paper's 4 x 4-view patch) or 5"), "{e}");
 }
+
+/// Issue 41, item 6: an output may never be an input or another output of the same run;
+/// each such run is refused before it writes anything, and the capture stays as it was.
+#[test]
+fn an_output_is_never_an_input_or_another_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    stdout(slf().args(["scene", "smooth", "--size", "12", "-o"]).arg(p("truth.npy")));
+    stdout(slf().arg("simulate").arg(p("truth.npy")).arg("-o").arg(p("cap")).args(["--format", "npy"]));
+    let before: Vec<Vec<u8>> =
+        ["capture.json", "snapshot_0.npy"].iter().map(|f| std::fs::read(p("cap").join(f)).unwrap()).collect();
+    let decode = |out: std::path::PathBuf, extra: &[&str]| {
+        failure(slf().arg("decode").arg(p("cap")).arg("-o").arg(out).args(extra).arg("-q"))
+    };
+    for (out, extra, says) in [
+        (p("cap/capture.json"), vec![], "may not be a file the run reads"),
+        (p("cap/snapshot_0.npy"), vec![], "may not be a file the run reads"),
+        // Another spelling of the same file.
+        (p("cap/../cap/./snapshot_0.npy"), vec![], "may not be a file the run reads"),
+        (p("x.npy"), vec!["--member-map", p("x.npy").to_str().unwrap()], "are the same file"),
+        (p("x.npy"), vec!["--disparity-map", p("cap/capture.json").to_str().unwrap()], "may not be a file"),
+    ] {
+        let e = decode(out, &extra);
+        assert!(e.contains(says) && e.trim().lines().count() == 1, "{e}");
+    }
+    let after: Vec<Vec<u8>> =
+        ["capture.json", "snapshot_0.npy"].iter().map(|f| std::fs::read(p("cap").join(f)).unwrap()).collect();
+    assert!(before == after, "the capture changed");
+    assert!(!p("x.npy").exists());
+    // A simulation whose capture would hold its own input; an import over its input.
+    std::fs::copy(p("truth.npy"), p("cap/snapshot_0.npy")).unwrap();
+    let e = failure(slf().arg("simulate").arg(p("cap/snapshot_0.npy")).arg("-o").arg(p("cap")).args(["--format", "npy"]));
+    assert!(e.contains("may not be a file the run reads"), "{e}");
+    let e = failure(slf().args(["import", "bands"]).arg(p("truth.npy")).arg("-o").arg(p("truth.npy")).args([
+        "--wavelengths",
+        "400:700",
+    ]));
+    assert!(e.contains("may not be a file the run reads"), "{e}");
+}
+
+/// Issue 41, item 7: a write that fails part way (here the file-size limit) leaves the
+/// previous file whole, not a truncated one.
+#[cfg(unix)]
+#[test]
+fn a_write_that_fails_leaves_the_previous_file_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("scene.npy");
+    stdout(slf().args(["scene", "smooth", "--size", "12", "-o"]).arg(&out));
+    let before = std::fs::read(&out).unwrap();
+    // The same scene larger: 5 x 5 x 30 x 30 x 13 f32 is 1.2 MB, past a 64 KiB limit.
+    let bin = assert_cmd::cargo::cargo_bin("slf");
+    let status = std::process::Command::new("bash")
+        .arg("-c")
+        .arg(format!("ulimit -f 64; exec '{}' scene smooth --size 30 -o '{}'", bin.display(), out.display()))
+        .status()
+        .unwrap();
+    assert!(!status.success(), "the write past the limit should fail");
+    assert!(std::fs::read(&out).unwrap() == before, "the previous file is not whole");
+}

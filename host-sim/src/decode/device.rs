@@ -59,7 +59,7 @@ pub fn write_capture(dir: &Path) -> Result<()> {
         noise,
         shot
     );
-    std::fs::write(dir.join("capture.rs"), consts).context("cannot write capture.rs")?;
+    crate::io::output::write_bytes(&dir.join("capture.rs"), consts.as_bytes())?;
     println!("wrote {} ({} frames)", dir.display(), capture.frames.len());
     Ok(())
 }

@@ -34,6 +34,7 @@ use crate::eval::metrics::evaluate;
 use crate::io::capture::MaskDescription;
 use crate::io::capture::regular_file;
 use crate::io::lightfield::LightField;
+use crate::io::output::{write_bytes, write_png_rgb};
 use crate::sim::camera::{CameraConfig, simulate};
 use crate::sim::scene::{self, SceneSize};
 
@@ -498,8 +499,8 @@ pub fn write(points: &[Point], device: &[DeviceFrame], dir: &Path) -> Result<()>
     if !device.is_empty() {
         md += &device_frame::markdown(device);
     }
-    std::fs::write(dir.join("bench.csv"), csv.into_inner().context("csv buffer")?)?;
-    std::fs::write(dir.join("bench.md"), md)?;
+    write_bytes(&dir.join("bench.csv"), &csv.into_inner().context("csv buffer")?)?;
+    write_bytes(&dir.join("bench.md"), md.as_bytes())?;
     plot(points, &dir.join("bench.png"))
 }
 
@@ -545,7 +546,14 @@ fn points_of<R: std::io::Read>(mut r: csv::Reader<R>) -> Result<Vec<Point>> {
 }
 
 fn plot(points: &[Point], path: &Path) -> Result<()> {
-    let root = BitMapBackend::new(path, (1000, 700)).into_drawing_area();
+    let (width, height) = (1000u32, 700u32);
+    let mut raw = vec![0u8; 3 * (width * height) as usize];
+    draw(points, BitMapBackend::with_buffer(&mut raw, (width, height)))?;
+    write_png_rgb(path, width, height, &raw)
+}
+
+fn draw(points: &[Point], backend: BitMapBackend<'_>) -> Result<()> {
+    let root = backend.into_drawing_area();
     root.fill(&WHITE).map_err(|e| anyhow::anyhow!("{e}"))?;
     let (tmin, tmax) = points.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.ms_one), b.max(p.ms_one)));
     let (pmin, pmax) =

@@ -8,10 +8,11 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result, ensure};
+use anyhow::{Result, ensure};
 use image::{Rgb, RgbImage};
 
 use crate::io::lightfield::LightField;
+use crate::io::output::write_png_rgb;
 use crate::sim::spectra::{CMF_1931, D65};
 
 /// XYZ of a radiance spectrum (white reflector: Y = 1).
@@ -129,6 +130,5 @@ pub fn write_comparison(path: &Path, truth: &LightField, recon: &LightField, lab
         text(&format!("{} x {} lenslets, sRGB at the truth's exposure", w, h), x0[0], top + ph + 12, &small)?;
         root.present().map_err(|e| anyhow::anyhow!("{e}"))?;
     }
-    let img = RgbImage::from_raw(width, height, raw).context("preview buffer")?;
-    img.save(path).with_context(|| format!("cannot write {}", path.display()))
+    write_png_rgb(path, width, height, &raw)
 }

@@ -13,6 +13,7 @@ use crate::eval::metrics::{Metrics, evaluate};
 use crate::eval::preview::write_comparison;
 use crate::io::capture::MaskDescription;
 use crate::io::lightfield::{Dtype, LightField, write_npy};
+use crate::io::output::write_bytes;
 use crate::sim::camera::{CameraConfig, simulate};
 use crate::sim::scene::{self, SceneSize};
 
@@ -123,7 +124,7 @@ pub fn sweep(size: usize, ks: &[u8], output: Option<&Path>, basis: &Basis, views
         }
     }
     if let Some(p) = output {
-        std::fs::write(p, lines.join("\n") + "\n").with_context(|| format!("cannot write {}", p.display()))?;
+        write_bytes(p, (lines.join("\n") + "\n").as_bytes())?;
     }
     Ok(())
 }
@@ -222,7 +223,7 @@ pub fn compare(
         }
     }
     if let Some(path) = output {
-        std::fs::write(path, lines.join("\n") + "\n").with_context(|| format!("cannot write {}", path.display()))?;
+        write_bytes(path, (lines.join("\n") + "\n").as_bytes())?;
     }
     Ok(())
 }

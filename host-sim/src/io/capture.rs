@@ -15,6 +15,7 @@ use slf_firmware::{
 
 use crate::io::lightfield::{read_npy_u16_2d, write_npy_u16_2d};
 use crate::io::message::one_line;
+use crate::io::output::{write_bytes, write_whole};
 
 /// The largest `capture.json` read (a long defect list fits many times over).
 pub const MAX_DESCRIPTION: u64 = 64 << 20;
@@ -363,6 +364,22 @@ impl Capture {
         self.source.as_ref().map_or_else(|| "the capture".into(), |p| p.display().to_string())
     }
 
+    /// The files this capture has in folder `dir`: `capture.json` and its frames (names
+    /// that are not paths inside the folder are left out; [`Self::new`] refuses them).
+    pub fn files_in(&self, dir: &Path) -> Vec<PathBuf> {
+        let frames = self.description.frames.iter().filter_map(|n| frame_path(dir, n).ok());
+        std::iter::once(dir.join(DESCRIPTION)).chain(frames).collect()
+    }
+
+    /// The files the capture was loaded from: `capture.json` and its frames; none for a
+    /// capture made in memory.
+    pub fn files(&self) -> Vec<PathBuf> {
+        match self.source.as_deref().and_then(Path::parent) {
+            Some(dir) => self.files_in(dir),
+            None => Vec::new(),
+        }
+    }
+
     /// Writes the capture folder: `capture.json` and the frames under their names
     /// (the extension picks the format: `.pgm`, `.png` or `.npy`).
     ///
@@ -376,7 +393,7 @@ impl Capture {
         }
         let path = dir.join(DESCRIPTION);
         let text = serde_json::to_string_pretty(&self.description)?;
-        fs::write(&path, text + "\n").with_context(|| format!("cannot write {}", path.display()))
+        write_bytes(&path, (text + "\n").as_bytes())
     }
 }
 
@@ -475,7 +492,7 @@ fn read_pgm(path: &Path, file_len: u64) -> Result<FrameFile> {
 /// I/O and encoding errors, with the file.
 pub fn write_frame(path: &Path, data: &[u16], rows: usize, cols: usize) -> Result<()> {
     match extension(path).as_str() {
-        "npy" => write_npy_u16_2d(path, data, rows, cols).with_context(|| format!("cannot write {}", path.display())),
+        "npy" => write_npy_u16_2d(path, data, rows, cols),
         "pgm" => {
             // P5 with MAXVAL 65535, as docs/capture-format.md says: values as stored.
             use image::codecs::pnm::{GraymapHeader, PnmEncoder, SampleEncoding};
@@ -486,20 +503,30 @@ pub fn write_frame(path: &Path, data: &[u16], rows: usize, cols: usize) -> Resul
                 width: cols as u32,
                 maxwhite: u32::from(u16::MAX),
             };
-            let file = fs::File::create(path).with_context(|| format!("cannot write {}", path.display()))?;
-            let mut out = std::io::BufWriter::new(file);
             let bytes: Vec<u8> = data.iter().flat_map(|x| x.to_ne_bytes()).collect();
-            PnmEncoder::new(&mut out)
-                .with_header(header.into())
-                .encode(&bytes[..], cols as u32, rows as u32, image::ExtendedColorType::L16)
-                .with_context(|| format!("cannot write {}", path.display()))?;
-            std::io::Write::flush(&mut out).with_context(|| format!("cannot write {}", path.display()))
+            write_whole(path, |out| {
+                PnmEncoder::new(out).with_header(header.into()).encode(
+                    &bytes[..],
+                    cols as u32,
+                    rows as u32,
+                    image::ExtendedColorType::L16,
+                )?;
+                Ok(())
+            })
         }
         "png" => {
-            let img =
-                image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_raw(cols as u32, rows as u32, data.to_vec())
-                    .context("frame size does not match its data")?;
-            img.save(path).with_context(|| format!("cannot write {}", path.display()))
+            use image::ImageEncoder;
+            ensure!(data.len() == rows * cols, "frame size does not match its data");
+            let bytes: Vec<u8> = data.iter().flat_map(|x| x.to_ne_bytes()).collect();
+            write_whole(path, |out| {
+                image::codecs::png::PngEncoder::new(out).write_image(
+                    &bytes,
+                    cols as u32,
+                    rows as u32,
+                    image::ExtendedColorType::L16,
+                )?;
+                Ok(())
+            })
         }
         other => bail!("{}: unknown frame format {other:?} (use .pgm, .png or .npy)", path.display()),
     }

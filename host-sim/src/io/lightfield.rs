@@ -7,11 +7,11 @@
 //! sensor's physical range, 0 to its brightest measurable value, a little above 1); files
 //! may also hold uint16 (`0..=65535` maps to `[0, 1]`).
 
-use std::fs::File;
-use std::io::BufWriter;
 use std::path::Path;
 
 use npyz::WriterBuilder;
+
+use crate::io::output::write_whole;
 
 /// A spectral light field, `(U, V, H, W, B)`, f32.
 #[derive(Clone, Debug, PartialEq)]
@@ -152,10 +152,6 @@ pub enum Dtype {
 use crate::io::npy::{self, Values};
 pub use crate::io::npy::{NpyError, NpyErrorKind};
 
-fn io_err(path: &Path) -> impl Fn(std::io::Error) -> NpyError + '_ {
-    move |source| NpyError::new(path, NpyErrorKind::Io(source))
-}
-
 /// Reads a 5-axis `(U, V, H, W, B)` light field from `.npy` (float32, float64 or uint16;
 /// C or Fortran order) and prints to stderr, as `note: FILE: ...`, any conversion made.
 ///
@@ -197,50 +193,43 @@ pub fn read_npy_with_notes(path: &Path) -> Result<(LightField, Vec<String>), Npy
     Ok((lf, a.notes))
 }
 
-/// Writes a light field as a 5-axis `.npy` file of `dtype` (uint16 clamps to `[0, 1]`).
+/// Writes a light field as a 5-axis `.npy` file of `dtype` (uint16 clamps to `[0, 1]`),
+/// whole or not at all ([`write_whole`]).
 ///
 /// # Errors
 /// I/O errors, with the path.
-pub fn write_npy(path: &Path, lf: &LightField, dtype: Dtype) -> Result<(), NpyError> {
+pub fn write_npy(path: &Path, lf: &LightField, dtype: Dtype) -> anyhow::Result<()> {
     let shape: Vec<u64> = lf.shape().iter().map(|&x| x as u64).collect();
-    let file = BufWriter::new(File::create(path).map_err(io_err(path))?);
-    match dtype {
-        Dtype::F32 => {
-            let mut w = npyz::WriteOptions::new()
-                .default_dtype()
-                .shape(&shape)
-                .writer(file)
-                .begin_nd()
-                .map_err(io_err(path))?;
-            w.extend(lf.data.iter().copied()).map_err(io_err(path))?;
-            w.finish().map_err(io_err(path))
+    write_whole(path, |out| {
+        match dtype {
+            Dtype::F32 => {
+                let mut w = npyz::WriteOptions::new().default_dtype().shape(&shape).writer(out).begin_nd()?;
+                w.extend(lf.data.iter().copied())?;
+                w.finish()?;
+            }
+            Dtype::U16 => {
+                let mut w = npyz::WriteOptions::new().default_dtype().shape(&shape).writer(out).begin_nd()?;
+                w.extend(lf.data.iter().map(|&x| (x.clamp(0.0, 1.0) * 65535.0).round() as u16))?;
+                w.finish()?;
+            }
         }
-        Dtype::U16 => {
-            let mut w = npyz::WriteOptions::new()
-                .default_dtype()
-                .shape(&shape)
-                .writer(file)
-                .begin_nd()
-                .map_err(io_err(path))?;
-            w.extend(lf.data.iter().map(|&x| (x.clamp(0.0, 1.0) * 65535.0).round() as u16)).map_err(io_err(path))?;
-            w.finish().map_err(io_err(path))
-        }
-    }
+        Ok(())
+    })
 }
 
-/// Writes a uint16 2D array (a raw frame) as `.npy`.
+/// Writes a uint16 2D array (a raw frame) as `.npy`, whole or not at all.
 ///
 /// # Errors
-/// I/O errors.
-pub fn write_npy_u16_2d(path: &Path, data: &[u16], rows: usize, cols: usize) -> std::io::Result<()> {
+/// I/O errors, with the path.
+pub fn write_npy_u16_2d(path: &Path, data: &[u16], rows: usize, cols: usize) -> anyhow::Result<()> {
     write_npy_2d(path, data, rows, cols)
 }
 
-/// Writes an f32 2D `.npy` array (a disparity map).
+/// Writes an f32 2D `.npy` array (a disparity map), whole or not at all.
 ///
 /// # Errors
-/// I/O errors.
-pub fn write_npy_f32_2d(path: &Path, data: &[f32], rows: usize, cols: usize) -> std::io::Result<()> {
+/// I/O errors, with the path.
+pub fn write_npy_f32_2d(path: &Path, data: &[f32], rows: usize, cols: usize) -> anyhow::Result<()> {
     write_npy_2d(path, data, rows, cols)
 }
 
@@ -249,11 +238,14 @@ fn write_npy_2d<T: npyz::AutoSerialize + Copy>(
     data: &[T],
     rows: usize,
     cols: usize,
-) -> std::io::Result<()> {
-    let file = BufWriter::new(File::create(path)?);
-    let mut w = npyz::WriteOptions::new().default_dtype().shape(&[rows as u64, cols as u64]).writer(file).begin_nd()?;
-    w.extend(data.iter().copied())?;
-    w.finish()
+) -> anyhow::Result<()> {
+    write_whole(path, |out| {
+        let mut w =
+            npyz::WriteOptions::new().default_dtype().shape(&[rows as u64, cols as u64]).writer(out).begin_nd()?;
+        w.extend(data.iter().copied())?;
+        w.finish()?;
+        Ok(())
+    })
 }
 
 /// Reads a uint16 2D `.npy` array (a raw frame): `(data, rows, cols)`.

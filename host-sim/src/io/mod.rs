@@ -6,7 +6,8 @@
 //! - [`lightfield`]: the `(U, V, H, W, B)` light field and its `.npy` files;
 //! - [`capture`]: the capture folder (frames and `capture.json`), loaded and saved;
 //! - [`import`]: views, hyperspectral cubes, HDF5 light fields and band resampling;
-//! - [`message`]: an error as the one line a user reads.
+//! - [`message`]: an error as the one line a user reads;
+//! - [`output`]: results written whole, never over an input of the same run.
 //!
 //! May use: nothing of this crate (the firmware crate's checked types). Used by every
 //! layer above.
@@ -16,3 +17,4 @@ pub mod import;
 pub mod lightfield;
 pub mod message;
 pub mod npy;
+pub mod output;

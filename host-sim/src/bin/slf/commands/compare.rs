@@ -43,6 +43,10 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
+    slf_host::io::output::Outputs::new()
+        .inputs(&args.blob, "--blob")
+        .output_opt(args.output.as_deref(), "-o")
+        .check()?;
     let masks: Vec<MaskFamily> = args.masks.iter().map(|m| m.family()).collect();
     report::compare(
         args.size,

@@ -2,7 +2,7 @@
 //! firmware's decoder, in parallel over tiles) or by a baseline without it. The decode's
 //! flags are [`DecodeSettings`], shared with the Python package.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use slf_host::decode::cs::{Balance, NoiseSource, PatchDecoder, disparity_per_lenslet};
@@ -10,6 +10,7 @@ use slf_host::decode::settings::{DecodeSettings, Outcome};
 use slf_host::firmware::disparity::Disparity;
 use slf_host::io::capture::Capture;
 use slf_host::io::lightfield::{Dtype, write_npy, write_npy_f32_2d};
+use slf_host::io::output::{Outputs, write_bytes};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -41,11 +42,16 @@ pub struct Args {
 
 pub fn run(args: Args) -> Result<()> {
     let Args { capture, output, settings, member_map, disparity_map, dtype, quiet } = args;
-    // Where the results go is checked before the decode, not found unwritable after it.
-    for path in std::iter::once(&output).chain(&member_map).chain(&disparity_map) {
-        check_writable(path)?;
-    }
     let cap = Capture::load(&capture)?;
+    // Where the results go is checked before the decode, not found unwritable after it, and
+    // no result may be written over a file the decode reads or another result.
+    Outputs::new()
+        .inputs(cap.files(), "a file of the capture")
+        .inputs(&settings.basis.blob, "--blob")
+        .output(&output, "-o")
+        .output_opt(member_map.as_deref(), "--member-map")
+        .output_opt(disparity_map.as_deref(), "--disparity-map")
+        .check()?;
     let cs = settings.method.baseline().is_none();
     anyhow::ensure!(cs || member_map.is_none(), "--member-map needs --method cs (baselines use no ensemble)");
     if cs {
@@ -90,7 +96,7 @@ pub fn run(args: Args) -> Result<()> {
                 d.name()
             );
         }
-        std::fs::write(&path, csv).with_context(|| format!("cannot write {}", path.display()))?;
+        write_bytes(&path, csv.as_bytes())?;
     }
     if let Some(path) = disparity_map {
         let (rows, cols) = (cap.description.lenslets[0], cap.description.lenslets[1]);
@@ -151,21 +157,5 @@ pub fn run(args: Args) -> Result<()> {
         r.seconds,
         output.display()
     );
-    Ok(())
-}
-
-/// Fails if `path` cannot be written: a folder, a missing parent, no permission. Leaves an
-/// existing file as it was, and no new one behind.
-fn check_writable(path: &Path) -> Result<()> {
-    let existed = path.exists();
-    anyhow::ensure!(!path.is_dir(), "cannot write {}: a folder", path.display());
-    std::fs::OpenOptions::new()
-        .append(true)
-        .create(true)
-        .open(path)
-        .with_context(|| format!("cannot write {} (checked before decoding)", path.display()))?;
-    if !existed {
-        std::fs::remove_file(path).with_context(|| format!("cannot remove {}", path.display()))?;
-    }
     Ok(())
 }

@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use slf_host::decode::cs::{PatchViews, read_blob};
 use slf_host::decode::settings::patch_views;
 use slf_host::eval::evaluation::{SETTINGS, evaluate_set, table};
@@ -59,7 +59,7 @@ pub fn run(args: Args) -> Result<()> {
     let rows = evaluate_set(&scenes, &SETTINGS, blob.as_deref(), &strides, window.window(), patch_views, &out)?;
     let t = table(&rows, &SETTINGS);
     let path = out.join("table.md");
-    std::fs::write(&path, &t).with_context(|| format!("cannot write {}", path.display()))?;
+    slf_host::io::output::write_bytes(&path, t.as_bytes())?;
     println!("{t}wrote {}", path.display());
     Ok(())
 }

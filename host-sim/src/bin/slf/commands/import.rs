@@ -9,6 +9,7 @@ use clap::Subcommand;
 use slf_host::io::import::hdf5::{Hdf5Layout, read_hdf5};
 use slf_host::io::import::views::Imported;
 use slf_host::io::lightfield::{Dtype, LightField, read_npy, write_npy, write_npy_f32_2d};
+use slf_host::io::output::Outputs;
 use slf_host::sim::import::{CubeSettings, ViewsSettings, with_camera_bands};
 
 use crate::args::positive;
@@ -20,6 +21,7 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
+    args.source.outputs().check()?;
     match args.source {
         ImportSource::Views { settings, output } => {
             let imported = settings.run()?;
@@ -103,6 +105,25 @@ pub enum ImportSource {
 }
 
 /// Writes an imported light field, its notes on stderr and its disparity beside it.
+impl ImportSource {
+    /// What the import reads (a folder's files, one input file) and writes (the light field
+    /// and, for views, its disparity map), to check against each other before the work.
+    fn outputs(&self) -> Outputs {
+        let (inputs, output, disparity): (Vec<PathBuf>, &Path, bool) = match self {
+            Self::Views { settings, output } => {
+                let files = std::fs::read_dir(&settings.folder)
+                    .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
+                    .unwrap_or_default();
+                (files, output, true)
+            }
+            Self::Cube { settings, output } => (vec![settings.input.clone()], output, false),
+            Self::Bands { input, output, .. } | Self::Hdf5 { input, output, .. } => (vec![input.clone()], output, false),
+        };
+        let o = Outputs::new().inputs(inputs, "an input").output(output, "-o");
+        if disparity { o.output(&disparity_path(output), "the disparity map beside -o") } else { o }
+    }
+}
+
 fn write_imported(imported: &Imported, input: &Path, output: &Path, what: &str) -> Result<()> {
     for n in &imported.notes {
         eprintln!("note: {}: {n}", input.display());

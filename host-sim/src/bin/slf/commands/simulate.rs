@@ -6,6 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use slf_host::io::lightfield::read_npy;
+use slf_host::io::output::Outputs;
 use slf_host::sim::settings::SimulateSettings;
 
 #[derive(clap::Args)]
@@ -25,6 +26,10 @@ pub fn run(args: Args) -> Result<()> {
     for n in &simulated.notes {
         eprintln!("{n}");
     }
+    Outputs::new()
+        .input(&input, "the light field")
+        .outputs(simulated.capture.files_in(&output), "a file of the capture -o")
+        .check_distinct()?;
     simulated.capture.save(&output)?;
     println!("wrote {} ({} snapshots)", output.display(), simulated.capture.frames.len());
     Ok(())

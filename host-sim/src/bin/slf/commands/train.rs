@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::ValueEnum;
 use slf_host::io::lightfield::read_npy;
+use slf_host::io::output::Outputs;
 use slf_host::train;
 
 use crate::args::ranged;
@@ -79,6 +80,7 @@ pub fn run(args: Args) -> Result<()> {
         balance,
         patch_views,
     } = args;
+    Outputs::new().inputs(&input, "--input").output(&output, "-o").check()?;
     let cfg = train::TrainConfig { members, tau, iterations, group, seed, dct_member: !no_dct_member, progress: true };
     let fields = if input.is_empty() {
         let generator = match generator {
