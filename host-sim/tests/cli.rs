@@ -802,12 +802,17 @@ fn an_output_is_never_an_input_or_another_output() {
     assert!(!p("x.npy").exists());
     // A simulation whose capture would hold its own input; an import over its input.
     std::fs::copy(p("truth.npy"), p("cap/snapshot_0.npy")).unwrap();
-    let e = failure(slf().arg("simulate").arg(p("cap/snapshot_0.npy")).arg("-o").arg(p("cap")).args(["--format", "npy"]));
+    let e =
+        failure(slf().arg("simulate").arg(p("cap/snapshot_0.npy")).arg("-o").arg(p("cap")).args(["--format", "npy"]));
     assert!(e.contains("may not be a file the run reads"), "{e}");
-    let e = failure(slf().args(["import", "bands"]).arg(p("truth.npy")).arg("-o").arg(p("truth.npy")).args([
-        "--wavelengths",
-        "400:700",
-    ]));
+    let e = failure(
+        slf()
+            .args(["import", "bands"])
+            .arg(p("truth.npy"))
+            .arg("-o")
+            .arg(p("truth.npy"))
+            .args(["--wavelengths", "400:700"]),
+    );
     assert!(e.contains("may not be a file the run reads"), "{e}");
 }
 

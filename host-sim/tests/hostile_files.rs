@@ -240,14 +240,14 @@ fn pgm_values_are_dn_as_stored_whatever_maxval_says() {
     let data: Vec<u16> = (0..60u16).map(|i| i * 68).collect(); // 0..=4012
     let p = dir.path().join("f.pgm");
     pgm_4095(&p, 6, 10, &data);
-    let f = read_frame(&p).unwrap();
+    let f = read_frame(&p, None).unwrap();
     assert_eq!((f.rows, f.cols, f.top), (6, 10, 4095));
     assert_eq!(f.data, data);
     // A sample above MAXVAL is an invalid file.
     let mut bad = data.clone();
     bad[13] = 4096;
     pgm_4095(&p, 6, 10, &bad);
-    let e = format!("{:#}", read_frame(&p).unwrap_err());
+    let e = format!("{:#}", read_frame(&p, None).unwrap_err());
     assert!(e.contains("pixel (1, 3) is 4096, above MAXVAL 4095"), "{e}");
     // Bytes after the image (a writer that disagrees with its header): refused (issue 32,
     // item 7), not read as a valid frame.
@@ -255,13 +255,13 @@ fn pgm_values_are_dn_as_stored_whatever_maxval_says() {
     let mut long = std::fs::read(&p).unwrap();
     long.extend([0u8; 100]);
     std::fs::write(&p, long).unwrap();
-    let e = format!("{:#}", read_frame(&p).unwrap_err());
+    let e = format!("{:#}", read_frame(&p, None).unwrap_err());
     assert!(e.contains("bytes after the 10 x 6 pixels"), "{e}");
     // slf writes P5 (not P7/PAM) with the values as they are.
     let q = dir.path().join("w.pgm");
     write_frame(&q, &data, 6, 10).unwrap();
     assert_eq!(&std::fs::read(&q).unwrap()[..3], b"P5\n");
-    assert_eq!(read_frame(&q).unwrap().data, data);
+    assert_eq!(read_frame(&q, None).unwrap().data, data);
 }
 
 #[test]
@@ -427,4 +427,70 @@ fn captures_without_signal_or_with_impossible_noise_are_refused() {
         let e = format!("{:#}", s.run(&dark, false, &|_, _| {}).unwrap_err());
         assert!(e.contains("no light was recorded"), "{method}: {e}");
     }
+}
+
+/// A PNG of a single IHDR (and IEND) claiming `w x h` 8-bit grey pixels: a few dozen bytes.
+fn png_claiming(w: u32, h: u32) -> Vec<u8> {
+    let chunk = |kind: &[u8; 4], data: &[u8]| {
+        let mut c = (data.len() as u32).to_be_bytes().to_vec();
+        c.extend(kind);
+        c.extend(data);
+        let mut crc = crc32fast::Hasher::new();
+        crc.update(kind);
+        crc.update(data);
+        c.extend(crc.finalize().to_be_bytes());
+        c
+    };
+    let mut ihdr = w.to_be_bytes().to_vec();
+    ihdr.extend(h.to_be_bytes());
+    ihdr.extend([8, 0, 0, 0, 0]);
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    png.extend(chunk(b"IHDR", &ihdr));
+    png.extend(chunk(b"IDAT", &[]));
+    png.extend(chunk(b"IEND", &[]));
+    png
+}
+
+/// Issue 41, item 1: a frame or light field whose header claims more than the capture (or
+/// the light-field cap) allows is refused from its header, before its body is allocated or
+/// read: sparse files claiming gigabytes, a tiny PNG claiming 15000 x 15000.
+#[test]
+fn headers_that_lie_about_their_size_are_refused_before_allocating() {
+    let (dir, _) = saved_capture();
+    let cap = Capture::load(dir.path()).unwrap();
+    let (rows, cols) = cap.frame_size();
+    let frame = dir.path().join("snapshot_0.pgm");
+    let sparse = |path: &Path, header: &[u8], len: u64| {
+        let mut f = std::fs::File::create(path).unwrap();
+        f.write_all(header).unwrap();
+        f.set_len(len).unwrap();
+    };
+    let load = |dir: PathBuf| within(20, move || format!("{:#}", Capture::load(&dir).unwrap_err()));
+    // PGM, 65535 x 65535 16-bit: 8.6 GB, sparse.
+    let header = b"P5\n65535 65535\n65535\n";
+    sparse(&frame, header, header.len() as u64 + 2 * 65535 * 65535);
+    let e = load(dir.path().to_path_buf());
+    assert!(e.contains(&format!("frame is 65535 x 65535, the capture's frames are {rows} x {cols}")), "{e}");
+    assert_eq!(e.lines().count(), 1);
+    // The same frame as a (65535, 65535) uint16 .npy.
+    let mut json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("capture.json")).unwrap()).unwrap();
+    json["frames"] = serde_json::json!(["snapshot_0.npy"]);
+    std::fs::write(dir.path().join("capture.json"), json.to_string()).unwrap();
+    let npy = npy_bytes(1, "{'descr': '<u2', 'fortran_order': False, 'shape': (65535, 65535), }", &[]);
+    sparse(&dir.path().join("snapshot_0.npy"), &npy, npy.len() as u64 + 2 * 65535 * 65535);
+    let e = load(dir.path().to_path_buf());
+    assert!(e.contains(&format!("frame is 65535 x 65535, the capture's frames are {rows} x {cols}")), "{e}");
+    // A 60-byte PNG claiming 15000 x 15000.
+    json["frames"] = serde_json::json!(["snapshot_0.png"]);
+    std::fs::write(dir.path().join("capture.json"), json.to_string()).unwrap();
+    std::fs::write(dir.path().join("snapshot_0.png"), png_claiming(15000, 15000)).unwrap();
+    let e = load(dir.path().to_path_buf());
+    assert!(e.contains(&format!("frame is 15000 x 15000, the capture's frames are {rows} x {cols}")), "{e}");
+    // A light field of 5 x 5 x 4000 x 4000 x 13 f4 (20.8 GB, sparse): over the cap.
+    let lf = dir.path().join("big.npy");
+    let npy = npy_bytes(1, "{'descr': '<f4', 'fortran_order': False, 'shape': (5, 5, 4000, 4000, 13), }", &[]);
+    sparse(&lf, &npy, npy.len() as u64 + 4 * 5 * 5 * 4000 * 4000 * 13);
+    let e = within(20, move || read_npy(&lf).unwrap_err().to_string());
+    assert!(e.contains("shape [5, 5, 4000, 4000, 13]") && e.contains("more than the"), "{e}");
 }

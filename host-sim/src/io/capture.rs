@@ -334,7 +334,7 @@ impl Capture {
         for (i, name) in description.frames.iter().enumerate() {
             let path =
                 frame_path(dir, name).map_err(|e| anyhow!("{}: frames[{i}]: {}", desc_path.display(), one_line(&e)))?;
-            let frame = read_frame(&path)?;
+            let frame = read_frame(&path, Some((rows, cols)))?;
             ensure!(
                 (frame.rows, frame.cols) == (rows, cols),
                 "{}: frame is {} x {}, {} implies {rows} x {cols}",
@@ -410,19 +410,34 @@ pub struct FrameFile {
 
 /// Reads a 16-bit raw frame: binary PGM (P5), 8- or 16-bit grey PNG, or `.npy` (uint16, 2
 /// axes). Values are DN as stored, whatever a PGM's MAXVAL says (image libraries rescale
-/// a MAXVAL of 4095 to 65535 for display; a decoder must not).
+/// a MAXVAL of 4095 to 65535 for display; a decoder must not). With `expect` (rows, cols),
+/// a file whose header states another size is refused before its pixels are read.
 ///
 /// # Errors
 /// A message with the file and what is wrong.
-pub fn read_frame(path: &Path) -> Result<FrameFile> {
+pub fn read_frame(path: &Path, expect: Option<(usize, usize)>) -> Result<FrameFile> {
     let len = regular_file(path, u64::MAX, "")?;
+    // A header that claims another size is refused before its pixels are read: a sparse
+    // file or a small PNG can claim gigabytes.
+    let sized = |rows: u64, cols: u64| match expect {
+        Some((r, c)) if (rows, cols) != (r as u64, c as u64) => {
+            Err(anyhow!("{}: frame is {rows} x {cols}, the capture's frames are {r} x {c}", path.display()))
+        }
+        _ => Ok(()),
+    };
     match extension(path).as_str() {
         "npy" => {
-            let (data, rows, cols) = read_npy_u16_2d(path)?;
+            let (data, rows, cols) = read_npy_u16_2d(path, expect)?;
             Ok(FrameFile { data, rows, cols, top: u32::from(u16::MAX) })
         }
-        "pgm" => read_pgm(path, len),
+        "pgm" => read_pgm(path, len, &sized),
         "png" => {
+            let reader = image::ImageReader::open(path)
+                .and_then(image::ImageReader::with_guessed_format)
+                .with_context(|| format!("cannot read {}", path.display()))?;
+            let (w, h) =
+                reader.into_dimensions().with_context(|| format!("{}: cannot decode image", path.display()))?;
+            sized(u64::from(h), u64::from(w))?;
             let img = image::open(path).with_context(|| format!("{}: cannot decode image", path.display()))?;
             let color = img.color();
             let top = match color {
@@ -440,7 +455,7 @@ pub fn read_frame(path: &Path) -> Result<FrameFile> {
 }
 
 /// A binary PGM: the header through the image library, the samples as stored.
-fn read_pgm(path: &Path, file_len: u64) -> Result<FrameFile> {
+fn read_pgm(path: &Path, file_len: u64, sized: &dyn Fn(u64, u64) -> Result<()>) -> Result<FrameFile> {
     use image::codecs::pnm::{PnmDecoder, PnmSubtype, SampleEncoding};
     let file = fs::File::open(path).with_context(|| format!("cannot read {}", path.display()))?;
     let decoder = PnmDecoder::new(std::io::BufReader::new(file))
@@ -454,6 +469,7 @@ fn read_pgm(path: &Path, file_len: u64) -> Result<FrameFile> {
     );
     let (w, h, top) = (header.width(), header.height(), header.maximal_sample());
     ensure!((1..=65535).contains(&top), "{}: MAXVAL {top} out of 1..=65535", path.display());
+    sized(u64::from(h), u64::from(w))?;
     let bytes_per = if top > 255 { 2u64 } else { 1 };
     let count = u64::from(w) * u64::from(h);
     ensure!(

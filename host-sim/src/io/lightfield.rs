@@ -171,15 +171,19 @@ pub fn read_npy(path: &Path) -> Result<LightField, NpyError> {
 /// # Errors
 /// As [`read_npy`].
 pub fn read_npy_with_notes(path: &Path) -> Result<(LightField, Vec<String>), NpyError> {
-    let a = npy::read(path)?;
+    // The shape is checked from the header, before the body is read: a sparse file can
+    // claim more values than memory holds.
+    let a = npy::read_checked(path, |s, _| {
+        if s.len() != 5 {
+            return Err(format!("{} axes {s:?}, expected 5 (U, V, H, W, B)", s.len()));
+        }
+        if s.contains(&0) {
+            return Err(format!("shape {s:?} has an empty axis"));
+        }
+        LightField::check_size((s[0], s[1]), s[2], s[3], s[4]).map_err(|e| format!("shape {s:?}: {e}"))
+    })?;
     let shape_err = |what: String| NpyError::new(path, NpyErrorKind::Shape(what));
     let s = &a.shape;
-    if s.len() != 5 {
-        return Err(shape_err(format!("{} axes {s:?}, expected 5 (U, V, H, W, B)", s.len())));
-    }
-    if s.contains(&0) {
-        return Err(shape_err(format!("shape {s:?} has an empty axis")));
-    }
     let data = a.values.into_f32();
     let lf = LightField { views: (s[0], s[1]), rows: s[2], cols: s[3], bands: s[4], data };
     let bad = lf.data.iter().filter(|x| !x.is_finite()).count();
@@ -248,18 +252,31 @@ fn write_npy_2d<T: npyz::AutoSerialize + Copy>(
     })
 }
 
-/// Reads a uint16 2D `.npy` array (a raw frame): `(data, rows, cols)`.
+/// Reads a uint16 2D `.npy` array (a raw frame): `(data, rows, cols)`; with `expect`, a
+/// header of another size is refused before the body is read.
 ///
 /// # Errors
 /// [`NpyError`]: what is wrong and where.
-pub fn read_npy_u16_2d(path: &Path) -> Result<(Vec<u16>, usize, usize), NpyError> {
-    let a = npy::read(path)?;
-    let shape_err = |what: String| NpyError::new(path, NpyErrorKind::Shape(what));
-    if a.shape.len() != 2 {
-        return Err(shape_err(format!("a raw frame has 2 axes (H, W), this array {:?}", a.shape)));
-    }
+pub fn read_npy_u16_2d(path: &Path, expect: Option<(usize, usize)>) -> Result<(Vec<u16>, usize, usize), NpyError> {
+    // Rank, type and size from the header, before the body is read.
+    let a = npy::read_checked(path, |s, element| {
+        if s.len() != 2 {
+            return Err(format!("a raw frame has 2 axes (H, W), this array {s:?}"));
+        }
+        if element != npy::Element::U16 {
+            return Err("a raw frame holds uint16 ('<u2') values, this array floats".into());
+        }
+        match expect {
+            Some((rows, cols)) if (s[0], s[1]) != (rows, cols) => {
+                Err(format!("frame is {} x {}, the capture's frames are {rows} x {cols}", s[0], s[1]))
+            }
+            _ => Ok(()),
+        }
+    })?;
     match a.values {
         Values::U16(v) => Ok((v, a.shape[0], a.shape[1])),
-        Values::F32(_) => Err(shape_err("a raw frame holds uint16 ('<u2') values, this array floats".into())),
+        Values::F32(_) => {
+            Err(NpyError::new(path, NpyErrorKind::Shape("a raw frame holds uint16 ('<u2') values".into())))
+        }
     }
 }

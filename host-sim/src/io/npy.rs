@@ -169,6 +169,18 @@ impl NpyError {
 /// # Errors
 /// [`NpyError`]: the file, and what is wrong in it and where.
 pub fn read(path: &Path) -> Result<Npy, NpyError> {
+    read_checked(path, |_, _| Ok(()))
+}
+
+/// As [`read`], with `check` called on the header's shape and element type before the body
+/// is read or anything is allocated for it: a caller that knows the shape it needs (a
+/// frame of the capture's size, a light field within the size cap) refuses a file that
+/// claims another, whatever the file's length (a sparse file can claim gigabytes).
+///
+/// # Errors
+/// [`NpyError`]: the file, and what is wrong in it and where; `check`'s message as
+/// [`NpyErrorKind::Shape`].
+pub fn read_checked(path: &Path, check: impl FnOnce(&[usize], Element) -> Result<(), String>) -> Result<Npy, NpyError> {
     let err = |kind| NpyError::new(path, kind);
     // Look before opening: opening a FIFO blocks until a writer comes.
     let meta = std::fs::metadata(path).map_err(|e| err(NpyErrorKind::Io(e)))?;
@@ -176,14 +188,26 @@ pub fn read(path: &Path) -> Result<Npy, NpyError> {
         return Err(err(NpyErrorKind::NotAFile));
     }
     let file = File::open(path).map_err(|e| err(NpyErrorKind::Io(e)))?;
-    read_from(BufReader::new(file), meta.len()).map_err(err)
+    read_from_checked(BufReader::new(file), meta.len(), check).map_err(err)
 }
 
 /// Reads an array from `r`, which holds `len` bytes in all.
 ///
 /// # Errors
 /// What is wrong, without the file's name.
-pub fn read_from(mut r: impl Read, len: u64) -> Result<Npy, NpyErrorKind> {
+pub fn read_from(r: impl Read, len: u64) -> Result<Npy, NpyErrorKind> {
+    read_from_checked(r, len, |_, _| Ok(()))
+}
+
+/// As [`read_from`], with `check` on the shape and element type before the body is read.
+///
+/// # Errors
+/// What is wrong, without the file's name.
+pub fn read_from_checked(
+    mut r: impl Read,
+    len: u64,
+    check: impl FnOnce(&[usize], Element) -> Result<(), String>,
+) -> Result<Npy, NpyErrorKind> {
     let io = NpyErrorKind::Io;
     let mut preamble = [0u8; 8];
     if len < 10 {
@@ -234,6 +258,7 @@ pub fn read_from(mut r: impl Read, len: u64) -> Result<Npy, NpyErrorKind> {
         .map(|&d| usize::try_from(d))
         .collect::<Result<Vec<_>, _>>()
         .map_err(|_| NpyErrorKind::Overflow { shape: shape64.clone() })?;
+    check(&shape, element).map_err(NpyErrorKind::Shape)?;
     // The body is at most the file's size: this allocation is bounded by the bytes on disk.
     let mut raw = vec![0u8; bytes as usize];
     r.read_exact(&mut raw).map_err(io)?;

@@ -117,7 +117,9 @@ impl ImportSource {
                 (files, output, true)
             }
             Self::Cube { settings, output } => (vec![settings.input.clone()], output, false),
-            Self::Bands { input, output, .. } | Self::Hdf5 { input, output, .. } => (vec![input.clone()], output, false),
+            Self::Bands { input, output, .. } | Self::Hdf5 { input, output, .. } => {
+                (vec![input.clone()], output, false)
+            }
         };
         let o = Outputs::new().inputs(inputs, "an input").output(output, "-o");
         if disparity { o.output(&disparity_path(output), "the disparity map beside -o") } else { o }
