@@ -346,7 +346,14 @@ pub fn run(opts: &BenchOptions) -> Result<Vec<Point>> {
         .context("named scene")?;
     let mut settings = settings(opts.quick);
     if let Some(only) = &opts.only {
+        let names: Vec<String> = settings.iter().map(|(name, _, _)| short(name).to_string()).collect();
         settings.retain(|(name, _, _)| name.contains(only.as_str()));
+        anyhow::ensure!(
+            !settings.is_empty(),
+            "--only {only:?} names no setting of the {} sweep (a part of a name, such as {:?})",
+            if opts.quick { "quick" } else { "full" },
+            names.iter().take(4).collect::<Vec<_>>()
+        );
     }
     let families = if opts.masks.is_empty() {
         vec![MaskFamily::Pixel, MaskFamily::Lenslet, MaskFamily::Kronecker]
@@ -447,6 +454,7 @@ pub fn mark_pareto(points: &mut [Point]) {
 /// # Errors
 /// I/O and drawing errors.
 pub fn write(points: &[Point], device: &[DeviceFrame], dir: &Path) -> Result<()> {
+    anyhow::ensure!(!points.is_empty(), "no points to write");
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     // Setting names hold commas ("ensemble screened, tolerance 1e-3, ..."): the csv crate
     // quotes them.
@@ -528,20 +536,32 @@ fn points_of<R: std::io::Read>(mut r: csv::Reader<R>) -> Result<Vec<Point>> {
             let x = at(j)?;
             x.parse().with_context(|| format!("line {line}: field {} {x:?} is not a number", j + 1))
         };
+        // What the plot and the Pareto front need: finite values, a time above zero.
+        let finite = |j: usize| -> Result<f64> {
+            let x = number(j)?;
+            anyhow::ensure!(x.is_finite(), "line {line}: field {} is {x}, not a finite number", j + 1);
+            Ok(x)
+        };
+        let time = |j: usize| -> Result<f64> {
+            let x = finite(j)?;
+            anyhow::ensure!(x > 0.0, "line {line}: field {} is a time of {x} ms, not above 0", j + 1);
+            Ok(x)
+        };
         points.push(Point {
             mask: at(0)?.to_owned(),
             k: at(1)?.parse().with_context(|| format!("line {line}: k"))?,
             setting: at(2)?.to_owned(),
-            psnr: number(3)?,
-            ssim: number(4)?,
-            sa: number(5)?,
-            ms_one: number(6)?,
-            ms_all: number(7)?,
-            solves: number(8)?,
-            frame_s: number(9)?,
+            psnr: finite(3)?,
+            ssim: finite(4)?,
+            sa: finite(5)?,
+            ms_one: time(6)?,
+            ms_all: time(7)?,
+            solves: finite(8)?,
+            frame_s: finite(9)?,
             pareto: at(10)? == "true",
         });
     }
+    anyhow::ensure!(!points.is_empty(), "no points (a header and no rows)");
     Ok(points)
 }
 
@@ -553,6 +573,12 @@ fn plot(points: &[Point], path: &Path) -> Result<()> {
 }
 
 fn draw(points: &[Point], backend: BitMapBackend<'_>) -> Result<()> {
+    // A point that cannot be placed (a time of 0 on the log axis, a PSNR of NaN from a
+    // decode that failed) is in the table, not on the plot; the axes span the others.
+    let points: Vec<Point> =
+        points.iter().filter(|p| p.ms_one > 0.0 && p.ms_one.is_finite() && p.psnr.is_finite()).cloned().collect();
+    anyhow::ensure!(!points.is_empty(), "no point with a time above 0 and a finite PSNR to plot");
+    let points = &points[..];
     let root = backend.into_drawing_area();
     root.fill(&WHITE).map_err(|e| anyhow::anyhow!("{e}"))?;
     let (tmin, tmax) = points.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.ms_one), b.max(p.ms_one)));
@@ -717,5 +743,50 @@ mod tests {
         let bad = dir.path().join("bad.csv");
         std::fs::write(&bad, "mask,k,setting\npixel,three,x\n").unwrap();
         assert!(format!("{:#}", read_points(&bad).unwrap_err()).contains("line 2"));
+    }
+
+    /// Issue 41, item 2: nothing to sweep or to draw is an error at once, and a point the
+    /// plot cannot place does not stall it (before: `--only bogus` grew to 24 GB, a time
+    /// of 0 or a PSNR of NaN ran past a minute).
+    #[test]
+    fn empty_or_unplaceable_benches_are_refused_or_drawn_at_once() {
+        let dir = tempfile::tempdir().unwrap();
+        let opts = BenchOptions { quick: true, progress: false, only: Some("bogus".into()), masks: Vec::new() };
+        let e = run(&opts).unwrap_err().to_string();
+        assert!(e.contains("--only \"bogus\" names no setting"), "{e}");
+        assert!(write(&[], &[], dir.path()).is_err());
+        let header = "mask,k,setting,psnr_db,ssim,sa_deg,ms_per_patch_1_thread,ms_per_patch_all_threads,\
+                      solves_per_patch,frame_512_s_1_thread,pareto\n";
+        let csv = dir.path().join("bench.csv");
+        std::fs::write(&csv, header).unwrap();
+        assert!(format!("{:#}", read_points(&csv).unwrap_err()).contains("no points"));
+        for (row, says) in [
+            ("pixel,3,x,30,0.9,4,0,0.5,1,2,true", "line 2: field 7 is a time of 0 ms"),
+            ("pixel,3,x,NaN,0.9,4,1,0.5,1,2,true", "line 2: field 4 is NaN"),
+            ("pixel,3,x,inf,0.9,4,1,0.5,1,2,true", "line 2: field 4 is inf"),
+        ] {
+            std::fs::write(&csv, format!("{header}{row}\n")).unwrap();
+            let e = format!("{:#}", read_points(&csv).unwrap_err());
+            assert!(e.contains(says), "{e}");
+        }
+        // A sweep's own point of NaN or 0 ms: in the table, not on the plot; written quickly.
+        let point = |psnr: f64, ms: f64| Point {
+            mask: "pixel".into(),
+            k: 3,
+            setting: "x".into(),
+            psnr,
+            ssim: 0.9,
+            sa: 4.0,
+            ms_one: ms,
+            ms_all: ms,
+            solves: 1.0,
+            frame_s: 1.0,
+            pareto: false,
+        };
+        let start = std::time::Instant::now();
+        write(&[point(f64::NAN, 1.0), point(30.0, 0.0), point(31.0, 2.0)], &[], dir.path()).unwrap();
+        assert!(start.elapsed().as_secs() < 30, "drawing took {:?}", start.elapsed());
+        assert!(std::fs::read_to_string(dir.path().join("bench.md")).unwrap().contains("| NaN |"));
+        assert!(write(&[point(f64::NAN, 1.0)], &[], dir.path()).is_err());
     }
 }
