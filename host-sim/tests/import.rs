@@ -267,6 +267,21 @@ fn missing_views_are_refused_or_filled_by_the_disparity() {
     let lift = RgbLift::new(&BAND_NM, CAMERA_FILTER).unwrap();
     let e = format!("{:#}", import_views(dir.path(), &cfg, &lift).unwrap_err());
     assert!(e.contains("1 of 9 views") && e.contains("input_Cam002.png") && e.contains("--fill warp"), "{e}");
+    // Issue 41, item 3: a sweep bound past any real disparity (1e9 asked for 17 GB of
+    // candidates) is refused, in the library and by the flag.
+    for bad in [1e9, 32.5, f32::NAN, 0.0] {
+        let e = format!(
+            "{:#}",
+            import_views(dir.path(), &ViewsConfig { fill: Fill::Warp, max_disparity: bad, ..cfg.clone() }, &lift)
+                .unwrap_err()
+        );
+        assert!(e.contains("--max-disparity") && e.contains("<= 32"), "{e}");
+    }
+    let folder = dir.path().display().to_string();
+    let e =
+        slf_host::sim::import::ViewsSettings::from_flags([folder.as_str(), "--fill", "warp", "--max-disparity", "1e9"])
+            .unwrap_err();
+    assert!(e.contains("1e9 pixels per view is more than the 32"), "{e}");
     let imported = import_views(dir.path(), &ViewsConfig { fill: Fill::Warp, ..cfg }, &lift).unwrap();
     assert!(
         imported.notes.iter().any(|n| n.contains("view (0, 2)") && n.contains("from view (0, 1)")),

@@ -16,7 +16,7 @@ use clap::{Args, ValueEnum};
 use crate::io::import::bands::{CAMERA_FILTER, parse_wavelengths};
 use crate::io::import::cube::{self, CubeConfig, Depth, Light};
 use crate::io::import::rgb::RgbLift;
-use crate::io::import::views::{Fill, Imported, Naming, ViewsConfig, import_views};
+use crate::io::import::views::{Fill, Imported, MAX_DISPARITY, Naming, ViewsConfig, import_views};
 use crate::io::import::{Crop, Geometry, resample_lightfield};
 use crate::io::lightfield::LightField;
 use crate::sim::flags::{pair, parse, positive};
@@ -92,9 +92,19 @@ pub struct ViewsSettings {
     /// folder). Cut and scaled with the views, written as OUTPUT's stem + .disparity.npy.
     #[arg(long)]
     pub disparity: Option<PathBuf>,
-    /// Largest disparity (pixels per view) tried when estimating one to fill views.
-    #[arg(long, default_value_t = 4.0, value_parser = positive)]
+    /// Largest disparity (pixels per view) tried when estimating one to fill views, at most
+    /// 32.
+    #[arg(long, default_value_t = 4.0, value_parser = max_disparity)]
     pub max_disparity: f32,
+}
+
+/// `--max-disparity`: above 0, at most [`MAX_DISPARITY`].
+fn max_disparity(s: &str) -> Result<f32, String> {
+    let d = positive(s)?;
+    if d > MAX_DISPARITY {
+        return Err(format!("{s} pixels per view is more than the {MAX_DISPARITY} the plane sweep tries"));
+    }
+    Ok(d)
 }
 
 impl ViewsSettings {

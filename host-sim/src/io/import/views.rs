@@ -87,6 +87,12 @@ impl Default for ViewsConfig {
     }
 }
 
+/// The largest disparity the plane sweep that fills missing views tries, pixels per view
+/// step: 8 times the largest of the HCI benchmark's scenes (about 4) and 32 times a lenslet
+/// camera's; at 0.1-pixel steps, 641 candidates. A larger bound (1e9 asked for 17 GB of
+/// candidates) is refused.
+pub const MAX_DISPARITY: f32 = 32.0;
+
 /// An imported light field, the disparity of its centre view if known, and what was done.
 #[derive(Clone, Debug)]
 pub struct Imported {
@@ -142,6 +148,11 @@ fn read_view(path: &Path, linear: bool) -> Result<Plane> {
 /// `centres_nm`.
 pub fn import_views(folder: &Path, cfg: &ViewsConfig, lift: &RgbLift) -> Result<Imported> {
     ensure!(folder.is_dir(), "{}: not a folder", folder.display());
+    ensure!(
+        cfg.max_disparity.is_finite() && cfg.max_disparity > 0.0 && cfg.max_disparity <= MAX_DISPARITY,
+        "--max-disparity {}: the plane sweep tries 0.1-pixel steps in 0 < d <= {MAX_DISPARITY} pixels per view",
+        cfg.max_disparity
+    );
     let (gr, gc) = cfg.grid;
     let (nu, nv) = cfg.views;
     ensure!((1..=64).contains(&gr) && (1..=64).contains(&gc), "grid {gr} x {gc}: each side must be in 1..=64");
