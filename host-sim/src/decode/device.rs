@@ -154,12 +154,28 @@ impl PatchSink<8125> for Collect {
     }
 }
 
+/// The largest device log read, bytes (the emulated device's is about 0.3 MB).
+pub const MAX_LOG: u64 = 64 << 20;
+
+/// The larger of two differences, NaN if either is: `f64::max` drops a NaN, so a device
+/// that printed NaN would pass a comparison folded with it.
+fn worse(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() { f64::NAN } else { a.max(b) }
+}
+
+/// Whether a relative difference is within the device check's 1e-5 (NaN is not).
+fn within(worst: f64) -> bool {
+    worst <= 1e-5
+}
+
 /// Checks the device's log against the host's decode of `capture_dir`.
 ///
 /// # Errors
 /// A malformed log, a missing or extra patch, or a difference above 1e-5 relative.
 pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
-    let text = std::fs::read_to_string(log).with_context(|| format!("cannot read {}", log.display()))?;
+    // A log is read whole only if it is a regular file of a log's size: a FIFO would block,
+    // /dev/zero never end.
+    let text = crate::io::capture::read_small_file(log, MAX_LOG)?;
     let DeviceLog { patches: device, rows, count, gains } = parse(&text)?;
     let capture = Capture::load(capture_dir)?;
     // The device decodes full-view patches with the shipped full-view ensemble.
@@ -174,9 +190,9 @@ pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
     let raw = capture.raw_frames()?;
     let host_gains = *decoder.gains();
     ensure!(gains.len() == 13, "the device printed {} gains, not 13", gains.len());
-    let worst_gain = gains.iter().zip(&host_gains).map(|(a, b)| (a - b).abs() / b).fold(0.0f32, f32::max);
+    let worst_gain = gains.iter().zip(&host_gains).map(|(a, b)| f64::from((a - b).abs() / b)).fold(0.0, worse);
     println!("device vs host: white balance gains differ by {worst_gain:.2e} relative (limit 1e-5)");
-    ensure!(worst_gain <= 1e-5, "the device's gains {gains:?} differ from the host's {host_gains:?}");
+    ensure!(within(worst_gain), "the device's gains {gains:?} differ from the host's {host_gains:?}");
     let mut host = Collect(HashMap::new());
     let mut ws = Box::new(slf_firmware::FullViewWorkspace::new());
     for tile in decoder.tiles((1, 1)) {
@@ -197,11 +213,11 @@ pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
         ensure!(d.values.len() == h.len(), "patch {o:?}: {} values from the device", d.values.len());
         ensure!(d.member == *member, "patch {o:?}: device member {}, host member {member}", d.member);
         let scale = h.iter().fold(0.0f32, |m, x| m.max(x.abs())).max(f32::MIN_POSITIVE);
-        let rel = d.values.iter().zip(h).map(|(a, b)| f64::from((a - b).abs() / scale)).fold(0.0, f64::max);
-        worst = worst.max(rel);
+        let rel = d.values.iter().zip(h).map(|(a, b)| f64::from((a - b).abs() / scale)).fold(0.0, worse);
+        worst = worse(worst, rel);
     }
     println!("device vs host: {} patches, largest relative difference {worst:.2e} (limit 1e-5)", host.0.len());
-    if worst > 1e-5 {
+    if !within(worst) {
         bail!("the device's patches differ from the host's by {worst:.2e} relative");
     }
     check_rows(&rows, &capture, &model)
@@ -241,7 +257,7 @@ fn check_rows(
             let (c, rest) = (i / per_col, i % per_col);
             let (u, v, b) = (rest / (lf.views.1 * lf.bands), (rest / lf.bands) % lf.views.1, rest % lf.bands);
             let h = lf.data[lf.index(u, v, row, first + c, b)];
-            worst = worst.max(f64::from((x - h).abs() / scale));
+            worst = worse(worst, f64::from((x - h).abs() / scale));
             covered[row * lf.cols + first + c] = true;
         }
     }
@@ -254,8 +270,40 @@ fn check_rows(
         opts.window,
         rows.len()
     );
-    if worst > 1e-5 {
+    if !within(worst) {
         bail!("the device's overlapped rows differ from the host's by {worst:.2e} relative");
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 41, item 17: a NaN the device printed fails the comparison.
+    #[test]
+    fn a_nan_difference_fails_the_check() {
+        let diffs = [1e-7, f64::NAN, 2e-7];
+        let worst = diffs.iter().copied().fold(0.0, worse);
+        assert!(worst.is_nan() && !within(worst));
+        assert!(diffs.iter().copied().fold(0.0, f64::max) <= 1e-5, "f64::max drops the NaN");
+        assert!(within([1e-7, 2e-7].iter().copied().fold(0.0, worse)));
+        assert!(!within(2e-5));
+    }
+
+    /// Issue 41, item 4: a FIFO or a device is refused, not read until memory runs out.
+    #[cfg(unix)]
+    #[test]
+    fn a_log_that_is_not_a_regular_file_is_refused_at_once() {
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("log.fifo");
+        assert!(std::process::Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+        for log in [fifo.as_path(), Path::new("/dev/zero")] {
+            let e = check(log, dir.path()).unwrap_err().to_string();
+            assert!(e.contains("not a regular file"), "{e}");
+        }
+        let big = dir.path().join("big.log");
+        std::fs::File::create(&big).unwrap().set_len(MAX_LOG + 1).unwrap();
+        assert!(check(&big, dir.path()).unwrap_err().to_string().contains("more than"));
+    }
 }
