@@ -320,6 +320,11 @@ fn decoder_config_is_checked() {
     assert_eq!(err(config(Mask::kronecker(1, 1, 13, L5, (4, 4)).unwrap())), ConfigError::BlockMismatch);
     let bad_raw = RawFormat { black: 1.0, white: 1.0, max_valid: 1.0 };
     assert_eq!(err(DecoderConfig { raw: bad_raw, ..config(m) }), ConfigError::RawFormat);
+    // Finite levels whose difference is not (issue 41, item 11): every value would
+    // normalise to 0.
+    let huge = RawFormat { black: -3e38, white: 3e38, max_valid: 1.0 };
+    assert!((huge.white - huge.black).is_infinite());
+    assert_eq!(err(DecoderConfig { raw: huge, ..config(m) }), ConfigError::RawFormat);
     let bad_sl0 = Sl0Config { steps: 0, ..Sl0Config::DEFAULT };
     assert_eq!(
         err(DecoderConfig { sl0: bad_sl0, ..config(m) }),

@@ -394,6 +394,35 @@ fn baselines_decode_from_the_command_line() {
             .arg(p("m.csv")),
     );
     assert!(e.contains("--member-map needs --method cs"), "{e}");
+    // Issue 41, item 9: a baseline refuses the compressed-sensing flags (before: ignored,
+    // valid or not, exit 0) and a --disparity-map it would not write.
+    let e = failure(
+        slf()
+            .arg("decode")
+            .arg(p("cap"))
+            .arg("-o")
+            .arg(p("x.npy"))
+            .args(["--method", "demosaic", "--disparity-map"])
+            .arg(p("d.npy")),
+    );
+    assert!(e.contains("--disparity-map needs --method cs"), "{e}");
+    for (method, flags, named) in [
+        ("interpolate", vec!["--mu", "nan"], "--mu"),
+        ("demosaic", vec!["--sigma-f", "5"], "--sigma-f"),
+        ("ppid", vec!["--gains", "1,2"], "--gains"),
+        ("demosaic", vec!["--blob", "/nonexistent"], "--blob"),
+        ("ppid", vec!["--preset", "best", "--stride", "1"], "--preset, --stride"),
+    ] {
+        let e = failure(
+            slf().arg("decode").arg(p("cap")).arg("-o").arg(p("x.npy")).args(["--method", method, "-q"]).args(&flags),
+        );
+        assert!(
+            e.contains(&format!("{named} given with --method {method}, which uses none of the compressed-sensing"))
+                && e.trim().lines().count() == 1,
+            "{e}"
+        );
+    }
+    assert!(!p("x.npy").exists() && !p("d.npy").exists());
 }
 
 #[test]
@@ -445,7 +474,16 @@ fn import_from_the_command_line_and_other_band_counts_resampled() {
             .arg(p("s.npy")),
     );
     assert!(e.contains("the import is 3 x 3 pixels a view: the decoder needs at least 5 x 5"), "{e}");
-    assert!(!p("v.npy").exists() && !p("s.npy").exists());
+    // Issue 41, item 10: a --white that makes every value infinite is refused, not written.
+    let e = failure(
+        slf()
+            .args(["import", "cube"])
+            .arg(p("cube.npy"))
+            .args(["--wavelengths", "400,500,600,700", "--white", "1e-40", "-o"])
+            .arg(p("w.npy")),
+    );
+    assert!(e.contains("not finite") && e.contains("--white"), "{e}");
+    assert!(!p("v.npy").exists() && !p("s.npy").exists() && !p("w.npy").exists());
 }
 
 #[test]

@@ -323,6 +323,32 @@ fn hostile_capture_descriptions_are_one_line_errors() {
         ),
         ("no frames", Box::new(|j| j["frames"] = serde_json::json!([])), "frames lists 0 files"),
         ("nan level", Box::new(|j| j["white_level"] = serde_json::json!(1e39)), "finite black_level"),
+        // Issue 41, item 11: finite levels whose difference is not (before: all zeros, exit 0).
+        (
+            "huge levels",
+            Box::new(|j| {
+                j["black_level"] = serde_json::json!(-3e38);
+                j["white_level"] = serde_json::json!(3e38);
+            }),
+            "black_level -3e38: must be in 0..=65535",
+        ),
+        // Issue 41, item 12: wavelengths no filter has, duplicates, a descending list.
+        ("band 1e39", Box::new(|j| j["bands_nm"][3] = serde_json::json!(1e38)), "bands_nm[3] is 1e38 nm"),
+        ("negative band", Box::new(|j| j["bands_nm"][0] = serde_json::json!(-400)), "bands_nm[0] is -400 nm"),
+        (
+            "same band",
+            Box::new(|j| j["bands_nm"] = serde_json::json!(vec![500.0; 13])),
+            "bands_nm[1] is 500 nm after 500",
+        ),
+        (
+            "descending",
+            Box::new(|j| {
+                let mut b: Vec<f64> = serde_json::from_value(j["bands_nm"].clone()).unwrap();
+                b.reverse();
+                j["bands_nm"] = serde_json::json!(b);
+            }),
+            "in increasing wavelength",
+        ),
     ];
     for (what, edit, want) in cases {
         let (dir, mut json) = saved_capture();

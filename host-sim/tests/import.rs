@@ -430,6 +430,9 @@ fn hdf5_light_fields_are_read_in_any_axis_order() {
         let e = read_hdf5(&path, &Hdf5Layout { dataset: "lf/data".into(), axes: axes.into() }, 1.0).unwrap_err();
         assert!(e.to_string().contains(why), "{axes}: {e}");
     }
+    // Issue 41, item 10: a white that makes the values infinite is refused, with the value.
+    let e = read_hdf5(&path, &layout, 1e-40).unwrap_err().to_string();
+    assert!(e.contains("divided by --white 1e-40 is inf"), "{e}");
     let e = read_hdf5(&path, &Hdf5Layout { dataset: "lf/nope".into(), axes: "uvhwb".into() }, 1.0).unwrap_err();
     assert!(e.to_string().contains("no dataset \"lf/nope\""), "{e}");
     let flat = dir.path().join("flat.h5");

@@ -9,6 +9,17 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use slf_host::io::lightfield::LightField;
 
+/// An array's values in C order (the last axis fastest), whatever its memory order:
+/// copied straight from a C-contiguous buffer, else element by element in logical order.
+/// (rust-numpy's `as_slice` also accepts a Fortran-ordered buffer, whose memory order is
+/// not the logical one: Fortran-ordered or transposed frames were read scrambled.)
+pub fn c_order<T: numpy::Element + Copy>(a: &PyReadonlyArrayDyn<'_, T>) -> Vec<T> {
+    match a.as_slice() {
+        Ok(s) if a.is_c_contiguous() => s.to_vec(),
+        _ => a.as_array().iter().copied().collect(),
+    }
+}
+
 /// A `(U, V, H, W, B)` float32 array as a light field; `what` names it in errors.
 pub fn light_field(a: &PyReadonlyArrayDyn<'_, f32>, what: &str) -> PyResult<LightField> {
     let shape = a.shape().to_vec();
@@ -18,7 +29,7 @@ pub fn light_field(a: &PyReadonlyArrayDyn<'_, f32>, what: &str) -> PyResult<Ligh
             shape.len()
         )));
     };
-    let data = a.as_slice().map_err(|_| PyValueError::new_err(format!("{what}: not C-contiguous")))?.to_vec();
+    let data = c_order(a);
     if let Some(i) = data.iter().position(|x| !x.is_finite()) {
         let bad = data.iter().filter(|x| !x.is_finite()).count();
         let lf = LightField { views: (u, v), rows: h, cols: w, bands: b, data: Vec::new() };

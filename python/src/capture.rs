@@ -23,7 +23,7 @@ pub fn from_parts(frames: &PyReadonlyArrayDyn<'_, u16>, description: &str) -> Py
     };
     let d: CaptureDescription = serde_json::from_str(description)
         .map_err(|e| PyValueError::new_err(format!("description: invalid capture description: {e}")))?;
-    let data = frames.as_slice().map_err(|_| PyValueError::new_err("frames: not C-contiguous"))?;
+    let data = crate::arrays::c_order(frames);
     let frames: Vec<Vec<u16>> =
         if rows * cols == 0 { vec![Vec::new(); k] } else { data.chunks(rows * cols).map(<[u16]>::to_vec).collect() };
     Capture::new(d, frames).or_py()

@@ -29,8 +29,17 @@ pub fn decode<'py>(
 ) -> PyResult<(Bound<'py, PyArrayDyn<f32>>, Bound<'py, PyDict>)> {
     let settings = DecodeSettings::from_flags(&args).map_err(flags)?;
     let capture = from_parts(&frames, description)?;
-    if threads == Some(0) {
-        return Err(PyValueError::new_err("threads: at least 1 (None: one per core)"));
+    // The decode is compute-bound: threads past a few per core buy nothing, and 10**9 of
+    // them were spawned until the OS refused.
+    let most = 4 * std::thread::available_parallelism().map_or(1, usize::from);
+    match threads {
+        Some(0) => return Err(PyValueError::new_err("threads: at least 1 (None: one per core)")),
+        Some(n) if n > most => {
+            return Err(PyValueError::new_err(format!(
+                "threads: {n} is more than the {most} (4 per core of this machine) a decode can use (None: one per core)"
+            )));
+        }
+        _ => {}
     }
     // The first exception the callback raised; the decode runs on, and it is raised after.
     let raised: Mutex<Option<PyErr>> = Mutex::new(None);

@@ -85,6 +85,7 @@ def test_a_broken_capture_is_named(tmp_path, capture):
         ({"gains": [1.0, 2.0]}, "--gains: 13 values, got 2"),
         ({"mu": -1.0}, "mu"),
         ({"threads": 0}, "threads: at least 1"),
+        ({"threads": 10**9}, "threads: 1000000000 is more than the"),
         ({"window": "round"}, "--window"),
         ({"min_bands": 14}, "--min-bands 14: at most 13"),
         ({"adaptive": 2.0, "stride": 5}, "--adaptive needs a stride below 5"),
@@ -94,6 +95,7 @@ def test_a_broken_capture_is_named(tmp_path, capture):
         ({"sigma_min": 1e30}, r"--sigma-min 1e30: must be in \(0, 1\]"),
         ({"noise": 1e30}, r"--noise 1e30: must be in \[0, 1\]"),
         ({"gains": [1.0] * 12 + [1e30]}, r"--gains: gain 13 is 1e30"),
+        ({"method": "demosaic", "mu": 0.5}, r"--mu given with --method demosaic"),
     ],
 )
 def test_bad_decode_settings(capture, kwargs, message):

@@ -32,12 +32,16 @@ impl RawFormat {
         Self { black, white: top, max_valid: top - 1.0 }
     }
 
-    /// Whether the format can normalise anything: finite, `white > black`, `max_valid >= 0`.
+    /// Whether the format can normalise anything: finite, `white > black` with a finite
+    /// difference (-3e38 and 3e38 are finite, their difference is not: every value would
+    /// normalise to 0), `max_valid >= 0`.
     pub fn is_valid(&self) -> bool {
         self.black.is_finite()
             && self.white.is_finite()
             && self.max_valid.is_finite()
             && self.white > self.black
+            && (self.white - self.black).is_finite()
+            && (self.max_valid - self.black).is_finite()
             && self.max_valid >= 0.0
     }
 

@@ -50,6 +50,16 @@ impl Method {
             Method::Ppid => Some(Baseline::Ppid),
         }
     }
+
+    /// The flag's value: `cs`, `interpolate`, `demosaic`, `ppid`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Cs => "cs",
+            Method::Interpolate => "interpolate",
+            Method::Demosaic => "demosaic",
+            Method::Ppid => "ppid",
+        }
+    }
 }
 
 /// `--dictionary`: the basis kind.
@@ -113,7 +123,7 @@ impl WhiteBalance {
 }
 
 /// The basis flags, shared by the commands that decode (`decode`, `sweep`, `demo`).
-#[derive(Args, Clone, Debug)]
+#[derive(Args, Clone, Debug, PartialEq)]
 pub struct BasisSettings {
     /// Basis to decode with [default: ensemble; dct with --preset preview].
     #[arg(long, value_enum)]
@@ -175,7 +185,7 @@ impl BasisSettings {
 }
 
 /// The solver's flags; each unset one is the preset's value ([`Preset::options`]).
-#[derive(Args, Clone, Debug)]
+#[derive(Args, Clone, Debug, PartialEq)]
 pub struct SolverSettings {
     /// SL0 sigma decrease factor per level, in (0, 1).
     #[arg(long, default_value_t = Sl0Config::DEFAULT.sigma_f)]
@@ -301,9 +311,7 @@ impl SolverSettings {
 }
 
 /// A flag's value as a user would write it: `1e30`, not thirty-one digits.
-fn show(v: f32) -> String {
-    if v != 0.0 && v.is_finite() && !(1e-4..1e6).contains(&v.abs()) { format!("{v:e}") } else { v.to_string() }
-}
+use crate::io::message::number as show;
 
 /// The range [`Sl0Config::validate`] holds `field` to, in words.
 fn config_range(field: &str) -> &'static str {
@@ -471,6 +479,51 @@ impl DecodeSettings {
         Ok((basis, options))
     }
 
+    /// The compressed-sensing flags given with values other than their defaults, by name
+    /// (a baseline uses none of them: each would be ignored in silence, a bad value never
+    /// checked). A flag set to its default value is not told apart from one not given.
+    pub fn compressed_sensing_flags(&self) -> Vec<&'static str> {
+        let Ok(d) = Self::from_flags(std::iter::empty::<&str>()) else { return Vec::new() };
+        let (s, ds) = (&self.solver, &d.solver);
+        // f32 by bits: a NaN given differs from the default.
+        let f = |a: f32, b: f32| a.to_bits() == b.to_bits();
+        let of = |a: Option<f32>, b: Option<f32>| a.map(f32::to_bits) == b.map(f32::to_bits);
+        [
+            (self.preset == d.preset, "--preset"),
+            (f(s.sigma_f, ds.sigma_f), "--sigma-f"),
+            (s.steps == ds.steps, "--steps"),
+            (f(s.mu, ds.mu), "--mu"),
+            (of(s.sigma_min, ds.sigma_min), "--sigma-min"),
+            (s.max_iterations == ds.max_iterations, "--max-iterations"),
+            (of(s.noise, ds.noise), "--noise"),
+            (of(s.shot, ds.shot), "--shot"),
+            (s.exact == ds.exact, "--exact"),
+            (f(s.tolerance, ds.tolerance), "--tolerance"),
+            (f(s.warm_start, ds.warm_start), "--warm-start"),
+            (f(s.warm_sigma_f, ds.warm_sigma_f), "--warm-sigma-f"),
+            (s.warm_steps == ds.warm_steps, "--warm-steps"),
+            (f(s.seed_sigma_f, ds.seed_sigma_f), "--seed-sigma-f"),
+            (of(s.cold_start, ds.cold_start), "--cold-start"),
+            (f(s.flat, ds.flat), "--flat"),
+            (s.min_bands == ds.min_bands, "--min-bands"),
+            (self.basis.dictionary == d.basis.dictionary, "--dictionary"),
+            (self.basis.choice == d.basis.choice, "--choice"),
+            (self.basis.blob == d.basis.blob, "--blob"),
+            (self.basis.patch_views == d.basis.patch_views, "--patch-views"),
+            (self.stride == d.stride, "--stride"),
+            (self.window == d.window, "--window"),
+            (of(self.adaptive, d.adaptive), "--adaptive"),
+            (self.balance == d.balance, "--balance"),
+            (self.gains.is_none(), "--gains"),
+            (self.disparities == d.disparities, "--disparities"),
+            (self.edge_fallback == d.edge_fallback, "--edge-fallback"),
+            (self.seeded == d.seeded, "--seeded"),
+        ]
+        .into_iter()
+        .filter_map(|(same, name)| (!same).then_some(name))
+        .collect()
+    }
+
     /// Decodes `capture`. `progress` shows a bar on stderr once the decode has taken a
     /// second; `observer` is called after each tile with (tiles done, tiles in the pass).
     ///
@@ -486,6 +539,14 @@ impl DecodeSettings {
             "every pixel of every frame is at or below the black level ({black} DN): no light was recorded"
         );
         if let Some(baseline) = self.method.baseline() {
+            let given = self.compressed_sensing_flags();
+            ensure!(
+                given.is_empty(),
+                "{} given with --method {}, which uses none of the compressed-sensing flags: drop them, or use \
+                 --method cs",
+                given.join(", "),
+                self.method.name()
+            );
             let (light_field, report) = baseline.run(capture)?;
             return Ok(Decoded { light_field, outcome: Outcome::Baseline { method: self.method, report } });
         }

@@ -106,6 +106,11 @@ pub struct CaptureDescription {
     pub defective_pixels: Vec<[u32; 2]>,
 }
 
+/// The shortest band centre a capture may state, nm.
+pub const MIN_NM: f32 = 200.0;
+/// The longest band centre a capture may state, nm.
+pub const MAX_NM: f32 = 2500.0;
+
 /// A loaded capture: description, frames and the checked pieces the decoder needs.
 #[derive(Clone, Debug)]
 pub struct Capture {
@@ -633,6 +638,22 @@ impl CaptureDescription {
             "bands_nm has {} entries, expected 1..=32",
             self.bands_nm.len()
         );
+        // Wavelengths a filter can have, each band once, in order: the bands' order is the
+        // light field's band axis, and a duplicate or a reversed list names bands wrongly.
+        if let Some((i, w)) = self.bands_nm.iter().enumerate().find(|(_, w)| !(MIN_NM..=MAX_NM).contains(*w)) {
+            bail!(
+                "bands_nm[{i}] is {} nm: each must be in {MIN_NM}..={MAX_NM} nm (ultraviolet to short-wave infrared)",
+                crate::io::message::number(*w)
+            );
+        }
+        if let Some(i) = self.bands_nm.windows(2).position(|p| p[1] <= p[0]) {
+            bail!(
+                "bands_nm[{}] is {} nm after {} nm: the bands must be listed in increasing wavelength, each once",
+                i + 1,
+                self.bands_nm[i + 1],
+                self.bands_nm[i]
+            );
+        }
         ensure!(
             self.black_level.is_finite()
                 && self.white_level.is_finite()
@@ -640,6 +661,17 @@ impl CaptureDescription {
                 && self.white_level > self.black_level
                 && self.saturation_level > self.black_level,
             "levels: need finite black_level < white_level and black_level < saturation_level"
+        );
+        // Frames hold 16-bit values: a black level outside them is no sensor's, and one of
+        // -3e38 under a white of 3e38 made white - black infinite and the decode all zeros.
+        ensure!(
+            (0.0..=65535.0).contains(&self.black_level),
+            "black_level {}: must be in 0..=65535 (the frames' 16-bit values)",
+            crate::io::message::number(self.black_level)
+        );
+        ensure!(
+            (self.white_level - self.black_level).is_finite(),
+            "levels: white_level - black_level is not a finite number"
         );
         Ok((rows, cols))
     }

@@ -61,6 +61,20 @@ impl LightField {
         }
     }
 
+    /// Checks that every value is finite.
+    ///
+    /// # Errors
+    /// How many are not (NaN or infinite) and where the first is, one line.
+    pub fn check_finite(&self) -> Result<(), String> {
+        let Some(first) = self.data.iter().position(|x| !x.is_finite()) else { return Ok(()) };
+        let bad = self.data.iter().filter(|x| !x.is_finite()).count();
+        let (u, v, y, x, b) = self.coordinates(first);
+        Err(format!(
+            "{bad} of {} values are not finite (NaN or infinite), the first at (u, v, y, x, b) = ({u}, {v}, {y}, {x}, {b})",
+            self.data.len()
+        ))
+    }
+
     /// A light field of zeros.
     pub fn zeros(views: (usize, usize), rows: usize, cols: usize, bands: usize) -> Self {
         let n = views.0 * views.1 * rows * cols * bands;
@@ -186,14 +200,7 @@ pub fn read_npy_with_notes(path: &Path) -> Result<(LightField, Vec<String>), Npy
     let s = &a.shape;
     let data = a.values.into_f32();
     let lf = LightField { views: (s[0], s[1]), rows: s[2], cols: s[3], bands: s[4], data };
-    let bad = lf.data.iter().filter(|x| !x.is_finite()).count();
-    if let Some(first) = lf.data.iter().position(|x| !x.is_finite()) {
-        let (u, v, y, x, b) = lf.coordinates(first);
-        return Err(shape_err(format!(
-            "{bad} of {} values are not finite (NaN or infinite), the first at (u, v, y, x, b) = ({u}, {v}, {y}, {x}, {b})",
-            lf.data.len()
-        )));
-    }
+    lf.check_finite().map_err(shape_err)?;
     Ok((lf, a.notes))
 }
 
@@ -201,8 +208,11 @@ pub fn read_npy_with_notes(path: &Path) -> Result<(LightField, Vec<String>), Npy
 /// whole or not at all ([`write_whole`]).
 ///
 /// # Errors
-/// I/O errors, with the path.
+/// A value that is not finite (nothing is written); I/O errors, with the path.
 pub fn write_npy(path: &Path, lf: &LightField, dtype: Dtype) -> anyhow::Result<()> {
+    // slf writes no light field it would refuse to read: NaN or infinity is a fault of
+    // what made it (an import's --white of 1e-40), not a value to store.
+    lf.check_finite().map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
     let shape: Vec<u64> = lf.shape().iter().map(|&x| x as u64).collect();
     write_whole(path, |out| {
         match dtype {

@@ -7,6 +7,11 @@
 //! or directory (os error 2): No such file or directory (os error 2)". Here a cause whose
 //! text the line already ends with is left out.
 
+/// A number as a user would write it: `1e30` and `1e-40`, not forty digits.
+pub fn number(v: f32) -> String {
+    if v != 0.0 && v.is_finite() && !(1e-4..1e6).contains(&v.abs()) { format!("{v:e}") } else { v.to_string() }
+}
+
 /// `e`'s chain on one line, without repeated causes or line breaks.
 pub fn one_line(e: &anyhow::Error) -> String {
     let mut line = String::new();

@@ -10,7 +10,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result, bail, ensure};
+use anyhow::{Context, Result, anyhow, bail, ensure};
 use clap::{Args, ValueEnum};
 
 use crate::io::import::bands::{CAMERA_FILTER, parse_wavelengths};
@@ -222,6 +222,13 @@ impl CubeSettings {
             geometry: self.geometry.geometry(),
         };
         let (lightfield, disparity) = cube::to_lightfield(&bands, &cfg, (data.rows, data.cols))?;
+        lightfield.check_finite().map_err(|e| {
+            anyhow!(
+                "{}: with --white {}: {e}: give the value of white in the cube's units",
+                input.display(),
+                crate::io::message::number(self.white)
+            )
+        })?;
         check_lenslets(&lightfield)?;
         Ok(Imported { lightfield, disparity, notes })
     }

@@ -107,7 +107,17 @@ pub fn read_hdf5(path: &Path, layout: &Hdf5Layout, white: f32) -> Result<LightFi
                             path.display(),
                             layout.dataset
                         );
-                        lf.data[o] = x / white;
+                        let y = x / white;
+                        ensure!(
+                            y.is_finite(),
+                            "{}: {}: value {} at (u, v, h, w, b) = ({u}, {v}, {h}, {w}, {b}) divided by --white {} \
+                             is {y}: give the value of white in the file's units",
+                            path.display(),
+                            layout.dataset,
+                            crate::io::message::number(x),
+                            crate::io::message::number(white)
+                        );
+                        lf.data[o] = y;
                         o += 1;
                     }
                 }

@@ -54,6 +54,10 @@ pub fn run(args: Args) -> Result<()> {
         .check()?;
     let cs = settings.method.baseline().is_none();
     anyhow::ensure!(cs || member_map.is_none(), "--member-map needs --method cs (baselines use no ensemble)");
+    anyhow::ensure!(
+        cs || disparity_map.is_none(),
+        "--disparity-map needs --method cs (baselines choose no disparity; nothing would be written)"
+    );
     if cs {
         // The flags first, so a bad one is named before the decode and not as the capture's.
         let (_, opts) = settings.resolve()?;
