@@ -520,3 +520,41 @@ fn headers_that_lie_about_their_size_are_refused_before_allocating() {
     let e = within(20, move || read_npy(&lf).unwrap_err().to_string());
     assert!(e.contains("shape [5, 5, 4000, 4000, 13]") && e.contains("more than the"), "{e}");
 }
+
+/// Issue 41, item 13: frame names outside the folder are refused when a capture is made
+/// (so `save` never writes outside it), and a frame that is a symbolic link to a file
+/// outside the folder is not read by `load`.
+#[test]
+fn frames_stay_inside_their_capture_folder() {
+    let (dir, json) = saved_capture();
+    let cap = Capture::load(dir.path()).unwrap();
+    for (names, says) in [
+        (vec!["../x.pgm"], "frames[0]: \"../x.pgm\" is not a path inside the capture folder"),
+        (vec!["/tmp/abs.pgm"], "is not a path inside the capture folder"),
+        (vec!["snapshot_0.txt"], "is not a .pgm, .png or .npy file"),
+    ] {
+        let mut d = cap.description.clone();
+        d.frames = names.iter().map(|s| s.to_string()).collect();
+        let e = format!("{:#}", Capture::new(d, cap.frames.clone()).unwrap_err());
+        assert!(e.contains(says), "{e}");
+    }
+    let mut d = cap.description.clone();
+    d.frames = vec!["a.pgm".into(), "a.pgm".into()];
+    let e = format!("{:#}", Capture::new(d, vec![cap.frames[0].clone(); 2]).unwrap_err());
+    assert!(e.contains("frames[1]: \"a.pgm\" is named twice"), "{e}");
+    // A link to a frame outside the folder.
+    #[cfg(unix)]
+    {
+        let outside = tempfile::tempdir().unwrap();
+        let name = json["frames"][0].as_str().unwrap().to_string();
+        std::fs::rename(dir.path().join(&name), outside.path().join(&name)).unwrap();
+        std::os::unix::fs::symlink(outside.path().join(&name), dir.path().join(&name)).unwrap();
+        let e = format!("{:#}", Capture::load(dir.path()).unwrap_err());
+        assert!(e.contains("outside the capture folder") && e.lines().count() == 1, "{e}");
+        // A link inside the folder is fine.
+        std::fs::remove_file(dir.path().join(&name)).unwrap();
+        std::fs::rename(outside.path().join(&name), dir.path().join("real.pgm")).unwrap();
+        std::os::unix::fs::symlink("real.pgm", dir.path().join(&name)).unwrap();
+        assert_eq!(Capture::load(dir.path()).unwrap().frames, cap.frames);
+    }
+}

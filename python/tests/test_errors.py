@@ -131,3 +131,16 @@ def test_each_cause_is_said_once(tmp_path):
         slf.import_views(tmp_path / "views")
     assert "not an image slf reads" in str(e.value)
     assert str(e.value).count("Invalid PNG signature") == 1, str(e.value)
+
+
+def test_frames_outside_the_capture_folder_are_refused(capture, tmp_path):
+    """Issue 41, item 13: a capture never writes a frame outside its folder."""
+    for name in ("../x.pgm", str(tmp_path / "abs.pgm")):
+        d = dict(capture.description, frames=[name])
+        with pytest.raises(ValueError, match="not a path inside the capture folder"):
+            slf.Capture(capture.frames, d)
+        c = slf.Capture(capture.frames, capture.description)
+        c.description = d  # changed after construction, as a user may
+        with pytest.raises(ValueError, match="not a path inside the capture folder"):
+            c.save(tmp_path / "cap")
+    assert not (tmp_path / "x.pgm").exists() and not (tmp_path / "abs.pgm").exists()

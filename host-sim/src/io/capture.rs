@@ -134,6 +134,15 @@ impl Capture {
         let d = &description;
         let (rows, cols) = d.frame_size()?;
         ensure!(frames.len() == d.frames.len(), "{} frames for {} names", frames.len(), d.frames.len());
+        // The names are where `save` writes: inside the folder, each once, a known format.
+        for (i, name) in d.frames.iter().enumerate() {
+            frame_path(Path::new(""), name).map_err(|e| anyhow!("frames[{i}]: {}", one_line(&e)))?;
+            ensure!(
+                matches!(extension(Path::new(name)).as_str(), "pgm" | "png" | "npy"),
+                "frames[{i}]: {name:?} is not a .pgm, .png or .npy file"
+            );
+            ensure!(!d.frames[..i].contains(name), "frames[{i}]: {name:?} is named twice (one file per snapshot)");
+        }
         for (i, f) in frames.iter().enumerate() {
             ensure!(
                 f.len() == rows * cols,
@@ -339,6 +348,7 @@ impl Capture {
         for (i, name) in description.frames.iter().enumerate() {
             let path =
                 frame_path(dir, name).map_err(|e| anyhow!("{}: frames[{i}]: {}", desc_path.display(), one_line(&e)))?;
+            inside(dir, &path).map_err(|e| anyhow!("{}: frames[{i}]: {}", desc_path.display(), one_line(&e)))?;
             let frame = read_frame(&path, Some((rows, cols)))?;
             ensure!(
                 (frame.rows, frame.cols) == (rows, cols),
@@ -603,6 +613,25 @@ pub fn frame_path(dir: &Path, name: &str) -> Result<PathBuf> {
         "{name:?} is not a path inside the capture folder (no absolute paths, no '..')"
     );
     Ok(dir.join(rel))
+}
+
+/// Checks that `path` (a frame of the capture folder `dir`) resolves inside `dir`: a
+/// symbolic link to a file elsewhere is not read as the capture's.
+///
+/// # Errors
+/// Where the link leads, or an I/O error resolving it.
+fn inside(dir: &Path, path: &Path) -> Result<()> {
+    let (Ok(d), Ok(p)) = (fs::canonicalize(dir), fs::canonicalize(path)) else {
+        // Missing files are named by the reader, which opens them next.
+        return Ok(());
+    };
+    ensure!(
+        p.starts_with(&d),
+        "{} leads to {}, outside the capture folder (frames are read from inside it only)",
+        path.display(),
+        p.display()
+    );
+    Ok(())
 }
 
 impl CaptureDescription {
