@@ -14,15 +14,31 @@ where
     I: IntoIterator<Item = S>,
     S: Into<std::ffi::OsString> + Clone,
 {
-    let cmd = T::augment_args(clap::Command::new(command).no_binary_name(true));
+    let cmd = negative_numbers(T::augment_args(clap::Command::new(command).no_binary_name(true)));
     cmd.try_get_matches_from(flags).and_then(|m| T::from_arg_matches(&m)).map_err(|e| one_line(&e))
 }
 
-/// A parser error as one line: its first, without clap's `error: ` prefix.
-fn one_line(e: &clap::Error) -> String {
+/// `cmd` and every subcommand under it taking values that look like negative numbers
+/// (`--defects -0.1`) as values, for their parser to refuse by range, not as unknown flags
+/// ("unexpected argument '-0' found").
+pub fn negative_numbers(cmd: clap::Command) -> clap::Command {
+    cmd.allow_negative_numbers(true).mut_subcommands(negative_numbers)
+}
+
+/// A parser error as one line, without clap's `error: ` prefix: its message and the lines
+/// that continue it (the arguments a "required arguments were not provided:" names), up to
+/// the usage and tips after the first blank line.
+pub fn one_line(e: &clap::Error) -> String {
     let text = e.render().to_string();
-    let line = text.lines().find(|l| !l.trim().is_empty()).unwrap_or("invalid flags");
-    line.trim_start_matches("error: ").to_string()
+    let line = text
+        .lines()
+        .map(str::trim)
+        .skip_while(|l| l.is_empty())
+        .take_while(|l| !l.is_empty() && !l.starts_with("Usage:"))
+        .collect::<Vec<_>>()
+        .join(" ");
+    let line = line.trim_start_matches("error: ");
+    if line.is_empty() { "invalid flags".to_string() } else { line.to_string() }
 }
 
 /// A finite number above zero, for clap.
@@ -44,4 +60,25 @@ pub fn pair(s: &str) -> Result<(usize, usize), String> {
     let (a, b) = s.split_once(',').ok_or_else(|| format!("{s:?} is not a pair A,B"))?;
     let num = |t: &str| t.trim().parse::<usize>().map_err(|_| format!("{t:?} in {s:?} is not a whole number"));
     Ok((num(a)?, num(b)?))
+}
+
+#[cfg(test)]
+mod tests {
+    /// Issue 41, item 14: a missing required argument is named on the one line.
+    #[test]
+    fn a_missing_argument_is_named() {
+        #[derive(clap::Parser, Debug)]
+        struct Cmd {
+            #[arg(long)]
+            output: String,
+        }
+        let e = <Cmd as clap::Parser>::try_parse_from(["x"]).unwrap_err();
+        assert_eq!(super::one_line(&e), "the following required arguments were not provided: --output <OUTPUT>");
+        let e = <Cmd as clap::Parser>::try_parse_from(["x", "--output", "a", "--nope"]).unwrap_err();
+        assert_eq!(super::one_line(&e), "unexpected argument '--nope' found");
+        // Issue 41, item 15: a negative number is a value, refused by its parser's range.
+        let e = super::parse::<crate::sim::settings::SimulateSettings, _, _>("simulate", ["--defects", "-0.1"])
+            .unwrap_err();
+        assert!(e.contains("--defects") && e.contains("-0.1") && !e.contains("unexpected argument"), "{e}");
+    }
 }

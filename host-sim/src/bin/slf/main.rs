@@ -62,7 +62,11 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    let cli = match Cli::try_parse() {
+    use clap::{CommandFactory, FromArgMatches};
+    let parsed = slf_host::sim::flags::negative_numbers(Cli::command())
+        .try_get_matches()
+        .and_then(|m| Cli::from_arg_matches(&m));
+    let cli = match parsed {
         Ok(cli) => cli,
         Err(e) => {
             use clap::error::ErrorKind;
@@ -71,15 +75,13 @@ fn main() -> ExitCode {
                 return ExitCode::SUCCESS;
             }
             if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
-                eprintln!(
-                    "error: a command is required: demo, scene, simulate, decode, eval, baseline or sweep (see `slf --help`)"
-                );
+                let names: Vec<String> = Cli::command().get_subcommands().map(|c| c.get_name().to_string()).collect();
+                eprintln!("error: a command is required: {} (see `slf --help`)", names.join(", "));
                 return ExitCode::from(2);
             }
-            // One readable line: clap's first line (its message), without usage and tips.
-            let text = e.render().to_string();
-            let first = text.lines().next().unwrap_or("error: invalid arguments");
-            eprintln!("{first} (see `slf --help`)");
+            // One readable line: clap's message (with the arguments it names on the lines
+            // after), without usage and tips.
+            eprintln!("error: {} (see `slf --help`)", slf_host::sim::flags::one_line(&e));
             return ExitCode::from(2);
         }
     };
