@@ -561,7 +561,7 @@ fn presets_are_their_flags_and_flags_override_them() {
 fn unwritable_outputs_are_refused_before_decoding() {
     let dir = tempfile::tempdir().unwrap();
     let p = |name: &str| dir.path().join(name);
-    stdout(slf().args(["scene", "smooth", "--size", "10", "-o"]).arg(p("t.npy")));
+    stdout(slf().args(["scene", "smooth", "--size", "11", "-o"]).arg(p("t.npy")));
     stdout(slf().arg("simulate").arg(p("t.npy")).arg("-o").arg(p("cap")));
     let e = failure(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("missing/x.npy")));
     assert!(e.contains("cannot write") && e.contains("checked before decoding"), "{e}");
@@ -734,8 +734,8 @@ fn bench_adds_the_devices_frame_figure_to_a_sweeps_table() {
 fn patch_views_are_a_decode_setting_that_fits_the_capture() {
     let dir = tempfile::tempdir().unwrap();
     let p = |name: &str| dir.path().join(name);
-    stdout(slf().args(["scene", "depth", "--size", "10", "-o"]).arg(p("five.npy")));
-    stdout(slf().args(["scene", "depth", "--size", "10", "--views", "4", "-o"]).arg(p("four.npy")));
+    stdout(slf().args(["scene", "depth", "--size", "11", "-o"]).arg(p("five.npy")));
+    stdout(slf().args(["scene", "depth", "--size", "11", "--views", "4", "-o"]).arg(p("four.npy")));
     for lf in ["five", "four"] {
         stdout(slf().arg("simulate").arg(p(&format!("{lf}.npy"))).arg("-o").arg(p(&format!("cap-{lf}"))));
     }
@@ -872,4 +872,53 @@ fn a_write_that_fails_leaves_the_previous_file_whole() {
         .unwrap();
     assert!(!status.success(), "the write past the limit should fail");
     assert!(std::fs::read(&out).unwrap() == before, "the previous file is not whole");
+}
+
+/// Issue 41, item 16: what a later command would refuse is refused by the first one (a
+/// scene eval cannot score, a capture decode cannot take), and values below 0 are said.
+#[test]
+fn the_first_command_refuses_what_a_later_one_would() {
+    use slf_host::io::lightfield::{Dtype, LightField, read_npy, write_npy};
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    let e = failure(slf().args(["scene", "smooth", "--size", "10", "-o"]).arg(p("s.npy")));
+    assert!(e.contains("--size") && e.contains("11"), "{e}");
+    // 3 x 3 views and 4 x 4 lenslets: no capture.
+    for (views, size, says) in [(3, 12, "3 x 3 views"), (5, 4, "4 x 4 lenslets")] {
+        let lf = LightField::zeros((views, views), size, size, 13);
+        write_npy(&p("small.npy"), &lf, Dtype::F32).unwrap();
+        let e = failure(slf().arg("simulate").arg(p("small.npy")).arg("-o").arg(p("cap")));
+        assert!(e.contains(says) && e.contains("the decoder needs"), "{e}");
+        assert!(!p("cap").exists());
+    }
+    // evaluate names the file and the command that mends it (issue 41, item 15).
+    write_npy(&p("two.npy"), &LightField::zeros((5, 5), 12, 12, 2), Dtype::F32).unwrap();
+    let e = failure(slf().arg("evaluate").arg(p("two.npy")).arg("-o").arg(p("ev")));
+    assert!(e.contains("two.npy: 2 bands") && e.contains("slf import bands") && !e.contains("--wavelengths to"), "{e}");
+    write_npy(&p("three.npy"), &LightField::zeros((3, 3), 12, 12, 13), Dtype::F32).unwrap();
+    let e = failure(slf().arg("evaluate").arg(p("three.npy")).arg("-o").arg(p("ev")));
+    assert!(e.contains("three.npy: 3 x 3 views") && !e.contains("the capture"), "{e}");
+    // Negative radiance is recorded as no light, with a warning.
+    let mut lf = LightField::zeros((5, 5), 12, 12, 13);
+    lf.data.iter_mut().enumerate().for_each(|(i, x)| *x = if i % 7 == 0 { -0.5 } else { 0.3 });
+    write_npy(&p("neg.npy"), &lf, Dtype::F32).unwrap();
+    let out = slf().arg("simulate").arg(p("neg.npy")).arg("-o").arg(p("cap")).assert().success().get_output().clone();
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(err.contains("values below 0 (down to -0.500) recorded as no light"), "{err}");
+    // A cube with negative reflectance: set to 0, with a note.
+    let body: Vec<u8> = (0..6 * 7 * 4).flat_map(|i| if i == 5 { -0.87f32 } else { 0.5 }.to_le_bytes()).collect();
+    let header = "{'descr': '<f4', 'fortran_order': False, 'shape': (6, 7, 4), }";
+    std::fs::write(p("cube.npy"), common::npy_bytes(1, header, &body)).unwrap();
+    let out = slf()
+        .args(["import", "cube"])
+        .arg(p("cube.npy"))
+        .args(["--wavelengths", "400,500,600,700", "-o"])
+        .arg(p("c.npy"))
+        .assert()
+        .success()
+        .get_output()
+        .clone();
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(err.contains("below 0") && err.contains("set to 0"), "{err}");
+    assert!(read_npy(&p("c.npy")).unwrap().data.iter().all(|&x| x >= 0.0));
 }

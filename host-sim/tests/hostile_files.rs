@@ -167,6 +167,14 @@ fn numpys_defaults_are_converted_with_a_note() {
     let (lf, notes) = read_npy_with_notes(&p).unwrap();
     assert_eq!(lf.data, [0.0, 1.0]);
     assert!(notes.is_empty());
+
+    // A finite float64 beyond float32's range is named as such (issue 41, item 15), not
+    // called "not finite".
+    let h = "{'descr': '<f8', 'fortran_order': False, 'shape': (1, 1, 1, 1, 2), }";
+    let body: Vec<u8> = [0.5f64, 1e300].iter().flat_map(|x| x.to_le_bytes()).collect();
+    let p = write(dir.path(), "big.npy", &npy_bytes(1, h, &body));
+    let e = read_npy(&p).unwrap_err().to_string();
+    assert!(e.contains("value 1 (in the file's order) is 1e300, beyond float32's range"), "{e}");
 }
 
 #[test]

@@ -439,6 +439,15 @@ fn hdf5_light_fields_are_read_in_any_axis_order() {
     write_h5(&flat, &[4, 13], |_| 0.5);
     let e = read_hdf5(&flat, &Hdf5Layout { dataset: "lf/data".into(), axes: "uvhwb".into() }, 1.0).unwrap_err();
     assert!(e.to_string().contains("has 2 axes"), "{e}");
+    // A type the reader does not convert is named, with the conversion (issue 41, item 15;
+    // before: "type mismatch: expected numeric, got ...").
+    let mut b = hdf5_pure::FileBuilder::new();
+    let mut g = b.create_group("lf");
+    g.create_dataset("data").with_complex32_data(&vec![(0.5, 0.0); 13]).with_shape(&[1, 1, 1, 1, 13]);
+    b.add_group(g.finish());
+    std::fs::write(dir.path().join("complex.h5"), b.finish().unwrap()).unwrap();
+    let e = read_hdf5(&dir.path().join("complex.h5"), &layout, 1.0).unwrap_err().to_string();
+    assert!(e.contains("holds") && e.contains("slf reads 32- or 64-bit floats and integers"), "{e}");
     std::fs::write(dir.path().join("junk.h5"), b"not hdf5 at all").unwrap();
     let e = read_hdf5(&dir.path().join("junk.h5"), &layout, 1.0).unwrap_err();
     assert!(e.to_string().contains("not an HDF5 file"), "{e}");

@@ -55,9 +55,20 @@ def _flag(name: str, value: Any) -> Optional[str]:
     flag = "--" + name.replace("_", "-")
     if value is True:
         return flag
+    if isinstance(value, np.ndarray):
+        value = value.tolist()  # gains=np.ones(13), as a list of numbers
     if isinstance(value, (list, tuple)):
         value = ",".join(str(v) for v in value)
     return f"{flag}={value}"
+
+
+def _raw_frames(frames: Any) -> np.ndarray:
+    """A capture's frames as the extension takes them (uint16), or one line saying why not:
+    ``capture.frames`` may have been replaced after the capture was made."""
+    arr = np.asarray(frames)
+    if arr.dtype != np.uint16:
+        raise ValueError(f"frames: dtype {arr.dtype}, want uint16 (raw sensor values)")
+    return arr
 
 
 def _flags(**kwargs: Any) -> list:
@@ -121,7 +132,7 @@ class Capture:
     def save(self, path: PathLike) -> None:
         """Writes the capture folder ``path`` (``capture.json`` and one frame file per
         snapshot, in the format its names say), as ``slf simulate -o path`` does."""
-        _slf.save_capture(self.frames, json.dumps(self.description), os.fspath(path))
+        _slf.save_capture(_raw_frames(self.frames), json.dumps(self.description), os.fspath(path))
 
     def __repr__(self) -> str:
         mask = self.description.get("mask", {}).get("family", "?")
@@ -150,8 +161,10 @@ def scene(name: str, size: int = 100, views: int = 5, seed: int = 0) -> np.ndarr
     for n, v in (("size", size), ("views", views), ("seed", seed)):
         if not isinstance(v, (int, np.integer)) or v < 0:
             raise ValueError(f"{n}: want a whole number at or above 0, got {v!r}")
-    if not 5 <= size <= 4096:
-        raise ValueError(f"size {size}: want 5..=4096 (as `slf scene --size`: the decoder's patch is 5 x 5 lenslets)")
+    if not 11 <= size <= 4096:
+        raise ValueError(
+            f"size {size}: want 11..=4096 (as `slf scene --size`: the smallest light field slf.evaluate scores)"
+        )
     if not 4 <= views <= 16:
         raise ValueError(f"views {views}: want 4..=16 (as `slf scene --views`: the decoder's patch takes 4 x 4)")
     return _slf.scene(name, int(size), int(views), int(seed))
@@ -340,7 +353,8 @@ def decode(
         flat=flat,
         min_bands=min_bands,
     )
-    lf, rep = _slf.decode(cap.frames, json.dumps(cap.description), args, threads, _progress_callback(progress))
+    frames = _raw_frames(cap.frames)
+    lf, rep = _slf.decode(frames, json.dumps(cap.description), args, threads, _progress_callback(progress))
     if "warning" in rep:
         warnings.warn(f"slf: {rep['warning']}", stacklevel=2)
     return (lf, rep) if report else lf

@@ -22,6 +22,12 @@ pub fn scene<'py>(
     seed: u64,
 ) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
     let s = realistic::by_name(name, seed).or_py()?;
+    if size < slf_host::sim::scene::MIN_SCENE {
+        return Err(PyValueError::new_err(format!(
+            "size {size}: want {}..=4096 (the smallest light field slf.evaluate scores, SSIM's 11 x 11 window)",
+            slf_host::sim::scene::MIN_SCENE
+        )));
+    }
     let shape = SceneSize { views: (views, views), rows: size, cols: size };
     shape.check().map_err(|e| PyValueError::new_err(format!("size {size} with views {views}: {e}")))?;
     let lf = py.detach(|| s.render(shape));

@@ -36,7 +36,7 @@ def test_patch_views_keyword_and_report(capture):
     _, four = slf.decode(capture, preset="preview", patch_views=4, report=True)
     assert five["patch_views"] == 5 and four["patch_views"] == 4
     assert four["decoded"] > five["decoded"]
-    small = slf.simulate(slf.scene("depth", size=10, views=4), k=1)
+    small = slf.simulate(slf.scene("depth", size=11, views=4), k=1)
     assert slf.decode(small, preset="preview", report=True)[1]["patch_views"] == 4
     with pytest.raises(ValueError, match="--patch-views 5: the capture's lenslets have 4 x 4 views"):
         slf.decode(small, patch_views=5)

@@ -144,3 +144,16 @@ def test_frames_outside_the_capture_folder_are_refused(capture, tmp_path):
         with pytest.raises(ValueError, match="not a path inside the capture folder"):
             c.save(tmp_path / "cap")
     assert not (tmp_path / "x.pgm").exists() and not (tmp_path / "abs.pgm").exists()
+
+
+def test_arrays_as_flags_and_float_frames(capture):
+    """Issue 41, item 15: gains as a numpy array are numbers, not their repr; float frames
+    set after construction are one ValueError line, not a two-line TypeError."""
+    assert np.array_equal(
+        slf.decode(capture, preset="preview", gains=np.ones(13)), slf.decode(capture, preset="preview", gains=[1.0] * 13)
+    )
+    c = slf.Capture(capture.frames, capture.description)
+    c.frames = capture.frames.astype(np.float32)
+    with pytest.raises(ValueError, match="frames: dtype float32, want uint16") as e:
+        slf.decode(c)
+    assert "\n" not in str(e.value)

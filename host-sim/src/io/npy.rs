@@ -119,6 +119,11 @@ pub enum NpyErrorKind {
     },
     /// The array's shape is not what the caller needs.
     Shape(String),
+    /// A finite float64 value (the `index`-th in the file's order) beyond float32's range.
+    Range {
+        index: u64,
+        value: f64,
+    },
 }
 
 impl fmt::Display for NpyError {
@@ -144,6 +149,11 @@ impl fmt::Display for NpyError {
                 write!(f, "truncated body: header promises {expected} values, file holds {found}")
             }
             NpyErrorKind::Shape(what) => write!(f, "{what}"),
+            NpyErrorKind::Range { index, value } => write!(
+                f,
+                "value {index} (in the file's order) is {value:e}, beyond float32's range (+-3.4e38) that slf \
+                 computes in"
+            ),
         }
     }
 }
@@ -271,16 +281,20 @@ pub fn read_from_checked(
         Element::F32 => Values::F32(raw.chunks_exact(4).map(|c| f32::from_bits(word32(c, swap))).collect()),
         Element::F64 => {
             notes.push("float64 converted to float32".into());
-            Values::F32(
-                raw.chunks_exact(8)
-                    .map(|c| {
-                        let mut b = [0u8; 8];
-                        b.copy_from_slice(c);
-                        let x = if swap { u64::from_be_bytes(b) } else { u64::from_le_bytes(b) };
-                        f64::from_bits(x) as f32
-                    })
-                    .collect(),
-            )
+            let wide: Vec<f64> = raw
+                .chunks_exact(8)
+                .map(|c| {
+                    let mut b = [0u8; 8];
+                    b.copy_from_slice(c);
+                    f64::from_bits(if swap { u64::from_be_bytes(b) } else { u64::from_le_bytes(b) })
+                })
+                .collect();
+            // A finite float64 beyond float32's range would become infinite: say so, not
+            // "not finite" of a value the file holds as finite.
+            if let Some(i) = wide.iter().position(|x| x.is_finite() && x.abs() > f64::from(f32::MAX)) {
+                return Err(NpyErrorKind::Range { index: i as u64, value: wide[i] });
+            }
+            Values::F32(wide.into_iter().map(|x| x as f32).collect())
         }
         Element::U16 => Values::U16(
             raw.chunks_exact(2)

@@ -221,7 +221,7 @@ impl CubeSettings {
             },
             geometry: self.geometry.geometry(),
         };
-        let (lightfield, disparity) = cube::to_lightfield(&bands, &cfg, (data.rows, data.cols))?;
+        let (mut lightfield, disparity) = cube::to_lightfield(&bands, &cfg, (data.rows, data.cols))?;
         lightfield.check_finite().map_err(|e| {
             anyhow!(
                 "{}: with --white {}: {e}: give the value of white in the cube's units",
@@ -230,6 +230,18 @@ impl CubeSettings {
             )
         })?;
         check_lenslets(&lightfield)?;
+        // Measured reflectance dips below 0 where dark subtraction met noise; no surface
+        // reflects less than nothing, and a light field below 0 is no light.
+        let negative = lightfield.data.iter().filter(|&&x| x < 0.0).count();
+        let mut notes = notes;
+        if negative > 0 {
+            let least = lightfield.data.iter().fold(0.0f32, |m, &x| m.min(x));
+            lightfield.data.iter_mut().for_each(|x| *x = x.max(0.0));
+            notes.push(format!(
+                "{negative} of {} values below 0 (down to {least:.3}) set to 0: light is not negative",
+                lightfield.data.len()
+            ));
+        }
         Ok(Imported { lightfield, disparity, notes })
     }
 }

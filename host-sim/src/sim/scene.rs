@@ -332,6 +332,11 @@ fn rect(y0: f32, x0: f32, y1: f32, x1: f32) -> Shape {
 /// The named test scenes, each of a distinct character.
 pub const NAMES: [&str; 5] = ["smooth", "texture", "depth", "saturated", "dark"];
 
+/// The fewest lenslets a side of a test scene (`slf scene --size`, `slf.scene`): the
+/// smallest light field the metrics score (SSIM's 11 x 11 window), so every scene made can
+/// be evaluated. (Training scenes may be smaller: `slf train --size` from 5.)
+pub const MIN_SCENE: usize = 11;
+
 /// A named test scene (see [`NAMES`]); `None` for an unknown name (the realistic named
 /// scenes are in `crate::sim::realistic`).
 pub fn named(name: &str) -> Option<Scene> {

@@ -73,6 +73,37 @@ pub fn read_hdf5(path: &Path, layout: &Hdf5Layout, white: f32) -> Result<LightFi
     let Some(total) = total else {
         bail!("{}: {}: shape {shape:?} is more than {MAX_VALUES} values", path.display(), layout.dataset);
     };
+    // The element type first: a type the reader does not convert (float16, strings,
+    // compounds) is named, not reported as the library's "type mismatch".
+    use hdf5_pure::DType;
+    let dtype = ds
+        .dtype()
+        .map_err(|e| anyhow::anyhow!("{}: {}: unreadable element type: {e}", path.display(), layout.dataset))?;
+    let numeric = matches!(
+        dtype,
+        DType::F32
+            | DType::F64
+            | DType::I8
+            | DType::I16
+            | DType::I32
+            | DType::I64
+            | DType::U8
+            | DType::U16
+            | DType::U32
+            | DType::U64
+    );
+    if !numeric {
+        let what = match ds.datatype() {
+            Ok(hdf5_pure::Datatype::FloatingPoint { size, .. }) => format!("{}-bit floats", 8 * size),
+            _ => format!("{dtype:?}").chars().take(60).collect(),
+        };
+        bail!(
+            "{}: {}: holds {what}; slf reads 32- or 64-bit floats and integers (convert it, e.g. h5py: \
+             f[name][...].astype('float32'))",
+            path.display(),
+            layout.dataset
+        );
+    }
     let values = ds
         .read_f32()
         .map_err(|e| anyhow::anyhow!("{}: {}: cannot read the values: {e}", path.display(), layout.dataset))?;

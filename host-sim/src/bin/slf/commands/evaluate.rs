@@ -10,9 +10,10 @@ use slf_host::decode::settings::patch_views;
 use slf_host::eval::evaluation::{SETTINGS, evaluate_set, table};
 use slf_host::io::lightfield::read_npy;
 
-use super::import::camera_bands;
 use crate::args::ranged;
 use slf_host::decode::settings::WindowKind;
+use slf_host::sim::import::MIN_VIEWS;
+use slf_host::sim::scene::MIN_SCENE;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -53,7 +54,30 @@ pub fn run(args: Args) -> Result<()> {
                 inputs[i].display()
             );
         }
-        scenes.push((name, camera_bands(read_npy(p)?, None, p)?));
+        let lf = read_npy(p)?;
+        // What the decodes and metrics need, named with the file before any work.
+        anyhow::ensure!(
+            lf.bands == 13,
+            "{}: {} bands, the camera's are 13: resample it first with slf import bands {} --wavelengths ... -o OUT",
+            p.display(),
+            lf.bands,
+            p.display()
+        );
+        anyhow::ensure!(
+            lf.views.0 >= MIN_VIEWS && lf.views.1 >= MIN_VIEWS,
+            "{}: {} x {} views: the decoder needs at least {MIN_VIEWS} x {MIN_VIEWS}",
+            p.display(),
+            lf.views.0,
+            lf.views.1
+        );
+        anyhow::ensure!(
+            lf.rows >= MIN_SCENE && lf.cols >= MIN_SCENE,
+            "{}: {} x {} lenslets: the metrics need at least {MIN_SCENE} x {MIN_SCENE} (SSIM's window)",
+            p.display(),
+            lf.rows,
+            lf.cols
+        );
+        scenes.push((name, lf));
     }
     let strides: Vec<(u8, u8)> = stride.iter().map(|&s| (s as u8, s as u8)).collect();
     let rows = evaluate_set(&scenes, &SETTINGS, blob.as_deref(), &strides, window.window(), patch_views, &out)?;

@@ -23,8 +23,9 @@ pub struct Args {
     /// Seed of a random scene.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Spatial rows and columns (lenslets), 5..=4096: the decoder's patch is 5 x 5.
-    #[arg(long, default_value_t = 100, value_parser = ranged::<5, 4096>)]
+    /// Spatial rows and columns (lenslets), 11..=4096: the smallest slf eval scores
+    /// (SSIM's 11 x 11 window).
+    #[arg(long, default_value_t = 100, value_parser = ranged::<11, 4096>)]
     pub size: usize,
     /// Views per side, 4..=16: the decoder's patch takes 4 x 4.
     #[arg(long, default_value_t = 5, value_parser = ranged::<4, 16>)]
