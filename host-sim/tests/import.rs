@@ -443,7 +443,7 @@ fn hdf5_light_fields_are_read_in_any_axis_order() {
     // before: "type mismatch: expected numeric, got ...").
     let mut b = hdf5_pure::FileBuilder::new();
     let mut g = b.create_group("lf");
-    g.create_dataset("data").with_complex32_data(&vec![(0.5, 0.0); 13]).with_shape(&[1, 1, 1, 1, 13]);
+    g.create_dataset("data").with_complex32_data(&[(0.5, 0.0); 13]).with_shape(&[1, 1, 1, 1, 13]);
     b.add_group(g.finish());
     std::fs::write(dir.path().join("complex.h5"), b.finish().unwrap()).unwrap();
     let e = read_hdf5(&dir.path().join("complex.h5"), &layout, 1.0).unwrap_err().to_string();
