@@ -94,6 +94,13 @@ fn u32_at(b: &[u8], at: usize) -> u32 {
     }
 }
 
+/// Copies `bytes` into `buf` at `at`, if they fit (the writers' offsets always do).
+fn put(buf: &mut [u8], at: usize, bytes: &[u8]) {
+    if let Some(dst) = buf.get_mut(at..at + bytes.len()) {
+        dst.copy_from_slice(bytes);
+    }
+}
+
 fn read_matrix<const D: usize>(bytes: &[u8]) -> Matrix<D> {
     let mut m = [[0.0f32; D]; D];
     let (words, _) = bytes.as_chunks::<4>();
@@ -247,26 +254,28 @@ pub fn write_blob<const PS: usize, const PT: usize, const PU: usize, const PV: u
         return Err(DictionaryError::BufferTooSmall { needed: total as u32 });
     };
     out.fill(0);
-    let (header, rest) = out.split_at_mut(HEADER_LEN);
-    header[..4].copy_from_slice(&BLOB_MAGIC);
-    header[VERSION_AT..VERSION_AT + 2].copy_from_slice(&BLOB_VERSION.to_le_bytes());
+    // Every offset below is within `total` by construction; `put` and `get_mut` keep a
+    // bounds failure from being a panic path in any build profile.
+    let (header, rest) = out.split_at_mut(HEADER_LEN.min(total));
+    put(header, 0, &BLOB_MAGIC);
+    put(header, VERSION_AT, &BLOB_VERSION.to_le_bytes());
     for (i, d) in dims.iter().enumerate() {
-        header[DIMS_AT + 2 * i..DIMS_AT + 2 * i + 2].copy_from_slice(&(*d as u16).to_le_bytes());
+        put(header, DIMS_AT + 2 * i, &(*d as u16).to_le_bytes());
     }
-    header[MEMBERS_AT..MEMBERS_AT + 2].copy_from_slice(&(members.len() as u16).to_le_bytes());
+    put(header, MEMBERS_AT, &(members.len() as u16).to_le_bytes());
     let payload_len = members.len() * member_len(dims);
-    header[PAYLOAD_LEN_AT..PAYLOAD_LEN_AT + 4].copy_from_slice(&(payload_len as u32).to_le_bytes());
+    put(header, PAYLOAD_LEN_AT, &(payload_len as u32).to_le_bytes());
     let mut at = 0;
     for m in members {
         let d = &m.d;
-        at += write_matrix(&d.m1, &mut rest[at..]);
-        at += write_matrix(&d.m2, &mut rest[at..]);
-        at += write_matrix(&d.m3, &mut rest[at..]);
-        at += write_matrix(&d.m4, &mut rest[at..]);
-        at += write_matrix(&d.m5, &mut rest[at..]);
+        at += write_matrix(&d.m1, rest.get_mut(at..).unwrap_or_default());
+        at += write_matrix(&d.m2, rest.get_mut(at..).unwrap_or_default());
+        at += write_matrix(&d.m3, rest.get_mut(at..).unwrap_or_default());
+        at += write_matrix(&d.m4, rest.get_mut(at..).unwrap_or_default());
+        at += write_matrix(&d.m5, rest.get_mut(at..).unwrap_or_default());
     }
     let body_len = total - CHECKSUM_LEN;
-    let crc = CRC32.checksum(&out[..body_len]);
-    out[body_len..].copy_from_slice(&crc.to_le_bytes());
+    let crc = CRC32.checksum(out.get(..body_len).unwrap_or_default());
+    put(out, body_len, &crc.to_le_bytes());
     Ok(total)
 }

@@ -192,10 +192,13 @@ fn overlap(half: usize, delta: usize) -> f32 {
     }
 }
 
-/// A grid position `s * pt + t` as `(s, t)`.
+/// A grid position `s * pt + t` as `(s, t)`. Checked division (`pt` is the patch's lenslet
+/// columns, never 0): where a build does not inline the constant, `/` would link a
+/// division-by-zero panic into the decoder (the release profile's thin LTO did).
 #[inline(always)]
 fn grid_position(p: u8, pt: usize) -> (usize, usize) {
-    (usize::from(p) / pt, usize::from(p) % pt)
+    let p = usize::from(p);
+    (p.checked_div(pt).unwrap_or(0), p.checked_rem(pt).unwrap_or(0))
 }
 
 /// Solves `G z = r` in place for one view and band's measurements at grid positions `at`
