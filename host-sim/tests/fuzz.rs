@@ -227,6 +227,16 @@ fn import_inputs() -> tempfile::TempDir {
             img.save(views.join(format!("lf_{:02}_{:02}.png", r + 1, c + 1))).unwrap();
         }
     }
+    // The same views with one of the default window's missing, for --fill warp.
+    let missing = dir.path().join("views-missing");
+    std::fs::create_dir(&missing).unwrap();
+    for entry in std::fs::read_dir(&views).unwrap() {
+        let entry = entry.unwrap();
+        let name = entry.file_name();
+        if name != "input_Cam020.png" && name != "lf_03_03.png" {
+            std::fs::copy(entry.path(), missing.join(name)).unwrap();
+        }
+    }
     let body: Vec<u8> = (0..8 * 8 * 31).flat_map(|i| (0.2 + (i % 7) as f32 * 0.1).to_le_bytes()).collect();
     let header = "{'descr': '<f4', 'fortran_order': False, 'shape': (8, 8, 31), }";
     std::fs::write(dir.path().join("cube.npy"), npy_bytes(1, header, &body)).unwrap();
@@ -245,6 +255,7 @@ fn fuzz_import_options() {
     use slf_host::sim::import::{CubeSettings, ViewsSettings};
     let inputs = import_inputs();
     let folder = inputs.path().join("views").display().to_string();
+    let missing = inputs.path().join("views-missing").display().to_string();
     let cube = inputs.path().join("cube.npy").display().to_string();
     let check = |result: anyhow::Result<slf_host::io::import::views::Imported>| -> Result<(), TestCaseError> {
         match result {
@@ -281,14 +292,18 @@ fn fuzz_import_options() {
         option("resize", flag_list(2).boxed()),
         option("index-base", flag_number().boxed()),
         any::<bool>(),
+        // Filling a missing view (issue 41: --max-disparity 1e9 asked for 17 GB).
+        option("fill", prop::sample::select(vec!["warp", "none", "x"]).prop_map(String::from).boxed()),
+        option("max-disparity", flag_number().boxed()),
+        any::<bool>(),
     );
     runner()
-        .run(&views, |(a, b, c, d, e, f, pattern)| {
-            let mut flags = vec![folder.clone()];
+        .run(&views, |(a, b, c, d, e, f, pattern, g, h, one_missing)| {
+            let mut flags = vec![if one_missing { missing.clone() } else { folder.clone() }];
             if pattern {
                 flags.push("--pattern=lf_{row:02}_{col:02}.png".into());
             }
-            flags.extend([a, b, c, d, e, f].into_iter().flatten().flatten());
+            flags.extend([a, b, c, d, e, f, g, h].into_iter().flatten().flatten());
             parsed(ViewsSettings::from_flags(&flags).map(|s| s.run()))
         })
         .unwrap();
@@ -391,4 +406,136 @@ fn fuzz_decode_flag_ranges() {
     let decoded = DECODED.load(Ordering::Relaxed);
     eprintln!("fuzz decode flag ranges: {} cases ({decoded} decoded), no failure", cases());
     assert!(decoded > 0, "the generator must reach a decode");
+}
+
+/// Frames read as a capture's (its frame size known).
+static FRAMES: AtomicU32 = AtomicU32::new(0);
+
+/// Frame files whose headers state any size, the file as long as the header claims (sparse)
+/// or not: a frame is read only at the capture's size, and a header that claims another is
+/// refused before its pixels are allocated (issue 41: 65535 x 65535 PGMs and `.npy` frames,
+/// a small PNG claiming 15000 x 15000).
+#[test]
+fn fuzz_frame_headers() {
+    use slf_host::io::capture::read_frame;
+    let dir = tempfile::tempdir().unwrap();
+    let expect = (10usize, 15usize);
+    let size = |right: u32| prop_oneof![3 => Just(right), 4 => 0u32..20, 2 => 0u32..70_000, 1 => any::<u32>()];
+    let inputs = (prop::sample::select(vec!["pgm", "npy", "png"]), size(15), size(10), 0u32..3, any::<bool>());
+    runner()
+        .run(&inputs, |(ext, w, h, depth, sparse)| {
+            let path = dir.path().join(format!("f.{ext}"));
+            let (header, body): (Vec<u8>, u64) = match ext {
+                "pgm" => {
+                    let top = [255u32, 4095, 65535][depth as usize];
+                    let per = if top > 255 { 2 } else { 1 };
+                    (format!("P5\n{w} {h}\n{top}\n").into_bytes(), (per * u64::from(w)).saturating_mul(u64::from(h)))
+                }
+                "npy" => {
+                    let h = format!("{{'descr': '<u2', 'fortran_order': False, 'shape': ({h}, {w}), }}");
+                    (npy_bytes(1, &h, &[]), (2 * u64::from(w)).saturating_mul(u64::from(h_of(&h))))
+                }
+                _ => (png_header(w, h), 0),
+            };
+            let file = std::fs::File::create(&path).unwrap();
+            std::io::Write::write_all(&mut &file, &header).unwrap();
+            // A sparse body of the claimed length (or a short one): no disk is used.
+            let len = header.len() as u64 + if sparse { body.min(1 << 40) } else { body.min(64) };
+            file.set_len(len).unwrap();
+            match read_frame(&path, Some(expect)) {
+                Ok(f) => {
+                    FRAMES.fetch_add(1, Ordering::Relaxed);
+                    prop_assert_eq!((f.rows, f.cols), expect);
+                    prop_assert_eq!(f.data.len(), expect.0 * expect.1);
+                }
+                Err(e) => {
+                    let text = format!("{e:#}");
+                    prop_assert!(!text.contains('\n'), "not one line: {}", text);
+                    prop_assert!(text.contains("f."), "names no file: {}", text);
+                }
+            }
+            Ok(())
+        })
+        .unwrap();
+    eprintln!("fuzz frame headers: {} cases ({} read), no failure", cases(), FRAMES.load(Ordering::Relaxed));
+    assert!(FRAMES.load(Ordering::Relaxed) > 0, "the generator must reach a frame of the capture's size");
+}
+
+/// The rows the `.npy` header in `h` states (its shape's first number).
+fn h_of(h: &str) -> u32 {
+    h.split("'shape': (").nth(1).and_then(|r| r.split(',').next()).and_then(|n| n.trim().parse().ok()).unwrap_or(0)
+}
+
+/// A PNG's signature and IHDR (8-bit grey, `w x h`), an empty IDAT and IEND.
+fn png_header(w: u32, h: u32) -> Vec<u8> {
+    let chunk = |kind: &[u8; 4], data: &[u8]| {
+        let mut c = (data.len() as u32).to_be_bytes().to_vec();
+        c.extend(kind);
+        c.extend(data);
+        let mut crc = crc32fast::Hasher::new();
+        crc.update(kind);
+        crc.update(data);
+        c.extend(crc.finalize().to_be_bytes());
+        c
+    };
+    let mut ihdr = w.to_be_bytes().to_vec();
+    ihdr.extend(h.to_be_bytes());
+    ihdr.extend([8, 0, 0, 0, 0]);
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    png.extend(chunk(b"IHDR", &ihdr));
+    png.extend(chunk(b"IDAT", &[]));
+    png.extend(chunk(b"IEND", &[]));
+    png
+}
+
+/// Bench tables read and drawn again.
+static DRAWN: AtomicU32 = AtomicU32::new(0);
+
+/// `slf bench --from` on tables of any rows (times of 0, NaN, negative, huge; no rows;
+/// short rows): a table is read only with finite values and times above 0, and what is read
+/// is drawn at once (issue 41: an empty table aborted, a time of 0 or a NaN ran past a
+/// minute).
+#[test]
+fn fuzz_bench_inputs() {
+    use slf_host::eval::bench::{read_points, write};
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("bench.csv");
+    let header = "mask,k,setting,psnr_db,ssim,sa_deg,ms_per_patch_1_thread,ms_per_patch_all_threads,\
+                  solves_per_patch,frame_512_s_1_thread,pareto";
+    let row = (
+        prop::sample::select(vec!["pixel", "lenslet", "kronecker", ""]),
+        prop::sample::select(vec!["1", "3", "0", "x", "300"]),
+        prop::collection::vec(flag_number(), 7),
+        any::<bool>(),
+    )
+        .prop_map(|(mask, k, numbers, pareto)| format!("{mask},{k},a setting,{},{pareto}", numbers.join(",")));
+    let table = prop::collection::vec(row, 0..6);
+    let drawn_at_most = 25; // drawing is 50 ms a table: a few suffice
+    runner()
+        .run(&table, |rows| {
+            let text = std::iter::once(header.to_string()).chain(rows).collect::<Vec<_>>().join("\n") + "\n";
+            std::fs::write(&csv, text).unwrap();
+            match read_points(&csv) {
+                Ok(points) => {
+                    prop_assert!(!points.is_empty());
+                    for p in &points {
+                        prop_assert!(p.ms_one > 0.0 && p.ms_one.is_finite() && p.psnr.is_finite());
+                    }
+                    if DRAWN.fetch_add(1, Ordering::Relaxed) < drawn_at_most {
+                        let out = dir.path().join("out");
+                        let start = std::time::Instant::now();
+                        write(&points, &[], &out).map_err(|e| TestCaseError::fail(format!("{e:#}")))?;
+                        prop_assert!(start.elapsed().as_secs() < 20, "drawing took {:?}", start.elapsed());
+                    }
+                }
+                Err(e) => {
+                    let text = format!("{e:#}");
+                    prop_assert!(!text.contains('\n'), "not one line: {}", text);
+                }
+            }
+            Ok(())
+        })
+        .unwrap();
+    eprintln!("fuzz bench inputs: {} cases ({} read), no failure", cases(), DRAWN.load(Ordering::Relaxed));
+    assert!(DRAWN.load(Ordering::Relaxed) > 0, "the generator must reach a table that reads");
 }

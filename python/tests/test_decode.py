@@ -1,5 +1,6 @@
 """The decode from Python: threads, progress, reports, the GIL released."""
 
+import json
 import threading
 import time
 
@@ -114,3 +115,38 @@ def test_light_fields_in_any_memory_order_are_read_by_value(depth):
     recon = depth + np.float32(0.01)
     want = dict(_slf.evaluate(depth, recon))
     assert dict(_slf.evaluate(np.asfortranarray(depth), np.asfortranarray(recon))) == want
+
+
+def test_random_array_layouts_are_read_by_value(capture, depth):
+    """Issue 41's fuzz target for the package's array layouts: frames and light fields in
+    random memory orders, strides and axis permutations (undone to the same values) decode
+    and score exactly as their C-ordered copies. A fixed seed; 40 layouts each."""
+    from slf import _slf
+
+    rng = np.random.default_rng(41)
+    frames = np.ascontiguousarray(capture.frames)
+    text = json.dumps(capture.description)
+    want = _slf.decode(frames, text, ["--preset=preview", "--disparities=0:0"], 1, None)[0]
+    recon = depth + np.float32(0.01)
+    score = dict(_slf.evaluate(depth, recon))
+
+    def relaid(a):
+        """`a`'s values in a random layout: a permuted copy permuted back, a strided view
+        of a larger buffer, or Fortran order."""
+        how = rng.integers(3)
+        if how == 0:
+            order = rng.permutation(a.ndim)
+            return np.ascontiguousarray(a.transpose(order)).transpose(np.argsort(order))
+        if how == 1:
+            axis = int(rng.integers(a.ndim))
+            step = int(rng.integers(2, 4))
+            return np.repeat(a, step, axis=axis)[(slice(None),) * axis + (slice(None, None, step),)]
+        return np.asfortranarray(a)
+
+    for _ in range(40):
+        f = relaid(frames)
+        assert np.array_equal(f, frames)
+        got = _slf.decode(f, text, ["--preset=preview", "--disparities=0:0"], 1, None)[0]
+        assert np.array_equal(got, want)
+        t, r = relaid(depth), relaid(recon)
+        assert dict(_slf.evaluate(t, r)) == score
