@@ -105,7 +105,7 @@ fn bad_captures_say_what_and_where() {
         (
             "lenslets",
             Box::new(|j| j["lenslets"] = serde_json::json!([11, 15])),
-            "frame is 50 x 75, capture.json implies 55 x 75",
+            "frame is 50 x 75, the capture's frames are 55 x 75",
         ),
         (
             "tile",

@@ -175,7 +175,8 @@ impl Outputs {
     pub fn check(&self) -> Result<()> {
         self.check_distinct()?;
         for o in &self.outputs {
-            writable(&o.given).with_context(|| format!("{} {}", o.what, o.given.display()))?;
+            writable(&o.given)
+                .with_context(|| format!("cannot write {} {} (checked before the run)", o.what, o.given.display()))?;
         }
         Ok(())
     }

@@ -15,8 +15,9 @@ use crate::args::{Family, ranged};
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Spatial size (lenslets per side), 5..=1024.
-    #[arg(long, default_value_t = 40, value_parser = ranged::<5, 1024>)]
+    /// Spatial size (lenslets per side), 11..=1024: the smallest the metrics score (SSIM's
+    /// 11 x 11 window).
+    #[arg(long, default_value_t = 40, value_parser = ranged::<11, 1024>)]
     pub size: usize,
     /// Snapshot counts.
     #[arg(long, value_delimiter = ',', default_value = "1,3,5,7")]

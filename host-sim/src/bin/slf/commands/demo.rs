@@ -17,8 +17,9 @@ pub struct Args {
     /// Named scene (smooth, texture, depth, saturated, dark).
     #[arg(long, default_value = "depth")]
     pub scene: String,
-    /// Spatial size (lenslets per side), 5..=2048.
-    #[arg(long, default_value_t = 100, value_parser = ranged::<5, 2048>)]
+    /// Spatial size (lenslets per side), 11..=2048: the smallest the metrics score (SSIM's
+    /// 11 x 11 window).
+    #[arg(long, default_value_t = 100, value_parser = ranged::<11, 2048>)]
     pub size: usize,
     #[command(flatten)]
     pub basis: BasisSettings,
