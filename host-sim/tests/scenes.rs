@@ -244,3 +244,55 @@ fn pink_texture_falls_as_one_over_f() {
     assert!((s10 + 1.0).abs() < 0.35, "beta 1: slope {s10:.2}");
     assert!(s13 < s10 && s10 < s08, "{s08:.2} {s10:.2} {s13:.2}");
 }
+
+/// Mean spectral angle (degrees) between horizontally neighbouring pixels of view (u, v).
+fn neighbour_angle(lf: &slf_host::io::lightfield::LightField, u: usize, v: usize) -> f64 {
+    let (mut sum, mut n) = (0.0f64, 0usize);
+    for y in 0..lf.rows {
+        for x in 0..lf.cols - 1 {
+            let (a, b) = (lf.spectrum(u, v, y, x), lf.spectrum(u, v, y, x + 1));
+            let dot: f64 = a.iter().zip(b).map(|(p, q)| f64::from(*p) * f64::from(*q)).sum();
+            let na: f64 = a.iter().map(|p| f64::from(*p).powi(2)).sum::<f64>().sqrt();
+            let nb: f64 = b.iter().map(|p| f64::from(*p).powi(2)).sum::<f64>().sqrt();
+            sum += (dot / (na * nb).max(1e-12)).clamp(-1.0, 1.0).acos().to_degrees();
+            n += 1;
+        }
+    }
+    sum / n as f64
+}
+
+/// The hard-case set (issue 42): each scene is what its name says it is.
+#[test]
+fn hard_cases_are_what_they_are_named() {
+    use slf_host::sim::{hard, realistic};
+    for name in hard::NAMES {
+        let a = hard::named(name).unwrap().render(SIZE);
+        assert_eq!(a, hard::named(name).unwrap().render(SIZE), "{name}: deterministic");
+        assert!(a.data.iter().all(|x| x.is_finite() && *x >= 0.0) && a.max() > 0.0, "{name}");
+        assert_eq!(hard::by_name(name, 0).unwrap(), hard::named(name).unwrap());
+    }
+    assert!(hard::by_name("nope", 0).unwrap_err().to_string().contains("or a hard case"));
+    let render = |n: &str| hard::named(n).unwrap().render(SIZE);
+    // Materials at the lenslet scale: neighbouring pixels' spectra far apart (a smooth
+    // realistic scene's are a few degrees).
+    let smooth = neighbour_angle(&realistic::named("outdoor").unwrap().render(SIZE), 2, 2);
+    let (one, two, field) = (render("mosaic"), render("mosaic-2"), render("field"));
+    assert!(neighbour_angle(&one, 2, 2) > 20.0 && neighbour_angle(&one, 2, 2) > 4.0 * smooth, "{smooth}");
+    assert!(neighbour_angle(&two, 2, 2) > 10.0 && neighbour_angle(&field, 2, 2) > 5.0);
+    // The mosaic's plane is at 0.3 pixels per view: the centre view's pixel x is the view
+    // one step right's, 0.3 pixels on (each pixel is the mean of four samples, so a
+    // 0.3-pixel shift of one-pixel cells mixes a pixel with its neighbour: not equal).
+    assert_ne!(one.spectrum(2, 2, 10, 10), one.spectrum(2, 3, 10, 10));
+    // Dim is the outdoor scene at 3 % of its exposure.
+    let (dim, outdoor) = (render("dim"), realistic::named("outdoor").unwrap().render(SIZE));
+    for (d, o) in dim.data.iter().zip(&outdoor.data) {
+        assert!((d - 0.03 * o).abs() <= 1e-6 + 1e-5 * o, "{d} vs {o}");
+    }
+    // Narrow light: most of the energy in the three lines' bands.
+    let narrow = render("narrow");
+    let line: f64 = narrow.data.chunks(13).map(|s| f64::from(s[2] + s[5] + s[9])).sum();
+    let all: f64 = narrow.data.iter().map(|&x| f64::from(x)).sum();
+    assert!(line > 0.8 * all, "{line} of {all}");
+    // Speculars exceed white (they saturate the sensor), print does not.
+    assert!(render("speculars").max() > 1.5 && render("print").max() < 1.0);
+}

@@ -4,7 +4,6 @@
 use numpy::{PyArrayDyn, PyReadonlyArrayDyn};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use slf_host::sim::realistic;
 use slf_host::sim::scene::SceneSize;
 use slf_host::sim::settings::SimulateSettings;
 
@@ -21,7 +20,7 @@ pub fn scene<'py>(
     views: usize,
     seed: u64,
 ) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
-    let s = realistic::by_name(name, seed).or_py()?;
+    let s = slf_host::sim::hard::by_name(name, seed).or_py()?;
     if size < slf_host::sim::scene::MIN_SCENE {
         return Err(PyValueError::new_err(format!(
             "size {size}: want {}..=4096 (the smallest light field slf.evaluate scores, SSIM's 11 x 11 window)",

@@ -5,6 +5,9 @@
 //! - [`scene`]: the named test scenes and the random training scenes;
 //! - [`realistic`]: scenes that look like the world (slanted and curved surfaces, 1/f
 //!   textures, measured spectra, five illuminants);
+//! - [`hard`]: the hard-case set, content the decode was measured to tie or lose on
+//!   (materials at the lenslet scale, disparities between the shears, speculars, spiky
+//!   light, dim captures);
 //! - [`camera`]: a light field to raw frames with the firmware's masks, noise, black level,
 //!   quantisation, saturation and defects, as a capture;
 //! - [`settings`]: what a user asks of a simulated capture (`slf simulate`'s flags,
@@ -17,6 +20,7 @@
 
 pub mod camera;
 pub mod flags;
+pub mod hard;
 pub mod import;
 pub mod realistic;
 pub mod scene;

@@ -161,6 +161,29 @@ pub struct Layer {
     /// 1: all of it, black where it faces away).
     pub shading: f32,
     pub highlight: Option<Highlight>,
+    /// Materials that change cell by cell, replacing `texture` and `reflectance` where set.
+    pub mosaic: Option<Mosaic>,
+}
+
+/// A surface of many materials: every `cell x cell` pixels of it (in its own coordinates)
+/// one reflectance of `palette`, picked by a hash of the cell, in place of the layer's
+/// texture and reflectances. With a cell of a lenslet or two, the spectrum changes at the
+/// decoder's patch scale: fields, mosaics, tiled floors.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mosaic {
+    /// Cell size, pixels.
+    pub cell: f32,
+    pub seed: u64,
+    pub palette: Vec<Spectrum>,
+}
+
+impl Mosaic {
+    /// The palette index of the cell holding layer point `(y, x)`.
+    fn index(&self, y: f32, x: f32) -> usize {
+        let c = self.cell.max(1e-3);
+        let h = hash01(self.seed, (y / c).floor() as i64, (x / c).floor() as i64);
+        ((h * self.palette.len() as f32) as usize).min(self.palette.len().saturating_sub(1))
+    }
 }
 
 impl Layer {
@@ -175,11 +198,16 @@ impl Layer {
             curvature: 0.0,
             shading: 0.0,
             highlight: None,
+            mosaic: None,
         }
     }
 
     fn is_flat(&self) -> bool {
-        self.slope == (0.0, 0.0) && self.curvature == 0.0 && self.shading == 0.0 && self.highlight.is_none()
+        self.slope == (0.0, 0.0)
+            && self.curvature == 0.0
+            && self.shading == 0.0
+            && self.highlight.is_none()
+            && self.mosaic.is_none()
     }
 
     /// Disparity and its gradient (per normalised unit) at normalised `(y, x)`.
@@ -257,6 +285,10 @@ impl Scene {
         let peak = self.illuminant.iter().fold(0.0f32, |m, &x| m.max(x));
         let lit = |r: &Spectrum| -> Spectrum { core::array::from_fn(|b| r[b] * self.illuminant[b] / peak * self.gain) };
         let radiance: Vec<[Spectrum; 2]> = layers.iter().map(|l| l.reflectance.map(|r| lit(&r))).collect();
+        let palettes: Vec<Vec<Spectrum>> = layers
+            .iter()
+            .map(|l| l.mosaic.as_ref().map_or_else(Vec::new, |m| m.palette.iter().map(lit).collect()))
+            .collect();
         let white = lit(&[1.0; BANDS]);
         // Fronto-parallel Lambertian layers (the regression scenes) take the first hit in
         // disparity order; other layers are all intersected and the nearest hit wins. A
@@ -310,8 +342,17 @@ impl Scene {
                         let r = hl.radius * h;
                         hl.strength * (-((ly - cy).powi(2) + (lx - cx).powi(2)) / (2.0 * r * r)).exp()
                     });
-                    for (b, a) in acc.iter_mut().enumerate() {
-                        *a += 0.25 * (shade * (rad[0][b] + t * (rad[1][b] - rad[0][b])) + spec * white[b]);
+                    match layer.mosaic.as_ref().and_then(|m| palettes[i].get(m.index(ly, lx))) {
+                        Some(material) => {
+                            for (b, a) in acc.iter_mut().enumerate() {
+                                *a += 0.25 * (shade * material[b] + spec * white[b]);
+                            }
+                        }
+                        None => {
+                            for (b, a) in acc.iter_mut().enumerate() {
+                                *a += 0.25 * (shade * (rad[0][b] + t * (rad[1][b] - rad[0][b])) + spec * white[b]);
+                            }
+                        }
                     }
                 }
                 px_out.copy_from_slice(&acc);

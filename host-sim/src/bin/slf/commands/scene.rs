@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use slf_host::io::lightfield::{Dtype, write_npy};
-use slf_host::sim::realistic;
+use slf_host::sim::hard;
 use slf_host::sim::scene::SceneSize;
 
 use crate::args::ranged;
@@ -13,9 +13,10 @@ use crate::args::ranged;
 #[derive(clap::Args)]
 pub struct Args {
     /// A name (test scenes: smooth, texture, depth, saturated, dark; realistic: outdoor,
-    /// tungsten, office, led), `random` (the training scenes of the shipped ensemble) or
-    /// `realistic` (slanted and curved surfaces, 1/f textures, measured spectra, five
-    /// illuminants), the last two drawn from --seed.
+    /// tungsten, office, led; hard cases: mosaic, mosaic-2, field, print, speculars, narrow,
+    /// dim), `random` (the training scenes of the shipped ensemble) or `realistic` (slanted
+    /// and curved surfaces, 1/f textures, measured spectra, five illuminants), the last two
+    /// drawn from --seed.
     pub name: String,
     /// Output .npy file.
     #[arg(short, long)]
@@ -37,7 +38,7 @@ pub struct Args {
 
 pub fn run(args: Args) -> Result<()> {
     let Args { name, output, seed, size, views, dtype } = args;
-    let s = realistic::by_name(&name, seed)?;
+    let s = hard::by_name(&name, seed)?;
     let size = SceneSize { views: (views, views), rows: size, cols: size };
     size.check().map_err(|e| anyhow::anyhow!("--size {} with --views {views}: {e}", size.rows))?;
     let lf = s.render(size);

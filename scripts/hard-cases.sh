@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# The hard-case set's tables (docs/results-hard.md, issue 42): the baselines and every preset
+# on each hard-case scene (`slf scene NAME`, host-sim/src/sim/hard.rs), at pixel k = 1 and 3,
+# lenslet k = 3 and kronecker k = 3, with the capture's noise model. One table per scene:
+# PSNR / SSIM / SA, the decode's wall time, and the default's and the preview's margins over the
+# strongest baseline. Nothing is kept but the tables: the light fields are rendered into
+# OUT_DIR, which may be deleted after.
+#
+#   bash scripts/hard-cases.sh OUT_DIR > docs/results-hard.md
+#   SLF_SIZE=40 SLF_SETTINGS="pixel:1" bash scripts/hard-cases.sh OUT_DIR   # smaller, faster
+#   RAYON_NUM_THREADS=1 bash scripts/hard-cases.sh OUT_DIR                  # times of one thread
+#
+# Times are of one run on a shared machine: compare them within a table, not across runs.
+set -euo pipefail
+out=${1:?usage: hard-cases.sh OUT_DIR}
+cd "$(dirname "$0")/.."
+cargo build --release -q -p slf-host
+slf=${SLF_BIN:-./target/release/slf}
+size=${SLF_SIZE:-64}
+scenes=${SLF_SCENES:-mosaic mosaic-2 field print speculars narrow dim}
+methods="demosaic=--method,demosaic ppid=--method,ppid preview=--preset,preview default=--preset,default best=--preset,best"
+mkdir -p "$out"
+echo "# The hard-case set"
+echo
+echo "Made by \`bash scripts/hard-cases.sh OUT_DIR\` (scenes of ${size} x ${size} lenslets, 5 x 5 views;"
+echo "\`RAYON_NUM_THREADS=${RAYON_NUM_THREADS:-all}\`). Each scene is described in"
+echo "\`host-sim/src/sim/hard.rs\`. Margins: the default's and the preview's PSNR less the"
+echo "strongest baseline's (demosaic or PPID)."
+# The real content the project evaluates joins the set when present (scripts/real-eval.sh's
+# crops in $SLF_REAL, default /tmp/hci/real; their licence allows evaluation only).
+real=${SLF_REAL:-/tmp/hci/real}
+for f in "$real"/*_128.npy; do
+  [ -f "$f" ] && scenes="$scenes real:$f"
+done
+for scene in $scenes; do
+  if [ "${scene#real:}" != "$scene" ]; then
+    lf=${scene#real:}
+    scene=$(basename "$lf" .npy)
+  else
+    lf="$out/$scene.npy"
+    [ -f "$lf" ] || "$slf" scene "$scene" --size "$size" -o "$lf" > /dev/null
+  fi
+  echo
+  echo "## $scene"
+  echo
+  echo "| setting | method | PSNR | SSIM | SA deg | seconds |"
+  echo "| --- | --- | --- | --- | --- | --- |"
+  for s in ${SLF_SETTINGS:-pixel:1 pixel:3 lenslet:3 kronecker:3}; do
+    mask=${s%:*}; k=${s#*:}
+    cap="$out/cap-$scene-$mask-$k"
+    [ -d "$cap" ] || "$slf" simulate "$lf" -o "$cap" --mask "$mask" -s "$k" --seed 3 > /dev/null 2>&1
+    baseline=-1000; default=0; preview=0
+    for m in $methods; do
+      name=${m%%=*}; args=${m#*=}; args=${args//,/ }
+      rec="$out/rec.npy"
+      # shellcheck disable=SC2086
+      log=$("$slf" decode "$cap" -o "$rec" --quiet $args)
+      t=$(echo "$log" | awk '/ in [0-9.]+ s/ { for (i = 1; i < NF; i++) if ($i == "in") print $(i + 1) }')
+      read -r p q a < <("$slf" eval "$lf" "$rec" | awk '/^PSNR/ { p = $2 } /^SSIM/ { q = $2 } /^SA/ { a = $2 } END { print p, q, a }')
+      printf '| %s k=%s | %s | %.2f | %.4f | %.2f | %.2f |\n' "$mask" "$k" "$name" "$p" "$q" "$a" "${t:-0}"
+      case $name in
+        demosaic | ppid) baseline=$(echo "if ($p > $baseline) $p else $baseline" | bc -l) ;;
+        default) default=$p ;;
+        preview) preview=$p ;;
+      esac
+    done
+    printf '| %s k=%s | **margins** | default %+.2f, preview %+.2f | | | |\n' "$mask" "$k" \
+      "$(echo "$default - $baseline" | bc -l)" "$(echo "$preview - $baseline" | bc -l)"
+  done
+done
