@@ -23,6 +23,7 @@ use crate::decode::cs::{
 use crate::decode::preset::Preset;
 use crate::io::capture::Capture;
 use crate::io::lightfield::LightField;
+use crate::io::message::number as show;
 use crate::sim::flags::parse;
 
 /// Decode method: compressed sensing, or a baseline without it.
@@ -309,9 +310,6 @@ impl SolverSettings {
         }
     }
 }
-
-/// A flag's value as a user would write it: `1e30`, not thirty-one digits.
-use crate::io::message::number as show;
 
 /// The range [`Sl0Config::validate`] holds `field` to, in words.
 fn config_range(field: &str) -> &'static str {
