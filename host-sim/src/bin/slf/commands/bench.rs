@@ -32,7 +32,8 @@ pub struct Args {
     #[arg(long, value_name = "CSV")]
     pub device: Option<PathBuf>,
     /// Instead of sweeping: draw bench.md and bench.png again from a bench.csv this command
-    /// wrote (e.g. with `--device`).
+    /// wrote (e.g. with `--device`). It may be the bench.csv of --out: it is read whole
+    /// before anything is written, and written again with the same rows.
     #[arg(long, value_name = "CSV")]
     pub from: Option<PathBuf>,
 }

@@ -42,6 +42,11 @@ pub struct Args {
 
 pub fn run(args: Args) -> Result<()> {
     let Args { inputs, out, blob, stride, window, patch_views } = args;
+    slf_host::io::output::Outputs::new()
+        .inputs(&inputs, "an input")
+        .inputs(&blob, "--blob")
+        .output(&out.join("table.md"), "the table in -o")
+        .check_distinct()?;
     let blob = blob.map(|p| read_blob(&p)).transpose()?;
     let mut scenes: Vec<(String, _)> = Vec::new();
     for (i, p) in inputs.iter().enumerate() {
