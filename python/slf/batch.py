@@ -68,6 +68,34 @@ def captures_in(folder: PathLike) -> List[str]:
     return found
 
 
+def check_outputs(captures: List[str], out_dir: str) -> None:
+    """Refuses, before any task runs, a run whose output ``out_dir/<name>.npy`` would be a
+    file of a capture (its ``capture.json`` or a frame) or another capture's output (two
+    folders of one name): the same rule ``slf`` keeps for its commands. Paths are compared
+    resolved."""
+    import json
+
+    inputs = {}
+    for c in captures:
+        files = ["capture.json"]
+        try:
+            with open(os.path.join(c, "capture.json"), encoding="utf-8") as f:
+                frames = json.load(f).get("frames", [])
+            files += [n for n in frames if isinstance(n, str)]
+        except (OSError, ValueError, AttributeError):
+            pass  # the task reports a capture it cannot read
+        for n in files:
+            inputs[os.path.realpath(os.path.join(c, n))] = c
+    seen = {}
+    for c in captures:
+        path = os.path.realpath(os.path.join(out_dir, os.path.basename(os.path.normpath(c)) + ".npy"))
+        if path in inputs:
+            raise ValueError(f"{path}: the output of {c} would be a file of the capture {inputs[path]}")
+        if path in seen:
+            raise ValueError(f"{c} and {seen[path]} would both write {path}: give folders of distinct names")
+        seen[path] = c
+
+
 def decode_one(capture: str, out_dir: str, options: dict) -> Result:
     """Decodes one capture folder into ``out_dir/<name>.npy``: the task each capture is.
     Never raises for a bad capture: the error is the result's."""
@@ -105,6 +133,7 @@ def decode_folder(
     else:
         captures = [os.fspath(c) for c in folder]
     out = os.fspath(out_dir)
+    check_outputs(captures, out)
     if client is None:
         results = []
         for c in captures:

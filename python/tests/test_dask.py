@@ -73,3 +73,21 @@ def test_example_script(folder, tmp_path):
 def test_no_captures_is_an_error(tmp_path):
     with pytest.raises(ValueError, match="no capture folders"):
         slf.batch.captures_in(tmp_path)
+
+
+def test_an_output_is_never_a_capture_file_or_another_output(folder, tmp_path, depth):
+    """Issue 41, item 6 for the package: refused before any task runs, nothing written."""
+    # A capture folder named like its own frame, decoded into itself.
+    cap = tmp_path / "snapshot_0"
+    slf.simulate(depth, k=1, seed=1, format="npy").save(cap)
+    before = (cap / "snapshot_0.npy").read_bytes()
+    with pytest.raises(ValueError, match="would be a file of the capture"):
+        slf.batch.decode_folder([cap], cap, preset="preview")
+    assert (cap / "snapshot_0.npy").read_bytes() == before
+    # Two folders of one name.
+    other = tmp_path / "again" / "cap1"
+    slf.simulate(depth, k=1, seed=2).save(other)
+    out = tmp_path / "out"
+    with pytest.raises(ValueError, match="would both write"):
+        slf.batch.decode_folder([folder / "cap1", other], out, preset="preview")
+    assert not out.exists()
