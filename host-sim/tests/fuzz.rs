@@ -23,7 +23,7 @@ use slf_host::io::npy::{self, Values};
 use slf_host::sim::camera::{CameraConfig, simulate};
 
 mod common;
-use common::{npy_bytes, small_smooth};
+use common::{npy_bytes, png_claiming, small_smooth};
 
 /// Inputs that were read (or loaded) successfully.
 static READ: AtomicU32 = AtomicU32::new(0);
@@ -435,7 +435,7 @@ fn fuzz_frame_headers() {
                     let h = format!("{{'descr': '<u2', 'fortran_order': False, 'shape': ({h}, {w}), }}");
                     (npy_bytes(1, &h, &[]), (2 * u64::from(w)).saturating_mul(u64::from(h_of(&h))))
                 }
-                _ => (png_header(w, h), 0),
+                _ => (png_claiming(w, h), 0),
             };
             let file = std::fs::File::create(&path).unwrap();
             std::io::Write::write_all(&mut &file, &header).unwrap();
@@ -464,28 +464,6 @@ fn fuzz_frame_headers() {
 /// The rows the `.npy` header in `h` states (its shape's first number).
 fn h_of(h: &str) -> u32 {
     h.split("'shape': (").nth(1).and_then(|r| r.split(',').next()).and_then(|n| n.trim().parse().ok()).unwrap_or(0)
-}
-
-/// A PNG's signature and IHDR (8-bit grey, `w x h`), an empty IDAT and IEND.
-fn png_header(w: u32, h: u32) -> Vec<u8> {
-    let chunk = |kind: &[u8; 4], data: &[u8]| {
-        let mut c = (data.len() as u32).to_be_bytes().to_vec();
-        c.extend(kind);
-        c.extend(data);
-        let mut crc = crc32fast::Hasher::new();
-        crc.update(kind);
-        crc.update(data);
-        c.extend(crc.finalize().to_be_bytes());
-        c
-    };
-    let mut ihdr = w.to_be_bytes().to_vec();
-    ihdr.extend(h.to_be_bytes());
-    ihdr.extend([8, 0, 0, 0, 0]);
-    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
-    png.extend(chunk(b"IHDR", &ihdr));
-    png.extend(chunk(b"IDAT", &[]));
-    png.extend(chunk(b"IEND", &[]));
-    png
 }
 
 /// Bench tables read and drawn again.

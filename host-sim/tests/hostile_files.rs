@@ -15,7 +15,7 @@ use slf_host::io::npy::{self, NpyErrorKind, Values};
 use slf_host::sim::camera::{CameraConfig, simulate};
 
 mod common;
-use common::{npy_bytes, small_smooth};
+use common::{npy_bytes, png_claiming, small_smooth};
 
 fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
     let p = dir.join(name);
@@ -461,28 +461,6 @@ fn captures_without_signal_or_with_impossible_noise_are_refused() {
         let e = format!("{:#}", s.run(&dark, false, &|_, _| {}).unwrap_err());
         assert!(e.contains("no light was recorded"), "{method}: {e}");
     }
-}
-
-/// A PNG of a single IHDR (and IEND) claiming `w x h` 8-bit grey pixels: a few dozen bytes.
-fn png_claiming(w: u32, h: u32) -> Vec<u8> {
-    let chunk = |kind: &[u8; 4], data: &[u8]| {
-        let mut c = (data.len() as u32).to_be_bytes().to_vec();
-        c.extend(kind);
-        c.extend(data);
-        let mut crc = crc32fast::Hasher::new();
-        crc.update(kind);
-        crc.update(data);
-        c.extend(crc.finalize().to_be_bytes());
-        c
-    };
-    let mut ihdr = w.to_be_bytes().to_vec();
-    ihdr.extend(h.to_be_bytes());
-    ihdr.extend([8, 0, 0, 0, 0]);
-    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
-    png.extend(chunk(b"IHDR", &ihdr));
-    png.extend(chunk(b"IDAT", &[]));
-    png.extend(chunk(b"IEND", &[]));
-    png
 }
 
 /// Issue 41, item 1: a frame or light field whose header claims more than the capture (or

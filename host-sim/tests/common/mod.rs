@@ -1,4 +1,4 @@
-//! Helpers shared by the host's tests: hand-made `.npy` files and a small test scene.
+//! Helpers shared by the host's tests: hand-made `.npy` and PNG files and a small test scene.
 #![allow(dead_code)] // each test binary uses a part
 
 use slf_host::firmware::RowSink;
@@ -40,4 +40,26 @@ impl RowSink for Rows {
         }
         Ok(())
     }
+}
+
+/// A PNG of a single IHDR (and IEND) claiming `w x h` 8-bit grey pixels: a few dozen bytes.
+pub fn png_claiming(w: u32, h: u32) -> Vec<u8> {
+    let chunk = |kind: &[u8; 4], data: &[u8]| {
+        let mut c = (data.len() as u32).to_be_bytes().to_vec();
+        c.extend(kind);
+        c.extend(data);
+        let mut crc = crc32fast::Hasher::new();
+        crc.update(kind);
+        crc.update(data);
+        c.extend(crc.finalize().to_be_bytes());
+        c
+    };
+    let mut ihdr = w.to_be_bytes().to_vec();
+    ihdr.extend(h.to_be_bytes());
+    ihdr.extend([8, 0, 0, 0, 0]);
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    png.extend(chunk(b"IHDR", &ihdr));
+    png.extend(chunk(b"IDAT", &[]));
+    png.extend(chunk(b"IEND", &[]));
+    png
 }
