@@ -104,10 +104,7 @@ class Capture:
     """
 
     def __init__(self, frames: np.ndarray, description: Dict[str, Any]):
-        frames = np.asarray(frames)
-        if frames.dtype != np.uint16:
-            raise ValueError(f"frames: dtype {frames.dtype}, want uint16 (raw sensor values)")
-        frames = np.ascontiguousarray(frames)
+        frames = np.ascontiguousarray(_raw_frames(frames))
         text = _slf.check_capture(frames, json.dumps(description))
         self.frames: np.ndarray = frames
         self.description: Dict[str, Any] = json.loads(text)

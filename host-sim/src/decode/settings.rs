@@ -51,16 +51,6 @@ impl Method {
             Method::Ppid => Some(Baseline::Ppid),
         }
     }
-
-    /// The flag's value: `cs`, `interpolate`, `demosaic`, `ppid`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Cs => "cs",
-            Method::Interpolate => "interpolate",
-            Method::Demosaic => "demosaic",
-            Method::Ppid => "ppid",
-        }
-    }
 }
 
 /// `--dictionary`: the basis kind.
@@ -124,7 +114,7 @@ impl WhiteBalance {
 }
 
 /// The basis flags, shared by the commands that decode (`decode`, `sweep`, `demo`).
-#[derive(Args, Clone, Debug, PartialEq)]
+#[derive(Args, Clone, Debug)]
 pub struct BasisSettings {
     /// Basis to decode with [default: ensemble; dct with --preset preview].
     #[arg(long, value_enum)]
@@ -186,7 +176,7 @@ impl BasisSettings {
 }
 
 /// The solver's flags; each unset one is the preset's value ([`Preset::options`]).
-#[derive(Args, Clone, Debug, PartialEq)]
+#[derive(Args, Clone, Debug)]
 pub struct SolverSettings {
     /// SL0 sigma decrease factor per level, in (0, 1).
     #[arg(long, default_value_t = Sl0Config::DEFAULT.sigma_f)]
@@ -543,7 +533,7 @@ impl DecodeSettings {
                 "{} given with --method {}, which uses none of the compressed-sensing flags: drop them, or use \
                  --method cs",
                 given.join(", "),
-                self.method.name()
+                self.method.to_possible_value().map_or_else(String::new, |v| v.get_name().to_string())
             );
             let (light_field, report) = baseline.run(capture)?;
             return Ok(Decoded { light_field, outcome: Outcome::Baseline { method: self.method, report } });

@@ -349,15 +349,8 @@ impl Capture {
             let path =
                 frame_path(dir, name).map_err(|e| anyhow!("{}: frames[{i}]: {}", desc_path.display(), one_line(&e)))?;
             inside(dir, &path).map_err(|e| anyhow!("{}: frames[{i}]: {}", desc_path.display(), one_line(&e)))?;
+            // Of the capture's size: read_frame refuses another from the file's header.
             let frame = read_frame(&path, Some((rows, cols)))?;
-            ensure!(
-                (frame.rows, frame.cols) == (rows, cols),
-                "{}: frame is {} x {}, {} implies {rows} x {cols}",
-                path.display(),
-                frame.rows,
-                frame.cols,
-                DESCRIPTION
-            );
             ensure!(
                 description.saturation_level <= frame.top as f32,
                 "{}: the file's largest value is {} (its MAXVAL or bit depth), below saturation_level {} in {}: \
@@ -447,13 +440,16 @@ pub fn read_frame(path: &Path, expect: Option<(usize, usize)>) -> Result<FrameFi
         }
         "pgm" => read_pgm(path, len, &sized),
         "png" => {
-            let reader = image::ImageReader::open(path)
+            use image::ImageDecoder;
+            let undecodable = || format!("{}: cannot decode image", path.display());
+            let decoder = image::ImageReader::open(path)
                 .and_then(image::ImageReader::with_guessed_format)
-                .with_context(|| format!("cannot read {}", path.display()))?;
-            let (w, h) =
-                reader.into_dimensions().with_context(|| format!("{}: cannot decode image", path.display()))?;
+                .with_context(|| format!("cannot read {}", path.display()))?
+                .into_decoder()
+                .with_context(undecodable)?;
+            let (w, h) = decoder.dimensions();
             sized(u64::from(h), u64::from(w))?;
-            let img = image::open(path).with_context(|| format!("{}: cannot decode image", path.display()))?;
+            let img = image::DynamicImage::from_decoder(decoder).with_context(undecodable)?;
             let color = img.color();
             let top = match color {
                 image::ColorType::L8 => 255,

@@ -152,19 +152,10 @@ impl Outputs {
         self
     }
 
-    /// Files the run writes.
+    /// Files the run writes (an `Option` for an output that may not be asked for).
     #[must_use]
     pub fn outputs<P: AsRef<Path>>(self, paths: impl IntoIterator<Item = P>, what: &str) -> Self {
         paths.into_iter().fold(self, |s, p| s.output(p.as_ref(), what))
-    }
-
-    /// As [`Self::output`], when the output was asked for.
-    #[must_use]
-    pub fn output_opt(self, path: Option<&Path>, what: &str) -> Self {
-        match path {
-            Some(p) => self.output(p, what),
-            None => self,
-        }
     }
 
     /// Checks that no output is an input or another output, and that every output can be

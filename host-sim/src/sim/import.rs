@@ -272,6 +272,28 @@ fn check_lenslets(lf: &LightField) -> Result<()> {
     Ok(())
 }
 
+/// Refuses a light field (named `source`) whose lenslets have fewer views, or which has
+/// fewer lenslets, than the decoder's patch: what `simulate` and `evaluate` would otherwise
+/// pass on for `decode` to refuse.
+///
+/// # Errors
+/// The sizes and the minimum, one line.
+pub fn check_decodable(lf: &LightField, source: &str) -> Result<()> {
+    ensure!(
+        lf.views.0 >= MIN_VIEWS && lf.views.1 >= MIN_VIEWS,
+        "{source}: {} x {} views: the decoder needs lenslets of at least {MIN_VIEWS} x {MIN_VIEWS} views",
+        lf.views.0,
+        lf.views.1
+    );
+    ensure!(
+        lf.rows >= MIN_LENSLETS && lf.cols >= MIN_LENSLETS,
+        "{source}: {} x {} lenslets: the decoder needs at least {MIN_LENSLETS} x {MIN_LENSLETS} (its patch)",
+        lf.rows,
+        lf.cols
+    );
+    Ok(())
+}
+
 /// A light field with the camera's bands: as given if it has 13, resampled from
 /// `wavelengths` otherwise; with a note when it was resampled. `source` names it in
 /// messages.

@@ -3,7 +3,7 @@
 //! ranges and give the same one-line errors ([`SimulateSettings::from_flags`] parses the
 //! flags from strings, the way the package passes its keywords).
 
-use anyhow::{Context, Result, ensure};
+use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use slf_firmware::MaskFamily;
 
@@ -11,7 +11,7 @@ use crate::io::capture::{Capture, MaskDescription};
 use crate::io::lightfield::LightField;
 use crate::sim::camera::{CameraConfig, simulate};
 use crate::sim::flags::{parse, positive};
-use crate::sim::import::{MIN_LENSLETS, MIN_VIEWS, with_camera_bands};
+use crate::sim::import::{check_decodable, with_camera_bands};
 
 /// `--mask`: the mask family, which band each pixel sees in each snapshot.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -138,18 +138,7 @@ impl SimulateSettings {
         let (lf, note) = with_camera_bands(lf, self.wavelengths.as_deref(), source)?;
         // A capture the decoder could not take is refused here, not written for `decode`
         // to refuse.
-        ensure!(
-            lf.views.0 >= MIN_VIEWS && lf.views.1 >= MIN_VIEWS,
-            "{source}: {} x {} views: the decoder needs lenslets of at least {MIN_VIEWS} x {MIN_VIEWS} views",
-            lf.views.0,
-            lf.views.1
-        );
-        ensure!(
-            lf.rows >= MIN_LENSLETS && lf.cols >= MIN_LENSLETS,
-            "{source}: {} x {} lenslets: the decoder needs at least {MIN_LENSLETS} x {MIN_LENSLETS} (its patch)",
-            lf.rows,
-            lf.cols
-        );
+        check_decodable(&lf, source)?;
         let cam = self.camera();
         let capture = simulate(&lf, &cam).with_context(|| source.to_string())?;
         let mut notes: Vec<String> = note.into_iter().collect();

@@ -44,10 +44,7 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    slf_host::io::output::Outputs::new()
-        .inputs(&args.blob, "--blob")
-        .output_opt(args.output.as_deref(), "-o")
-        .check()?;
+    slf_host::io::output::Outputs::new().inputs(&args.blob, "--blob").outputs(args.output.as_deref(), "-o").check()?;
     let masks: Vec<MaskFamily> = args.masks.iter().map(|m| m.family()).collect();
     report::compare(
         args.size,

@@ -49,8 +49,8 @@ pub fn run(args: Args) -> Result<()> {
         .inputs(cap.files(), "a file of the capture")
         .inputs(&settings.basis.blob, "--blob")
         .output(&output, "-o")
-        .output_opt(member_map.as_deref(), "--member-map")
-        .output_opt(disparity_map.as_deref(), "--disparity-map")
+        .outputs(member_map.as_deref(), "--member-map")
+        .outputs(disparity_map.as_deref(), "--disparity-map")
         .check()?;
     let cs = settings.method.baseline().is_none();
     anyhow::ensure!(cs || member_map.is_none(), "--member-map needs --method cs (baselines use no ensemble)");

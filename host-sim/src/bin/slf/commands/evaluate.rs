@@ -12,7 +12,7 @@ use slf_host::io::lightfield::read_npy;
 
 use crate::args::ranged;
 use slf_host::decode::settings::WindowKind;
-use slf_host::sim::import::MIN_VIEWS;
+use slf_host::sim::import::check_decodable;
 use slf_host::sim::scene::MIN_SCENE;
 
 #[derive(clap::Args)]
@@ -68,13 +68,7 @@ pub fn run(args: Args) -> Result<()> {
             lf.bands,
             p.display()
         );
-        anyhow::ensure!(
-            lf.views.0 >= MIN_VIEWS && lf.views.1 >= MIN_VIEWS,
-            "{}: {} x {} views: the decoder needs at least {MIN_VIEWS} x {MIN_VIEWS}",
-            p.display(),
-            lf.views.0,
-            lf.views.1
-        );
+        check_decodable(&lf, &p.display().to_string())?;
         anyhow::ensure!(
             lf.rows >= MIN_SCENE && lf.cols >= MIN_SCENE,
             "{}: {} x {} lenslets: the metrics need at least {MIN_SCENE} x {MIN_SCENE} (SSIM's window)",

@@ -28,7 +28,7 @@ pub struct Args {
 pub fn run(args: Args) -> Result<()> {
     slf_host::io::output::Outputs::new()
         .inputs(&args.basis.blob, "--blob")
-        .output_opt(args.output.as_deref(), "-o")
+        .outputs(args.output.as_deref(), "-o")
         .check()?;
     report::sweep(args.size, &args.k, args.output.as_deref(), &args.basis.basis()?, args.basis.patch_views)
 }
