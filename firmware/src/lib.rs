@@ -22,8 +22,9 @@
 //!   `kronecker`, `lenslet`, `pixel`); and the white balance, a gain per band that the decode
 //!   divides out of the measurements and multiplies back.
 //! - **operators** ([`operators`]: [`shape`], [`disparity`], [`dct`], [`dictionary`],
-//!   [`blob`], [`transform`]): the patch geometry in the types, sheared patches that align
-//!   the views on a depth, dictionaries (the 5D DCT and blobs in flash) and the separable
+//!   [`schedule`], [`blob`], [`transform`]): the patch geometry in the types, sheared patches that align
+//!   the views on a depth, dictionaries (the 5D DCT and blobs in flash, with the trained
+//!   schedules of their solves) and the separable
 //!   synthesis and analysis transforms.
 //! - **solver** ([`solver`]: [`error`](solver::error), [`workspace`], [`sl0`], [`ascent`],
 //!   [`ball`], [`projection`], [`fractional`], [`pinv`], [`fill`](solver::fill), [`choice`],
@@ -113,7 +114,7 @@ pub mod solver;
 
 // Every module by its path of before the layer folders, for integrators' code.
 pub use decode::{overlap, tile};
-pub use operators::{blob, dct, dictionary, disparity, shape, transform};
+pub use operators::{blob, dct, dictionary, disparity, schedule, shape, transform};
 pub use sensor::{defects, gains, mask, raw, spi};
 pub use solver::{ascent, ball, choice, fractional, interpolate, pinv, projection, sl0, workspace};
 

@@ -6,22 +6,26 @@
 //! | offset | size | field |
 //! | --- | --- | --- |
 //! | 0 | 4 | magic `b"SLFD"` |
-//! | 4 | 2 | format version, [`BLOB_VERSION`] (= 1) |
+//! | 4 | 2 | format version: 1, or [`BLOB_VERSION`] (= 2) with trained schedules |
 //! | 6 | 2 | reserved, 0 |
 //! | 8 | 10 | patch dimensions `PS, PT, PU, PV, B` (u16 each) |
 //! | 18 | 2 | member count K (u16, >= 1) |
-//! | 20 | 4 | payload length in bytes (u32) = `K * 4 * (PS^2 + PT^2 + PU^2 + PV^2 + B^2)` |
-//! | 24 | payload | per member, `D_1 .. D_5` (synthesis matrices, columns are atoms), each row-major f32 |
+//! | 20 | 4 | payload length in bytes (u32): the members' `K * 4 * (PS^2 + PT^2 + PU^2 + PV^2 + B^2)`, plus the schedules' in version 2 |
+//! | 24 | members | per member, `D_1 .. D_5` (synthesis matrices, columns are atoms), each row-major f32 |
+//! | | schedules | version 2 only: the cold, then the warm [`Schedule`], each `T` (u16), 0 (u16), `T` sigmas, `T` mus, then the `PS + PT + PU + PV + B` group weights (f32) |
 //! | 24 + payload | 4 | CRC-32/ISO-HDLC (zlib's, PNG's) of every byte before it |
 //!
 //! [`Ensemble::new`] checks, in this order: length, magic, version, reserved, dimensions,
 //! member count, payload length, checksum, then every matrix for non-finite values and
-//! orthonormality. Each failure is its own [`DictionaryError`] variant. After that,
-//! [`Ensemble::member`] only copies one member's 1 KiB out of flash.
+//! orthonormality, then (version 2) each schedule's length and ranges ([`Schedule::new`]).
+//! Each failure is its own [`DictionaryError`] variant. After that, [`Ensemble::member`]
+//! only copies one member's 1 KiB out of flash. A version 1 blob is read as before: its
+//! solves take the hand-set schedule.
 
 use crc::{CRC_32_ISO_HDLC, Crc};
 
 use crate::operators::dictionary::{Dictionary, DictionaryError, Factors, Matrix};
+use crate::operators::schedule::{MAX_STEPS, Schedule, Schedules, Weights};
 
 /// The shipped default ensemble for the paper's patch (5 x 5 x 4 x 4 x 13): 8 members
 /// trained by `cargo run --release -p slf-host -- train -o firmware/dictionaries/ensemble8.slfd`
@@ -40,8 +44,10 @@ pub static DEFAULT_FULL_VIEW_ENSEMBLE: &[u8] = include_bytes!("../../dictionarie
 
 /// The magic bytes at the start of a blob.
 pub const BLOB_MAGIC: [u8; 4] = *b"SLFD";
-/// The format version this decoder reads and writes.
-pub const BLOB_VERSION: u16 = 1;
+/// The format version this decoder writes with schedules (and reads, with version 1).
+pub const BLOB_VERSION: u16 = 2;
+/// The format version without schedules, which this decoder reads and writes too.
+pub const BLOB_VERSION_UNSCHEDULED: u16 = 1;
 /// Header length in bytes.
 pub const HEADER_LEN: usize = 24;
 /// Checksum length in bytes.
@@ -64,6 +70,17 @@ pub const fn member_len(dims: [usize; 5]) -> usize {
 /// Total bytes of a blob of `members` members.
 pub const fn blob_len(dims: [usize; 5], members: usize) -> usize {
     HEADER_LEN + members * member_len(dims) + CHECKSUM_LEN
+}
+
+/// Bytes of one schedule of `steps` steps in a blob.
+pub const fn schedule_len(dims: [usize; 5], steps: usize) -> usize {
+    4 + 8 * steps + 4 * (dims[0] + dims[1] + dims[2] + dims[3] + dims[4])
+}
+
+/// Total bytes of a blob of `members` members and a cold and a warm schedule of the given
+/// steps.
+pub const fn scheduled_blob_len(dims: [usize; 5], members: usize, cold: usize, warm: usize) -> usize {
+    blob_len(dims, members) + schedule_len(dims, cold) + schedule_len(dims, warm)
 }
 
 fn u16_at(b: &[u8], at: usize) -> u16 {
@@ -118,11 +135,69 @@ fn write_matrix<const D: usize>(m: &Matrix<D>, out: &mut [u8]) -> usize {
     4 * D * D
 }
 
+fn f32_at(b: &[u8], at: usize) -> f32 {
+    f32::from_bits(u32_at(b, at))
+}
+
+/// One schedule from `bytes`; returns it and its length in bytes.
+fn read_schedule<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
+    bytes: &[u8],
+) -> Result<(Schedule<PS, PT, PU, PV, B>, usize), DictionaryError> {
+    let steps = usize::from(u16_at(bytes, 0));
+    let len = schedule_len([PS, PT, PU, PV, B], steps);
+    if bytes.len() < 4 || steps == 0 || steps > MAX_STEPS || bytes.len() < len || u16_at(bytes, 2) != 0 {
+        return Err(DictionaryError::BadSchedule { part: "steps" });
+    }
+    let (mut sigma, mut mu) = ([0.0f32; MAX_STEPS], [0.0f32; MAX_STEPS]);
+    for t in 0..steps {
+        (sigma[t], mu[t]) = (f32_at(bytes, 4 + 4 * t), f32_at(bytes, 4 + 4 * (steps + t)));
+    }
+    let mut weights = Weights::ONES;
+    let mut at = 4 + 8 * steps;
+    for mode in weights.modes_mut() {
+        for w in mode {
+            *w = f32_at(bytes, at);
+            at += 4;
+        }
+    }
+    let schedule = Schedule::new(sigma.get(..steps).unwrap_or(&[]), mu.get(..steps).unwrap_or(&[]), weights)?;
+    Ok((schedule, len))
+}
+
+/// The cold and the warm schedule, which must fill `bytes` exactly.
+fn read_schedules<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
+    bytes: &[u8],
+) -> Result<Schedules<PS, PT, PU, PV, B>, DictionaryError> {
+    let (cold, at) = read_schedule(bytes)?;
+    let (warm, len) = read_schedule(bytes.get(at..).unwrap_or(&[]))?;
+    if at + len != bytes.len() {
+        return Err(DictionaryError::BadSchedule { part: "steps" });
+    }
+    Ok(Schedules { cold, warm })
+}
+
+/// Writes one schedule at the start of `out`; returns its length.
+fn write_schedule<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
+    s: &Schedule<PS, PT, PU, PV, B>,
+    out: &mut [u8],
+) -> usize {
+    put(out, 0, &(s.len() as u16).to_le_bytes());
+    let mut at = 4;
+    let weights = s.weights().modes();
+    for x in s.sigma().iter().chain(s.mu()).chain(weights.iter().flat_map(|w| w.iter())) {
+        put(out, at, &x.to_le_bytes());
+        at += 4;
+    }
+    at
+}
+
 /// A validated blob of K >= 1 members, read in place from flash.
 #[derive(Clone, Copy, Debug)]
 pub struct Ensemble<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> {
     payload: &'a [u8],
     members: u16,
+    /// The schedules' bytes (version 2), validated.
+    schedules: Option<&'a [u8]>,
 }
 
 impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>
@@ -144,7 +219,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             return Err(DictionaryError::BadMagic);
         }
         let version = u16_at(blob, VERSION_AT);
-        if version != BLOB_VERSION {
+        if version != BLOB_VERSION && version != BLOB_VERSION_UNSCHEDULED {
             return Err(DictionaryError::UnsupportedVersion { found: version });
         }
         if u16_at(blob, RESERVED_AT) != 0 {
@@ -161,9 +236,14 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         if members == 0 {
             return Err(DictionaryError::MemberCount { found: 0 });
         }
-        let payload_len = members as usize * Self::MEMBER_LEN;
-        let expected = HEADER_LEN + payload_len + CHECKSUM_LEN;
-        if u32_at(blob, PAYLOAD_LEN_AT) as usize != payload_len || len != expected {
+        let members_len = members as usize * Self::MEMBER_LEN;
+        // Version 2 adds the schedules after the members: at least two empty ones' headers.
+        let least = if version == BLOB_VERSION { members_len + 2 * schedule_len(Self::DIMS, 1) } else { members_len };
+        let payload_len = u32_at(blob, PAYLOAD_LEN_AT) as usize;
+        let expected = HEADER_LEN + payload_len.max(least) + CHECKSUM_LEN;
+        let fits = if version == BLOB_VERSION { payload_len >= least } else { payload_len == members_len };
+        if !fits || len != expected {
+            let expected = HEADER_LEN + least + CHECKSUM_LEN;
             return Err(DictionaryError::LengthMismatch { expected: expected as u32, found: len as u32 });
         }
         let body_len = len - CHECKSUM_LEN;
@@ -172,11 +252,22 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         if stored != computed {
             return Err(DictionaryError::Checksum { stored, computed });
         }
-        let ensemble = Self { payload: blob.get(HEADER_LEN..body_len).unwrap_or(&[]), members };
+        let schedules = (version == BLOB_VERSION).then(|| blob.get(HEADER_LEN + members_len..body_len).unwrap_or(&[]));
+        let ensemble =
+            Self { payload: blob.get(HEADER_LEN..HEADER_LEN + members_len).unwrap_or(&[]), members, schedules };
         for m in 0..members {
             ensemble.factors(m).validate(m)?;
         }
+        if let Some(bytes) = schedules {
+            read_schedules::<PS, PT, PU, PV, B>(bytes)?;
+        }
         Ok(ensemble)
+    }
+
+    /// The trained schedules of a version 2 blob (validated by [`new`](Self::new)); `None`
+    /// for a version 1 blob, whose solves take the hand-set schedule.
+    pub fn schedules(&self) -> Option<Schedules<PS, PT, PU, PV, B>> {
+        self.schedules.and_then(|b| read_schedules(b).ok())
     }
 
     /// Number of members K.
@@ -245,11 +336,28 @@ pub fn write_blob<const PS: usize, const PT: usize, const PU: usize, const PV: u
     members: &[Dictionary<PS, PT, PU, PV, B>],
     out: &mut [u8],
 ) -> Result<usize, DictionaryError> {
+    write_blob_scheduled(members, None, out)
+}
+
+/// Writes `members` and, if given, their trained `schedules` as a blob into `out` (version
+/// 2 with schedules, 1 without); returns the number of bytes written
+/// ([`scheduled_blob_len`], or [`blob_len`] without schedules).
+///
+/// # Errors
+/// As [`write_blob`].
+pub fn write_blob_scheduled<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
+    members: &[Dictionary<PS, PT, PU, PV, B>],
+    schedules: Option<&Schedules<PS, PT, PU, PV, B>>,
+    out: &mut [u8],
+) -> Result<usize, DictionaryError> {
     let dims = [PS, PT, PU, PV, B];
     if members.is_empty() || members.len() > u16::MAX as usize {
         return Err(DictionaryError::MemberCount { found: members.len().min(u16::MAX as usize) as u16 });
     }
-    let total = blob_len(dims, members.len());
+    let total = match schedules {
+        Some(s) => scheduled_blob_len(dims, members.len(), s.cold.len(), s.warm.len()),
+        None => blob_len(dims, members.len()),
+    };
     let Some(out) = out.get_mut(..total) else {
         return Err(DictionaryError::BufferTooSmall { needed: total as u32 });
     };
@@ -258,12 +366,13 @@ pub fn write_blob<const PS: usize, const PT: usize, const PU: usize, const PV: u
     // bounds failure from being a panic path in any build profile.
     let (header, rest) = out.split_at_mut(HEADER_LEN.min(total));
     put(header, 0, &BLOB_MAGIC);
-    put(header, VERSION_AT, &BLOB_VERSION.to_le_bytes());
+    let version = if schedules.is_some() { BLOB_VERSION } else { BLOB_VERSION_UNSCHEDULED };
+    put(header, VERSION_AT, &version.to_le_bytes());
     for (i, d) in dims.iter().enumerate() {
         put(header, DIMS_AT + 2 * i, &(*d as u16).to_le_bytes());
     }
     put(header, MEMBERS_AT, &(members.len() as u16).to_le_bytes());
-    let payload_len = members.len() * member_len(dims);
+    let payload_len = total - HEADER_LEN - CHECKSUM_LEN;
     put(header, PAYLOAD_LEN_AT, &(payload_len as u32).to_le_bytes());
     let mut at = 0;
     for m in members {
@@ -273,6 +382,10 @@ pub fn write_blob<const PS: usize, const PT: usize, const PU: usize, const PV: u
         at += write_matrix(&d.m3, rest.get_mut(at..).unwrap_or_default());
         at += write_matrix(&d.m4, rest.get_mut(at..).unwrap_or_default());
         at += write_matrix(&d.m5, rest.get_mut(at..).unwrap_or_default());
+    }
+    if let Some(s) = schedules {
+        at += write_schedule(&s.cold, rest.get_mut(at..).unwrap_or_default());
+        write_schedule(&s.warm, rest.get_mut(at..).unwrap_or_default());
     }
     let body_len = total - CHECKSUM_LEN;
     let crc = CRC32.checksum(out.get(..body_len).unwrap_or_default());

@@ -65,6 +65,9 @@ pub enum DictionaryError {
     NoSuchMember { index: u16, members: u16 },
     /// The output buffer cannot hold the blob.
     BufferTooSmall { needed: u32 },
+    /// A trained schedule out of range (`part`: `steps`, `sigma`, `mu` or `weights`), or
+    /// a schedule section of a length its step counts do not imply.
+    BadSchedule { part: &'static str },
 }
 
 impl fmt::Display for DictionaryError {
@@ -100,6 +103,7 @@ impl fmt::Display for DictionaryError {
             Self::BufferTooSmall { needed } => {
                 write!(f, "output buffer too small ({needed} bytes needed)")
             }
+            Self::BadSchedule { part } => write!(f, "dictionary blob's trained schedule: bad {part}"),
         }
     }
 }

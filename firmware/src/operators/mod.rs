@@ -6,6 +6,8 @@
 //!   consistency score that chooses the shear;
 //! - [`dct`]: the orthonormal DCT-II matrices as compile-time tables;
 //! - [`dictionary`]: one member, five small orthonormal matrices, checked when built;
+//! - [`schedule`]: a trained schedule, SL0 unrolled to a fixed number of steps with
+//!   learned parameters, which a blob carries with its dictionaries;
 //! - [`blob`]: the ensemble's file format in flash (write, validate, read);
 //! - [`transform`]: the separable synthesis and analysis transforms and the mode products
 //!   the projections are built of.
@@ -16,5 +18,6 @@ pub mod blob;
 pub mod dct;
 pub mod dictionary;
 pub mod disparity;
+pub mod schedule;
 pub mod shape;
 pub mod transform;

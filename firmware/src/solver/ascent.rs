@@ -19,6 +19,8 @@
 //! Accuracy (tests/ascent.rs): [`exp2`] within 2.5e-7 relative of f64 over its whole
 //! range; the step within 3e-7 of the `libm::expf` step's size.
 
+use crate::operators::schedule::Weights;
+
 /// `t` is clamped here: `2^-115` is a normal f32, and beyond it `mu * 2^t` is below
 /// `2^-25` for any `mu < 1e27`, so the step would leave `s` unchanged after rounding (the
 /// select in [`ascend`] makes that exact for any `mu`).
@@ -140,4 +142,45 @@ pub fn ascend(coeffs: &mut [f32], mu: f32, inv: f32) -> f32 {
         }
     }
     moved
+}
+
+/// The ascent step of a trained schedule ([`crate::solver::schedule`]): as [`ascend`], with
+/// each coefficient's exponent scaled by its group weight, `s <- s - mu s exp(-w s^2 inv)`,
+/// `w` the product of its indices' weights (`coeffs` in the patch layout `[s, t, u, v, b]`,
+/// the band last). The weights of the four pixel modes are multiplied once per pixel, the
+/// band's once per step, so a coefficient costs one multiply more than in [`ascend`].
+///
+/// Returns the squared length of the step, as [`ascend`] does.
+pub fn ascend_weighted<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
+    coeffs: &mut [f32],
+    mu: f32,
+    inv: f32,
+    weights: &Weights<PS, PT, PU, PV, B>,
+) -> f32 {
+    let (c, skip) = exponents(mu, inv);
+    let k = scaled(mu);
+    let band: [f32; B] = core::array::from_fn(|b| c * weights.b[b]);
+    let mut fibres = coeffs.as_chunks_mut::<B>().0.iter_mut();
+    let mut sums = [0.0f32; B];
+    for ws in &weights.s {
+        for wt in &weights.t {
+            let st = ws * wt;
+            for wu in &weights.u {
+                let stu = st * wu;
+                for wv in &weights.v {
+                    let pixel = stu * wv;
+                    let Some(fibre) = fibres.next() else { return sums.iter().sum() };
+                    for ((s, sum), cb) in fibre.iter_mut().zip(sums.iter_mut()).zip(&band) {
+                        let t = *s * *s * (cb * pixel);
+                        // A comparison, not `f32::max` (see `ascend` on the Cortex-M).
+                        let d = *s * scaled_exp2(&k, if t > T_MIN { t } else { T_MIN });
+                        let d = if t >= skip { d } else { 0.0 };
+                        *s -= d;
+                        *sum += d * d;
+                    }
+                }
+            }
+        }
+    }
+    sums.iter().sum()
 }

@@ -40,9 +40,13 @@
 
 use crate::operators::blob::Ensemble;
 use crate::operators::dictionary::Dictionary;
+use crate::operators::schedule::Schedules;
 use crate::operators::shape::PatchShape;
 use crate::operators::transform::analyze_preserving;
-use crate::solver::sl0::{Ended, Outcome, Sl0Config, SolveError, max_abs, seed, solve, solve_seeded, solve_warm};
+use crate::solver::sl0::{
+    Ended, Outcome, Sl0Config, SolveError, max_abs, seed, solve, solve_scheduled, solve_seeded, solve_warm,
+    solve_warm_scheduled,
+};
 use crate::solver::workspace::Workspace;
 
 /// How much sparser than the DCT's own solution a member's must score to replace it
@@ -249,6 +253,8 @@ pub struct EnsembleModel<'a, const PS: usize, const PT: usize, const PU: usize, 
     /// The member that is the screening DCT, if one is (to f32 rounding).
     screen_member: Option<u16>,
     choice: MemberChoice,
+    /// The trained schedules its solves take; `None`: the hand-set schedule.
+    schedules: Option<Schedules<PS, PT, PU, PV, B>>,
 }
 
 /// Whether two dictionaries hold the same matrices to `1e-6`.
@@ -271,12 +277,62 @@ type Ws<const PS: usize, const PT: usize, const PU: usize, const PV: usize, cons
 impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>
     EnsembleModel<'a, PS, PT, PU, PV, B>
 {
-    /// An ensemble that screens with the 5D DCT.
+    /// An ensemble that screens with the 5D DCT, solving with the blob's trained schedules
+    /// if it has them ([`Ensemble::schedules`]), else with the hand-set schedule.
     pub fn new(ensemble: Ensemble<'a, PS, PT, PU, PV, B>, choice: MemberChoice) -> Self {
         let screen = Dictionary::dct();
         let screen_member =
             (0..ensemble.len()).find(|&k| ensemble.member(k).is_ok_and(|m| same(&m, &screen))).map(|k| k as u16);
-        Self { ensemble, screen, screen_member, choice }
+        Self { ensemble, screen, screen_member, choice, schedules: ensemble.schedules() }
+    }
+
+    /// The model with these schedules for its solves (`None`: the hand-set schedule).
+    pub fn with_schedules(self, schedules: Option<Schedules<PS, PT, PU, PV, B>>) -> Self {
+        Self { schedules, ..self }
+    }
+
+    /// The trained schedules its solves take, if any.
+    pub fn schedules(&self) -> Option<&Schedules<PS, PT, PU, PV, B>> {
+        self.schedules.as_ref()
+    }
+
+    /// A solve from the measurements alone: the cold trained schedule, or [`solve`].
+    fn cold<const N: usize>(
+        &self,
+        dict: &Dictionary<PS, PT, PU, PV, B>,
+        cfg: &Sl0Config,
+        ws: &mut Ws<PS, PT, PU, PV, B, N>,
+    ) -> Result<Outcome, SolveError> {
+        match &self.schedules {
+            Some(s) => solve_scheduled(dict, cfg, &s.cold, ws),
+            None => solve(dict, cfg, ws),
+        }
+    }
+
+    /// A solve from another member's solution: the warm trained schedule, or [`solve_warm`].
+    fn warm<const N: usize>(
+        &self,
+        dict: &Dictionary<PS, PT, PU, PV, B>,
+        cfg: &Sl0Config,
+        ws: &mut Ws<PS, PT, PU, PV, B, N>,
+    ) -> Result<Outcome, SolveError> {
+        match &self.schedules {
+            Some(s) => solve_warm_scheduled(dict, cfg, &s.warm, ws),
+            None => solve_warm(dict, cfg, ws),
+        }
+    }
+
+    /// A solve from a seed: the warm trained schedule, or [`solve_seeded`].
+    fn from_seed<const N: usize>(
+        &self,
+        dict: &Dictionary<PS, PT, PU, PV, B>,
+        cfg: &Sl0Config,
+        ws: &mut Ws<PS, PT, PU, PV, B, N>,
+    ) -> Result<Outcome, SolveError> {
+        match &self.schedules {
+            Some(s) => solve_warm_scheduled(dict, cfg, &s.warm, ws),
+            None => solve_seeded(dict, cfg, ws),
+        }
     }
 
     /// The ensemble.
@@ -338,7 +394,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let mut best = (f32::INFINITY, 0u16);
         for k in 0..self.ensemble.len() as u16 {
             let member = self.member(k)?;
-            let outcome = solve(&member, cfg, ws)?;
+            let outcome = self.cold(&member, cfg, ws)?;
             if outcome.ended == Ended::Flat {
                 // Flat patches decode the same with every member (no solve).
                 return Ok(ModelOutcome { outcome, member: Some(k), solves: 1 });
@@ -348,7 +404,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                 best = (s, k);
             }
         }
-        let outcome = solve(&self.member(best.1)?, cfg, ws)?;
+        let outcome = self.cold(&self.member(best.1)?, cfg, ws)?;
         Ok(ModelOutcome { outcome, member: Some(best.1), solves: self.ensemble.len() as u16 + 1 })
     }
 
@@ -363,7 +419,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         ws: &mut Ws<PS, PT, PU, PV, B, N>,
         resolve: bool,
     ) -> Result<ModelOutcome, SolveError> {
-        let first = solve(&self.screen, cfg, ws)?;
+        let first = self.cold(&self.screen, cfg, ws)?;
         if first.ended == Ended::Flat {
             return Ok(ModelOutcome { outcome: first, member: self.screen_member, solves: 1 });
         }
@@ -372,12 +428,12 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let (Some(chosen), Some(dct)) = (best.1, self.screen_member) else {
             // No other member, or no DCT member to compete: solve with the screen's pick.
             let k = best.1.or(self.screen_member).unwrap_or(0);
-            let outcome = solve_warm(&self.member(k)?, cfg, ws)?;
+            let outcome = self.warm(&self.member(k)?, cfg, ws)?;
             return Ok(ModelOutcome { outcome, member: Some(k), solves: 2 });
         };
         let member = self.member(chosen)?;
         ws.measurements.stash(&ws.signal);
-        let solved = solve_warm(&member, cfg, ws).map(|outcome| (outcome, self.score(&member, rule, ws)));
+        let solved = self.warm(&member, cfg, ws).map(|outcome| (outcome, self.score(&member, rule, ws)));
         let (outcome, member_score) = solved.inspect_err(|_| ws.measurements.drop_stash())?;
         let dct_wins = dct_score < DCT_MARGIN * member_score;
         // The stash keeps the DCT's solution in the unmeasured entries only, which is all
@@ -393,7 +449,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         }
         ws.measurements.drop_stash();
         if dct_wins {
-            let outcome = solve_warm(&self.screen, cfg, ws)?;
+            let outcome = self.warm(&self.screen, cfg, ws)?;
             return Ok(ModelOutcome { outcome, member: Some(dct), solves: 3 });
         }
         Ok(ModelOutcome { outcome, member: Some(chosen), solves: 2 })
@@ -420,17 +476,17 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let best = self.screen_members(rule, ws)?;
         let (Some(chosen), Some(dct)) = (best.1, self.screen_member) else {
             let k = best.1.or(self.screen_member).unwrap_or(0);
-            let outcome = solve_seeded(&self.member(k)?, cfg, ws)?;
+            let outcome = self.from_seed(&self.member(k)?, cfg, ws)?;
             return Ok(ModelOutcome { outcome, member: Some(k), solves: 1 });
         };
         let member = self.member(chosen)?;
         let selection = ws.measurements.half.is_none();
         if !selection {
-            let outcome = solve_seeded(&member, cfg, ws)?;
+            let outcome = self.from_seed(&member, cfg, ws)?;
             return Ok(ModelOutcome { outcome, member: Some(chosen), solves: 1 });
         }
         ws.measurements.stash(&ws.signal);
-        let solved = solve_seeded(&member, cfg, ws).map(|outcome| (outcome, self.score(&member, rule, ws)));
+        let solved = self.from_seed(&member, cfg, ws).map(|outcome| (outcome, self.score(&member, rule, ws)));
         let (outcome, member_score) = solved.inspect_err(|_| ws.measurements.drop_stash())?;
         if dct_score < DCT_MARGIN * member_score {
             let Workspace { signal, measurements, .. } = ws;

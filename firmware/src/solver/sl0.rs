@@ -25,8 +25,9 @@
 //! [`Outcome`], never a hang.
 
 use crate::operators::dictionary::Dictionary;
+use crate::operators::schedule::{Schedule, Weights};
 use crate::operators::transform::{analyze, synthesize};
-use crate::solver::ascent::ascend;
+use crate::solver::ascent::{ascend, ascend_weighted};
 use crate::solver::ball::{Ball, Move};
 use crate::solver::fill::fill_bands;
 use crate::solver::fractional::project_fractional;
@@ -205,6 +206,8 @@ pub enum Ended {
     /// Too few bands measured: decoded by per-pixel spectral interpolation, no
     /// solve ([`Sl0Config::min_bands`]).
     Interpolated,
+    /// Every step of a trained [`Schedule`] was taken: the normal end of a scheduled solve.
+    Scheduled,
 }
 
 /// How a solve ended.
@@ -347,6 +350,37 @@ pub(crate) fn run_schedule(cfg: &Sl0Config, sigma0: f32, values: usize, mut step
     out
 }
 
+/// A trained schedule's steps, shared by both projection paths: `step(inv, mu)` for each
+/// step, `sigma = max(schedule.sigma[t] * sigma0, cfg.sigma_min)`, until the schedule's
+/// end, the iteration bound or sigma underflow.
+pub(crate) fn run_trained<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
+    cfg: &Sl0Config,
+    schedule: &Schedule<PS, PT, PU, PV, B>,
+    sigma0: f32,
+    mut step: impl FnMut(f32, f32) -> Step,
+) -> Outcome {
+    let mut out = Outcome { iterations: 0, levels: 0, sigma0, residual: 0.0, ended: Ended::Scheduled };
+    for (&fraction, &mu) in schedule.sigma().iter().zip(schedule.mu()) {
+        if out.iterations >= cfg.max_iterations {
+            out.ended = Ended::IterationBound;
+            break;
+        }
+        // A comparison, not `f32::max` (a call on the Cortex-M4F); a NaN `sigma0` takes
+        // `sigma_min`.
+        let sigma = fraction * sigma0;
+        let sigma = if sigma > cfg.sigma_min { sigma } else { cfg.sigma_min };
+        let inv = 1.0 / (2.0 * sigma * sigma);
+        if !inv.is_finite() {
+            out.ended = Ended::SigmaUnderflow;
+            break;
+        }
+        out.residual = step(inv, mu).residual;
+        out.iterations += 1;
+        out.levels += 1;
+    }
+    out
+}
+
 /// Decodes the patch whose measurements are in `ws`, with an orthonormal dictionary (the
 /// fast path). On success the patch is in [`Workspace::patch`]; it matches every
 /// measurement (to the noise ball in noise-aware mode) and holds no NaN or infinity.
@@ -372,7 +406,7 @@ pub fn solve<const PS: usize, const PT: usize, const PU: usize, const PV: usize,
         }
         project_fractional(dict, coeffs, signal, m, &Ball::new(0.0, 0.0, m.count, 0));
         synthesize(dict, coeffs, signal);
-        return descend(dict, cfg, ws, &ball, cfg.cold_start);
+        return descend(dict, cfg, ws, &ball, Plan::Annealed { scale: cfg.cold_start });
     }
     if let Some(outcome) = short_path(cfg, ws) {
         return Ok(outcome);
@@ -386,7 +420,7 @@ pub fn solve<const PS: usize, const PT: usize, const PU: usize, const PV: usize,
             *x = if k { y } else { 0.0 };
         }
     }
-    descend(dict, cfg, ws, &ball, cfg.cold_start)
+    descend(dict, cfg, ws, &ball, Plan::Annealed { scale: cfg.cold_start })
 }
 
 /// The short path for a flat patch: if every band is measured and each band's
@@ -464,7 +498,7 @@ fn descend_from<const PS: usize, const PT: usize, const PU: usize, const PV: usi
 ) -> Result<Outcome, SolveError> {
     let ball = start::<B, N>(cfg, &ws.measurements)?;
     let from = Sl0Config { sigma_f, steps: cfg.warm_steps, ..*cfg };
-    descend(dict, &from, ws, &ball, cfg.warm_start)
+    descend(dict, &from, ws, &ball, Plan::Annealed { scale: cfg.warm_start })
 }
 
 /// Decodes the patch from the estimate in `ws.patch()` ([`seed`] must have prepared it):
@@ -518,22 +552,93 @@ pub fn seed<const PS: usize, const PT: usize, const PU: usize, const PV: usize, 
     Ok(None)
 }
 
-/// The schedule from the patch in `ws.signal`, from `sigma0 = scale * max |S|`, projecting
-/// onto `ball`.
+/// How a descent walks sigma down: the hand-set schedule of the config from `scale` times
+/// the start's largest coefficient, or a trained [`Schedule`].
+#[derive(Clone, Copy)]
+enum Plan<'s, const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> {
+    Annealed { scale: f32 },
+    Trained(&'s Schedule<PS, PT, PU, PV, B>),
+}
+
+/// Decodes the patch whose measurements are in `ws` with a trained schedule's steps
+/// ([`crate::solver::schedule`]), from the minimum-norm start (the config's `cold_start`
+/// is the hand-set schedule's: a trained schedule learned its own start). As [`solve`]
+/// otherwise: the flat short path, half-pixel shears, the noise ball.
+///
+/// # Errors
+/// As [`solve`].
+pub fn solve_scheduled<
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+    const N: usize,
+>(
+    dict: &Dictionary<PS, PT, PU, PV, B>,
+    cfg: &Sl0Config,
+    schedule: &Schedule<PS, PT, PU, PV, B>,
+    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+) -> Result<Outcome, SolveError> {
+    let ball = start::<B, N>(cfg, &ws.measurements)?;
+    if !ws.measurements.half.is_none() {
+        let Workspace { coeffs, signal, measurements: m } = ws;
+        coeffs.fill(0.0);
+        project_fractional(dict, coeffs, signal, m, &Ball::new(0.0, 0.0, m.count, 0));
+        synthesize(dict, coeffs, signal);
+        return descend(dict, cfg, ws, &ball, Plan::Trained(schedule));
+    }
+    if let Some(outcome) = short_path(cfg, ws) {
+        return Ok(outcome);
+    }
+    let Workspace { signal, measurements: m, .. } = ws;
+    for ((x, &y), &k) in signal.iter_mut().zip(&m.values).zip(&m.measured) {
+        *x = if k { y } else { 0.0 };
+    }
+    descend(dict, cfg, ws, &ball, Plan::Trained(schedule))
+}
+
+/// Decodes the patch again with `dict` and a trained schedule, starting from the estimate
+/// in `ws.patch()`: another member's solution (the screened choice's second solve), or a
+/// seed that [`seed`] prepared. `sigma0` is the estimate's largest coefficient in `dict`.
+///
+/// # Errors
+/// As [`solve`].
+pub fn solve_warm_scheduled<
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+    const N: usize,
+>(
+    dict: &Dictionary<PS, PT, PU, PV, B>,
+    cfg: &Sl0Config,
+    schedule: &Schedule<PS, PT, PU, PV, B>,
+    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+) -> Result<Outcome, SolveError> {
+    let ball = start::<B, N>(cfg, &ws.measurements)?;
+    descend(dict, cfg, ws, &ball, Plan::Trained(schedule))
+}
+
+/// The schedule from the patch in `ws.signal` (`plan`), projecting onto `ball`.
 fn descend<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
     dict: &Dictionary<PS, PT, PU, PV, B>,
     cfg: &Sl0Config,
     ws: &mut Workspace<PS, PT, PU, PV, B, N>,
     ball: &Ball,
-    scale: f32,
+    plan: Plan<'_, PS, PT, PU, PV, B>,
 ) -> Result<Outcome, SolveError> {
     let Workspace { coeffs, signal, measurements: m } = ws;
     analyze(dict, signal, coeffs);
-    let sigma0 = scale * max_abs(coeffs);
+    let top = max_abs(coeffs);
 
     let selection = m.half.is_none();
-    let outcome = run_schedule(cfg, sigma0, N, |inv| {
-        let step2 = ascend(coeffs, cfg.mu, inv);
+    let mut step = |inv: f32, mu: f32, weights: Option<&Weights<PS, PT, PU, PV, B>>| {
+        let step2 = match weights {
+            Some(w) => ascend_weighted(coeffs, mu, inv, w),
+            None => ascend(coeffs, mu, inv),
+        };
         let residual = if selection {
             project_coefficients(dict, coeffs, signal, m, ball)
         } else {
@@ -546,7 +651,11 @@ fn descend<const PS: usize, const PT: usize, const PU: usize, const PV: usize, c
         // the projection removes), |d| bounds it.
         let moved2 = if ball.is_exact() && selection { step2 - residual * residual } else { step2 };
         Step { residual, moved: libm::sqrtf(moved2.max(0.0)) }
-    });
+    };
+    let outcome = match plan {
+        Plan::Annealed { scale } => run_schedule(cfg, scale * top, N, |inv| step(inv, cfg.mu, None)),
+        Plan::Trained(schedule) => run_trained(cfg, schedule, top, |inv, mu| step(inv, mu, Some(schedule.weights()))),
+    };
 
     synthesize(dict, coeffs, signal);
     if selection {

@@ -13,7 +13,7 @@ use anyhow::Result;
 use clap::{Parser, Subcommand};
 use commands::{
     baseline, bench, compare, decode, demo, device_capture, device_check, eval, evaluate, import, scene, simulate,
-    sweep, train,
+    sweep, train, train_schedule,
 };
 
 #[derive(Parser)]
@@ -42,6 +42,9 @@ enum Command {
     Baseline(baseline::Args),
     /// Learn a dictionary ensemble from light fields (or random training scenes); writes a blob.
     Train(train::Args),
+    /// Learn the trained schedules of an ensemble's solves (SL0 unrolled to a few steps, its
+    /// per-step sigma, mu and penalty weights learned); writes the blob with them.
+    TrainSchedule(train_schedule::Args),
     /// PSNR / SSIM / SA of every test scene x mask family x k, decoded with --dictionary
     /// (default: the shipped ensemble, screened); a markdown table.
     Sweep(sweep::Args),
@@ -108,6 +111,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Eval(args) => eval::run(args),
         Command::Baseline(args) => baseline::run(args),
         Command::Train(args) => train::run(args),
+        Command::TrainSchedule(args) => train_schedule::run(args),
         Command::Sweep(args) => sweep::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Evaluate(args) => evaluate::run(args),

@@ -14,3 +14,4 @@ pub mod scene;
 pub mod simulate;
 pub mod sweep;
 pub mod train;
+pub mod train_schedule;

@@ -364,14 +364,7 @@ pub fn train<const PU: usize, const PV: usize, const N: usize>(
     let fixed = usize::from(cfg.dct_member && cfg.members > 0);
     let mut members = init_members::<PU, PV, N>(patches, cfg);
     let dct_error = coding_error::<PU, PV, N>(patches, &Dictionary::dct(), cfg.tau);
-    let bar = ProgressBar::with_draw_target(Some(cfg.iterations as u64), ProgressDrawTarget::hidden());
-    if cfg.progress {
-        bar.set_draw_target(ProgressDrawTarget::stderr());
-        bar.set_style(
-            ProgressStyle::with_template("training {bar:40} {pos}/{len} iterations {msg}")
-                .unwrap_or_else(|_| ProgressStyle::default_bar()),
-        );
-    }
+    let bar = progress_bar(cfg.iterations as u64, cfg.progress);
     let mut reports = Vec::new();
     for _ in 0..cfg.iterations {
         let dicts: Vec<Dictionary<5, 5, PU, PV, 13>> = members.iter().map(Member::dictionary).collect();
@@ -404,6 +397,19 @@ pub fn train<const PU: usize, const PV: usize, const N: usize>(
     }
     bar.finish_and_clear();
     (members.iter().map(Member::dictionary).collect(), reports)
+}
+
+/// A bar of `iterations` on standard error if `shown`, else hidden.
+pub fn progress_bar(iterations: u64, shown: bool) -> ProgressBar {
+    let bar = ProgressBar::with_draw_target(Some(iterations), ProgressDrawTarget::hidden());
+    if shown {
+        bar.set_draw_target(ProgressDrawTarget::stderr());
+        bar.set_style(
+            ProgressStyle::with_template("training {bar:40} {pos}/{len} iterations {msg}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+    }
+    bar
 }
 
 /// `lf` white-balanced as the decoder balances a capture: each band divided by its

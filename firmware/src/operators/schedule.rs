@@ -1,0 +1,177 @@
+//! The trained schedule: SL0 unrolled to a fixed number of steps, each with its own
+//! learned parameters (DESIGN.md section 10, "a trained solve").
+//!
+//! The hand-set schedule of [`crate::solver::sl0`] anneals `sigma` by a fixed factor with `L`
+//! steps a level from the start's largest coefficient down to `sigma_min`: 60 steps or more
+//! a cold solve, whatever the patch. A [`Schedule`] names every step instead:
+//!
+//! - `sigma[t]`, as a fraction of the start's largest coefficient `sigma0 = max |S0|` (so
+//!   one schedule serves a bright and a dark patch alike), never below the config's
+//!   `sigma_min`;
+//! - `mu[t]`, the step size, in (0, 2];
+//! - the penalty's weights per coefficient group, separable: one number per index of each
+//!   mode ([`Weights`], `PS + PT + PU + PV + B` numbers). The smoothed-l0 penalty of a
+//!   coefficient `s` in group `i` is `1 - exp(-w_i s^2 / (2 sigma^2))`, `w_i` the product of
+//!   its indices' weights: a group with a larger weight is pulled to zero from a larger
+//!   magnitude (a threshold `sigma / sqrt(w_i)`), as ALISTA learns a threshold per layer.
+//!   All ones is SL0's penalty.
+//!
+//! The step itself is SL0's: the ascent `s <- s - mu s exp(-w s^2 / (2 sigma^2))`
+//! (the solver's `ascent::ascend_weighted`) and the projection onto the measurements, whose
+//! adjoint is itself; this is what makes the parameters trainable by gradients through the
+//! steps (the host's `train::schedule`). The operators stay the dictionaries: only these
+//! few scalars are learned, so the device keeps its kernels.
+//!
+//! A blob carries two: [`Schedules::cold`] for a solve from the measurements alone (the
+//! minimum-norm start) and [`Schedules::warm`] for a solve from an estimate (another
+//! member's solution, or a seed from the neighbours' decode).
+
+use crate::operators::dictionary::DictionaryError;
+
+/// The most steps a schedule may hold: bounds every trained solve.
+pub const MAX_STEPS: usize = 64;
+
+/// The penalty's weights per coefficient group: one per index of each mode. A coefficient
+/// at `[s, t, u, v, b]` weighs `s[s] * t[t] * u[u] * v[v] * b[b]`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Weights<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> {
+    pub s: [f32; PS],
+    pub t: [f32; PT],
+    pub u: [f32; PU],
+    pub v: [f32; PV],
+    pub b: [f32; B],
+}
+
+impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> Weights<PS, PT, PU, PV, B> {
+    /// Every weight 1: SL0's own penalty.
+    pub const ONES: Self = Self { s: [1.0; PS], t: [1.0; PT], u: [1.0; PU], v: [1.0; PV], b: [1.0; B] };
+
+    /// The weights mode by mode (`s`, `t`, `u`, `v`, `b`).
+    pub fn modes(&self) -> [&[f32]; 5] {
+        [&self.s, &self.t, &self.u, &self.v, &self.b]
+    }
+
+    /// The weights mode by mode, to write.
+    pub fn modes_mut(&mut self) -> [&mut [f32]; 5] {
+        [&mut self.s, &mut self.t, &mut self.u, &mut self.v, &mut self.b]
+    }
+
+    /// The weight of the coefficient at `[s, t, u, v, b]` (0 outside the patch).
+    pub fn at(&self, [s, t, u, v, b]: [usize; 5]) -> f32 {
+        let get = |w: &[f32], i: usize| w.get(i).copied().unwrap_or(0.0);
+        get(&self.s, s) * get(&self.t, t) * get(&self.u, u) * get(&self.v, v) * get(&self.b, b)
+    }
+}
+
+/// One solve's schedule: `len` steps, each a `sigma` (fraction of `sigma0`) and a `mu`,
+/// and the penalty's group weights.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Schedule<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> {
+    len: u8,
+    sigma: [f32; MAX_STEPS],
+    mu: [f32; MAX_STEPS],
+    weights: Weights<PS, PT, PU, PV, B>,
+}
+
+impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> Schedule<PS, PT, PU, PV, B> {
+    /// A checked schedule: 1 to [`MAX_STEPS`] steps (`sigma` and `mu` of the same length),
+    /// every `sigma` in (0, 1], every `mu` in (0, 2] (above 2 the ascent grows a small
+    /// coefficient: see the solver's `Sl0Config::mu`), every weight finite in
+    /// [1/64, 64] (a coefficient group's threshold moved at most 8 times either way).
+    ///
+    /// # Errors
+    /// [`DictionaryError::BadSchedule`] naming the first bad part (`steps`, `sigma`, `mu`,
+    /// `weights`).
+    pub fn new(sigma: &[f32], mu: &[f32], weights: Weights<PS, PT, PU, PV, B>) -> Result<Self, DictionaryError> {
+        let bad = |part| Err(DictionaryError::BadSchedule { part });
+        if sigma.is_empty() || sigma.len() > MAX_STEPS || sigma.len() != mu.len() {
+            return bad("steps");
+        }
+        if !sigma.iter().all(|s| *s > 0.0 && *s <= 1.0) {
+            return bad("sigma");
+        }
+        if !mu.iter().all(|m| *m > 0.0 && *m <= 2.0) {
+            return bad("mu");
+        }
+        if !weights.modes().iter().all(|w| w.iter().all(|x| (1.0 / 64.0..=64.0).contains(x))) {
+            return bad("weights");
+        }
+        let mut out = Self { len: sigma.len() as u8, sigma: [0.0; MAX_STEPS], mu: [0.0; MAX_STEPS], weights };
+        out.sigma.iter_mut().zip(sigma).for_each(|(d, s)| *d = *s);
+        out.mu.iter_mut().zip(mu).for_each(|(d, m)| *d = *m);
+        Ok(out)
+    }
+
+    /// Steps.
+    pub fn len(&self) -> usize {
+        self.len as usize
+    }
+
+    /// Always false: a checked schedule has a step.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Each step's `sigma` (fraction of `sigma0`).
+    pub fn sigma(&self) -> &[f32] {
+        self.sigma.get(..self.len()).unwrap_or(&[])
+    }
+
+    /// Each step's `mu`.
+    pub fn mu(&self) -> &[f32] {
+        self.mu.get(..self.len()).unwrap_or(&[])
+    }
+
+    /// The penalty's group weights.
+    pub fn weights(&self) -> &Weights<PS, PT, PU, PV, B> {
+        &self.weights
+    }
+}
+
+/// The two schedules a blob carries: from the measurements alone, and from an estimate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Schedules<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> {
+    /// A cold solve: from the minimum-norm start (the measurements, zeros elsewhere).
+    pub cold: Schedule<PS, PT, PU, PV, B>,
+    /// A warm solve: from another member's solution or a seed.
+    pub warm: Schedule<PS, PT, PU, PV, B>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_schedule_out_of_range_is_refused_by_name() {
+        let w = Weights::<5, 5, 5, 5, 13>::ONES;
+        let field = |r: Result<Schedule<5, 5, 5, 5, 13>, DictionaryError>| match r {
+            Err(DictionaryError::BadSchedule { part }) => part,
+            _ => "accepted",
+        };
+        assert_eq!(field(Schedule::new(&[], &[], w)), "steps");
+        assert_eq!(field(Schedule::new(&[0.5; 65], &[1.0; 65], w)), "steps");
+        assert_eq!(field(Schedule::new(&[0.5, 0.2], &[1.0], w)), "steps");
+        assert_eq!(field(Schedule::new(&[0.5, 0.0], &[1.0, 1.0], w)), "sigma");
+        assert_eq!(field(Schedule::new(&[0.5, f32::NAN], &[1.0, 1.0], w)), "sigma");
+        assert_eq!(field(Schedule::new(&[0.5, 0.1], &[1.0, 2.5], w)), "mu");
+        let mut heavy = w;
+        heavy.b[12] = 100.0;
+        assert_eq!(field(Schedule::new(&[0.5], &[1.0], heavy)), "weights");
+        heavy.b[12] = f32::NAN;
+        assert_eq!(field(Schedule::new(&[0.5], &[1.0], heavy)), "weights");
+        let ok = Schedule::new(&[0.5, 0.1], &[1.0, 2.0], w).unwrap();
+        assert_eq!((ok.len(), ok.sigma(), ok.mu()), (2, &[0.5, 0.1][..], &[1.0, 2.0][..]));
+    }
+
+    #[test]
+    fn a_weight_is_the_product_of_its_indices_weights() {
+        let mut w = Weights::<2, 2, 2, 2, 3>::ONES;
+        (w.s[1], w.t[0], w.u[1], w.v[1], w.b[2]) = (2.0, 3.0, 0.5, 4.0, 0.25);
+        assert_eq!(w.at([1, 0, 1, 1, 2]), 2.0 * 3.0 * 0.5 * 4.0 * 0.25);
+        assert_eq!(w.at([0, 1, 0, 0, 0]), 1.0);
+        assert_eq!(w.at([2, 0, 0, 0, 0]), 0.0);
+    }
+}
