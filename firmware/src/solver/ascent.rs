@@ -159,28 +159,64 @@ pub fn ascend_weighted<const PS: usize, const PT: usize, const PU: usize, const 
 ) -> f32 {
     let (c, skip) = exponents(mu, inv);
     let k = scaled(mu);
-    let band: [f32; B] = core::array::from_fn(|b| c * weights.b[b]);
-    let mut fibres = coeffs.as_chunks_mut::<B>().0.iter_mut();
-    let mut sums = [0.0f32; B];
-    for ws in &weights.s {
-        for wt in &weights.t {
-            let st = ws * wt;
-            for wu in &weights.u {
-                let stu = st * wu;
-                for wv in &weights.v {
-                    let pixel = stu * wv;
-                    let Some(fibre) = fibres.next() else { return sums.iter().sum() };
-                    for ((s, sum), cb) in fibre.iter_mut().zip(sums.iter_mut()).zip(&band) {
-                        let t = *s * *s * (cb * pixel);
-                        // A comparison, not `f32::max` (see `ascend` on the Cortex-M).
-                        let d = *s * scaled_exp2(&k, if t > T_MIN { t } else { T_MIN });
-                        let d = if t >= skip { d } else { 0.0 };
-                        *s -= d;
-                        *sum += d * d;
-                    }
-                }
+    // The exponent's factor of every (view, band) of a lenslet, `c w_u w_v w_b`, on the
+    // stack ([u, v, b] is a contiguous run of the patch layout): each lenslet's run is
+    // then one loop over contiguous values with a per-lenslet factor, which vectorises as
+    // `ascend` does (a loop per 13-band fibre stayed 4 times slower).
+    let mut views = [[[0.0f32; B]; PV]; PU];
+    for (row, wu) in views.iter_mut().zip(&weights.u) {
+        for (fibre, wv) in row.iter_mut().zip(&weights.v) {
+            for (x, wb) in fibre.iter_mut().zip(&weights.b) {
+                *x = c * wu * wv * wb;
             }
         }
     }
+    let views = views.as_flattened().as_flattened();
+    let mut sums = [0.0f32; 8];
+    let mut lenslets = coeffs.chunks_exact_mut(PU * PV * B);
+    for ws in &weights.s {
+        for wt in &weights.t {
+            let Some(run) = lenslets.next() else { return sums.iter().sum() };
+            lenslet_step(run, views, ws * wt, &k, skip, &mut sums);
+        }
+    }
     sums.iter().sum()
+}
+
+/// One lenslet's run of coefficients, `views` its (view, band) exponent factors, `scale` the
+/// lenslet's: eight lanes at a time, as [`ascend`], with each lane's factor in an array first
+/// (zipped with the lanes, the loop stayed scalar: 8 times the time of [`ascend`]).
+#[cfg(not(target_arch = "arm"))]
+#[inline(always)]
+fn lenslet_step(run: &mut [f32], views: &[f32], scale: f32, k: &[f32; 6], skip: f32, sums: &mut [f32; 8]) {
+    let (lanes, tail) = run.as_chunks_mut::<8>();
+    let (wlanes, wtail) = views.as_chunks::<8>();
+    for (lane, w) in lanes.iter_mut().zip(wlanes) {
+        let c: [f32; 8] = core::array::from_fn(|l| scale * w[l]);
+        let d: [f32; 8] = core::array::from_fn(|l| step(k, c[l], skip, lane[l]));
+        for l in 0..8 {
+            lane[l] -= d[l];
+            sums[l] += d[l] * d[l];
+        }
+    }
+    for (s, w) in tail.iter_mut().zip(wtail) {
+        let d = step(k, scale * w, skip, *s);
+        *s -= d;
+        sums[0] += d * d;
+    }
+}
+
+/// [`lenslet_step`] on a scalar core: the coefficients the step cannot move are skipped by a
+/// branch, as the Cortex-M [`ascend`] does; each gets the same value as on the host.
+#[cfg(target_arch = "arm")]
+#[inline(always)]
+fn lenslet_step(run: &mut [f32], views: &[f32], scale: f32, k: &[f32; 6], skip: f32, sums: &mut [f32; 8]) {
+    for (s, w) in run.iter_mut().zip(views) {
+        let t = *s * *s * (scale * w);
+        if t >= skip {
+            let d = *s * scaled_exp2(k, if t > T_MIN { t } else { T_MIN });
+            *s -= d;
+            sums[0] += d * d;
+        }
+    }
 }
