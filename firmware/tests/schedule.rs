@@ -109,8 +109,8 @@ fn a_scheduled_solve_stays_in_its_noise_ball_and_its_bound() {
     assert!(r2.sqrt() <= 0.02 * m.sqrt() * 1.001, "residual {} outside the ball {}", r2.sqrt(), 0.02 * m.sqrt());
     // The iteration bound holds on a schedule too.
     let mut ws = workspace(&truth, &measured);
-    let out = solve_scheduled(&dict, &Sl0Config { max_iterations: 4, ..Sl0Config::DEFAULT }, &schedule(), &mut ws)
-        .unwrap();
+    let out =
+        solve_scheduled(&dict, &Sl0Config { max_iterations: 4, ..Sl0Config::DEFAULT }, &schedule(), &mut ws).unwrap();
     assert_eq!((out.iterations, out.ended), (4, Ended::IterationBound));
 }
 
@@ -147,7 +147,11 @@ fn a_scheduled_solve_of_half_pixel_views_meets_their_interpolating_measurements(
     assert_eq!(out.ended, Ended::Scheduled);
     let p = ws.patch();
     for ((s, t, u, v, b), y) in wanted {
-        let got = if u == 1 { 0.5 * (p[shape(s, t, u, v, b)] + p[shape(s + 1, t, u, v, b)]) } else { p[shape(s, t, u, v, b)] };
+        let got = if u == 1 {
+            0.5 * (p[shape(s, t, u, v, b)] + p[shape(s + 1, t, u, v, b)])
+        } else {
+            p[shape(s, t, u, v, b)]
+        };
         assert!((got - y).abs() < 1e-4, "({s}, {t}, {u}, {v}, {b}): {got} against {y}");
     }
 }

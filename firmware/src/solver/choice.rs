@@ -323,7 +323,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     }
 
     /// A solve from a seed: the warm trained schedule, or [`solve_seeded`].
-    fn from_seed<const N: usize>(
+    fn seeded_solve<const N: usize>(
         &self,
         dict: &Dictionary<PS, PT, PU, PV, B>,
         cfg: &Sl0Config,
@@ -476,17 +476,17 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let best = self.screen_members(rule, ws)?;
         let (Some(chosen), Some(dct)) = (best.1, self.screen_member) else {
             let k = best.1.or(self.screen_member).unwrap_or(0);
-            let outcome = self.from_seed(&self.member(k)?, cfg, ws)?;
+            let outcome = self.seeded_solve(&self.member(k)?, cfg, ws)?;
             return Ok(ModelOutcome { outcome, member: Some(k), solves: 1 });
         };
         let member = self.member(chosen)?;
         let selection = ws.measurements.half.is_none();
         if !selection {
-            let outcome = self.from_seed(&member, cfg, ws)?;
+            let outcome = self.seeded_solve(&member, cfg, ws)?;
             return Ok(ModelOutcome { outcome, member: Some(chosen), solves: 1 });
         }
         ws.measurements.stash(&ws.signal);
-        let solved = self.from_seed(&member, cfg, ws).map(|outcome| (outcome, self.score(&member, rule, ws)));
+        let solved = self.seeded_solve(&member, cfg, ws).map(|outcome| (outcome, self.score(&member, rule, ws)));
         let (outcome, member_score) = solved.inspect_err(|_| ws.measurements.drop_stash())?;
         if dct_score < DCT_MARGIN * member_score {
             let Workspace { signal, measurements, .. } = ws;
