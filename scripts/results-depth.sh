@@ -15,7 +15,10 @@
 #     RAYON_NUM_THREADS=1 bash scripts/results-depth.sh OUT_DIR  # the presets before and after issue 40
 #
 # The `-before` rows are the presets with the paper's patch as they were before issue 40 (4 x 4
-# views, default stride 3, best stride 2); `default-stride3` the full-view patch at stride 3.
+# views, default stride 3, best stride 2); `default-stride3` the full-view patch at stride 3;
+# the `-annealed` rows the presets with the hand-set schedule (before issue 42's trained one):
+#   SLF_MODELS="demosaic ppid preview-annealed preview default-annealed default" \
+#     RAYON_NUM_THREADS=1 bash scripts/results-depth.sh OUT > docs/results-schedule.md
 #
 # The real light fields are scripts/real-eval.sh's 128 x 128 crops, in $SLF_REAL (default
 # /tmp/hci/real); their licence allows evaluation only.
@@ -40,7 +43,9 @@ ensemble+halves=--disparities=-1:1:0.5
 preview=--preset,preview default=--preset,default best=--preset,best
 default-unseeded=--preset,default,--seeded,false best-unseeded=--preset,best,--seeded,false
 preview-before=--preset,preview,--patch-views,4 default-before=--preset,default,--patch-views,4,--stride,3
-best-before=--preset,best,--patch-views,4,--stride,2 default-stride3=--preset,default,--stride,3"
+best-before=--preset,best,--patch-views,4,--stride,2 default-stride3=--preset,default,--stride,3
+preview-annealed=--preset,preview,--schedule,annealed default-annealed=--preset,default,--schedule,annealed
+best-annealed=--preset,best,--schedule,annealed"
 models=""
 for m in $all; do
   case " ${SLF_MODELS:-${m%%=*}} " in *" ${m%%=*} "*) models="$models $m" ;; esac

@@ -138,6 +138,6 @@ pub use sensor::mask::{BandTile, LensletSize, Mask, MaskFamily, SensingError};
 pub use sensor::raw::{Frame, FrameSource, LeU16Frame, RawFormat, RawFrame};
 pub use sensor::source::TileSource;
 pub use sensor::spi::{SpiFrameBuffer, SpiSourceError};
-pub use solver::choice::{ChoiceRule, EnsembleModel, MemberChoice, ModelOutcome, PatchModel};
+pub use solver::choice::{ChoiceRule, EnsembleModel, MemberChoice, ModelOutcome, PatchModel, ScheduledDictionary};
 pub use solver::sl0::{Ended, Outcome, Sl0Config, SolveError, solve};
 pub use solver::workspace::{FullViewWorkspace, Measurements, PaperWorkspace, Workspace};

@@ -89,6 +89,17 @@ fn a_scheduled_solve_is_the_steps_it_names() {
         }
         solve_warm_scheduled(&dict, &Sl0Config::DEFAULT, &schedule(), &mut warm).unwrap();
         assert!(max_abs_diff(warm.patch(), ws.patch()) < 1e-6);
+        // A schedule that starts from the band-gain fill is the warm solve from the fill.
+        let filled = schedule().with_fill_start(true);
+        let mut cold = workspace(&truth, &measured);
+        solve_scheduled(&dict, &Sl0Config::DEFAULT, &filled, &mut cold).unwrap();
+        let mut from_fill = workspace(&truth, &measured);
+        let mut x = [0.0f32; N];
+        slf_firmware::solver::fill::fill_bands::<4, N>(from_fill.measurements(), &mut x);
+        from_fill.patch_mut().copy_from_slice(&x);
+        solve_warm_scheduled(&dict, &Sl0Config::DEFAULT, &filled, &mut from_fill).unwrap();
+        assert!(max_abs_diff(cold.patch(), from_fill.patch()) < 1e-6);
+        assert!(max_abs_diff(cold.patch(), ws.patch()) > 1e-4, "the fill start changed nothing");
     }
 }
 
@@ -158,7 +169,7 @@ fn a_scheduled_solve_of_half_pixel_views_meets_their_interpolating_measurements(
 
 fn scheduled_blob(members: &[Dictionary<3, 3, 2, 2, 4>], s: &Schedules<3, 3, 2, 2, 4>) -> &'static [u8] {
     let dims = [3, 3, 2, 2, 4];
-    let mut out = vec![0u8; scheduled_blob_len(dims, members.len(), s.cold.len(), s.warm.len())];
+    let mut out = vec![0u8; scheduled_blob_len(dims, members.len(), [s.cold.len(), s.warm.len(), s.alone.len()])];
     assert_eq!(write_blob_scheduled(members, Some(s), &mut out).unwrap(), out.len());
     Box::leak(out.into_boxed_slice())
 }
@@ -174,10 +185,12 @@ fn reseal(b: &mut [u8]) {
 fn a_blob_carries_its_schedules_and_refuses_bad_ones() {
     let members = [random_dictionary::<3, 3, 2, 2, 4>(51), random_dictionary(52)];
     let warm = S::new(&[0.01, 0.001], &[2.0, 1.0], W::ONES).unwrap();
-    let both = Schedules { cold: schedule(), warm };
-    let blob = scheduled_blob(&members, &both);
+    let alone = S::new(&[0.5, 0.05, 0.005], &[1.0, 1.5, 2.0], weights()).unwrap().with_fill_start(true);
+    let all = Schedules { cold: schedule(), warm, alone };
+    let blob = scheduled_blob(&members, &all);
     let e = Ensemble::<3, 3, 2, 2, 4>::new(blob).unwrap();
-    assert_eq!(e.schedules(), Some(both));
+    assert_eq!(e.schedules(), Some(all));
+    assert!(e.schedules().unwrap().alone.fill_start() && !e.schedules().unwrap().cold.fill_start());
     assert_eq!(u16::from_le_bytes([blob[4], blob[5]]), 2);
     // Version 1 (no schedules) is still read, and has none.
     let mut v1 = vec![0u8; blob::blob_len([3, 3, 2, 2, 4], 2)];
@@ -195,7 +208,7 @@ fn a_blob_carries_its_schedules_and_refuses_bad_ones() {
     let part = |part| Some(DictionaryError::BadSchedule { part });
     assert_eq!(bad(&|b| b[at..at + 2].copy_from_slice(&0u16.to_le_bytes())), part("steps"));
     assert_eq!(bad(&|b| b[at..at + 2].copy_from_slice(&60u16.to_le_bytes())), part("steps"));
-    assert_eq!(bad(&|b| b[at + 2] = 1), part("steps"));
+    assert_eq!(bad(&|b| b[at + 2] = 2), part("start"));
     assert_eq!(bad(&|b| b[at + 4..at + 8].copy_from_slice(&1.5f32.to_le_bytes())), part("sigma"));
     assert_eq!(bad(&|b| b[at + 4..at + 8].copy_from_slice(&f32::NAN.to_le_bytes())), part("sigma"));
     assert_eq!(bad(&|b| b[at + 28..at + 32].copy_from_slice(&2.5f32.to_le_bytes())), part("mu"));
@@ -228,7 +241,7 @@ fn an_ensemble_decodes_with_its_blobs_schedules_cold_sheared_and_seeded() {
     let fall: Vec<f32> = (0..24).map(|t| 10f32.powf(-4.0 * t as f32 / 23.0)).collect();
     let cold = S::new(&fall, &[2.0; 24], W::ONES).unwrap();
     let model = EnsembleModel::new(
-        Ensemble::new(scheduled_blob(&members, &Schedules { cold, warm })).unwrap(),
+        Ensemble::new(scheduled_blob(&members, &Schedules { cold, warm, alone: cold })).unwrap(),
         MemberChoice::Screened(ChoiceRule::DEFAULT),
     );
     assert!(model.schedules().is_some());

@@ -133,13 +133,50 @@ fn scene_simulate_decode_eval_round_trip() {
     ]));
     assert!(out.contains("coding error") && out.contains("vs DCT"), "{out}");
     stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("e2.npy")).arg("--blob").arg(p("e.slfd")).arg("-q"));
+    // Its trained schedules, by one more command; the decode takes them, and the hand-set
+    // schedule's flags are refused beside them.
+    let out = stdout(slf().arg("train-schedule").arg(p("e.slfd")).arg("-o").arg(p("es.slfd")).args([
+        "--scenes",
+        "2",
+        "--size",
+        "12",
+        "--patches",
+        "8",
+        "--iterations",
+        "2",
+        "--batch",
+        "4",
+        "--cold-steps",
+        "4",
+        "--warm-steps",
+        "3",
+        "--alone-steps",
+        "3",
+    ]));
+    assert!(out.contains("| cold | 4 |") && out.contains("| warm | 3 |") && out.contains("| alone | 3 |"), "{out}");
+    let es = std::fs::read(p("es.slfd")).unwrap();
+    assert_eq!(u16::from_le_bytes([es[4], es[5]]), 2, "a blob with schedules is format version 2");
+    let log = stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("e4.npy")).arg("--blob").arg(p("es.slfd")));
+    assert!(log.contains("4.0 steps a patch") || log.contains("3.0 steps a patch"), "{log}");
+    let e = failure(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("e5.npy")).args(["--sigma-f", "0.8"]));
+    assert!(e.contains("--sigma-f sets the hand-set schedule") && e.contains("--schedule annealed"), "{e}");
+    stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("e5.npy")).args([
+        "--sigma-f",
+        "0.8",
+        "--schedule",
+        "annealed",
+        "-q",
+    ]));
+    let e = failure(slf().arg("train-schedule").arg(p("es.slfd")).arg("-o").arg(p("es.slfd")));
+    assert!(e.lines().count() == 1, "{e}");
     std::fs::write(p("bad.slfd"), b"SLFDxx").unwrap();
     let e = failure(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("e3.npy")).arg("--blob").arg(p("bad.slfd")));
     assert!(e.contains("dictionary blob"), "{e}");
     // A random training scene in uint16.
     stdout(slf().args(["scene", "random", "--seed", "4", "--size", "12", "--dtype", "u16", "-o"]).arg(p("r.npy")));
     // Every command has help.
-    for c in ["demo", "scene", "simulate", "decode", "eval", "baseline", "sweep", "train", "compare"] {
+    for c in ["demo", "scene", "simulate", "decode", "eval", "baseline", "sweep", "train", "train-schedule", "compare"]
+    {
         assert!(stdout(slf().args([c, "--help"])).contains("Usage"), "{c}");
     }
 }
@@ -540,12 +577,16 @@ fn presets_are_their_flags_and_flags_override_them() {
         "false",
         "--sigma-min",
         "3e-3",
-        "--cold-start",
-        "0.03",
     ];
     let (flags, n_flags) = decode("flags.npy", &spelled);
     assert_eq!(n_preview, n_flags);
     assert!(preview == flags, "--preset preview is not its flags");
+    // With the hand-set schedule the preview starts from the band-gain fill at 0.03.
+    let (annealed, _) = decode("pa.npy", &["--preset", "preview", "--schedule", "annealed"]);
+    let spelled_annealed = [&spelled[..], &["--schedule", "annealed", "--cold-start", "0.03"]].concat();
+    let (flags_annealed, _) = decode("fa.npy", &spelled_annealed);
+    assert!(annealed == flags_annealed, "--preset preview --schedule annealed is not its flags");
+    assert!(annealed != preview, "the trained and the hand-set schedule decode the same");
     // A flag beside the preset wins: the preview at stride 3 decodes more patches, and
     // is the default's stride with the preview's other choices.
     let (_, n_stride3) = decode("s3.npy", &["--preset", "preview", "--stride", "3"]);

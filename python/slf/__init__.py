@@ -257,6 +257,7 @@ def decode(
     disparities: Union[None, str, Sequence[float]] = None,
     edge_fallback: Optional[bool] = None,
     seeded: Optional[bool] = None,
+    schedule: Optional[str] = None,
     patch_views: Optional[int] = None,
     dictionary: Optional[str] = None,
     choice: Optional[str] = None,
@@ -300,7 +301,8 @@ def decode(
     value. The keywords are ``slf decode``'s flags (see ``slf decode --help``):
     ``stride`` 1..=5, ``window`` uniform or tapered, ``disparities`` ``"MIN:MAX[:STEP]"``
     or ``(min, max[, step])``, ``edge_fallback``, ``seeded`` (shifted patches started from
-    the disjoint grid's decode), ``patch_views`` 4 or 5 (the paper's 4 x 4-view patch or the
+    the disjoint grid's decode), ``schedule`` trained (the blob's trained schedules, the
+    default) or annealed (the hand-set one the solver keywords set), ``patch_views`` 4 or 5 (the paper's 4 x 4-view patch or the
     full-view patch; default 5 for lenslets of 5 x 5 views), ``dictionary`` dct or ensemble,
     ``choice``, ``blob`` (an ensemble file), ``balance`` grey or off, ``gains`` (13),
     ``adaptive`` and the solver's ``sigma_f`` ... ``min_bands``.
@@ -326,6 +328,7 @@ def decode(
         disparities=disparities,
         edge_fallback=edge_fallback,
         seeded=seeded,
+        schedule=schedule,
         patch_views=patch_views,
         dictionary=dictionary,
         choice=choice,

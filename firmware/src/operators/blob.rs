@@ -12,7 +12,7 @@
 //! | 18 | 2 | member count K (u16, >= 1) |
 //! | 20 | 4 | payload length in bytes (u32): the members' `K * 4 * (PS^2 + PT^2 + PU^2 + PV^2 + B^2)`, plus the schedules' in version 2 |
 //! | 24 | members | per member, `D_1 .. D_5` (synthesis matrices, columns are atoms), each row-major f32 |
-//! | | schedules | version 2 only: the cold, then the warm [`Schedule`], each `T` (u16), 0 (u16), `T` sigmas, `T` mus, then the `PS + PT + PU + PV + B` group weights (f32) |
+//! | | schedules | version 2 only: the cold, the warm, then the alone [`Schedule`] ([`Schedules`]), each `T` (u16), its cold start (u16: 0 minimum-norm, 1 band-gain fill), `T` sigmas, `T` mus, then the `PS + PT + PU + PV + B` group weights (f32) |
 //! | 24 + payload | 4 | CRC-32/ISO-HDLC (zlib's, PNG's) of every byte before it |
 //!
 //! [`Ensemble::new`] checks, in this order: length, magic, version, reserved, dimensions,
@@ -35,11 +35,13 @@ use crate::operators::schedule::{MAX_STEPS, Schedule, Schedules, Weights};
 /// `Ensemble::<5, 5, 4, 4, 13>::new(DEFAULT_ENSEMBLE)` validates it.
 pub static DEFAULT_ENSEMBLE: &[u8] = include_bytes!("../../dictionaries/ensemble8.slfd");
 
-/// The shipped default ensemble for the full-view patch (5 x 5 x 5 x 5 x 13): 8 members
-/// trained by `cargo run --release -p slf-host -- train --patch-views 5 -o
-/// firmware/dictionaries/fullview8.slfd` (the same defaults and training scenes as
-/// [`DEFAULT_ENSEMBLE`]). `Ensemble::<5, 5, 5, 5, 13>::new(DEFAULT_FULL_VIEW_ENSEMBLE)`
-/// validates it.
+/// The shipped default ensemble for the full-view patch (5 x 5 x 5 x 5 x 13), with its
+/// trained schedules (format version 2): 8 members trained by `cargo run --release -p
+/// slf-host -- train --patch-views 5 -o fullview8-ensemble.slfd` (the same defaults and
+/// training scenes as [`DEFAULT_ENSEMBLE`]), then its schedules by `slf train-schedule
+/// fullview8-ensemble.slfd -o firmware/dictionaries/fullview8.slfd` (all defaults: a cold
+/// schedule of 24 steps and a warm one of 16, on 1,024 patches of 24 realistic training
+/// scenes). `Ensemble::<5, 5, 5, 5, 13>::new(DEFAULT_FULL_VIEW_ENSEMBLE)` validates it.
 pub static DEFAULT_FULL_VIEW_ENSEMBLE: &[u8] = include_bytes!("../../dictionaries/fullview8.slfd");
 
 /// The magic bytes at the start of a blob.
@@ -77,10 +79,10 @@ pub const fn schedule_len(dims: [usize; 5], steps: usize) -> usize {
     4 + 8 * steps + 4 * (dims[0] + dims[1] + dims[2] + dims[3] + dims[4])
 }
 
-/// Total bytes of a blob of `members` members and a cold and a warm schedule of the given
-/// steps.
-pub const fn scheduled_blob_len(dims: [usize; 5], members: usize, cold: usize, warm: usize) -> usize {
-    blob_len(dims, members) + schedule_len(dims, cold) + schedule_len(dims, warm)
+/// Total bytes of a blob of `members` members and schedules of the given steps (cold, warm,
+/// alone).
+pub const fn scheduled_blob_len(dims: [usize; 5], members: usize, steps: [usize; 3]) -> usize {
+    blob_len(dims, members) + schedule_len(dims, steps[0]) + schedule_len(dims, steps[1]) + schedule_len(dims, steps[2])
 }
 
 fn u16_at(b: &[u8], at: usize) -> u16 {
@@ -145,9 +147,14 @@ fn read_schedule<const PS: usize, const PT: usize, const PU: usize, const PV: us
 ) -> Result<(Schedule<PS, PT, PU, PV, B>, usize), DictionaryError> {
     let steps = usize::from(u16_at(bytes, 0));
     let len = schedule_len([PS, PT, PU, PV, B], steps);
-    if bytes.len() < 4 || steps == 0 || steps > MAX_STEPS || bytes.len() < len || u16_at(bytes, 2) != 0 {
+    if bytes.len() < 4 || steps == 0 || steps > MAX_STEPS || bytes.len() < len {
         return Err(DictionaryError::BadSchedule { part: "steps" });
     }
+    let fill_start = match u16_at(bytes, 2) {
+        0 => false,
+        1 => true,
+        _ => return Err(DictionaryError::BadSchedule { part: "start" }),
+    };
     let (mut sigma, mut mu) = ([0.0f32; MAX_STEPS], [0.0f32; MAX_STEPS]);
     for t in 0..steps {
         (sigma[t], mu[t]) = (f32_at(bytes, 4 + 4 * t), f32_at(bytes, 4 + 4 * (steps + t)));
@@ -161,19 +168,20 @@ fn read_schedule<const PS: usize, const PT: usize, const PU: usize, const PV: us
         }
     }
     let schedule = Schedule::new(sigma.get(..steps).unwrap_or(&[]), mu.get(..steps).unwrap_or(&[]), weights)?;
-    Ok((schedule, len))
+    Ok((schedule.with_fill_start(fill_start), len))
 }
 
-/// The cold and the warm schedule, which must fill `bytes` exactly.
+/// The cold, the warm and the alone schedule, which must fill `bytes` exactly.
 fn read_schedules<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
     bytes: &[u8],
 ) -> Result<Schedules<PS, PT, PU, PV, B>, DictionaryError> {
-    let (cold, at) = read_schedule(bytes)?;
-    let (warm, len) = read_schedule(bytes.get(at..).unwrap_or(&[]))?;
-    if at + len != bytes.len() {
+    let (cold, a) = read_schedule(bytes)?;
+    let (warm, b) = read_schedule(bytes.get(a..).unwrap_or(&[]))?;
+    let (alone, c) = read_schedule(bytes.get(a + b..).unwrap_or(&[]))?;
+    if a + b + c != bytes.len() {
         return Err(DictionaryError::BadSchedule { part: "steps" });
     }
-    Ok(Schedules { cold, warm })
+    Ok(Schedules { cold, warm, alone })
 }
 
 /// Writes one schedule at the start of `out`; returns its length.
@@ -182,6 +190,7 @@ fn write_schedule<const PS: usize, const PT: usize, const PU: usize, const PV: u
     out: &mut [u8],
 ) -> usize {
     put(out, 0, &(s.len() as u16).to_le_bytes());
+    put(out, 2, &u16::from(s.fill_start()).to_le_bytes());
     let mut at = 4;
     let weights = s.weights().modes();
     for x in s.sigma().iter().chain(s.mu()).chain(weights.iter().flat_map(|w| w.iter())) {
@@ -238,7 +247,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         }
         let members_len = members as usize * Self::MEMBER_LEN;
         // Version 2 adds the schedules after the members: at least two empty ones' headers.
-        let least = if version == BLOB_VERSION { members_len + 2 * schedule_len(Self::DIMS, 1) } else { members_len };
+        let least = if version == BLOB_VERSION { members_len + 3 * schedule_len(Self::DIMS, 1) } else { members_len };
         let payload_len = u32_at(blob, PAYLOAD_LEN_AT) as usize;
         let expected = HEADER_LEN + payload_len.max(least) + CHECKSUM_LEN;
         let fits = if version == BLOB_VERSION { payload_len >= least } else { payload_len == members_len };
@@ -355,7 +364,7 @@ pub fn write_blob_scheduled<const PS: usize, const PT: usize, const PU: usize, c
         return Err(DictionaryError::MemberCount { found: members.len().min(u16::MAX as usize) as u16 });
     }
     let total = match schedules {
-        Some(s) => scheduled_blob_len(dims, members.len(), s.cold.len(), s.warm.len()),
+        Some(s) => scheduled_blob_len(dims, members.len(), [s.cold.len(), s.warm.len(), s.alone.len()]),
         None => blob_len(dims, members.len()),
     };
     let Some(out) = out.get_mut(..total) else {
@@ -384,8 +393,9 @@ pub fn write_blob_scheduled<const PS: usize, const PT: usize, const PU: usize, c
         at += write_matrix(&d.m5, rest.get_mut(at..).unwrap_or_default());
     }
     if let Some(s) = schedules {
-        at += write_schedule(&s.cold, rest.get_mut(at..).unwrap_or_default());
-        write_schedule(&s.warm, rest.get_mut(at..).unwrap_or_default());
+        for schedule in [&s.cold, &s.warm, &s.alone] {
+            at += write_schedule(schedule, rest.get_mut(at..).unwrap_or_default());
+        }
     }
     let body_len = total - CHECKSUM_LEN;
     let crc = CRC32.checksum(out.get(..body_len).unwrap_or_default());

@@ -65,8 +65,8 @@ pub enum DictionaryError {
     NoSuchMember { index: u16, members: u16 },
     /// The output buffer cannot hold the blob.
     BufferTooSmall { needed: u32 },
-    /// A trained schedule out of range (`part`: `steps`, `sigma`, `mu` or `weights`), or
-    /// a schedule section of a length its step counts do not imply.
+    /// A trained schedule out of range (`part`: `steps`, `start`, `sigma`, `mu` or
+    /// `weights`), or a schedule section of a length its step counts do not imply.
     BadSchedule { part: &'static str },
 }
 

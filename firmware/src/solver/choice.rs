@@ -198,8 +198,9 @@ pub struct ModelOutcome {
     pub solves: u16,
 }
 
-/// Something that decodes the patch in a workspace: a single [`Dictionary`] or an
-/// [`EnsembleModel`]. The tile decoder takes either.
+/// Something that decodes the patch in a workspace: a single [`Dictionary`] (with the
+/// hand-set schedule, or trained ones: [`ScheduledDictionary`]) or an [`EnsembleModel`].
+/// The tile decoder takes any.
 pub trait PatchModel<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
 {
     /// Decodes the patch whose measurements are in `ws` into `ws.patch()`.
@@ -241,6 +242,36 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
             return Ok(ModelOutcome { outcome, member: None, solves: 0 });
         }
         let outcome = solve_seeded(self, cfg, ws)?;
+        Ok(ModelOutcome { outcome, member: None, solves: 1 })
+    }
+}
+
+/// One dictionary solved with trained schedules: the alone one from the measurements, the
+/// warm one from a seed. The DCT with the schedules of a blob that screens with it (its
+/// alone schedule is trained on the DCT's solves).
+#[derive(Clone, Debug)]
+pub struct ScheduledDictionary<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> {
+    pub dictionary: Dictionary<PS, PT, PU, PV, B>,
+    pub schedules: Schedules<PS, PT, PU, PV, B>,
+}
+
+impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
+    PatchModel<PS, PT, PU, PV, B, N> for ScheduledDictionary<PS, PT, PU, PV, B>
+{
+    fn decode(&self, cfg: &Sl0Config, ws: &mut Workspace<PS, PT, PU, PV, B, N>) -> Result<ModelOutcome, SolveError> {
+        let outcome = solve_scheduled(&self.dictionary, cfg, &self.schedules.alone, ws)?;
+        Ok(ModelOutcome { outcome, member: None, solves: 1 })
+    }
+
+    fn decode_seeded(
+        &self,
+        cfg: &Sl0Config,
+        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ) -> Result<ModelOutcome, SolveError> {
+        if let Some(outcome) = seed(&self.dictionary, cfg, ws)? {
+            return Ok(ModelOutcome { outcome, member: None, solves: 0 });
+        }
+        let outcome = solve_warm_scheduled(&self.dictionary, cfg, &self.schedules.warm, ws)?;
         Ok(ModelOutcome { outcome, member: None, solves: 1 })
     }
 }

@@ -583,7 +583,12 @@ pub fn solve_scheduled<
     let ball = start::<B, N>(cfg, &ws.measurements)?;
     if !ws.measurements.half.is_none() {
         let Workspace { coeffs, signal, measurements: m } = ws;
-        coeffs.fill(0.0);
+        if schedule.fill_start() {
+            fill_bands::<B, N>(m, signal);
+            analyze(dict, signal, coeffs);
+        } else {
+            coeffs.fill(0.0);
+        }
         project_fractional(dict, coeffs, signal, m, &Ball::new(0.0, 0.0, m.count, 0));
         synthesize(dict, coeffs, signal);
         return descend(dict, cfg, ws, &ball, Plan::Trained(schedule));
@@ -592,8 +597,12 @@ pub fn solve_scheduled<
         return Ok(outcome);
     }
     let Workspace { signal, measurements: m, .. } = ws;
-    for ((x, &y), &k) in signal.iter_mut().zip(&m.values).zip(&m.measured) {
-        *x = if k { y } else { 0.0 };
+    if schedule.fill_start() {
+        fill_bands::<B, N>(m, signal);
+    } else {
+        for ((x, &y), &k) in signal.iter_mut().zip(&m.values).zip(&m.measured) {
+            *x = if k { y } else { 0.0 };
+        }
     }
     descend(dict, cfg, ws, &ball, Plan::Trained(schedule))
 }

@@ -202,11 +202,24 @@ fn decode_basis<const PU: usize, const PV: usize, const N: usize>(
     opts: &DecodeOptions,
     observer: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<(LightField, DecodeReport)> {
+    let trained = opts.schedule == SolveSchedule::Trained;
     match basis {
-        Basis::Dct => decode_observed::<PU, PV, N, _>(capture, &Dictionary::<5, 5, PU, PV, 13>::dct(), opts, observer),
+        Basis::Dct => {
+            let dictionary = Dictionary::<5, 5, PU, PV, 13>::dct();
+            // The DCT takes the schedules of the shipped blob, whose cold one is trained on
+            // the DCT's solves (the screen's).
+            match ensemble::<PU, PV>(None)?.schedules().filter(|_| trained) {
+                Some(schedules) => {
+                    let model = slf_firmware::ScheduledDictionary { dictionary, schedules };
+                    decode_observed::<PU, PV, N, _>(capture, &model, opts, observer)
+                }
+                None => decode_observed::<PU, PV, N, _>(capture, &dictionary, opts, observer),
+            }
+        }
         Basis::Ensemble { blob, choice } => {
             let ensemble = ensemble::<PU, PV>(blob.as_deref())?;
             let model = slf_firmware::EnsembleModel::new(ensemble, *choice);
+            let model = if trained { model } else { model.with_schedules(None) };
             decode_observed::<PU, PV, N, _>(capture, &model, opts, observer)
         }
     }
@@ -337,6 +350,21 @@ pub struct DecodeOptions {
     /// The patch's views per axis; `None` (the default): [`PatchViews::fitting`] the
     /// capture's lenslets, or the patch a given ensemble blob was made for.
     pub patch_views: Option<PatchViews>,
+    /// The solves' schedule: a blob's trained ones (the default), or the hand-set one of
+    /// [`Self::sl0`].
+    pub schedule: SolveSchedule,
+}
+
+/// Which schedule the solves take.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum SolveSchedule {
+    /// The trained schedules the ensemble's blob carries (the DCT takes the shipped blob's);
+    /// a blob without them (format version 1) solves with the hand-set one.
+    #[default]
+    Trained,
+    /// The hand-set schedule: sigma annealed by --sigma-f with --steps a level down to
+    /// --sigma-min (the decode before 2026-11-26).
+    Annealed,
 }
 
 impl Default for DecodeOptions {
@@ -353,6 +381,7 @@ impl Default for DecodeOptions {
             disparities: None,
             edge_fallback: true,
             seeded: true,
+            schedule: SolveSchedule::Trained,
             patch_views: None,
         }
     }

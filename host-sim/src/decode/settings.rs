@@ -18,7 +18,8 @@ use slf_firmware::{ChoiceRule, DisparityRange, MemberChoice, Sl0Config, SolveErr
 
 use crate::decode::baselines::{Baseline, BaselineReport};
 use crate::decode::cs::{
-    Balance, Basis, DecodeOptions, DecodeReport, NoiseSource, PatchViews, Window, decode_with_observer, read_blob,
+    Balance, Basis, DecodeOptions, DecodeReport, NoiseSource, PatchViews, SolveSchedule, Window, decode_with_observer,
+    read_blob,
 };
 use crate::decode::preset::Preset;
 use crate::io::capture::Capture;
@@ -367,6 +368,11 @@ pub struct DecodeSettings {
     /// nothing, the decode before 2026-11-25) [default: true].
     #[arg(long, value_name = "BOOL")]
     pub seeded: Option<bool>,
+    /// The solves' schedule: trained (the blob's trained schedules, a few steps each; the
+    /// DCT takes the shipped blob's) or annealed (the hand-set schedule the solver flags
+    /// --sigma-f, --steps, --mu, --tolerance, --warm-*, --seed-sigma-f and --cold-start set).
+    #[arg(long, value_enum, default_value_t = SolveSchedule::Trained)]
+    pub schedule: SolveSchedule,
 }
 
 /// A decode's light field and what it reports.
@@ -440,8 +446,29 @@ impl DecodeSettings {
             edge_fallback: self.edge_fallback.unwrap_or(base.edge_fallback),
             seeded: self.seeded.unwrap_or(base.seeded),
             patch_views: self.basis.patch_views.or(base.patch_views),
+            schedule: self.schedule,
             ..base
         };
+        // The hand-set schedule's flags mean nothing to a trained schedule.
+        if self.schedule == SolveSchedule::Trained {
+            let d = Self::from_flags(std::iter::empty::<&str>()).map_err(|e| anyhow!(e))?;
+            let (s, ds) = (&self.solver, &d.solver);
+            let f = |a: f32, b: f32| a.to_bits() == b.to_bits();
+            let hand = [
+                (f(s.sigma_f, ds.sigma_f), "--sigma-f"),
+                (s.steps == ds.steps, "--steps"),
+                (f(s.mu, ds.mu), "--mu"),
+                (f(s.tolerance, ds.tolerance), "--tolerance"),
+                (f(s.warm_start, ds.warm_start), "--warm-start"),
+                (f(s.warm_sigma_f, ds.warm_sigma_f), "--warm-sigma-f"),
+                (s.warm_steps == ds.warm_steps, "--warm-steps"),
+                (f(s.seed_sigma_f, ds.seed_sigma_f), "--seed-sigma-f"),
+                (s.cold_start.map(f32::to_bits) == ds.cold_start.map(f32::to_bits), "--cold-start"),
+            ];
+            if let Some((_, flag)) = hand.iter().find(|(same, _)| !same) {
+                bail!("{flag} sets the hand-set schedule, which the trained one replaces: add --schedule annealed");
+            }
+        }
         // Flags the decode would otherwise ignore in silence.
         let bands = PATCH_BANDS;
         ensure!(
@@ -506,6 +533,7 @@ impl DecodeSettings {
             (self.disparities == d.disparities, "--disparities"),
             (self.edge_fallback == d.edge_fallback, "--edge-fallback"),
             (self.seeded == d.seeded, "--seeded"),
+            (self.schedule == d.schedule, "--schedule"),
         ]
         .into_iter()
         .filter_map(|(same, name)| (!same).then_some(name))

@@ -23,13 +23,16 @@
 //! start's largest coefficient), `mu_t = 2 sigmoid(p_t)` (in (0, 2)), `log w` per mode
 //! index; Adam on mini-batches. A test compares the gradients with finite differences.
 //!
-//! **Two schedules.** The cold one is trained from the minimum-norm start with the DCT (the
-//! screened choice's first solve); then, with the cold one fixed, the warm one from each
-//! patch's cold solution, with the member the screen picks for it (the second solve; a seeded
-//! solve starts from a like estimate).
+//! **Three schedules** ([`Schedules`]). The cold one is trained from the minimum-norm start
+//! with the DCT (the screened choice's first solve); then, with the cold one fixed, the warm
+//! one from each patch's cold solution, with the member the screen picks for it (the second
+//! solve; a seeded solve starts from a like estimate); then the alone one, the DCT decoding
+//! alone (the preview) from the band-gain fill.
 //!
 //! Deterministic: patches, masks and batches come from one seed, per-patch gradients are
-//! summed in order, so the same inputs give the same blob bytes on any thread count.
+//! summed in order, and every exponential and logarithm is `libm`'s (not the platform C
+//! library's, which may differ between machines), so the same inputs give the same blob
+//! bytes on any thread count and machine of the same build.
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -71,6 +74,8 @@ pub struct ScheduleConfig {
     /// Adam's step size (on the log and logit parameters).
     pub rate: f32,
     pub seed: u64,
+    /// Steps of the alone schedule (a dictionary decoding alone).
+    pub alone_steps: usize,
     /// Show a progress bar.
     pub progress: bool,
 }
@@ -78,13 +83,14 @@ pub struct ScheduleConfig {
 impl Default for ScheduleConfig {
     fn default() -> Self {
         Self {
-            cold_steps: 16,
-            warm_steps: 12,
+            cold_steps: 24,
+            warm_steps: 16,
             patches: 1024,
             iterations: 120,
             batch: 64,
             rate: 0.05,
             seed: 1,
+            alone_steps: 24,
             progress: false,
         }
     }
@@ -150,7 +156,7 @@ pub struct Params<const PU: usize, const PV: usize> {
 }
 
 fn sigmoid(x: f32) -> f32 {
-    1.0 / (1.0 + (-x).exp())
+    1.0 / (1.0 + libm::expf(-x))
 }
 
 impl<const PU: usize, const PV: usize> Params<PU, PV> {
@@ -159,7 +165,7 @@ impl<const PU: usize, const PV: usize> Params<PU, PV> {
     pub fn geometric(steps: usize, from: f32, to: f32) -> Self {
         let at = |t: usize| if steps > 1 { t as f32 / (steps - 1) as f32 } else { 0.0 };
         Self {
-            log_sigma: (0..steps).map(|t| from.ln() + at(t) * (to.ln() - from.ln())).collect(),
+            log_sigma: (0..steps).map(|t| libm::logf(from) + at(t) * (libm::logf(to) - libm::logf(from))).collect(),
             mu_logit: vec![0.0; steps],
             log_weights: dims::<PU, PV>().map(|d| vec![0.0; d]),
         }
@@ -181,7 +187,7 @@ impl<const PU: usize, const PV: usize> Params<PU, PV> {
 
     /// Each step's sigma fraction, in (0, 1].
     pub fn sigma(&self) -> Vec<f32> {
-        self.log_sigma.iter().map(|l| l.exp().clamp(1e-7, 1.0)).collect()
+        self.log_sigma.iter().map(|&l| libm::expf(l).clamp(1e-7, 1.0)).collect()
     }
 
     /// Each step's mu, in (0, 2).
@@ -194,7 +200,7 @@ impl<const PU: usize, const PV: usize> Params<PU, PV> {
         let mut w = Weights::ONES;
         for (mode, logs) in w.modes_mut().into_iter().zip(&self.log_weights) {
             for (x, l) in mode.iter_mut().zip(logs) {
-                *x = l.exp().clamp(1.0 / 64.0, 64.0);
+                *x = libm::expf(*l).clamp(1.0 / 64.0, 64.0);
             }
         }
         w
@@ -230,6 +236,18 @@ pub fn start<const PU: usize, const PV: usize, const N: usize>(
     let exact = Ball::new(0.0, 0.0, problem.measurements.count() as u32, 0);
     project_coefficients(dict, &mut c, &mut x, &problem.measurements, &exact);
     c.to_vec()
+}
+
+/// A cold solve's start as a patch: the band-gain fill ([`slf_firmware::solver::fill`]), or
+/// the measurements with zeros elsewhere.
+pub fn cold_start<const N: usize>(problem: &Problem<N>, fill: bool) -> Vec<f32> {
+    if fill {
+        let mut x: Box<[f32; N]> = Box::new([0.0; N]);
+        slf_firmware::solver::fill::fill_bands::<13, N>(&problem.measurements, &mut x);
+        x.to_vec()
+    } else {
+        (0..N).map(|i| problem.measurements.get(i).unwrap_or(0.0)).collect()
+    }
 }
 
 /// The solve from `start` (coefficients in `dict`), keeping every step's coefficients.
@@ -293,7 +311,7 @@ pub fn loss_and_gradient<const PU: usize, const PV: usize, const N: usize>(
     // smooth patches a decode makes nearly exact weigh as much as the textured ones whose
     // squared error is a thousand times theirs (on the squared error the schedule learned
     // the textured patches and lost 4 dB on a smooth real scene).
-    let loss = (mse + LOSS_FLOOR).ln();
+    let loss = libm::log(mse + LOSS_FLOOR);
     let mut g: Box<[f32; N]> = Box::new([0.0; N]);
     for ((g, s), t) in g.iter_mut().zip(last).zip(truth_c.iter()) {
         *g = (2.0 * f64::from(s - t) / n / (mse + LOSS_FLOOR)) as f32;
@@ -315,7 +333,7 @@ pub fn loss_and_gradient<const PU: usize, const PV: usize, const N: usize>(
             let idx = PatchShape::<5, 5, PU, PV, 13, N>::coordinates(i);
             let w = weights.at(idx);
             let x = w * s * s * inv;
-            let a = (-x).exp();
+            let a = libm::expf(-x);
             let gz = *g;
             dmu += f64::from(gz * (-s * a));
             dinv += f64::from(gz * mu * w * s * s * s * a);
@@ -444,6 +462,7 @@ pub fn mean_error<const PU: usize, const PV: usize, const N: usize>(
 pub struct ScheduleReport {
     pub cold: Fit,
     pub warm: Fit,
+    pub alone: Fit,
 }
 
 /// Trains the cold and the warm schedule for `members` (member `dct`, if any, is the DCT
@@ -459,10 +478,11 @@ pub fn train<const PU: usize, const PV: usize, const N: usize>(
     cfg: &ScheduleConfig,
 ) -> anyhow::Result<(Schedules<5, 5, PU, PV, 13>, ScheduleReport)> {
     anyhow::ensure!(
-        (1..=MAX_STEPS).contains(&cfg.cold_steps) && (1..=MAX_STEPS).contains(&cfg.warm_steps),
-        "schedule steps: 1 to {MAX_STEPS} each (cold {}, warm {})",
+        [cfg.cold_steps, cfg.warm_steps, cfg.alone_steps].iter().all(|s| (1..=MAX_STEPS).contains(s)),
+        "schedule steps: 1 to {MAX_STEPS} each (cold {}, warm {}, alone {})",
         cfg.cold_steps,
-        cfg.warm_steps
+        cfg.warm_steps,
+        cfg.alone_steps
     );
     anyhow::ensure!(patches.len() >= N, "no training patch");
     let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed);
@@ -471,12 +491,11 @@ pub fn train<const PU: usize, const PV: usize, const N: usize>(
     dicts.extend_from_slice(members);
     let problems: Vec<Problem<N>> =
         patches.chunks_exact(N).map(|truth| Problem::new(truth, &random_pattern::<PU, PV, N>(&mut rng))).collect();
-    // The cold solve: the DCT from the minimum-norm start.
+    // The screened choice's first solve: the DCT from the minimum-norm start.
     let cold_problems: Vec<(usize, Problem<N>, Vec<f32>)> = problems
         .into_par_iter()
         .map(|p| {
-            let zero_filled: Vec<f32> = (0..N).map(|i| p.measurements.get(i).unwrap_or(0.0)).collect();
-            let s = start(&dicts[0], &p, &zero_filled);
+            let s = start(&dicts[0], &p, &cold_start::<N>(&p, false));
             (0, p, s)
         })
         .collect();
@@ -486,10 +505,10 @@ pub fn train<const PU: usize, const PV: usize, const N: usize>(
     // The warm solve: each patch's cold solution, in the member the screen picks for it.
     let rule = ChoiceRule::DEFAULT;
     let learned: Vec<usize> = (0..members.len()).filter(|&k| Some(k) != dct).collect();
-    let warm_problems: Vec<(usize, Problem<N>, Vec<f32>)> = cold_problems
-        .into_par_iter()
+    let warm_starts: Vec<(usize, Vec<f32>)> = cold_problems
+        .par_iter()
         .map(|(_, p, s)| {
-            let path = unroll(&dicts[0], &cold_schedule, &p, &s);
+            let path = unroll(&dicts[0], &cold_schedule, p, s);
             let x = patch_of::<PU, PV, N>(&dicts[0], path.coeffs.last().map_or(&[][..], |c| c));
             let mut signal: Box<[f32; N]> = Box::new([0.0; N]);
             signal.copy_from_slice(&x);
@@ -502,14 +521,24 @@ pub fn train<const PU: usize, const PV: usize, const N: usize>(
                 })
                 .min_by(|a, b| a.0.total_cmp(&b.0))
                 .map_or(0, |(_, k)| k + 1);
-            let s = start(&dicts[pick], &p, &x);
-            (pick, p, s)
+            (pick, start(&dicts[pick], p, &x))
         })
         .collect();
+    let mut warm_problems: Vec<(usize, Problem<N>, Vec<f32>)> =
+        cold_problems.into_iter().zip(warm_starts).map(|((_, p, _), (pick, s))| (pick, p, s)).collect();
     let mut warm = Params::<PU, PV>::geometric(cfg.warm_steps, 1e-2, 1e-4);
     let warm_fit = fit(&mut warm, &dicts, &warm_problems, cfg, cfg.seed + 2)?;
-    let schedules = Schedules { cold: cold_schedule, warm: warm.schedule()? };
-    Ok((schedules, ScheduleReport { cold: cold_fit, warm: warm_fit }))
+    // A dictionary alone (the DCT of the preview): from the band-gain fill (measured: 1.2-2.8
+    // dB over the minimum-norm start on the realistic set with nothing solved after it).
+    for (d, p, s) in &mut warm_problems {
+        *d = 0;
+        *s = start(&dicts[0], p, &cold_start::<N>(p, true));
+    }
+    let mut alone = Params::<PU, PV>::geometric(cfg.alone_steps, 1.0, 1e-4);
+    let alone_fit = fit(&mut alone, &dicts, &warm_problems, cfg, cfg.seed + 3)?;
+    let schedules =
+        Schedules { cold: cold_schedule, warm: warm.schedule()?, alone: alone.schedule()?.with_fill_start(true) };
+    Ok((schedules, ScheduleReport { cold: cold_fit, warm: warm_fit, alone: alone_fit }))
 }
 
 /// `slf train-schedule`: trains the cold and the warm schedule for the ensemble in `blob` on
@@ -557,15 +586,21 @@ fn train_schedule_blob_of<const PU: usize, const PV: usize, const N: usize>(
     let patches = crate::train::ensemble::sample_patches::<PU, PV, N>(fields, cfg.patches, cfg.seed);
     let (schedules, report) = train::<PU, PV, N>(&members, dct, &patches, cfg)?;
     println!("| schedule | steps | first batch mean PSNR | last batch mean PSNR |\n| --- | --- | --- | --- |");
-    for (name, s, f) in [("cold", &schedules.cold, report.cold), ("warm", &schedules.warm, report.warm)] {
+    let all = [
+        ("cold", &schedules.cold, report.cold),
+        ("warm", &schedules.warm, report.warm),
+        ("alone", &schedules.alone, report.alone),
+    ];
+    for (name, s, f) in all {
         println!("| {name} | {} | {:.2} dB | {:.2} dB |", s.len(), Fit::psnr(f.first), Fit::psnr(f.last));
     }
-    for (name, s) in [("cold", &schedules.cold), ("warm", &schedules.warm)] {
+    for (name, s, _) in all {
         let list = |v: &[f32]| v.iter().map(|x| format!("{x:.3e}")).collect::<Vec<_>>().join(" ");
         println!("{name} sigma: {}\n{name} mu: {}", list(s.sigma()), list(s.mu()));
     }
     let dims = dims::<PU, PV>();
-    let len = slf_firmware::blob::scheduled_blob_len(dims, members.len(), schedules.cold.len(), schedules.warm.len());
+    let steps = [schedules.cold.len(), schedules.warm.len(), schedules.alone.len()];
+    let len = slf_firmware::blob::scheduled_blob_len(dims, members.len(), steps);
     let mut out = vec![0u8; len];
     slf_firmware::blob::write_blob_scheduled(&members, Some(&schedules), &mut out)
         .map_err(|e| anyhow::anyhow!("{e}"))?;

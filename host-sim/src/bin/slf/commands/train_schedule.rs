@@ -42,10 +42,14 @@ pub struct Args {
     /// Seed of the scenes, patches, masks and batches.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Steps of the alone schedule (a dictionary decoding alone: the preview's DCT), 1..=64.
+    #[arg(long, default_value_t = ScheduleConfig::default().alone_steps, value_parser = ranged::<1, 64>)]
+    pub alone_steps: usize,
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let Args { blob, output, cold_steps, warm_steps, scenes, size, patches, iterations, batch, seed } = args;
+    let Args { blob, output, cold_steps, warm_steps, scenes, size, patches, iterations, batch, seed, alone_steps } =
+        args;
     Outputs::new().inputs(std::slice::from_ref(&blob), "BLOB").output(&output, "-o").check()?;
     let bytes = read_blob(&blob)?;
     let cfg = ScheduleConfig {
@@ -55,6 +59,7 @@ pub fn run(args: Args) -> Result<()> {
         iterations,
         batch,
         seed,
+        alone_steps,
         progress: true,
         ..Default::default()
     };
