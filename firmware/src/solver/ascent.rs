@@ -144,7 +144,7 @@ pub fn ascend(coeffs: &mut [f32], mu: f32, inv: f32) -> f32 {
     moved
 }
 
-/// The ascent step of a trained schedule ([`crate::solver::schedule`]): as [`ascend`], with
+/// The ascent step of a trained schedule ([`crate::operators::schedule`]): as [`ascend`], with
 /// each coefficient's exponent scaled by its group weight, `s <- s - mu s exp(-w s^2 inv)`,
 /// `w` the product of its indices' weights (`coeffs` in the patch layout `[s, t, u, v, b]`,
 /// the band last). The weights of the four pixel modes are multiplied once per pixel, the

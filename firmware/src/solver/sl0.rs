@@ -561,9 +561,9 @@ enum Plan<'s, const PS: usize, const PT: usize, const PU: usize, const PV: usize
 }
 
 /// Decodes the patch whose measurements are in `ws` with a trained schedule's steps
-/// ([`crate::solver::schedule`]), from the minimum-norm start (the config's `cold_start`
-/// is the hand-set schedule's: a trained schedule learned its own start). As [`solve`]
-/// otherwise: the flat short path, half-pixel shears, the noise ball.
+/// ([`crate::operators::schedule`]), from the start the schedule names: the minimum-norm
+/// solution or the band-gain fill (the config's `cold_start` is the hand-set schedule's).
+/// As [`solve`] otherwise: the flat short path, half-pixel shears, the noise ball.
 ///
 /// # Errors
 /// As [`solve`].

@@ -3,13 +3,16 @@
 //!
 //! - [`Preset::Preview`]: the camera's screen and batch triage. The 5D DCT on the grid of
 //!   disjoint patches, sheared to whole-pixel disparities (-1..=1) per block without the
-//!   edge fallback, SL0 from the band-gain fill ([`slf_firmware::solver::fill`]) at 0.03 of
-//!   its largest coefficient down to `sigma_min = 3e-3`: one solve a patch of about 50
-//!   steps, a quarter of the default's patches, no half-pixel shears (their projection
-//!   costs about 1.5 times a whole one's).
+//!   edge fallback, one solve a patch with the shipped blob's trained `alone` schedule (24
+//!   steps from the band-gain fill, [`slf_firmware::solver::fill`], sigma floored at
+//!   `sigma_min = 3e-3`): a quarter of the default's patches, no half-pixel shears (their
+//!   projection costs about 1.5 times a whole one's). With `--schedule annealed` it is the
+//!   preview before the trained schedule: SL0 from the fill at 0.03 of its largest
+//!   coefficient, about 50 steps.
 //! - [`Preset::Default`]: the screened ensemble on full-view patches at stride 2 with the
-//!   tapered window, the capture's disparities (half pixels at one snapshot): what `slf
-//!   decode` does unless told.
+//!   tapered window, the capture's disparities (half pixels at one snapshot), seeded, with
+//!   the blob's trained schedules (24 steps the DCT's cold solve, 16 a member's or a seeded
+//!   solve): what `slf decode` does unless told.
 //! - [`Preset::Best`]: the default at stride 1, where every lenslet is covered by every
 //!   patch that holds it: 25 instead of 9 times the disjoint grid's patches.
 //!
@@ -29,8 +32,8 @@ use slf_firmware::{DisparityRange, Sl0Config};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Preset {
     /// Fast, for the camera's screen and batch triage: the DCT on disjoint patches,
-    /// whole-pixel shears without the edge fallback, SL0 from the band-gain fill at 0.03
-    /// of its largest coefficient to sigma 3e-3.
+    /// whole-pixel shears without the edge fallback, one trained solve a patch from the
+    /// band-gain fill (sigma floored at 3e-3).
     Preview,
     /// The screened ensemble at stride 2 with the capture's disparities.
     Default,

@@ -144,6 +144,24 @@ pub fn random_pattern<const PU: usize, const PV: usize, const N: usize>(rng: &mu
     measured
 }
 
+/// Leaves out, a quarter of the time, the measurements of the patch's brightest values
+/// (above a random quantile from 0.6 to 1 of its values) as a saturated capture does: the
+/// decoder flags clipped samples and solves without them, so the schedule learns patches
+/// with holes too. At least one measurement stays.
+pub fn clip_bright(truth: &[f32], measured: &mut [bool], rng: &mut ChaCha8Rng) {
+    if rng.random_range(0..4) != 0 {
+        return;
+    }
+    let mut sorted: Vec<f32> = truth.to_vec();
+    sorted.sort_by(f32::total_cmp);
+    let q = rng.random_range(0.6f64..1.0);
+    let limit = sorted[((sorted.len() - 1) as f64 * q) as usize];
+    let kept = truth.iter().zip(measured.iter()).filter(|(x, m)| **m && **x <= limit).count();
+    if kept > 0 {
+        measured.iter_mut().zip(truth).filter(|(_, x)| **x > limit).for_each(|(m, _)| *m = false);
+    }
+}
+
 /// A schedule's trainable parameters, unconstrained.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Params<const PU: usize, const PV: usize> {
@@ -489,8 +507,14 @@ pub fn train<const PU: usize, const PV: usize, const N: usize>(
     let screen = Dictionary::<5, 5, PU, PV, 13>::dct();
     let mut dicts = vec![screen];
     dicts.extend_from_slice(members);
-    let problems: Vec<Problem<N>> =
-        patches.chunks_exact(N).map(|truth| Problem::new(truth, &random_pattern::<PU, PV, N>(&mut rng))).collect();
+    let problems: Vec<Problem<N>> = patches
+        .chunks_exact(N)
+        .map(|truth| {
+            let mut pattern = random_pattern::<PU, PV, N>(&mut rng);
+            clip_bright(truth, &mut pattern, &mut rng);
+            Problem::new(truth, &pattern)
+        })
+        .collect();
     // The screened choice's first solve: the DCT from the minimum-norm start.
     let cold_problems: Vec<(usize, Problem<N>, Vec<f32>)> = problems
         .into_par_iter()
