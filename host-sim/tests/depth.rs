@@ -7,7 +7,7 @@ use assert_cmd::Command;
 use slf_host::decode::cs::{Basis, DecodeOptions, PatchViews, decode_with, disparity_per_lenslet, tile_decoder};
 use slf_host::eval::metrics::psnr;
 use slf_host::firmware::disparity::Disparity;
-use slf_host::firmware::{Dictionary, DisparityRange, FrameSource, Overlap, OverlapDecoder, Workspace};
+use slf_host::firmware::{DisparityRange, FrameSource, Overlap, OverlapDecoder, Workspace};
 use slf_host::io::lightfield::{Dtype, LightField, write_npy};
 use slf_host::sim::camera::{CameraConfig, simulate};
 use slf_host::sim::scene::{Layer, Scene, SceneSize, Shape, Texture};
@@ -123,7 +123,7 @@ fn ring_matches_the_host<const PU: usize, const PV: usize, const N: usize>(views
     let mut rows = Rows(LightField::zeros(truth.views, truth.rows, truth.cols, 13));
     let raw = capture.raw_frames().unwrap();
     let mut ws = Box::new(Workspace::<5, 5, PU, PV, 13, N>::new());
-    let dct = Dictionary::<5, 5, PU, PV, 13>::dct();
+    let dct = common::DctModel::<PU, PV>::shipped();
     let r = od.decode_frame(&dct, &mut FrameSource::new(&raw), &mut strip, &mut rows, &mut ws).unwrap();
     assert_eq!((r.bands, r.uncovered, r.filled as usize), (3, 0, report.filled), "{views} views");
     let worst = host.data.iter().zip(&rows.0.data).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);

@@ -720,7 +720,10 @@ mod tests {
             resolved(&[&format!("{flag}={good}"), "--schedule", "annealed"]);
         }
         let e = DecodeSettings::from_flags(["--tolerance=1"]).unwrap().resolve().unwrap_err().to_string();
-        assert_eq!(e, "--tolerance sets the hand-set schedule, which the trained one replaces: add --schedule annealed");
+        assert_eq!(
+            e,
+            "--tolerance sets the hand-set schedule, which the trained one replaces: add --schedule annealed"
+        );
         for g in ["1e30", "0", "0.01", "65", "nan"] {
             let arg = format!("--gains=1,1,1,{g},1,1,1,1,1,1,1,1,1");
             let e = DecodeSettings::from_flags([arg.as_str()]).unwrap().resolve().unwrap_err().to_string();

@@ -63,3 +63,46 @@ pub fn png_claiming(w: u32, h: u32) -> Vec<u8> {
     png.extend(chunk(b"IEND", &[]));
     png
 }
+
+/// The DCT as the host's `Basis::Dct` decodes with it: with the shipped blob's trained
+/// schedules where the patch's blob has them (the full-view one), bare otherwise.
+pub enum DctModel<const PU: usize, const PV: usize> {
+    Bare(slf_host::firmware::Dictionary<5, 5, PU, PV, 13>),
+    Scheduled(slf_host::firmware::ScheduledDictionary<5, 5, PU, PV, 13>),
+}
+
+impl<const PU: usize, const PV: usize> DctModel<PU, PV> {
+    pub fn shipped() -> Self {
+        let dictionary = slf_host::firmware::Dictionary::<5, 5, PU, PV, 13>::dct();
+        match slf_host::decode::cs::ensemble::<PU, PV>(None).unwrap().schedules() {
+            Some(schedules) => Self::Scheduled(slf_host::firmware::ScheduledDictionary { dictionary, schedules }),
+            None => Self::Bare(dictionary),
+        }
+    }
+}
+
+impl<const PU: usize, const PV: usize, const N: usize> slf_host::firmware::PatchModel<5, 5, PU, PV, 13, N>
+    for DctModel<PU, PV>
+{
+    fn decode(
+        &self,
+        cfg: &slf_host::firmware::Sl0Config,
+        ws: &mut slf_host::firmware::Workspace<5, 5, PU, PV, 13, N>,
+    ) -> Result<slf_host::firmware::ModelOutcome, slf_host::firmware::SolveError> {
+        match self {
+            Self::Bare(d) => d.decode(cfg, ws),
+            Self::Scheduled(d) => d.decode(cfg, ws),
+        }
+    }
+
+    fn decode_seeded(
+        &self,
+        cfg: &slf_host::firmware::Sl0Config,
+        ws: &mut slf_host::firmware::Workspace<5, 5, PU, PV, 13, N>,
+    ) -> Result<slf_host::firmware::ModelOutcome, slf_host::firmware::SolveError> {
+        match self {
+            Self::Bare(d) => d.decode_seeded(cfg, ws),
+            Self::Scheduled(d) => d.decode_seeded(cfg, ws),
+        }
+    }
+}
