@@ -127,6 +127,8 @@ def main():
         s.run(["import", "bands", f, "--wavelengths", "400:700:25", "-o", "imp.npy"], f"import bands {f}",
               outputs=["imp.npy"])
         s.run(["train", "--input", f, "-o", "t.slfd", "--patches", "100", "--iterations", "1"], f"train {f}")
+        s.run(["train-schedule", f, "-o", "ts.slfd", "--patches", "4", "--iterations", "1", "--scenes", "1",
+               "--size", "12"], f"train-schedule {f}")
         s.run(["device-check", f, "--capture", "cap"], f"device-check {f}")
         s.run(["bench", "--from", f, "--out", "bench-out"], f"bench --from {f}")
         s.run(["decode", f, "-o", "x.npy"], f"decode {f}")
