@@ -67,16 +67,18 @@ pub fn png_claiming(w: u32, h: u32) -> Vec<u8> {
 /// The DCT as the host's `Basis::Dct` decodes with it: with the shipped blob's trained
 /// schedules where the patch's blob has them (the full-view one), bare otherwise.
 pub enum DctModel<const PU: usize, const PV: usize> {
-    Bare(slf_host::firmware::Dictionary<5, 5, PU, PV, 13>),
-    Scheduled(slf_host::firmware::ScheduledDictionary<5, 5, PU, PV, 13>),
+    Bare(Box<slf_host::firmware::Dictionary<5, 5, PU, PV, 13>>),
+    Scheduled(Box<slf_host::firmware::ScheduledDictionary<5, 5, PU, PV, 13>>),
 }
 
 impl<const PU: usize, const PV: usize> DctModel<PU, PV> {
     pub fn shipped() -> Self {
         let dictionary = slf_host::firmware::Dictionary::<5, 5, PU, PV, 13>::dct();
         match slf_host::decode::cs::ensemble::<PU, PV>(None).unwrap().schedules() {
-            Some(schedules) => Self::Scheduled(slf_host::firmware::ScheduledDictionary { dictionary, schedules }),
-            None => Self::Bare(dictionary),
+            Some(schedules) => {
+                Self::Scheduled(Box::new(slf_host::firmware::ScheduledDictionary { dictionary, schedules }))
+            }
+            None => Self::Bare(Box::new(dictionary)),
         }
     }
 }
