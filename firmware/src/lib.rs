@@ -28,7 +28,8 @@
 //!   synthesis and analysis transforms.
 //! - **solver** ([`solver`]: [`error`](solver::error), [`workspace`], [`sl0`], [`ascent`],
 //!   [`ball`], [`projection`], [`fractional`], [`pinv`], [`fill`](solver::fill), [`choice`],
-//!   [`interpolate`]): the caller-owned workspace every path works in, nD SL0 with the
+//!   [`interpolate`]): the caller-owned workspace every path works in, nD SL0 (its hand-set
+//!   schedule, or the trained ones a blob carries) with the
 //!   orthonormal fast path and its cold start from the band-gain fill, the
 //!   noise ball a projection moves onto, the projection of half-pixel sheared patches (whose
 //!   measurements interpolate them), the paper's general pseudo-inverse path for kronecker
