@@ -393,12 +393,24 @@ pub fn solve<const PS: usize, const PT: usize, const PU: usize, const PV: usize,
     cfg: &Sl0Config,
     ws: &mut Workspace<PS, PT, PU, PV, B, N>,
 ) -> Result<Outcome, SolveError> {
+    cold(dict, cfg, ws, cfg.cold_start < 1.0, Plan::Annealed { scale: cfg.cold_start })
+}
+
+/// A solve from the measurements alone ([`solve`], [`solve_scheduled`]): from the band-gain
+/// fill (`fill`) or the minimum-norm start, down `plan`'s sigmas.
+fn cold<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
+    dict: &Dictionary<PS, PT, PU, PV, B>,
+    cfg: &Sl0Config,
+    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    fill: bool,
+    plan: Plan<'_, PS, PT, PU, PV, B>,
+) -> Result<Outcome, SolveError> {
     let ball = start::<B, N>(cfg, &ws.measurements)?;
     if !ws.measurements.half.is_none() {
         // Interpolating measurements: the minimum-norm start `M^+ I` is the exact
         // projection of zero; the fill's start is the exact projection of the fill.
         let Workspace { coeffs, signal, measurements: m } = ws;
-        if cfg.cold_start < 1.0 {
+        if fill {
             fill_bands::<B, N>(m, signal);
             analyze(dict, signal, coeffs);
         } else {
@@ -406,13 +418,13 @@ pub fn solve<const PS: usize, const PT: usize, const PU: usize, const PV: usize,
         }
         project_fractional(dict, coeffs, signal, m, &Ball::new(0.0, 0.0, m.count, 0));
         synthesize(dict, coeffs, signal);
-        return descend(dict, cfg, ws, &ball, Plan::Annealed { scale: cfg.cold_start });
+        return descend(dict, cfg, ws, &ball, plan);
     }
     if let Some(outcome) = short_path(cfg, ws) {
         return Ok(outcome);
     }
     let Workspace { signal, measurements: m, .. } = ws;
-    if cfg.cold_start < 1.0 {
+    if fill {
         fill_bands::<B, N>(m, signal);
     } else {
         // Minimum-norm start: S0 = analysis of the measurements, zeros elsewhere.
@@ -420,7 +432,7 @@ pub fn solve<const PS: usize, const PT: usize, const PU: usize, const PV: usize,
             *x = if k { y } else { 0.0 };
         }
     }
-    descend(dict, cfg, ws, &ball, Plan::Annealed { scale: cfg.cold_start })
+    descend(dict, cfg, ws, &ball, plan)
 }
 
 /// The short path for a flat patch: if every band is measured and each band's
@@ -580,31 +592,7 @@ pub fn solve_scheduled<
     schedule: &Schedule<PS, PT, PU, PV, B>,
     ws: &mut Workspace<PS, PT, PU, PV, B, N>,
 ) -> Result<Outcome, SolveError> {
-    let ball = start::<B, N>(cfg, &ws.measurements)?;
-    if !ws.measurements.half.is_none() {
-        let Workspace { coeffs, signal, measurements: m } = ws;
-        if schedule.fill_start() {
-            fill_bands::<B, N>(m, signal);
-            analyze(dict, signal, coeffs);
-        } else {
-            coeffs.fill(0.0);
-        }
-        project_fractional(dict, coeffs, signal, m, &Ball::new(0.0, 0.0, m.count, 0));
-        synthesize(dict, coeffs, signal);
-        return descend(dict, cfg, ws, &ball, Plan::Trained(schedule));
-    }
-    if let Some(outcome) = short_path(cfg, ws) {
-        return Ok(outcome);
-    }
-    let Workspace { signal, measurements: m, .. } = ws;
-    if schedule.fill_start() {
-        fill_bands::<B, N>(m, signal);
-    } else {
-        for ((x, &y), &k) in signal.iter_mut().zip(&m.values).zip(&m.measured) {
-            *x = if k { y } else { 0.0 };
-        }
-    }
-    descend(dict, cfg, ws, &ball, Plan::Trained(schedule))
+    cold(dict, cfg, ws, schedule.fill_start(), Plan::Trained(schedule))
 }
 
 /// Decodes the patch again with `dict` and a trained schedule, starting from the estimate
