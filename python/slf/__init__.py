@@ -179,6 +179,16 @@ def simulate(
     defects: Optional[float] = None,
     wavelengths: Optional[str] = None,
     format: Optional[str] = None,
+    leakage: Optional[float] = None,
+    filter_width: Optional[float] = None,
+    secondary: Optional[float] = None,
+    secondary_nm: Optional[float] = None,
+    leak_floor: Optional[float] = None,
+    dark_sd: Optional[float] = None,
+    hot_pixels: Optional[float] = None,
+    prnu: Optional[float] = None,
+    vignetting: Optional[float] = None,
+    sensor_seed: Optional[int] = None,
 ) -> Capture:
     """Records the light field ``lf`` ``(U, V, H, W, B)`` with the camera, as ``slf simulate``.
 
@@ -188,6 +198,14 @@ def simulate(
     defective pixels, default 0), ``wavelengths`` (of ``lf``'s bands when it does not have
     the camera's 13: ``"START:STOP:STEP"`` or a comma list, nm) and ``format`` (of the frame
     files :meth:`Capture.save` writes: pgm, png, npy) as the command's flags.
+
+    A real sensor, all off by default (the command's flags of the same names): ``leakage``
+    (the share of a pixel's response from bands other than its filter's, in [0, 0.9]) with
+    its shape ``filter_width`` (nm), ``secondary`` (peaks relative to the main one),
+    ``secondary_nm`` and ``leak_floor``; ``dark_sd`` (DN) and ``hot_pixels`` (fraction),
+    ``prnu`` (gain spread), ``vignetting`` (light the corner view loses) and ``sensor_seed``
+    (one sensor for every capture made with it). Such a capture records its sensor in its
+    description's ``simulated_sensor`` (format version 2).
     """
     arr = _as_float32(lf, "lf", "(U, V, H, W, B)")
     args = _flags(
@@ -200,6 +218,16 @@ def simulate(
         defects=defects,
         wavelengths=wavelengths,
         format=format,
+        leakage=leakage,
+        filter_width=filter_width,
+        secondary=secondary,
+        secondary_nm=secondary_nm,
+        leak_floor=leak_floor,
+        dark_sd=dark_sd,
+        hot_pixels=hot_pixels,
+        prnu=prnu,
+        vignetting=vignetting,
+        sensor_seed=sensor_seed,
     )
     frames, text, notes = _slf.simulate(arr, args)
     for n in notes:

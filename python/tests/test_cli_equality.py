@@ -31,6 +31,19 @@ def test_simulate_equals_cli_and_round_trips(tmp_path, slf_bin, depth):
     assert json.loads((tmp_path / "py" / "capture.json").read_text()) == ours.description
 
 
+def test_a_real_sensor_equals_cli(tmp_path, slf_bin, depth):
+    np.save(tmp_path / "lf.npy", depth)
+    flags = ["--leakage", "0.1", "--vignetting", "0.5", "--dark-sd", "3", "--prnu", "0.01", "--hot-pixels", "0.001", "--sensor-seed", "4"]
+    run([slf_bin, "simulate", tmp_path / "lf.npy", "-o", tmp_path / "cli", "--seed", "7", *flags])
+    from_cli = slf.load_capture(tmp_path / "cli")
+    ours = slf.simulate(depth, seed=7, leakage=0.1, vignetting=0.5, dark_sd=3, prnu=0.01, hot_pixels=0.001, sensor_seed=4)
+    assert np.array_equal(ours.frames, from_cli.frames)
+    assert ours.description == from_cli.description
+    assert ours.description["version"] == 2 and ours.description["simulated_sensor"]["filters"]["leakage"] == pytest.approx(0.1)
+    ideal = slf.simulate(depth, seed=7)
+    assert "simulated_sensor" not in ideal.description and not np.array_equal(ideal.frames, ours.frames)
+
+
 @pytest.mark.parametrize(
     "flags, kwargs",
     [

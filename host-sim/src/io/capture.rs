@@ -16,6 +16,7 @@ use slf_firmware::{
 use crate::io::lightfield::{read_npy_u16_2d, write_npy_u16_2d};
 use crate::io::message::one_line;
 use crate::io::output::{write_bytes, write_whole};
+use crate::io::sensor::SensorDescription;
 
 /// The largest `capture.json` read (a long defect list fits many times over).
 pub const MAX_DESCRIPTION: u64 = 64 << 20;
@@ -26,8 +27,12 @@ use slf_firmware::shape::MAX_BANDS;
 pub const DESCRIPTION: &str = "capture.json";
 /// The `format` field's value.
 pub const FORMAT: &str = "slf-capture";
-/// The `version` field's value.
+/// The `version` field's value: 1, or 2 for a capture that records its simulated sensor
+/// (`simulated_sensor`). Both are read; a capture of the ideal sensor is written as 1, as
+/// before version 2.
 pub const VERSION: u32 = 1;
+/// The version of a capture with a `simulated_sensor`.
+pub const VERSION_SENSOR: u32 = 2;
 
 /// The mask, by family and seed, or (pixel and lenslet) as an explicit periodic tile.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -104,6 +109,10 @@ pub struct CaptureDescription {
     /// `[row, col]` of pixels that are not measurements.
     #[serde(default)]
     pub defective_pixels: Vec<[u32; 2]>,
+    /// The sensor a simulated capture was made with (version 2): what a calibration should
+    /// recover. The decoder never reads it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub simulated_sensor: Option<SensorDescription>,
 }
 
 /// The shortest band centre a capture may state, nm.
@@ -637,7 +646,19 @@ impl CaptureDescription {
     /// A message naming the field that is wrong and its range.
     pub fn frame_size(&self) -> Result<(usize, usize)> {
         ensure!(self.format == FORMAT, "format is {:?}, expected {FORMAT:?}", self.format);
-        ensure!(self.version == VERSION, "version {} is not supported (this slf reads {VERSION})", self.version);
+        ensure!(
+            self.version == VERSION || self.version == VERSION_SENSOR,
+            "version {} is not supported (this slf reads {VERSION} and {VERSION_SENSOR})",
+            self.version
+        );
+        if let Some(sensor) = &self.simulated_sensor {
+            ensure!(
+                self.version == VERSION_SENSOR,
+                "simulated_sensor needs version {VERSION_SENSOR}, this capture says {}",
+                self.version
+            );
+            sensor.check()?;
+        }
         ensure!(
             self.lenslets.iter().all(|&x| (1..=usize::from(u16::MAX)).contains(&x)),
             "lenslets {:?} out of range 1..={}",

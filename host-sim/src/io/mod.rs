@@ -7,7 +7,8 @@
 //! - [`capture`]: the capture folder (frames and `capture.json`), loaded and saved;
 //! - [`import`]: views, hyperspectral cubes, HDF5 light fields and band resampling;
 //! - [`message`]: an error as the one line a user reads;
-//! - [`output`]: results written whole, never over an input of the same run.
+//! - [`output`]: results written whole, never over an input of the same run;
+//! - [`sensor`]: a simulated sensor's imperfections as its captures record them.
 //!
 //! May use: nothing of this crate (the firmware crate's checked types). Used by every
 //! layer above.
@@ -18,3 +19,4 @@ pub mod lightfield;
 pub mod message;
 pub mod npy;
 pub mod output;
+pub mod sensor;

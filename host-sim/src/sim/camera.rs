@@ -7,6 +7,11 @@
 //! white levels, plus Gaussian read noise, rounded and clipped to the sensor's bits (the top
 //! code is saturated). Defective pixels are stuck at 0 or the top code and listed in the
 //! capture description, as a calibrated camera would list them.
+//!
+//! With a real sensor ([`crate::sim::sensor`]) a pixel records its filter's response to
+//! every band, times its gain and its view's vignetting, above its own dark level; the
+//! capture then records the sensor (`simulated_sensor`, version 2). The ideal sensor's
+//! captures are made and written exactly as before.
 
 use anyhow::{Result, ensure};
 use rand::{Rng, SeedableRng};
@@ -14,9 +19,12 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal, Poisson};
 
 use crate::io::capture::{
-    Capture, CaptureDescription, FORMAT, MaskDescription, MaskSource, NoiseDescription, VERSION, frame_names,
+    Capture, CaptureDescription, FORMAT, MaskDescription, MaskSource, NoiseDescription, VERSION, VERSION_SENSOR,
+    frame_names,
 };
 use crate::io::lightfield::LightField;
+use crate::io::sensor::SensorDescription;
+use crate::sim::sensor::Sensor;
 use crate::sim::spectra::BAND_NM;
 
 /// Everything about the simulated camera besides the light field.
@@ -40,6 +48,8 @@ pub struct CameraConfig {
     pub seed: u64,
     /// Frame file extension: `pgm`, `png` or `npy`.
     pub frame_ext: String,
+    /// The sensor's imperfections ([`SensorDescription::IDEAL`]: none).
+    pub sensor: SensorDescription,
 }
 
 impl CameraConfig {
@@ -56,6 +66,7 @@ impl CameraConfig {
             defect_fraction: 0.0,
             seed,
             frame_ext: "pgm".into(),
+            sensor: SensorDescription::IDEAL,
         }
     }
 
@@ -125,9 +136,10 @@ pub fn simulate(lf: &LightField, cam: &CameraConfig) -> Result<Capture> {
         .filter(|_| cam.defect_fraction > 0.0 && rng.random_bool(cam.defect_fraction.min(1.0)))
         .map(|p| [(p / cols) as u32, (p % cols) as u32])
         .collect();
+    let real = !cam.sensor.is_ideal();
     let description = CaptureDescription {
         format: FORMAT.into(),
-        version: VERSION,
+        version: if real { VERSION_SENSOR } else { VERSION },
         lenslets: [lf.rows, lf.cols],
         views: [lu, lv],
         bands_nm: BAND_NM.to_vec(),
@@ -139,11 +151,17 @@ pub fn simulate(lf: &LightField, cam: &CameraConfig) -> Result<Capture> {
         saturation_level: top,
         noise: cam.full_well.map(|fw| NoiseDescription { full_well_electrons: fw, read_noise_dn: cam.read_noise }),
         defective_pixels: defects.clone(),
+        simulated_sensor: real.then_some(cam.sensor),
     };
     // Build the mask through the capture so the description is checked the same way as a
     // loaded one.
     let blank = Capture::new(description.clone(), vec![vec![0; rows * cols]; k])?;
     let mask = blank.mask()?;
+    let sensor = if real {
+        Some(Sensor::new(&cam.sensor, [lf.rows, lf.cols], [lu, lv], &BAND_NM, white - black)?)
+    } else {
+        None
+    };
     let read = Normal::new(0.0f32, cam.read_noise.max(0.0)).map_err(|e| anyhow::anyhow!("read noise: {e}"))?;
     let mut frames = vec![vec![0u16; rows * cols]; k];
     for row in 0..rows {
@@ -151,7 +169,12 @@ pub fn simulate(lf: &LightField, cam: &CameraConfig) -> Result<Capture> {
             let bands = mask.bands_at(row, col);
             let (s, u, t, v) = (row / lu, row % lu, col / lv, col % lv);
             for (j, &band) in bands.iter().enumerate() {
-                let l = lf.get(u, v, s, t, band as usize).max(0.0);
+                let p = row * cols + col;
+                let l = match &sensor {
+                    None => lf.get(u, v, s, t, band as usize).max(0.0),
+                    Some(sensor) => sensor.signal(p, band as usize, |b| lf.get(u, v, s, t, b)),
+                };
+                let dark = sensor.as_ref().map_or(0.0, |sensor| sensor.dark[p]);
                 let signal = match cam.full_well {
                     Some(fw) if l > 0.0 => {
                         let e = f64::from(l * fw);
@@ -160,8 +183,10 @@ pub fn simulate(lf: &LightField, cam: &CameraConfig) -> Result<Capture> {
                     }
                     _ => l,
                 };
-                let dn =
-                    black + signal * (white - black) + if cam.read_noise > 0.0 { read.sample(&mut rng) } else { 0.0 };
+                let dn = black
+                    + dark
+                    + signal * (white - black)
+                    + if cam.read_noise > 0.0 { read.sample(&mut rng) } else { 0.0 };
                 frames[j][row * cols + col] = dn.round().clamp(0.0, top) as u16;
             }
         }

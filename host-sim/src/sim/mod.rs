@@ -10,6 +10,8 @@
 //!   light, dim captures);
 //! - [`camera`]: a light field to raw frames with the firmware's masks, noise, black level,
 //!   quantisation, saturation and defects, as a capture;
+//! - [`sensor`]: the sensor as it is: leaky filters, dark levels and gains per pixel, hot
+//!   pixels, vignetted views;
 //! - [`settings`]: what a user asks of a simulated capture (`slf simulate`'s flags,
 //!   `slf.simulate`'s keywords);
 //! - [`flags`]: parsers the settings types share;
@@ -24,6 +26,7 @@ pub mod hard;
 pub mod import;
 pub mod realistic;
 pub mod scene;
+pub mod sensor;
 pub mod settings;
 pub mod spectra;
 pub mod spectra_data;

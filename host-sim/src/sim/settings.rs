@@ -9,6 +9,7 @@ use slf_firmware::MaskFamily;
 
 use crate::io::capture::{Capture, MaskDescription};
 use crate::io::lightfield::LightField;
+use crate::io::sensor::{FilterDescription, SensorDescription};
 use crate::sim::camera::{CameraConfig, simulate};
 use crate::sim::flags::{parse, positive};
 use crate::sim::import::{check_decodable, with_camera_bands};
@@ -94,6 +95,68 @@ pub struct SimulateSettings {
     /// Frame file format.
     #[arg(long, value_enum, default_value_t = FrameFormat::Pgm)]
     pub format: FrameFormat,
+    /// A real sensor (all off by default: the ideal sensor the decoder assumes).
+    #[command(flatten)]
+    pub sensor: SensorSettings,
+}
+
+/// `slf simulate`'s real-sensor flags ([`crate::sim::sensor`]); a capture made with any of
+/// them records its sensor (capture format version 2).
+#[derive(Args, Clone, Debug)]
+pub struct SensorSettings {
+    /// Filter leakage: the fraction of a pixel's response to an equal-energy spectrum that
+    /// comes from bands other than its filter's, in [0, 0.9].
+    #[arg(long, default_value_t = 0.0, value_parser = |s: &str| within(s, 0.0, 0.9))]
+    pub leakage: f32,
+    /// The filters' main peak width (FWHM), nm, in [1, 200]: where leaked light comes from.
+    #[arg(long, default_value_t = FilterDescription::IDEAL.width_nm, value_parser = |s: &str| within(s, 1.0, 200.0))]
+    pub filter_width: f32,
+    /// The filters' secondary peaks, relative to the main one, in [0, 1].
+    #[arg(long, default_value_t = FilterDescription::IDEAL.secondary, value_parser = |s: &str| within(s, 0.0, 1.0))]
+    pub secondary: f32,
+    /// How far the secondary peaks lie from the main one (both sides), nm, in [0, 1000].
+    #[arg(long, default_value_t = FilterDescription::IDEAL.secondary_nm, value_parser = |s: &str| within(s, 0.0, 1000.0))]
+    pub secondary_nm: f32,
+    /// The filters' transmission away from their peaks, relative to the main peak, in [0, 1].
+    #[arg(long, default_value_t = FilterDescription::IDEAL.floor, value_parser = |s: &str| within(s, 0.0, 1.0))]
+    pub leak_floor: f32,
+    /// Spread of each pixel's dark level about the black level, DN, in [0, 1000].
+    #[arg(long, default_value_t = 0.0, value_parser = |s: &str| within(s, 0.0, 1000.0))]
+    pub dark_sd: f32,
+    /// Fraction of hot pixels (dark level 10-50 % of the range above black), in [0, 0.5].
+    #[arg(long, default_value_t = 0.0, value_parser = |s: &str| within(s, 0.0, 0.5).map(f64::from))]
+    pub hot_pixels: f64,
+    /// Spread of each pixel's gain about 1 (PRNU), in [0, 0.5].
+    #[arg(long, default_value_t = 0.0, value_parser = |s: &str| within(s, 0.0, 0.5))]
+    pub prnu: f32,
+    /// Light the corner view under the centre lenslet loses against the centre view, in
+    /// [0, 0.95].
+    #[arg(long, default_value_t = 0.0, value_parser = |s: &str| within(s, 0.0, 0.95))]
+    pub vignetting: f32,
+    /// Seed of the sensor's dark levels, gains and hot pixels (one sensor for every capture
+    /// made with it).
+    #[arg(long, default_value_t = SensorDescription::IDEAL.seed)]
+    pub sensor_seed: u64,
+}
+
+impl SensorSettings {
+    /// The sensor these flags describe.
+    pub fn description(&self) -> SensorDescription {
+        SensorDescription {
+            filters: FilterDescription {
+                leakage: self.leakage,
+                width_nm: self.filter_width,
+                secondary: self.secondary,
+                secondary_nm: self.secondary_nm,
+                floor: self.leak_floor,
+            },
+            dark_sd_dn: self.dark_sd,
+            hot_fraction: self.hot_pixels,
+            prnu: self.prnu,
+            vignetting: self.vignetting,
+            seed: self.sensor_seed,
+        }
+    }
 }
 
 /// A simulated capture and what a user should hear about it.
@@ -126,6 +189,7 @@ impl SimulateSettings {
         cam.full_well = Some(self.full_well);
         cam.defect_fraction = self.defects;
         cam.frame_ext = self.format.extension().to_string();
+        cam.sensor = self.sensor.description();
         if self.no_noise { cam.noiseless() } else { cam }
     }
 
@@ -169,6 +233,14 @@ fn non_negative(s: &str) -> Result<f32, String> {
     match s.parse::<f32>() {
         Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
         _ => Err(format!("{s:?} is not a finite number at or above 0")),
+    }
+}
+
+/// A finite number in `[lo, hi]`, for clap.
+fn within(s: &str, lo: f32, hi: f32) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(v) if v.is_finite() && (lo..=hi).contains(&v) => Ok(v),
+        _ => Err(format!("{s:?} is not a number in [{lo}, {hi}]")),
     }
 }
 
