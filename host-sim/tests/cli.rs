@@ -969,3 +969,42 @@ fn the_first_command_refuses_what_a_later_one_would() {
     assert!(err.contains("below 0") && err.contains("set to 0"), "{err}");
     assert!(read_npy(&p("c.npy")).unwrap().data.iter().all(|&x| x >= 0.0));
 }
+
+/// Issue 43: a real sensor's scene and calibration captures from `slf simulate`, its
+/// calibration from `slf calibrate` (a folder of captures, or the captures named); what
+/// is not a calibration capture, one line and a failure.
+#[test]
+fn simulate_calibration_captures_then_calibrate() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    stdout(slf().args(["scene", "office", "--size", "12", "-o"]).arg(p("lf.npy")));
+    let out = stdout(
+        slf()
+            .arg("simulate")
+            .arg(p("lf.npy"))
+            .arg("-o")
+            .arg(p("scene"))
+            .args(["--leakage", "0.1", "--vignetting", "0.4", "--dark-sd", "2", "--exposures", "2"])
+            .arg("--calibration-captures")
+            .arg(p("cal")),
+    );
+    assert!(out.contains("wrote 30 calibration captures"), "{out}");
+    let out = stdout(slf().arg("calibrate").arg(p("cal")).arg("-o").arg(p("calibration")));
+    assert!(out.contains("wrote"), "{out}");
+    let c = slf_host::io::calibration::Calibration::load(&p("calibration")).unwrap();
+    assert_eq!(c.description.sources.band, 26);
+    assert!((c.description.response[6][6] - 0.9).abs() < 0.01, "{:?}", c.description.response[6]);
+    // The captures named one by one: the same calibration.
+    let names: Vec<_> = std::fs::read_dir(p("cal")).unwrap().map(|e| e.unwrap().path()).collect();
+    stdout(slf().arg("calibrate").args(&names).arg("-o").arg(p("again")));
+    assert_eq!(slf_host::io::calibration::Calibration::load(&p("again")).unwrap(), c);
+    // A scene is no calibration capture; an empty folder holds none; --exposures alone asks
+    // for the folder.
+    let e = failure(slf().arg("calibrate").arg(p("scene")).arg(p("cal")).arg("-o").arg(p("x")));
+    assert!(e.contains("a scene's capture") && e.lines().count() == 1, "{e}");
+    std::fs::create_dir(p("empty")).unwrap();
+    let e = failure(slf().arg("calibrate").arg(p("empty")).arg("-o").arg(p("x")));
+    assert!(e.contains("holds no capture folder"), "{e}");
+    let e = failure(slf().arg("simulate").arg(p("lf.npy")).arg("-o").arg(p("y")).args(["--exposures", "2"]));
+    assert!(e.contains("--calibration-captures"), "{e}");
+}

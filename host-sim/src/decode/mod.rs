@@ -1,6 +1,7 @@
 //! Decoding captures: compressed sensing with the firmware's decoder, and the methods it
 //! is measured against.
 //!
+//! - [`calibrate`]: a sensor's calibration from its calibration captures (`slf calibrate`);
 //! - [`cs`]: the firmware's tile decoder over a capture in parallel (rayon), with
 //!   overlapping patches, white balance, the noise model and the depth search;
 //! - [`baselines`]: decode methods without compressed sensing (per-pixel interpolation, a
@@ -15,6 +16,7 @@
 //! May use: [`crate::io`], [`crate::sim`]. Used by the train and eval layers.
 
 pub mod baselines;
+pub mod calibrate;
 pub mod cs;
 pub mod device;
 pub mod paper_1d;

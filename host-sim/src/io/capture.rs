@@ -113,6 +113,34 @@ pub struct CaptureDescription {
     /// recover. The decoder never reads it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub simulated_sensor: Option<SensorDescription>,
+    /// The light the capture was taken under (version 2): a scene (the default, left out),
+    /// or one of the calibration captures `slf calibrate` reads.
+    #[serde(default, skip_serializing_if = "Light::is_scene")]
+    pub light: Light,
+}
+
+/// What a capture looked at: a scene, or a calibration target.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase", deny_unknown_fields)]
+pub enum Light {
+    /// A scene to decode.
+    #[default]
+    Scene,
+    /// No light (the lens capped): each pixel's dark level.
+    Dark,
+    /// A uniform white target under light of equal energy in every band, `level` times
+    /// white: each pixel's gain and its view's vignetting.
+    Flat { level: f32 },
+    /// A uniform white target under light of band `band` only, `level` times white: every
+    /// filter's response to that band.
+    Band { band: u8, level: f32 },
+}
+
+impl Light {
+    /// Whether it is a scene's (the field is then left out of `capture.json`).
+    pub fn is_scene(&self) -> bool {
+        *self == Light::Scene
+    }
 }
 
 /// The shortest band centre a capture may state, nm.
@@ -658,6 +686,26 @@ impl CaptureDescription {
                 self.version
             );
             sensor.check()?;
+        }
+        match self.light {
+            Light::Scene => {}
+            _ if self.version != VERSION_SENSOR => {
+                bail!("light {:?} needs version {VERSION_SENSOR}, this capture says {}", self.light, self.version)
+            }
+            Light::Dark => {}
+            Light::Flat { level } | Light::Band { level, .. } => ensure!(
+                level.is_finite() && level > 0.0 && level <= 1.0,
+                "light level {}: must be in (0, 1] (a fraction of white)",
+                crate::io::message::number(level)
+            ),
+        }
+        if let Light::Band { band, .. } = self.light {
+            ensure!(
+                usize::from(band) < self.bands_nm.len(),
+                "light band {band}: the capture has {} bands (0..={})",
+                self.bands_nm.len(),
+                self.bands_nm.len().saturating_sub(1)
+            );
         }
         ensure!(
             self.lenslets.iter().all(|&x| (1..=usize::from(u16::MAX)).contains(&x)),

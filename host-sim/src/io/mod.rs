@@ -4,6 +4,8 @@
 //! - [`npy`]: `.npy` files of float32, float64 or uint16 in either byte order and either
 //!   memory order, every size checked before anything is allocated;
 //! - [`lightfield`]: the `(U, V, H, W, B)` light field and its `.npy` files;
+//! - [`calibration`]: the calibration folder `slf calibrate` writes and a calibrated
+//!   decode reads;
 //! - [`capture`]: the capture folder (frames and `capture.json`), loaded and saved;
 //! - [`import`]: views, hyperspectral cubes, HDF5 light fields and band resampling;
 //! - [`message`]: an error as the one line a user reads;
@@ -13,6 +15,7 @@
 //! May use: nothing of this crate (the firmware crate's checked types). Used by every
 //! layer above.
 
+pub mod calibration;
 pub mod capture;
 pub mod import;
 pub mod lightfield;

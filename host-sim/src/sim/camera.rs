@@ -19,7 +19,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal, Poisson};
 
 use crate::io::capture::{
-    Capture, CaptureDescription, FORMAT, MaskDescription, MaskSource, NoiseDescription, VERSION, VERSION_SENSOR,
+    Capture, CaptureDescription, FORMAT, Light, MaskDescription, MaskSource, NoiseDescription, VERSION, VERSION_SENSOR,
     frame_names,
 };
 use crate::io::lightfield::LightField;
@@ -96,6 +96,15 @@ impl CameraConfig {
 /// # Errors
 /// A bad mask or sensor description.
 pub fn simulate(lf: &LightField, cam: &CameraConfig) -> Result<Capture> {
+    simulate_under(lf, cam, Light::Scene)
+}
+
+/// As [`simulate`], for a capture taken under `light` (a calibration capture: the light
+/// field is the calibration target, recorded in the description, version 2).
+///
+/// # Errors
+/// As [`simulate`].
+pub fn simulate_under(lf: &LightField, cam: &CameraConfig, light: Light) -> Result<Capture> {
     ensure!(lf.bands == BAND_NM.len(), "light field has {} bands, the camera {}", lf.bands, BAND_NM.len());
     ensure!(
         lf.views.0 <= lf.rows && lf.views.1 <= lf.cols,
@@ -139,7 +148,7 @@ pub fn simulate(lf: &LightField, cam: &CameraConfig) -> Result<Capture> {
     let real = !cam.sensor.is_ideal();
     let description = CaptureDescription {
         format: FORMAT.into(),
-        version: if real { VERSION_SENSOR } else { VERSION },
+        version: if real || !light.is_scene() { VERSION_SENSOR } else { VERSION },
         lenslets: [lf.rows, lf.cols],
         views: [lu, lv],
         bands_nm: BAND_NM.to_vec(),
@@ -152,6 +161,7 @@ pub fn simulate(lf: &LightField, cam: &CameraConfig) -> Result<Capture> {
         noise: cam.full_well.map(|fw| NoiseDescription { full_well_electrons: fw, read_noise_dn: cam.read_noise }),
         defective_pixels: defects.clone(),
         simulated_sensor: real.then_some(cam.sensor),
+        light,
     };
     // Build the mask through the capture so the description is checked the same way as a
     // loaded one.

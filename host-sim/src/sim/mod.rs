@@ -10,6 +10,7 @@
 //!   light, dim captures);
 //! - [`camera`]: a light field to raw frames with the firmware's masks, noise, black level,
 //!   quantisation, saturation and defects, as a capture;
+//! - [`calibration`]: a simulated sensor's calibration captures (dark, flat, band sweep);
 //! - [`sensor`]: the sensor as it is: leaky filters, dark levels and gains per pixel, hot
 //!   pixels, vignetted views;
 //! - [`settings`]: what a user asks of a simulated capture (`slf simulate`'s flags,
@@ -20,6 +21,7 @@
 //!
 //! May use: [`crate::io`]. Used by the decode, train and eval layers.
 
+pub mod calibration;
 pub mod camera;
 pub mod flags;
 pub mod hard;

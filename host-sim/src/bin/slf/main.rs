@@ -12,7 +12,7 @@ use std::process::ExitCode;
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 use commands::{
-    baseline, bench, compare, decode, demo, device_capture, device_check, eval, evaluate, import, scene, simulate,
+    baseline, bench, calibrate, compare, decode, demo, device_capture, device_check, eval, evaluate, import, scene, simulate,
     sweep, train, train_schedule,
 };
 
@@ -34,6 +34,9 @@ enum Command {
     Import(import::Args),
     /// Record a light field with the camera model: writes a capture folder.
     Simulate(simulate::Args),
+    /// A sensor's calibration (dark levels, flats, vignetting, the filters' response matrix,
+    /// hot pixels) from its calibration captures; writes a calibration folder.
+    Calibrate(calibrate::Args),
     /// Decode a capture folder into a light field .npy.
     Decode(decode::Args),
     /// PSNR, SSIM and spectral angle of a reconstruction against the ground truth.
@@ -107,6 +110,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Scene(args) => scene::run(args),
         Command::Import(args) => import::run(args),
         Command::Simulate(args) => simulate::run(args),
+        Command::Calibrate(args) => calibrate::run(args),
         Command::Decode(args) => decode::run(args),
         Command::Eval(args) => eval::run(args),
         Command::Baseline(args) => baseline::run(args),

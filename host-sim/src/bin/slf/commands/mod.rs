@@ -2,6 +2,7 @@
 
 pub mod baseline;
 pub mod bench;
+pub mod calibrate;
 pub mod compare;
 pub mod decode;
 pub mod demo;

@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 use slf_host::io::lightfield::read_npy;
 use slf_host::io::output::Outputs;
+use slf_host::sim::calibration::calibration_captures as calibration_captures_for;
 use slf_host::sim::settings::SimulateSettings;
 
 #[derive(clap::Args)]
@@ -18,19 +19,42 @@ pub struct Args {
     pub output: PathBuf,
     #[command(flatten)]
     pub settings: SimulateSettings,
+    /// Also write the sensor's calibration captures into this folder (dark-NN, flat-NN,
+    /// band-BB-NN: what `slf calibrate` reads), made with the same camera.
+    #[arg(long)]
+    pub calibration_captures: Option<PathBuf>,
+    /// Exposures of each calibration capture kind (averaged by `slf calibrate`), 1..=256.
+    #[arg(long, default_value_t = 8, requires = "calibration_captures")]
+    pub exposures: usize,
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let Args { input, output, settings } = args;
+    let Args { input, output, settings, calibration_captures, exposures } = args;
     let simulated = settings.run(read_npy(&input)?, &input.display().to_string())?;
     for n in &simulated.notes {
         eprintln!("{n}");
     }
-    Outputs::new()
+    let d = &simulated.capture.description;
+    let calibration = match &calibration_captures {
+        Some(_) => calibration_captures_for(&settings.camera(), d.lenslets, d.views, d.bands_nm.len(), exposures)?,
+        None => Vec::new(),
+    };
+    let mut outputs = Outputs::new()
         .input(&input, "the light field")
-        .outputs(simulated.capture.files_in(&output), "a file of the capture -o")
-        .check_distinct()?;
+        .outputs(simulated.capture.files_in(&output), "a file of the capture -o");
+    if let Some(dir) = &calibration_captures {
+        for (name, c) in &calibration {
+            outputs = outputs.outputs(c.files_in(&dir.join(name)), "a calibration capture's file");
+        }
+    }
+    outputs.check_distinct()?;
     simulated.capture.save(&output)?;
     println!("wrote {} ({} snapshots)", output.display(), simulated.capture.frames.len());
+    if let Some(dir) = &calibration_captures {
+        for (name, c) in &calibration {
+            c.save(&dir.join(name))?;
+        }
+        println!("wrote {} calibration captures into {}", calibration.len(), dir.display());
+    }
     Ok(())
 }

@@ -1,0 +1,213 @@
+//! The calibration file (issue 43): what `slf calibrate` learns of a sensor from its
+//! calibration captures, and what a calibrated decode corrects with. A folder:
+//! `calibration.json` (geometry, levels, the response matrix, vignetting per view, hot
+//! pixels) and two float32 `.npy` frames, each pixel's dark level (DN) and its flat (gain
+//! times its view's vignetting, 1 for an ideal pixel). Everything is checked on load, sizes
+//! before anything is allocated (`docs/capture-format.md`, "Calibration").
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Result, anyhow, ensure};
+use serde::{Deserialize, Serialize};
+
+use crate::io::capture::MAX_DESCRIPTION;
+use crate::io::lightfield::write_npy_f32_2d;
+use crate::io::message::number;
+use crate::io::npy::{self, Element, Values};
+use crate::io::output::write_bytes;
+
+/// The description file's name inside a calibration folder.
+pub const DESCRIPTION: &str = "calibration.json";
+/// The `format` field's value.
+pub const FORMAT: &str = "slf-calibration";
+/// The `version` field's value.
+pub const VERSION: u32 = 1;
+/// The dark levels' file.
+pub const DARK: &str = "dark.npy";
+/// The flats' file.
+pub const FLAT: &str = "flat.npy";
+
+/// How many calibration captures of each kind went into a calibration (informational).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Sources {
+    pub dark: usize,
+    pub flat: usize,
+    pub band: usize,
+}
+
+/// `calibration.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CalibrationDescription {
+    pub format: String,
+    pub version: u32,
+    /// `[S, T]`, as the captures it decodes.
+    pub lenslets: [usize; 2],
+    /// `[U, V]`.
+    pub views: [usize; 2],
+    pub bands_nm: Vec<f32>,
+    /// The captures' black and white levels (DN) the flat and response are relative to.
+    pub black_level: f32,
+    pub white_level: f32,
+    /// `response[f][b]`: what a pixel behind filter `f` records of band `b`, relative to
+    /// its response to light of equal energy in every band (a row sums to about 1).
+    pub response: Vec<Vec<f32>>,
+    /// `vignetting[u][v]`: view `(u, v)`'s mean flat over the sensor, relative to the
+    /// brightest view's: the compact model of the flat (the device's table).
+    pub vignetting: Vec<Vec<f32>>,
+    /// `[row, col]` of pixels whose dark level or flat is no working pixel's.
+    pub hot_pixels: Vec<[u32; 2]>,
+    pub sources: Sources,
+}
+
+/// A loaded calibration.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Calibration {
+    pub description: CalibrationDescription,
+    /// Each pixel's dark level, DN, row-major.
+    pub dark: Vec<f32>,
+    /// Each pixel's flat: its gain times its view's vignetting (1: an ideal pixel).
+    pub flat: Vec<f32>,
+}
+
+impl CalibrationDescription {
+    /// The frame size `(rows, cols)`, with every field checked.
+    ///
+    /// # Errors
+    /// The first field out of its range, named.
+    pub fn check(&self) -> Result<(usize, usize)> {
+        ensure!(self.format == FORMAT, "format is {:?}, expected {FORMAT:?}", self.format);
+        ensure!(self.version == VERSION, "version {} is not supported (this slf reads {VERSION})", self.version);
+        ensure!(
+            self.lenslets.iter().all(|&x| (1..=usize::from(u16::MAX)).contains(&x))
+                && self.views.iter().all(|&x| (1..=255).contains(&x)),
+            "lenslets {:?} or views {:?} out of range",
+            self.lenslets,
+            self.views
+        );
+        let (rows, cols) = (self.lenslets[0] * self.views[0], self.lenslets[1] * self.views[1]);
+        ensure!(
+            rows <= usize::from(u16::MAX) && cols <= usize::from(u16::MAX),
+            "lenslets {:?} x views {:?} is a {rows} x {cols} frame, at most 65535 x 65535",
+            self.lenslets,
+            self.views
+        );
+        let b = self.bands_nm.len();
+        ensure!((2..=32).contains(&b), "bands_nm has {b} entries, expected 2..=32");
+        ensure!(
+            self.black_level.is_finite()
+                && self.white_level.is_finite()
+                && (0.0..=65535.0).contains(&self.black_level)
+                && self.white_level > self.black_level,
+            "levels: need 0 <= black_level < white_level, finite"
+        );
+        ensure!(
+            self.response.len() == b && self.response.iter().all(|r| r.len() == b),
+            "response is {} x {}, expected {b} x {b} (filters x bands)",
+            self.response.len(),
+            self.response.first().map_or(0, Vec::len)
+        );
+        for (f, row) in self.response.iter().enumerate() {
+            if let Some(x) = row.iter().find(|x| !(x.is_finite() && (-0.1..=2.0).contains(*x))) {
+                return Err(anyhow!("response[{f}] holds {}: each entry must be in [-0.1, 2]", number(*x)));
+            }
+            ensure!(row[f] > 0.0, "response[{f}][{f}] is {}: a filter must see its own band", number(row[f]));
+        }
+        ensure!(
+            self.vignetting.len() == self.views[0] && self.vignetting.iter().all(|r| r.len() == self.views[1]),
+            "vignetting is not {} x {} (views)",
+            self.views[0],
+            self.views[1]
+        );
+        if let Some(x) = self.vignetting.iter().flatten().find(|x| !(x.is_finite() && **x > 0.0 && **x <= 1.5)) {
+            return Err(anyhow!("vignetting holds {}: each view's must be in (0, 1.5]", number(*x)));
+        }
+        if let Some(p) = self.hot_pixels.iter().find(|p| p[0] as usize >= rows || p[1] as usize >= cols) {
+            return Err(anyhow!("hot pixel {p:?} outside the {rows} x {cols} frame"));
+        }
+        Ok((rows, cols))
+    }
+}
+
+impl Calibration {
+    /// Checks the description and the frames against each other.
+    ///
+    /// # Errors
+    /// A field out of range, a frame of another size, a dark level or flat that is not a
+    /// finite number in range (a flat of 0 is a dead pixel: list it as hot).
+    pub fn new(description: CalibrationDescription, dark: Vec<f32>, flat: Vec<f32>) -> Result<Self> {
+        let (rows, cols) = description.check()?;
+        ensure!(
+            dark.len() == rows * cols && flat.len() == rows * cols,
+            "dark and flat hold {} and {} values, the frame {rows} x {cols}",
+            dark.len(),
+            flat.len()
+        );
+        if let Some(i) = dark.iter().position(|x| !(x.is_finite() && (-65535.0..=65535.0).contains(x))) {
+            return Err(anyhow!("dark[{}, {}] is {}: must be a finite DN", i / cols, i % cols, number(dark[i])));
+        }
+        if let Some(i) = flat.iter().position(|x| !(x.is_finite() && (0.0..=16.0).contains(x))) {
+            return Err(anyhow!("flat[{}, {}] is {}: must be in [0, 16]", i / cols, i % cols, number(flat[i])));
+        }
+        Ok(Self { description, dark, flat })
+    }
+
+    /// The frame size.
+    pub fn frame_size(&self) -> (usize, usize) {
+        let d = &self.description;
+        (d.lenslets[0] * d.views[0], d.lenslets[1] * d.views[1])
+    }
+
+    /// The response matrix row-major, `[filter][band]`.
+    pub fn response(&self) -> Vec<f32> {
+        self.description.response.iter().flatten().copied().collect()
+    }
+
+    /// Reads a calibration folder.
+    ///
+    /// # Errors
+    /// The file and what is wrong in it.
+    pub fn load(dir: &Path) -> Result<Self> {
+        let path = dir.join(DESCRIPTION);
+        let meta = std::fs::metadata(&path).map_err(|e| anyhow!("{}: {e}", path.display()))?;
+        ensure!(meta.is_file(), "{}: not a regular file", path.display());
+        ensure!(meta.len() <= MAX_DESCRIPTION, "{}: {} bytes, more than a calibration holds", path.display(), meta.len());
+        let text = std::fs::read_to_string(&path).map_err(|e| anyhow!("{}: {e}", path.display()))?;
+        let description: CalibrationDescription =
+            serde_json::from_str(&text).map_err(|e| anyhow!("{}: invalid calibration: {e}", path.display()))?;
+        let (rows, cols) = description.check().map_err(|e| anyhow!("{}: {e}", path.display()))?;
+        let read = |name: &str| -> Result<Vec<f32>> {
+            let p: PathBuf = dir.join(name);
+            let a = npy::read_checked(&p, |s, element| {
+                if s != [rows, cols] {
+                    return Err(format!("is {s:?}, the calibration's frame [{rows}, {cols}]"));
+                }
+                if element == Element::U16 {
+                    return Err("holds uint16, a calibration frame float32".into());
+                }
+                Ok(())
+            })
+            .map_err(|e| anyhow!("{e}"))?;
+            match a.values {
+                Values::F32(v) => Ok(v),
+                Values::U16(_) => Err(anyhow!("{}: holds uint16, a calibration frame float32", p.display())),
+            }
+        };
+        let (dark, flat) = (read(DARK)?, read(FLAT)?);
+        Self::new(description, dark, flat).map_err(|e| anyhow!("{}: {e}", dir.display()))
+    }
+
+    /// Writes the calibration folder, each file whole.
+    ///
+    /// # Errors
+    /// I/O errors, with the file.
+    pub fn save(&self, dir: &Path) -> Result<()> {
+        std::fs::create_dir_all(dir).map_err(|e| anyhow!("cannot create {}: {e}", dir.display()))?;
+        let (rows, cols) = self.frame_size();
+        write_npy_f32_2d(&dir.join(DARK), &self.dark, rows, cols)?;
+        write_npy_f32_2d(&dir.join(FLAT), &self.flat, rows, cols)?;
+        let text = serde_json::to_string_pretty(&self.description)?;
+        write_bytes(&dir.join(DESCRIPTION), (text + "\n").as_bytes())
+    }
+}

@@ -1,0 +1,60 @@
+//! The calibration captures of a simulated sensor (issue 43): what a camera maker takes to
+//! calibrate one, made with the same camera (mask, sensor, noise) as its scene captures, so
+//! `slf calibrate` can be checked against the sensor that made them.
+//!
+//! - `dark-NN`: no light (the lens capped);
+//! - `flat-NN`: a uniform white target under light of equal energy in every band, at
+//!   [`FLAT_LEVEL`] of white;
+//! - `band-BB-NN`: the same target under light of band `BB` only (a monochromator's
+//!   sweep), at [`FLAT_LEVEL`] of white.
+//!
+//! `NN` counts exposures: each exposure draws its own noise, and `slf calibrate` averages
+//! them.
+
+use anyhow::{Result, ensure};
+
+use crate::io::capture::{Capture, Light};
+use crate::io::lightfield::LightField;
+use crate::sim::camera::{CameraConfig, simulate_under};
+
+/// The flat's and the sweep's light, a fraction of white: bright for a good signal, below
+/// the top code with the brightest pixel's gain.
+pub const FLAT_LEVEL: f32 = 0.8;
+
+/// The most exposures of each kind.
+pub const MAX_EXPOSURES: usize = 256;
+
+/// The calibration captures for `cam` over frames of `lenslets` lenslets of `views` views
+/// and `bands` bands, `exposures` of each kind, named as the module says.
+///
+/// # Errors
+/// `exposures` out of 1..=[`MAX_EXPOSURES`]; the camera's own errors ([`simulate_under`]).
+pub fn calibration_captures(
+    cam: &CameraConfig,
+    lenslets: [usize; 2],
+    views: [usize; 2],
+    bands: usize,
+    exposures: usize,
+) -> Result<Vec<(String, Capture)>> {
+    ensure!((1..=MAX_EXPOSURES).contains(&exposures), "exposures {exposures}: must be in 1..={MAX_EXPOSURES}");
+    let field = |band: Option<usize>, level: f32| {
+        LightField::from_fn((views[0], views[1]), lenslets[0], lenslets[1], bands, |_, _, _, _, b| {
+            if band.is_none_or(|band| band == b) { level } else { 0.0 }
+        })
+    };
+    let mut kinds = vec![("dark".to_string(), Light::Dark, field(None, 0.0))];
+    kinds.push(("flat".into(), Light::Flat { level: FLAT_LEVEL }, field(None, FLAT_LEVEL)));
+    for b in 0..bands {
+        kinds.push((format!("band-{b:02}"), Light::Band { band: b as u8, level: FLAT_LEVEL }, field(Some(b), FLAT_LEVEL)));
+    }
+    let mut out = Vec::with_capacity(kinds.len() * exposures);
+    for (i, (name, light, lf)) in kinds.iter().enumerate() {
+        for n in 0..exposures {
+            // Each exposure its own noise; the mask and the sensor stay the camera's.
+            let seed = cam.seed.wrapping_mul(1_000_003).wrapping_add((i * MAX_EXPOSURES + n + 1) as u64);
+            let shot = CameraConfig { seed, ..cam.clone() };
+            out.push((format!("{name}-{n:02}"), simulate_under(lf, &shot, *light)?));
+        }
+    }
+    Ok(out)
+}
