@@ -25,7 +25,8 @@ echo
 echo "Made by \`bash scripts/hard-cases.sh OUT_DIR\` (scenes of ${size} x ${size} lenslets, 5 x 5 views;"
 echo "\`RAYON_NUM_THREADS=${RAYON_NUM_THREADS:-all}\`). Each scene is described in"
 echo "\`host-sim/src/sim/hard.rs\`. Margins: the default's and the preview's PSNR less the"
-echo "strongest baseline's (demosaic or PPID)."
+echo "strongest baseline's (demosaic or PPID). The presets decode with the shipped blob's trained"
+echo "schedules (\`--schedule trained\`, the default since issue 42)."
 # The real content the project evaluates joins the set when present (scripts/real-eval.sh's
 # crops in $SLF_REAL, default /tmp/hci/real; their licence allows evaluation only).
 real=${SLF_REAL:-/tmp/hci/real}
