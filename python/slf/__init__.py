@@ -290,6 +290,7 @@ def decode(
     dictionary: Optional[str] = None,
     choice: Optional[str] = None,
     blob: Optional[PathLike] = None,
+    calibration: Optional[PathLike] = None,
     balance: Optional[str] = None,
     gains: Optional[Sequence[float]] = None,
     adaptive: Optional[float] = None,
@@ -332,7 +333,9 @@ def decode(
     the disjoint grid's decode), ``schedule`` trained (the blob's trained schedules, the
     default) or annealed (the hand-set one the solver keywords set), ``patch_views`` 4 or 5 (the paper's 4 x 4-view patch or the
     full-view patch; default 5 for lenslets of 5 x 5 views), ``dictionary`` dct or ensemble,
-    ``choice``, ``blob`` (an ensemble file), ``balance`` grey or off, ``gains`` (13),
+    ``choice``, ``blob`` (an ensemble file), ``calibration`` (a folder ``slf calibrate``
+    wrote: dark levels, flats, hot pixels and the filters' response corrected, baselines
+    too), ``balance`` grey or off, ``gains`` (13),
     ``adaptive`` and the solver's ``sigma_f`` ... ``min_bands``.
 
     ``threads``: threads of this decode (None: one per core; 1 inside a Dask task).
@@ -348,6 +351,8 @@ def decode(
         seeded = "true" if seeded else "false"  # type: ignore[assignment]
     if blob is not None:
         blob = os.fspath(blob)
+    if calibration is not None:
+        calibration = os.fspath(calibration)
     args = _flags(
         method=method,
         preset=preset,
@@ -361,6 +366,7 @@ def decode(
         dictionary=dictionary,
         choice=choice,
         blob=blob,
+        calibration=calibration,
         balance=balance,
         gains=gains,
         adaptive=adaptive,

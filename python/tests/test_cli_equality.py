@@ -44,6 +44,19 @@ def test_a_real_sensor_equals_cli(tmp_path, slf_bin, depth):
     assert "simulated_sensor" not in ideal.description and not np.array_equal(ideal.frames, ours.frames)
 
 
+def test_a_calibrated_decode_equals_cli(tmp_path, slf_bin, depth):
+    np.save(tmp_path / "lf.npy", depth)
+    flags = ["--leakage", "0.1", "--vignetting", "0.4", "--dark-sd", "2", "--hot-pixels", "0.001"]
+    run([slf_bin, "simulate", tmp_path / "lf.npy", "-o", tmp_path / "cap", *flags, "--calibration-captures", tmp_path / "cal", "--exposures", "2"])
+    run([slf_bin, "calibrate", tmp_path / "cal", "-o", tmp_path / "calibration"])
+    for method in ["cs", "demosaic"]:
+        run([slf_bin, "decode", tmp_path / "cap", "-o", tmp_path / "cli.npy", "--method", method, "--calibration", tmp_path / "calibration"])
+        ours = slf.decode(tmp_path / "cap", method=method, calibration=tmp_path / "calibration")
+        assert np.array_equal(ours, np.load(tmp_path / "cli.npy")), method
+    plain = slf.decode(tmp_path / "cap", method="demosaic")
+    assert not np.array_equal(plain, ours)
+
+
 @pytest.mark.parametrize(
     "flags, kwargs",
     [

@@ -92,9 +92,8 @@ pub fn calibrate(captures: &[(String, Capture)], response: Option<Vec<Vec<f32>>>
     let flat: Vec<f32> = flat.iter().map(|&v| (v / n as f64).max(0.0) as f32).collect();
 
     // Hot and dead pixels, and the ones the captures list as defective.
-    let mut bad: Vec<bool> = (0..rows * cols)
-        .map(|p| dark[p] - black > HOT_DARK * range || flat[p] < DEAD_FLAT || saturated[p])
-        .collect();
+    let mut bad: Vec<bool> =
+        (0..rows * cols).map(|p| dark[p] - black > HOT_DARK * range || flat[p] < DEAD_FLAT || saturated[p]).collect();
     for (_, c) in captures {
         for &[r, col] in &c.description.defective_pixels {
             bad[r as usize * cols + col as usize] = true;
@@ -192,4 +191,101 @@ pub fn calibrate(captures: &[(String, Capture)], response: Option<Vec<Vec<f32>>>
         ],
     };
     Ok((Calibration::new(description, dark, flat)?, report))
+}
+
+/// The largest condition number of a response matrix a decode inverts: beyond it the
+/// unmixing would amplify noise more than the leakage it removes.
+pub const MAX_CONDITION: f64 = 1e3;
+
+/// `capture` corrected by `cal` for its dark levels and flats: each raw value becomes
+/// `black + (raw - dark) / flat` (DN), so a pixel reads as an ideal, unvignetted one of the
+/// capture's black and white levels; hot, dead and saturated pixels join the defects. The
+/// corrected capture's saturation level is the top of 16 bits (a vignetted pixel corrected
+/// may read above the sensor's top code and is still a measurement).
+///
+/// # Errors
+/// A calibration of another geometry, bands or levels.
+pub fn corrected(capture: &Capture, cal: &Calibration) -> Result<Capture> {
+    let (d, c) = (&capture.description, &cal.description);
+    ensure!(
+        d.lenslets == c.lenslets && d.views == c.views && d.bands_nm == c.bands_nm,
+        "the calibration is of {:?} lenslets, {:?} views, {} bands; the capture {:?}, {:?}, {}",
+        c.lenslets,
+        c.views,
+        c.bands_nm.len(),
+        d.lenslets,
+        d.views,
+        d.bands_nm.len()
+    );
+    ensure!(
+        d.black_level == c.black_level && d.white_level == c.white_level,
+        "the calibration's levels (black {}, white {}) are not the capture's ({}, {})",
+        c.black_level,
+        c.white_level,
+        d.black_level,
+        d.white_level
+    );
+    let (_, cols) = capture.frame_size();
+    let saturation = d.saturation_level;
+    let mut defects: std::collections::BTreeSet<[u32; 2]> = d.defective_pixels.iter().copied().collect();
+    defects.extend(c.hot_pixels.iter().copied());
+    let top = f32::from(u16::MAX);
+    let frames: Vec<Vec<u16>> = capture
+        .frames
+        .iter()
+        .map(|f| {
+            f.iter()
+                .enumerate()
+                .map(|(p, &raw)| {
+                    if f32::from(raw) >= saturation {
+                        return u16::MAX; // at the corrected saturation level: left out
+                    }
+                    let v = d.black_level + (f32::from(raw) - cal.dark[p]) / cal.flat[p].max(DEAD_FLAT);
+                    v.round().clamp(0.0, top - 1.0) as u16
+                })
+                .collect()
+        })
+        .collect();
+    // A pixel the flat calls dead never reads as a measurement.
+    for (p, &f) in cal.flat.iter().enumerate() {
+        if f < DEAD_FLAT {
+            defects.insert([(p / cols) as u32, (p % cols) as u32]);
+        }
+    }
+    let mut description = d.clone();
+    description.saturation_level = top;
+    description.defective_pixels = defects.into_iter().collect();
+    Capture::new(description, frames)
+}
+
+/// The inverse of `cal`'s response matrix, row-major `[band][filter]`.
+///
+/// # Errors
+/// A response matrix that is singular or whose condition number exceeds [`MAX_CONDITION`].
+pub fn unmixing(cal: &Calibration) -> Result<Vec<f32>> {
+    let b = cal.description.bands_nm.len();
+    let r = nalgebra::DMatrix::from_fn(b, b, |f, band| f64::from(cal.description.response[f][band]));
+    let sv = r.singular_values();
+    let (hi, lo) = (sv.max(), sv.min());
+    ensure!(
+        lo > 0.0 && hi / lo <= MAX_CONDITION,
+        "the response matrix's condition number is {:.3e} (at most {MAX_CONDITION:e}): the filters do not \
+         tell the bands apart",
+        hi / lo
+    );
+    let inv = r.try_inverse().ok_or_else(|| anyhow::anyhow!("the response matrix is singular"))?;
+    Ok((0..b).flat_map(|i| (0..b).map(move |j| (i, j))).map(|(i, j)| inv[(i, j)] as f32).collect())
+}
+
+/// Every spectrum of `lf` (what the one-hot decode recovered: each band as its filter saw
+/// it) unmixed by `inverse` ([`unmixing`]): the light the scene sent.
+pub fn unmix(lf: &mut crate::io::lightfield::LightField, inverse: &[f32]) {
+    let b = lf.bands;
+    let mut out = vec![0.0f32; b];
+    for z in lf.data.chunks_exact_mut(b) {
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = inverse[i * b..(i + 1) * b].iter().zip(z.iter()).map(|(a, x)| a * x).sum();
+        }
+        z.copy_from_slice(&out);
+    }
 }

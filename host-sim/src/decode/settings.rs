@@ -17,11 +17,13 @@ use slf_firmware::disparity::MAX_DISPARITY;
 use slf_firmware::{ChoiceRule, DisparityRange, MemberChoice, Sl0Config, SolveError, gains};
 
 use crate::decode::baselines::{Baseline, BaselineReport};
+use crate::decode::calibrate::{corrected, unmix, unmixing};
 use crate::decode::cs::{
     Balance, Basis, DecodeOptions, DecodeReport, NoiseSource, PatchViews, SolveSchedule, Window, decode_with_observer,
     read_blob,
 };
 use crate::decode::preset::Preset;
+use crate::io::calibration::Calibration;
 use crate::io::capture::Capture;
 use crate::io::lightfield::LightField;
 use crate::io::message::number as show;
@@ -342,6 +344,11 @@ pub struct DecodeSettings {
     /// this many times those between its other lenslets.
     #[arg(long)]
     pub adaptive: Option<f32>,
+    /// A calibration folder (`slf calibrate`): the capture corrected for each pixel's dark
+    /// level and flat (gain and vignetting), its hot pixels left out, and the decoded
+    /// spectra unmixed by the inverse of the filters' response matrix. Baselines too.
+    #[arg(long)]
+    pub calibration: Option<std::path::PathBuf>,
     /// White balance: each band divided by a gain before the solve and multiplied back
     /// (grey: each band's mean over the frame, as the device does it).
     #[arg(long, value_enum, default_value_t = WhiteBalance::Grey)]
@@ -554,6 +561,29 @@ impl DecodeSettings {
             capture.frames.iter().flatten().any(|&x| f32::from(x) > black),
             "every pixel of every frame is at or below the black level ({black} DN): no light was recorded"
         );
+        let calibrated;
+        let (capture, inverse) = match &self.calibration {
+            Some(dir) => {
+                let cal = Calibration::load(dir)?;
+                calibrated = corrected(capture, &cal)?;
+                (&calibrated, Some(unmixing(&cal).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?))
+            }
+            None => (capture, None),
+        };
+        let mut decoded = self.run_corrected(capture, progress, observer)?;
+        if let Some(inverse) = &inverse {
+            unmix(&mut decoded.light_field, inverse);
+        }
+        Ok(decoded)
+    }
+
+    /// [`Self::run`] on a capture as it is (corrected already, or needing no correction).
+    fn run_corrected(
+        &self,
+        capture: &Capture,
+        progress: bool,
+        observer: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<Decoded> {
         if let Some(baseline) = self.method.baseline() {
             let given = self.compressed_sensing_flags();
             ensure!(

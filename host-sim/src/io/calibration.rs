@@ -172,7 +172,12 @@ impl Calibration {
         let path = dir.join(DESCRIPTION);
         let meta = std::fs::metadata(&path).map_err(|e| anyhow!("{}: {e}", path.display()))?;
         ensure!(meta.is_file(), "{}: not a regular file", path.display());
-        ensure!(meta.len() <= MAX_DESCRIPTION, "{}: {} bytes, more than a calibration holds", path.display(), meta.len());
+        ensure!(
+            meta.len() <= MAX_DESCRIPTION,
+            "{}: {} bytes, more than a calibration holds",
+            path.display(),
+            meta.len()
+        );
         let text = std::fs::read_to_string(&path).map_err(|e| anyhow!("{}: {e}", path.display()))?;
         let description: CalibrationDescription =
             serde_json::from_str(&text).map_err(|e| anyhow!("{}: invalid calibration: {e}", path.display()))?;

@@ -45,7 +45,11 @@ pub fn calibration_captures(
     let mut kinds = vec![("dark".to_string(), Light::Dark, field(None, 0.0))];
     kinds.push(("flat".into(), Light::Flat { level: FLAT_LEVEL }, field(None, FLAT_LEVEL)));
     for b in 0..bands {
-        kinds.push((format!("band-{b:02}"), Light::Band { band: b as u8, level: FLAT_LEVEL }, field(Some(b), FLAT_LEVEL)));
+        kinds.push((
+            format!("band-{b:02}"),
+            Light::Band { band: b as u8, level: FLAT_LEVEL },
+            field(Some(b), FLAT_LEVEL),
+        ));
     }
     let mut out = Vec::with_capacity(kinds.len() * exposures);
     for (i, (name, light, lf)) in kinds.iter().enumerate() {

@@ -12,8 +12,8 @@ use std::process::ExitCode;
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 use commands::{
-    baseline, bench, calibrate, compare, decode, demo, device_capture, device_check, eval, evaluate, import, scene, simulate,
-    sweep, train, train_schedule,
+    baseline, bench, calibrate, compare, decode, demo, device_capture, device_check, eval, evaluate, import, scene,
+    simulate, sweep, train, train_schedule,
 };
 
 #[derive(Parser)]

@@ -45,10 +45,8 @@ pub fn run(args: Args) -> Result<()> {
             folders.extend(inner);
         }
     }
-    let loaded: Vec<(String, Capture)> = folders
-        .iter()
-        .map(|p| Capture::load(p).map(|c| (p.display().to_string(), c)))
-        .collect::<Result<_>>()?;
+    let loaded: Vec<(String, Capture)> =
+        folders.iter().map(|p| Capture::load(p).map(|c| (p.display().to_string(), c))).collect::<Result<_>>()?;
     let curves = match &response {
         Some(path) => {
             let bands = loaded.first().map_or(0, |(_, c)| c.description.bands_nm.len());
