@@ -1,0 +1,84 @@
+#!/usr/bin/env bash
+# The real sensor's tables (docs/results-sensor.md, issue 43): for each scene at pixel k = 1
+# and 3, a sensor with 0, 10 and 30 % filter leakage, with and without vignetting to 50 %
+# (and always a 3 DN dark spread, 1 % PRNU, 0.1 % hot pixels when the sensor is real): the
+# ideal sensor's decode, the real sensor's uncorrected decode, its calibrated decode
+# (`slf simulate --calibration-captures`, `slf calibrate`, `slf decode --calibration`), and
+# the calibrated baselines. PSNR / SSIM / SA and the decode's seconds. Nothing is kept but
+# the tables: light fields, captures and calibrations go to OUT_DIR.
+#
+#   bash scripts/sensor-results.sh OUT_DIR > docs/results-sensor.md
+#   SLF_SCENES="office" SLF_KS=1 bash scripts/sensor-results.sh OUT_DIR   # smaller, faster
+#
+# Times are of one run on a shared machine: compare them within a table.
+set -euo pipefail
+out=${1:?usage: sensor-results.sh OUT_DIR}
+cd "$(dirname "$0")/.."
+cargo build --release -q -p slf-host
+slf=${SLF_BIN:-./target/release/slf}
+size=${SLF_SIZE:-64}
+scenes=${SLF_SCENES:-outdoor tungsten office led}
+ks=${SLF_KS:-1 3}
+exposures=${SLF_EXPOSURES:-8}
+mkdir -p "$out"
+# The real content the project evaluates joins the set when present (evaluation only).
+real=${SLF_REAL:-/tmp/hci/real}
+for f in "$real"/*_128.npy; do
+  [ -f "$f" ] && scenes="$scenes real:$f"
+done
+
+# decode CAPTURE LABEL ARGS...: one table row.
+decode() {
+  local cap=$1 label=$2; shift 2
+  local rec="$out/rec.npy" log t p q a
+  log=$("$slf" decode "$cap" -o "$rec" --quiet "$@")
+  t=$(echo "$log" | awk '/ in [0-9.]+ s/ { for (i = 1; i < NF; i++) if ($i == "in") print $(i + 1) }')
+  read -r p q a < <("$slf" eval "$lf" "$rec" | awk '/^PSNR/ { p = $2 } /^SSIM/ { q = $2 } /^SA/ { a = $2 } END { print p, q, a }')
+  printf '| %s | %s | %.2f | %.4f | %.2f | %.2f |\n' "$setting" "$label" "$p" "$q" "$a" "${t:-0}"
+}
+
+echo "# A real sensor, calibrated"
+echo
+echo "Made by \`bash scripts/sensor-results.sh OUT_DIR\` (scenes of ${size} x ${size} lenslets, 5 x 5 views,"
+echo "$exposures exposures of each calibration capture; \`RAYON_NUM_THREADS=${RAYON_NUM_THREADS:-all}\`)."
+echo "A real sensor has the leakage and vignetting its row names, a 3 DN dark spread, 1 % PRNU and"
+echo "0.1 % hot pixels (\`slf simulate --leakage L --vignetting V --dark-sd 3 --prnu 0.01"
+echo "--hot-pixels 0.001\`); \`calibrated\` decodes with what \`slf calibrate\` made of its calibration"
+echo "captures, the baselines too. The ideal sensor's rows are the reference."
+for scene in $scenes; do
+  if [ "${scene#real:}" != "$scene" ]; then
+    lf=${scene#real:}
+    scene=$(basename "$lf" .npy)
+  else
+    lf="$out/$scene.npy"
+    [ -f "$lf" ] || "$slf" scene "$scene" --size "$size" -o "$lf" > /dev/null
+  fi
+  echo
+  echo "## $scene"
+  echo
+  echo "| setting | decode | PSNR | SSIM | SA deg | seconds |"
+  echo "| --- | --- | --- | --- | --- | --- |"
+  for k in $ks; do
+    setting="pixel k=$k, ideal sensor"
+    cap="$out/cap-$scene-$k-ideal"
+    "$slf" simulate "$lf" -o "$cap" -s "$k" --seed 3 > /dev/null 2>&1
+    decode "$cap" "default"
+    decode "$cap" "demosaic" --method demosaic
+    decode "$cap" "ppid" --method ppid
+    for leakage in 0.1 0.3; do
+      for vignetting in 0 0.5; do
+        setting="pixel k=$k, leakage $leakage, vignetting $vignetting"
+        cap="$out/cap-$scene-$k-$leakage-$vignetting"
+        rm -rf "$cap" "$out/cal" "$out/calibration"
+        "$slf" simulate "$lf" -o "$cap" -s "$k" --seed 3 --leakage "$leakage" --vignetting "$vignetting" \
+          --dark-sd 3 --prnu 0.01 --hot-pixels 0.001 --calibration-captures "$out/cal" --exposures "$exposures" \
+          > /dev/null 2>&1
+        "$slf" calibrate "$out/cal" -o "$out/calibration" > /dev/null 2>&1
+        decode "$cap" "default, uncorrected"
+        decode "$cap" "default, calibrated" --calibration "$out/calibration"
+        decode "$cap" "demosaic, calibrated" --method demosaic --calibration "$out/calibration"
+        decode "$cap" "ppid, calibrated" --method ppid --calibration "$out/calibration"
+      done
+    done
+  done
+done
