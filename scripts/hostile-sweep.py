@@ -132,8 +132,17 @@ def main():
         s.run(["device-check", f, "--capture", "cap"], f"device-check {f}")
         s.run(["bench", "--from", f, "--out", "bench-out"], f"bench --from {f}")
         s.run(["decode", f, "-o", "x.npy"], f"decode {f}")
+        s.run(["calibrate", f, "-o", "cal-out"], f"calibrate {f}")
+        s.run(["decode", "cap", "-o", "x.npy", "--calibration", f], f"decode --calibration {f}")
     for name, d in lying.items():
         s.run(["decode", d, "-o", "x.npy", "-q"], f"decode a {name} frame claiming 65535 x 65535")
+
+    # The real sensor's flags of simulate, with values no flag takes.
+    for flag in ["--leakage", "--filter-width", "--secondary", "--secondary-nm", "--leak-floor", "--dark-sd",
+                 "--hot-pixels", "--prnu", "--vignetting", "--sensor-seed", "--exposures"]:
+        for v in ["nan", "inf", "-1", "1e39", "", "x", "0.99"]:
+            s.run(["simulate", "truth.npy", "-o", "sim-out", "--calibration-captures", "cal-caps", flag, v],
+                  f"simulate {flag} {v!r}")
 
     # Every numeric flag of decode, with values no flag takes, for each method.
     flags = ["--sigma-f", "--steps", "--mu", "--sigma-min", "--max-iterations", "--noise", "--shot",
