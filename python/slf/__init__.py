@@ -243,6 +243,30 @@ def load_capture(path: PathLike) -> Capture:
     return _from_parts(_slf.load_capture(p))
 
 
+def calibrate(captures: Union[PathLike, Sequence[PathLike]], output: PathLike) -> list:
+    """A sensor's calibration from its calibration captures, as ``slf calibrate``: each of
+    ``captures`` a capture folder (its ``light`` dark, flat or a band) or a folder of them
+    (as ``slf simulate --calibration-captures`` writes); writes the calibration folder
+    ``output`` that ``decode(..., calibration=output)`` reads. Returns the command's report
+    lines (captures used, hot pixels found, the darkest view's vignetting)."""
+    given = [captures] if isinstance(captures, (str, os.PathLike)) else list(captures)
+    folders = []
+    for c in given:
+        p = os.fspath(c)
+        if os.path.isfile(os.path.join(p, "capture.json")):
+            folders.append(p)
+        elif os.path.isdir(p):
+            inner = sorted(
+                os.path.join(p, n) for n in os.listdir(p) if os.path.isfile(os.path.join(p, n, "capture.json"))
+            )
+            if not inner:
+                raise ValueError(f"{p}: holds no capture folder")
+            folders.extend(inner)
+        else:
+            raise FileNotFoundError(f"{p}: neither a capture folder nor a folder of them")
+    return list(_slf.calibrate(folders, os.fspath(output)))
+
+
 def _progress_callback(progress: Any) -> Optional[Callable[[int, int], None]]:
     """``progress`` as a ``(done, total)`` callback: a callable as is, True a tqdm bar
     (a line on stderr without tqdm), None or False nothing."""

@@ -9,6 +9,7 @@
 //! - [`arrays`]: numpy arrays to light fields and frames and back;
 //! - [`errors`]: the library's errors as `ValueError` / `OSError`, one line;
 //! - [`capture`]: capture folders loaded, saved and checked;
+//! - [`calibration`]: a sensor's calibration from its calibration captures;
 //! - [`scene`]: the named scenes and the simulated camera;
 //! - [`decode`]: the decode, with the GIL released, threads and a progress callback;
 //! - [`metrics`]: PSNR, SSIM, SA;
@@ -17,6 +18,7 @@
 use pyo3::prelude::*;
 
 mod arrays;
+mod calibration;
 mod capture;
 mod decode;
 mod errors;
@@ -32,6 +34,7 @@ fn _slf(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(capture::load_capture, m)?)?;
     m.add_function(wrap_pyfunction!(capture::save_capture, m)?)?;
     m.add_function(wrap_pyfunction!(capture::check_capture, m)?)?;
+    m.add_function(wrap_pyfunction!(calibration::calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(decode::decode, m)?)?;
     m.add_function(wrap_pyfunction!(metrics::evaluate, m)?)?;
     m.add_function(wrap_pyfunction!(import::import_views, m)?)?;

@@ -49,6 +49,13 @@ def test_a_calibrated_decode_equals_cli(tmp_path, slf_bin, depth):
     flags = ["--leakage", "0.1", "--vignetting", "0.4", "--dark-sd", "2", "--hot-pixels", "0.001"]
     run([slf_bin, "simulate", tmp_path / "lf.npy", "-o", tmp_path / "cap", *flags, "--calibration-captures", tmp_path / "cal", "--exposures", "2"])
     run([slf_bin, "calibrate", tmp_path / "cal", "-o", tmp_path / "calibration"])
+    # The package's calibration is the command's, file for file.
+    lines = slf.calibrate(tmp_path / "cal", tmp_path / "py-calibration")
+    assert len(lines) == 2 and "calibration:" in lines[0]
+    for name in ["calibration.json", "dark.npy", "flat.npy"]:
+        assert (tmp_path / "calibration" / name).read_bytes() == (tmp_path / "py-calibration" / name).read_bytes(), name
+    with pytest.raises(ValueError, match="a scene's capture"):
+        slf.calibrate([tmp_path / "cap", tmp_path / "cal"], tmp_path / "bad")
     for method in ["cs", "demosaic"]:
         run([slf_bin, "decode", tmp_path / "cap", "-o", tmp_path / "cli.npy", "--method", method, "--calibration", tmp_path / "calibration"])
         ours = slf.decode(tmp_path / "cap", method=method, calibration=tmp_path / "calibration")
