@@ -14,6 +14,7 @@
 set -euo pipefail
 out=${1:?usage: hard-cases.sh OUT_DIR}
 cd "$(dirname "$0")/.."
+. scripts/scene-tables.sh
 cargo build --release -q -p slf-host
 slf=${SLF_BIN:-./target/release/slf}
 size=${SLF_SIZE:-64}
@@ -27,20 +28,9 @@ echo "\`RAYON_NUM_THREADS=${RAYON_NUM_THREADS:-all}\`). Each scene is described 
 echo "\`host-sim/src/sim/hard.rs\`. Margins: the default's and the preview's PSNR less the"
 echo "strongest baseline's (demosaic or PPID). The presets decode with the shipped blob's trained"
 echo "schedules (\`--schedule trained\`, the default since issue 42)."
-# The real content the project evaluates joins the set when present (scripts/real-eval.sh's
-# crops in $SLF_REAL, default /tmp/hci/real; their licence allows evaluation only).
-real=${SLF_REAL:-/tmp/hci/real}
-for f in "$real"/*_128.npy; do
-  [ -f "$f" ] && scenes="$scenes real:$f"
-done
-for scene in $scenes; do
-  if [ "${scene#real:}" != "$scene" ]; then
-    lf=${scene#real:}
-    scene=$(basename "$lf" .npy)
-  else
-    lf="$out/$scene.npy"
-    [ -f "$lf" ] || "$slf" scene "$scene" --size "$size" -o "$lf" > /dev/null
-  fi
+add_real_scenes
+for token in $scenes; do
+  scene_light_field "$token"
   echo
   echo "## $scene"
   echo
@@ -53,11 +43,8 @@ for scene in $scenes; do
     baseline=-1000; default=0; preview=0
     for m in $methods; do
       name=${m%%=*}; args=${m#*=}; args=${args//,/ }
-      rec="$out/rec.npy"
       # shellcheck disable=SC2086
-      log=$("$slf" decode "$cap" -o "$rec" --quiet $args)
-      t=$(echo "$log" | awk '/ in [0-9.]+ s/ { for (i = 1; i < NF; i++) if ($i == "in") print $(i + 1) }')
-      read -r p q a < <("$slf" eval "$lf" "$rec" | awk '/^PSNR/ { p = $2 } /^SSIM/ { q = $2 } /^SA/ { a = $2 } END { print p, q, a }')
+      decode_eval "$cap" $args
       printf '| %s k=%s | %s | %.2f | %.4f | %.2f | %.2f |\n' "$mask" "$k" "$name" "$p" "$q" "$a" "${t:-0}"
       case $name in
         demosaic | ppid) baseline=$(echo "if ($p > $baseline) $p else $baseline" | bc -l) ;;

@@ -14,6 +14,7 @@
 set -euo pipefail
 out=${1:?usage: sensor-results.sh OUT_DIR}
 cd "$(dirname "$0")/.."
+. scripts/scene-tables.sh
 cargo build --release -q -p slf-host
 slf=${SLF_BIN:-./target/release/slf}
 size=${SLF_SIZE:-64}
@@ -21,19 +22,12 @@ scenes=${SLF_SCENES:-outdoor tungsten office led}
 ks=${SLF_KS:-1 3}
 exposures=${SLF_EXPOSURES:-8}
 mkdir -p "$out"
-# The real content the project evaluates joins the set when present (evaluation only).
-real=${SLF_REAL:-/tmp/hci/real}
-for f in "$real"/*_128.npy; do
-  [ -f "$f" ] && scenes="$scenes real:$f"
-done
+add_real_scenes
 
-# decode CAPTURE LABEL ARGS...: one table row.
-decode() {
+# row CAPTURE LABEL ARGS...: one table row.
+row() {
   local cap=$1 label=$2; shift 2
-  local rec="$out/rec.npy" log t p q a
-  log=$("$slf" decode "$cap" -o "$rec" --quiet "$@")
-  t=$(echo "$log" | awk '/ in [0-9.]+ s/ { for (i = 1; i < NF; i++) if ($i == "in") print $(i + 1) }')
-  read -r p q a < <("$slf" eval "$lf" "$rec" | awk '/^PSNR/ { p = $2 } /^SSIM/ { q = $2 } /^SA/ { a = $2 } END { print p, q, a }')
+  decode_eval "$cap" "$@"
   printf '| %s | %s | %.2f | %.4f | %.2f | %.2f |\n' "$setting" "$label" "$p" "$q" "$a" "${t:-0}"
 }
 
@@ -45,14 +39,8 @@ echo "A real sensor has the leakage and vignetting its row names, a 3 DN dark sp
 echo "0.1 % hot pixels (\`slf simulate --leakage L --vignetting V --dark-sd 3 --prnu 0.01"
 echo "--hot-pixels 0.001\`); \`calibrated\` decodes with what \`slf calibrate\` made of its calibration"
 echo "captures, the baselines too. The ideal sensor's rows are the reference."
-for scene in $scenes; do
-  if [ "${scene#real:}" != "$scene" ]; then
-    lf=${scene#real:}
-    scene=$(basename "$lf" .npy)
-  else
-    lf="$out/$scene.npy"
-    [ -f "$lf" ] || "$slf" scene "$scene" --size "$size" -o "$lf" > /dev/null
-  fi
+for token in $scenes; do
+  scene_light_field "$token"
   echo
   echo "## $scene"
   echo
@@ -62,9 +50,9 @@ for scene in $scenes; do
     setting="pixel k=$k, ideal sensor"
     cap="$out/cap-$scene-$k-ideal"
     "$slf" simulate "$lf" -o "$cap" -s "$k" --seed 3 > /dev/null 2>&1
-    decode "$cap" "default"
-    decode "$cap" "demosaic" --method demosaic
-    decode "$cap" "ppid" --method ppid
+    row "$cap" "default"
+    row "$cap" "demosaic" --method demosaic
+    row "$cap" "ppid" --method ppid
     for leakage in 0.1 0.3; do
       for vignetting in 0 0.5; do
         setting="pixel k=$k, leakage $leakage, vignetting $vignetting"
@@ -74,10 +62,10 @@ for scene in $scenes; do
           --dark-sd 3 --prnu 0.01 --hot-pixels 0.001 --calibration-captures "$out/cal" --exposures "$exposures" \
           > /dev/null 2>&1
         "$slf" calibrate "$out/cal" -o "$out/calibration" > /dev/null 2>&1
-        decode "$cap" "default, uncorrected"
-        decode "$cap" "default, calibrated" --calibration "$out/calibration"
-        decode "$cap" "demosaic, calibrated" --method demosaic --calibration "$out/calibration"
-        decode "$cap" "ppid, calibrated" --method ppid --calibration "$out/calibration"
+        row "$cap" "default, uncorrected"
+        row "$cap" "default, calibrated" --calibration "$out/calibration"
+        row "$cap" "demosaic, calibrated" --method demosaic --calibration "$out/calibration"
+        row "$cap" "ppid, calibrated" --method ppid --calibration "$out/calibration"
       done
     done
   done

@@ -250,21 +250,7 @@ def calibrate(captures: Union[PathLike, Sequence[PathLike]], output: PathLike) -
     ``output`` that ``decode(..., calibration=output)`` reads. Returns the command's report
     lines (captures used, hot pixels found, the darkest view's vignetting)."""
     given = [captures] if isinstance(captures, (str, os.PathLike)) else list(captures)
-    folders = []
-    for c in given:
-        p = os.fspath(c)
-        if os.path.isfile(os.path.join(p, "capture.json")):
-            folders.append(p)
-        elif os.path.isdir(p):
-            inner = sorted(
-                os.path.join(p, n) for n in os.listdir(p) if os.path.isfile(os.path.join(p, n, "capture.json"))
-            )
-            if not inner:
-                raise ValueError(f"{p}: holds no capture folder")
-            folders.extend(inner)
-        else:
-            raise FileNotFoundError(f"{p}: neither a capture folder nor a folder of them")
-    return list(_slf.calibrate(folders, os.fspath(output)))
+    return list(_slf.calibrate([os.fspath(c) for c in given], os.fspath(output)))
 
 
 def _progress_callback(progress: Any) -> Optional[Callable[[int, int], None]]:

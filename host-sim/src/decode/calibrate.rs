@@ -12,11 +12,13 @@
 //! removed and divided by their flat and the light's level.
 
 use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 
-use anyhow::{Result, bail, ensure};
+use anyhow::{Context, Result, bail, ensure};
 
-use crate::io::calibration::{Calibration, CalibrationDescription, FORMAT, Sources, VERSION};
-use crate::io::capture::{Capture, Light};
+use crate::io::calibration::{Calibration, CalibrationDescription, FORMAT, Sources, VERSION, read_response};
+use crate::io::capture::{Capture, DESCRIPTION, Light};
+use crate::io::output::Outputs;
 
 /// A pixel whose dark level lies more than this fraction of the range (white - black) above
 /// black is hot; so is one whose flat is below [`DEAD_FLAT`] or at saturation.
@@ -28,6 +30,47 @@ pub const DEAD_FLAT: f32 = 0.1;
 #[derive(Clone, Debug, Default)]
 pub struct Report {
     pub lines: Vec<String>,
+}
+
+/// `slf calibrate` (and `slf.calibrate`): the calibration of the capture folders `paths`
+/// (a folder holding only capture folders, as `slf simulate --calibration-captures`
+/// writes, stands for them, in name order), with measured filter curves from `response`
+/// instead of a band sweep if given, written to the folder `output`.
+///
+/// # Errors
+/// A path that is neither a capture folder nor a folder of them; a capture or curves file
+/// that does not load; an output over an input; what [`calibrate`] refuses.
+pub fn calibrate_folders(paths: &[PathBuf], output: &Path, response: Option<&Path>) -> Result<Report> {
+    let mut folders = Vec::new();
+    for dir in paths {
+        if dir.join(DESCRIPTION).is_file() {
+            folders.push(dir.clone());
+        } else {
+            let mut inner: Vec<PathBuf> = std::fs::read_dir(dir)
+                .with_context(|| format!("{}: neither a capture folder nor a folder of them", dir.display()))?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.join(DESCRIPTION).is_file())
+                .collect();
+            ensure!(!inner.is_empty(), "{}: holds no capture folder", dir.display());
+            inner.sort();
+            folders.extend(inner);
+        }
+    }
+    let loaded: Vec<(String, Capture)> =
+        folders.iter().map(|p| Capture::load(p).map(|c| (p.display().to_string(), c))).collect::<Result<_>>()?;
+    let mut outputs = Outputs::new();
+    for (_, c) in &loaded {
+        outputs = outputs.inputs(c.files(), "a calibration capture's file");
+    }
+    if let Some(path) = response {
+        outputs = outputs.input(path, "the filter curves");
+    }
+    outputs.outputs(Calibration::files_in(output), "a file of the calibration -o").check_distinct()?;
+    let bands = loaded.first().map_or(0, |(_, c)| c.description.bands_nm.len());
+    let curves = response.map(|path| read_response(path, bands)).transpose()?;
+    let (calibration, report) = calibrate(&loaded, curves)?;
+    calibration.save(output)?;
+    Ok(report)
 }
 
 /// Calibrates the sensor behind `captures` (dark, flat and, unless `response` is given as

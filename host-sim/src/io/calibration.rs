@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Result, anyhow, ensure};
 use serde::{Deserialize, Serialize};
 
-use crate::io::capture::MAX_DESCRIPTION;
+use crate::io::capture::{MAX_DESCRIPTION, read_small_file};
 use crate::io::lightfield::write_npy_f32_2d;
 use crate::io::message::number;
 use crate::io::npy::{self, Element, Values};
@@ -59,6 +59,28 @@ pub struct CalibrationDescription {
     /// `[row, col]` of pixels whose dark level or flat is no working pixel's.
     pub hot_pixels: Vec<[u32; 2]>,
     pub sources: Sources,
+}
+
+/// Measured filter curves: a float `.npy` of shape `(bands, bands)`, `[filter][band]` as
+/// [`CalibrationDescription::response`] holds them; the shape checked from the header.
+///
+/// # Errors
+/// The file and what is wrong in it.
+pub fn read_response(path: &Path, bands: usize) -> Result<Vec<Vec<f32>>> {
+    let a = npy::read_checked(path, |s, element| {
+        if s != [bands, bands] {
+            return Err(format!("is {s:?}: filter curves are (filters, bands) = ({bands}, {bands})"));
+        }
+        if element == Element::U16 {
+            return Err("holds uint16: filter curves are floats".into());
+        }
+        Ok(())
+    })
+    .map_err(|e| anyhow!("{e}"))?;
+    match a.values {
+        Values::F32(v) => Ok(v.chunks(bands).map(<[f32]>::to_vec).collect()),
+        Values::U16(_) => Err(anyhow!("{}: filter curves are floats", path.display())),
+    }
 }
 
 /// A loaded calibration.
@@ -170,15 +192,7 @@ impl Calibration {
     /// The file and what is wrong in it.
     pub fn load(dir: &Path) -> Result<Self> {
         let path = dir.join(DESCRIPTION);
-        let meta = std::fs::metadata(&path).map_err(|e| anyhow!("{}: {e}", path.display()))?;
-        ensure!(meta.is_file(), "{}: not a regular file", path.display());
-        ensure!(
-            meta.len() <= MAX_DESCRIPTION,
-            "{}: {} bytes, more than a calibration holds",
-            path.display(),
-            meta.len()
-        );
-        let text = std::fs::read_to_string(&path).map_err(|e| anyhow!("{}: {e}", path.display()))?;
+        let text = read_small_file(&path, MAX_DESCRIPTION)?;
         let description: CalibrationDescription =
             serde_json::from_str(&text).map_err(|e| anyhow!("{}: invalid calibration: {e}", path.display()))?;
         let (rows, cols) = description.check().map_err(|e| anyhow!("{}: {e}", path.display()))?;
@@ -201,6 +215,11 @@ impl Calibration {
         };
         let (dark, flat) = (read(DARK)?, read(FLAT)?);
         Self::new(description, dark, flat).map_err(|e| anyhow!("{}: {e}", dir.display()))
+    }
+
+    /// The files a calibration has in folder `dir`.
+    pub fn files_in(dir: &Path) -> [PathBuf; 3] {
+        [DESCRIPTION, DARK, FLAT].map(|name| dir.join(name))
     }
 
     /// Writes the calibration folder, each file whole.

@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use slf_host::decode::cs::{Balance, NoiseSource, PatchDecoder, disparity_per_lenslet};
 use slf_host::decode::settings::{DecodeSettings, Outcome};
 use slf_host::firmware::disparity::Disparity;
-use slf_host::io::calibration::{DARK, DESCRIPTION, FLAT};
+use slf_host::io::calibration::Calibration;
 use slf_host::io::capture::Capture;
 use slf_host::io::lightfield::{Dtype, write_npy, write_npy_f32_2d};
 use slf_host::io::output::{Outputs, write_bytes};
@@ -49,10 +49,7 @@ pub fn run(args: Args) -> Result<()> {
     Outputs::new()
         .inputs(cap.files(), "a file of the capture")
         .inputs(&settings.basis.blob, "--blob")
-        .inputs(
-            settings.calibration.iter().flat_map(|d| [DESCRIPTION, DARK, FLAT].map(|f| d.join(f))),
-            "a file of --calibration",
-        )
+        .inputs(settings.calibration.iter().flat_map(|d| Calibration::files_in(d)), "a file of --calibration")
         .output(&output, "-o")
         .outputs(member_map.as_deref(), "--member-map")
         .outputs(disparity_map.as_deref(), "--disparity-map")

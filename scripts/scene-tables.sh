@@ -1,0 +1,35 @@
+# Sourced by the scripts that tabulate decodes per scene (hard-cases.sh, sensor-results.sh):
+# the scene list with the real crops, a scene's light field, and one decode measured.
+# They set `slf`, `out` and `size` first.
+
+# Appends the real content the project evaluates to $scenes when present (scripts/real-eval.sh's
+# crops in $SLF_REAL, default /tmp/hci/real; their licence allows evaluation only).
+add_real_scenes() {
+  local real=${SLF_REAL:-/tmp/hci/real} f
+  for f in "$real"/*_128.npy; do
+    [ -f "$f" ] && scenes="$scenes real:$f"
+  done
+  return 0
+}
+
+# scene_light_field TOKEN: sets $scene (its name) and $lf (its light field: a real crop, or
+# `slf scene` rendered into $out once).
+scene_light_field() {
+  scene=$1
+  if [ "${scene#real:}" != "$scene" ]; then
+    lf=${scene#real:}
+    scene=$(basename "$lf" .npy)
+  else
+    lf="$out/$scene.npy"
+    [ -f "$lf" ] || "$slf" scene "$scene" --size "$size" -o "$lf" > /dev/null
+  fi
+}
+
+# decode_eval CAPTURE ARGS...: decodes CAPTURE with ARGS against $lf; sets $p $q $a (PSNR,
+# SSIM, SA) and $t (the decode's seconds).
+decode_eval() {
+  local cap=$1 rec="$out/rec.npy" log; shift
+  log=$("$slf" decode "$cap" -o "$rec" --quiet "$@")
+  t=$(echo "$log" | awk '/ in [0-9.]+ s/ { for (i = 1; i < NF; i++) if ($i == "in") print $(i + 1) }')
+  read -r p q a < <("$slf" eval "$lf" "$rec" | awk '/^PSNR/ { p = $2 } /^SSIM/ { q = $2 } /^SA/ { a = $2 } END { print p, q, a }')
+}
