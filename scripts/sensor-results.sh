@@ -38,7 +38,10 @@ echo "$exposures exposures of each calibration capture; \`RAYON_NUM_THREADS=${RA
 echo "A real sensor has the leakage and vignetting its row names, a 3 DN dark spread, 1 % PRNU and"
 echo "0.1 % hot pixels (\`slf simulate --leakage L --vignetting V --dark-sd 3 --prnu 0.01"
 echo "--hot-pixels 0.001\`); \`calibrated\` decodes with what \`slf calibrate\` made of its calibration"
-echo "captures, the baselines too. The ideal sensor's rows are the reference."
+echo "captures, the baselines too: the default decodes the spectra the filters saw and unmixes each"
+echo "by the response matrix's inverse, as the baselines do; \`response in the projection\` puts"
+echo "each pixel's measurements as rows of the response into every projection of the solve"
+echo "(\`--response-model projection\`). The ideal sensor's rows are the reference."
 for token in $scenes; do
   scene_light_field "$token"
   echo
@@ -64,6 +67,7 @@ for token in $scenes; do
         "$slf" calibrate "$out/cal" -o "$out/calibration" > /dev/null 2>&1
         row "$cap" "default, uncorrected"
         row "$cap" "default, calibrated" --calibration "$out/calibration"
+        row "$cap" "default, calibrated, response in the projection" --calibration "$out/calibration" --response-model projection
         row "$cap" "demosaic, calibrated" --method demosaic --calibration "$out/calibration"
         row "$cap" "ppid, calibrated" --method ppid --calibration "$out/calibration"
       done

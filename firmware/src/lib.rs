@@ -16,22 +16,24 @@
 //! before it (the repository's `tests/layers.rs` checks every `crate::` path):
 //!
 //! - **sensor** ([`sensor`]: [`raw`], [`source`](sensor::source), [`defects`], [`spi`],
-//!   [`mask`], [`gains`]): samples, which of them are measurements, frames in memory or
+//!   [`mask`], [`gains`], [`response`]): samples, which of them are measurements, frames in memory or
 //!   flash, a frame buffer read over `embedded-hal` SPI, the [`TileSource`] trait they all
 //!   implement; which band each pixel sees in each snapshot (the three mask families
-//!   `kronecker`, `lenslet`, `pixel`); and the white balance, a gain per band that the decode
-//!   divides out of the measurements and multiplies back.
+//!   `kronecker`, `lenslet`, `pixel`); the white balance, a gain per band that the decode
+//!   divides out of the measurements and multiplies back; and the filters' [`response`]
+//!   matrix, what a real filter lets through of each band.
 //! - **operators** ([`operators`]: [`shape`], [`disparity`], [`dct`], [`dictionary`],
 //!   [`schedule`], [`blob`], [`transform`]): the patch geometry in the types, sheared patches that align
 //!   the views on a depth, dictionaries (the 5D DCT and blobs in flash, with the trained
 //!   schedules of their solves) and the separable
 //!   synthesis and analysis transforms.
 //! - **solver** ([`solver`]: [`error`](solver::error), [`workspace`], [`sl0`], [`ascent`],
-//!   [`ball`], [`projection`], [`fractional`], [`pinv`], [`fill`](solver::fill), [`choice`],
+//!   [`ball`], [`projection`], [`mixing`], [`fractional`], [`pinv`], [`fill`](solver::fill), [`choice`],
 //!   [`interpolate`]): the caller-owned workspace every path works in, nD SL0 (its hand-set
 //!   schedule, or the trained ones a blob carries) with the
 //!   orthonormal fast path and its cold start from the band-gain fill, the
-//!   noise ball a projection moves onto, the projection of half-pixel sheared patches (whose
+//!   noise ball a projection moves onto, the projection for filters whose response mixes
+//!   bands (a `k x k` solve per pixel), the projection of half-pixel sheared patches (whose
 //!   measurements interpolate them), the paper's general pseudo-inverse path for kronecker
 //!   masks, the choice of an ensemble member per patch (exhaustive or screened, or seeded:
 //!   one solve from an estimate of the patch), and per-pixel spectral interpolation for
@@ -83,8 +85,8 @@
 //!
 //! Configuration (dictionaries, masks, defect lists, solver parameters) is immutable and
 //! can live in flash; all mutable state is one caller-owned [`Workspace`], whose size is the
-//! decoder's whole RAM need besides the stack: three patch buffers, a flag per value and a
-//! gain per band, 67,744 bytes for the paper's 5 x 5 x 4 x 4 x 13 patch and 105,768 for the
+//! decoder's whole RAM need besides the stack: three patch buffers, a flag per value, a
+//! gain per band and the filters' response matrix with its inverse, 69,100 bytes for the paper's 5 x 5 x 4 x 4 x 13 patch and 107,124 for the
 //! full-view 5 x 5 x 5 x 5 x 13 patch ([`FullViewWorkspace`], the device's). Overlapping patches
 //! ([`OverlapDecoder`]) add a caller-owned strip of lenslet rows, 7,000 bytes per lenslet
 //! column of 5 x 5 views, or 12,600 with sheared patches ([`disparity`]: the default range
@@ -116,8 +118,8 @@ pub mod solver;
 // Every module by its path of before the layer folders, for integrators' code.
 pub use decode::{overlap, tile};
 pub use operators::{blob, dct, dictionary, disparity, schedule, shape, transform};
-pub use sensor::{defects, gains, mask, raw, spi};
-pub use solver::{ascent, ball, choice, fractional, interpolate, pinv, projection, sl0, workspace};
+pub use sensor::{defects, gains, mask, raw, response, spi};
+pub use solver::{ascent, ball, choice, fractional, interpolate, mixing, pinv, projection, sl0, workspace};
 
 pub mod prelude;
 
@@ -127,7 +129,7 @@ pub mod prelude;
 pub use decode::overlap::{Overlap, OverlapDecoder, OverlapError, OverlapReport, RowSink, Window};
 pub use decode::tile::{
     ConfigError, DecoderConfig, FrameReport, NoSeed, PatchFlags, PatchOrigin, PatchReport, PatchSeed, PatchSink,
-    SensorGeometry, Tile, TileDecoder, TileError, TileReport,
+    ResponseModel, SensorGeometry, Tile, TileDecoder, TileError, TileReport,
 };
 pub use operators::blob::{DEFAULT_ENSEMBLE, DEFAULT_FULL_VIEW_ENSEMBLE, Ensemble};
 pub use operators::dictionary::{Dictionary, DictionaryError};
@@ -137,6 +139,7 @@ pub use prelude::{PAPER_N, PaperDecoder, PaperDictionary, PaperEnsemble, PaperEn
 pub use sensor::defects::{DefectList, Pixel};
 pub use sensor::mask::{BandTile, LensletSize, Mask, MaskFamily, SensingError};
 pub use sensor::raw::{Frame, FrameSource, LeU16Frame, RawFormat, RawFrame};
+pub use sensor::response::Response;
 pub use sensor::source::TileSource;
 pub use sensor::spi::{SpiFrameBuffer, SpiSourceError};
 pub use solver::choice::{ChoiceRule, EnsembleModel, MemberChoice, ModelOutcome, PatchModel, ScheduledDictionary};

@@ -132,7 +132,8 @@ fn main() -> Result<()> {
     let (r0, c0): (usize, usize) = (args[2].parse()?, args[3].parse()?);
     let disparity = |y: usize, x: usize| f64::from(map[(r0 + y) * map_shape[1] + c0 + x]);
     let capture = simulate(&truth, &CameraConfig::pixel(3, 1).noiseless())?;
-    let decoder = tile_decoder::<4, 4, 5200>(&capture, &DecodeOptions::default())?;
+    let opts = DecodeOptions::default();
+    let decoder = tile_decoder::<4, 4, 5200>(&capture, &opts)?;
     let (gains, raw_format) = (*decoder.gains(), decoder.config().raw);
     let mask = decoder.config().mask;
     let raw = capture.raw_frames()?;

@@ -71,7 +71,8 @@ fn reference<const PU: usize, const PV: usize, const N: usize>(
     let capture = simulate(truth, &CameraConfig::pixel(3, k)).unwrap();
     // The solver config `decode_with` uses: the capture's noise ball, and the white balance
     // (the gains are the frame's; a patch decoded alone uses the same ones).
-    let decoder = tile_decoder::<PU, PV, N>(&capture, &unsheared()).unwrap();
+    let opts = unsheared();
+    let decoder = tile_decoder::<PU, PV, N>(&capture, &opts).unwrap();
     let raw = capture.raw_frames().unwrap();
     let dct = common::DctModel::<PU, PV>::shipped();
     let mut ws = Box::new(Workspace::<5, 5, PU, PV, 13, N>::new());

@@ -45,8 +45,8 @@ mod device {
     use slf_firmware::{
         ChoiceRule, DEFAULT_FULL_VIEW_ENSEMBLE, DecoderConfig, DefectList, Dictionary, Disparity, DisparityRange,
         Ensemble, EnsembleModel, FrameSource, FullViewShape, FullViewWorkspace, LeU16Frame, LensletSize, Mask,
-        MemberChoice, Overlap, OverlapDecoder, PatchModel, PatchOrigin, PatchReport, PatchSink, RawFormat, RowSink,
-        SensorGeometry, Sl0Config, TileDecoder,
+        MemberChoice, Overlap, OverlapDecoder, PatchModel, PatchOrigin, PatchReport, PatchSink, Pixel, RawFormat,
+        Response, ResponseModel, RowSink, SensorGeometry, Sl0Config, TileDecoder,
     };
 
     use super::{bench_begin, bench_end};
@@ -55,6 +55,13 @@ mod device {
         include_bytes!("../capture/snapshot_0.npy"),
         include_bytes!("../capture/snapshot_1.npy"),
         include_bytes!("../capture/snapshot_2.npy"),
+    ];
+
+    /// The real sensor's frames (leaky filters, vignetting, dark spread, hot pixels).
+    static SENSOR_FRAMES: [&[u8]; 3] = [
+        include_bytes!("../capture-sensor/snapshot_0.npy"),
+        include_bytes!("../capture-sensor/snapshot_1.npy"),
+        include_bytes!("../capture-sensor/snapshot_2.npy"),
     ];
 
     /// The body of an `.npy` v1 file: past the 10-byte preamble and the header whose length
@@ -83,6 +90,70 @@ mod device {
             }
             hprintln!();
         }
+    }
+
+    /// The real sensor's capture decoded with the screened ensemble: windows 8 (each tile as
+    /// the ideal sensor's, uncalibrated) and 9 (each tile with the compact calibration:
+    /// the dark level as the raw black, a flat per view, the hot pixels as defects, the
+    /// response matrix unmixing each decoded spectrum), the calibrated patches printed
+    /// after a `calibrated` line for `slf device-check`. Returns the failures.
+    #[inline(never)]
+    fn calibrated(
+        config: &DecoderConfig<'static>,
+        model: &EnsembleModel<'static, 5, 5, 5, 5, 13>,
+        ws: &mut FullViewWorkspace,
+    ) -> u32 {
+        static DEFECTS: [Pixel; SENSOR_DEFECTS.len()] = SENSOR_DEFECTS;
+        static VIEW_GAINS: [f32; SENSOR_VIEW_GAINS.len()] = SENSOR_VIEW_GAINS;
+        let (rows, cols) = (LENSLETS.0 as usize * VIEWS.0 as usize, LENSLETS.1 as usize * VIEWS.1 as usize);
+        let mut frames = [LeU16Frame::new(&[], 0, 0).ok(), None, None];
+        for (f, file) in frames.iter_mut().zip(SENSOR_FRAMES) {
+            *f = LeU16Frame::new(npy_body(file), rows, cols).ok();
+        }
+        let [Some(f0), Some(f1), Some(f2)] = frames else {
+            hprintln!("error: a real sensor's frame does not match the capture's size");
+            return 1;
+        };
+        let frames = [f0, f1, f2];
+        let plain = TileDecoder::<5, 5, 5, 5, 13, 8125>::new(*config)
+            .ok()
+            .and_then(|d| d.estimate_gains(&mut FrameSource::new(&frames)).ok().and_then(|g| d.with_gains(&g).ok()));
+        let (Ok(defects), Ok(response)) = (DefectList::new(&DEFECTS), Response::new(&SENSOR_RESPONSE)) else {
+            hprintln!("error: the compact calibration does not validate");
+            return 1;
+        };
+        let raw = RawFormat { black: SENSOR_BLACK, white: SENSOR_WHITE, max_valid: MAX_VALID };
+        let calibrated = TileDecoder::<5, 5, 5, 5, 13, 8125>::new(DecoderConfig { raw, defects, ..*config })
+            .ok()
+            .and_then(|d| d.with_response(&response, ResponseModel::Unmix).ok())
+            .and_then(|d| d.with_view_gains(Some(&VIEW_GAINS)).ok())
+            .and_then(|d| d.estimate_gains(&mut FrameSource::new(&frames)).ok().and_then(|g| d.with_gains(&g).ok()));
+        let (Some(plain), Some(calibrated)) = (plain, calibrated) else {
+            hprintln!("error: the real sensor's decoders were rejected");
+            return 1;
+        };
+        let mut failed = 0;
+        let mut quiet = Print { checksum: 0, patches: 0, print: false };
+        for tile in plain.tiles((1, 1)) {
+            bench_begin(8);
+            let r = plain.decode_tile(model, tile, &mut FrameSource::new(&frames), &mut quiet, ws);
+            bench_end(8);
+            failed += r.map_or(1, |t| t.failed);
+        }
+        hprint!("calibrated gains");
+        for g in calibrated.gains() {
+            hprint!(" {:08x}", g.to_bits());
+        }
+        hprintln!();
+        let mut out = Print { checksum: 0, patches: 0, print: true };
+        for tile in calibrated.tiles((1, 1)) {
+            bench_begin(9);
+            let r = calibrated.decode_tile(model, tile, &mut FrameSource::new(&frames), &mut out, ws);
+            bench_end(9);
+            failed += r.map_or(1, |t| t.failed);
+        }
+        hprintln!("calibrated patches {} defects {}", out.patches, DEFECTS.len());
+        failed
     }
 
     /// Prints each accepted patch, folds it into a checksum.
@@ -334,6 +405,7 @@ mod device {
             }
         }
         hprintln!("sheared dct steps whole {} half {}", steps[0], steps[1]);
+        failed += calibrated(&config, &model, ws);
         hprintln!("sheared stack peak bytes {}", crate::stack::peak());
         hprintln!("strip bytes {}", core::mem::size_of::<[f32; STRIP_LEN]>());
         hprintln!("disjoint stack peak bytes {}", disjoint_stack);

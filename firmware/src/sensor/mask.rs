@@ -64,6 +64,10 @@ pub enum SensingError {
     DefectsUnsorted { index: u32 },
     /// A raw frame whose data length is not `rows * cols`.
     FrameSize { expected: u32, found: u32 },
+    /// A response matrix with an entry that is not finite, a row that does not sum to a
+    /// positive amount, or a condition number above
+    /// [`MAX_CONDITION`](crate::sensor::response::MAX_CONDITION).
+    Response,
 }
 
 impl fmt::Display for SensingError {
@@ -91,6 +95,9 @@ impl fmt::Display for SensingError {
             Self::FrameSize { expected, found } => {
                 write!(f, "raw frame holds {found} samples, expected {expected}")
             }
+            Self::Response => f.write_str(
+                "response matrix not finite, a row not summing to a positive amount, or a condition number above 1e3",
+            ),
         }
     }
 }

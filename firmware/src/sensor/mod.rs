@@ -7,7 +7,9 @@
 //! - [`defects`]: the sensor's defect list;
 //! - [`mask`]: which band each pixel sees in each snapshot (the three mask families), and
 //!   [`MAX_BANDS`](mask::MAX_BANDS);
-//! - [`gains`]: the white balance, a gain per band.
+//! - [`gains`]: the white balance, a gain per band;
+//! - [`response`]: the filters' response matrix (what each filter lets through of each
+//!   band), checked and inverted.
 //!
 //! May use: nothing of the crate but the logging shim. Everything above (operators, solver,
 //! decode) may use it.
@@ -16,5 +18,6 @@ pub mod defects;
 pub mod gains;
 pub mod mask;
 pub mod raw;
+pub mod response;
 pub mod source;
 pub mod spi;

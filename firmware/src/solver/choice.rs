@@ -44,7 +44,7 @@ use crate::operators::schedule::Schedules;
 use crate::operators::shape::PatchShape;
 use crate::operators::transform::analyze_preserving;
 use crate::solver::sl0::{
-    Ended, Outcome, Sl0Config, SolveError, max_abs, seed, solve, solve_scheduled, solve_seeded, solve_warm,
+    Ended, Outcome, Sl0Config, SolveError, max_abs, put_back, seed, solve, solve_scheduled, solve_seeded, solve_warm,
     solve_warm_scheduled,
 };
 use crate::solver::workspace::Workspace;
@@ -476,6 +476,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             // other's score: all of the DCT's where its score is 0.
             let Workspace { signal, measurements, .. } = ws;
             measurements.blend_stash(signal, member_score / (member_score + dct_score));
+            put_back(&self.screen, cfg, ws)?;
             return Ok(ModelOutcome { outcome, member: Some(dct), solves: 2 });
         }
         ws.measurements.drop_stash();
@@ -522,6 +523,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         if dct_score < DCT_MARGIN * member_score {
             let Workspace { signal, measurements, .. } = ws;
             measurements.blend_stash(signal, member_score / (member_score + dct_score));
+            put_back(&self.screen, cfg, ws)?;
             return Ok(ModelOutcome { outcome, member: Some(dct), solves: 1 });
         }
         ws.measurements.drop_stash();

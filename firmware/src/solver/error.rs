@@ -30,6 +30,9 @@ pub enum SolveError {
     NoSuchMember,
     /// Band gains that are not finite and positive, or more than `MAX_BANDS` of them.
     BadGains,
+    /// Half-pixel shears (interpolating measurements) with a response matrix that mixes
+    /// bands: the projection of the two together is not built.
+    MixedHalfViews,
 }
 
 impl fmt::Display for SolveError {
@@ -50,6 +53,7 @@ impl fmt::Display for SolveError {
             }
             Self::NoSuchMember => f.write_str("ensemble member could not be read"),
             Self::BadGains => f.write_str("band gains must be finite and positive, at most MAX_BANDS"),
+            Self::MixedHalfViews => f.write_str("half-pixel shears with a response matrix that mixes bands"),
         }
     }
 }

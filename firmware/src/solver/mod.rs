@@ -7,6 +7,8 @@
 //! - [`ball`]: the noise ball a projection moves onto (per-measurement variance);
 //! - [`ascent`]: SL0's ascent step on the coefficients;
 //! - [`projection`]: the orthonormal fast path's projection onto the measurements;
+//! - [`mixing`]: the projection for filters whose response matrix mixes bands (a pixel
+//!   measures `k` rows of it: a `k x k` solve per pixel);
 //! - [`fractional`]: the projection of half-pixel sheared patches, whose measurements
 //!   interpolate the patch;
 //! - [`pinv`]: the paper's general pseudo-inverse path for kronecker masks;
@@ -26,6 +28,7 @@ pub mod error;
 pub mod fill;
 pub mod fractional;
 pub mod interpolate;
+pub mod mixing;
 pub mod pinv;
 pub mod projection;
 pub mod sl0;

@@ -173,7 +173,11 @@ pub fn solve_pinv<
     cfg: &Sl0Config,
     ws: &mut Workspace<PS, PT, PU, PV, B, N>,
 ) -> Result<Outcome, SolveError> {
-    let Workspace { coeffs, signal, measurements: m } = ws;
+    let Workspace { coeffs, signal, measurements: m, response } = ws;
+    if !response.is_identity() {
+        // The paper's operator is a selection of the patch's entries: no mixed filters.
+        return Err(SolveError::InvalidConfig { field: "response" });
+    }
     let ball = start::<B, N>(cfg, m)?;
     let mut complete = true;
     op.for_each_selected(|_, e| complete &= m.measured.get(e).copied().unwrap_or(false));

@@ -27,10 +27,12 @@
 use crate::operators::dictionary::Dictionary;
 use crate::operators::schedule::{Schedule, Weights};
 use crate::operators::transform::{analyze, synthesize};
+use crate::sensor::response::Response;
 use crate::solver::ascent::{ascend, ascend_weighted};
 use crate::solver::ball::{Ball, Move};
 use crate::solver::fill::fill_bands;
 use crate::solver::fractional::project_fractional;
+use crate::solver::mixing::{BandModel, min_norm, project_mixed, project_signal};
 use crate::solver::projection::project_coefficients;
 use crate::solver::workspace::{Measurements, Workspace};
 
@@ -406,10 +408,14 @@ fn cold<const PS: usize, const PT: usize, const PU: usize, const PV: usize, cons
     plan: Plan<'_, PS, PT, PU, PV, B>,
 ) -> Result<Outcome, SolveError> {
     let ball = start::<B, N>(cfg, &ws.measurements)?;
+    let mixed = !ws.response.is_identity();
     if !ws.measurements.half.is_none() {
+        if mixed {
+            return Err(SolveError::MixedHalfViews);
+        }
         // Interpolating measurements: the minimum-norm start `M^+ I` is the exact
         // projection of zero; the fill's start is the exact projection of the fill.
-        let Workspace { coeffs, signal, measurements: m } = ws;
+        let Workspace { coeffs, signal, measurements: m, .. } = ws;
         if fill {
             fill_bands::<B, N>(m, signal);
             analyze(dict, signal, coeffs);
@@ -423,8 +429,10 @@ fn cold<const PS: usize, const PT: usize, const PU: usize, const PV: usize, cons
     if let Some(outcome) = short_path(cfg, ws) {
         return Ok(outcome);
     }
-    let Workspace { signal, measurements: m, .. } = ws;
-    if fill {
+    let Workspace { signal, measurements: m, response, .. } = ws;
+    if mixed {
+        mixed_start(dict, response, m, signal, fill);
+    } else if fill {
         fill_bands::<B, N>(m, signal);
     } else {
         // Minimum-norm start: S0 = analysis of the measurements, zeros elsewhere.
@@ -443,7 +451,7 @@ fn short_path<const PS: usize, const PT: usize, const PU: usize, const PV: usize
     cfg: &Sl0Config,
     ws: &mut Workspace<PS, PT, PU, PV, B, N>,
 ) -> Option<Outcome> {
-    let Workspace { signal, measurements: m, .. } = ws;
+    let Workspace { signal, measurements: m, response, .. } = ws;
     let (mut lo, mut hi, mut sum, mut count) = ([f32::INFINITY; B], [f32::NEG_INFINITY; B], [0.0f32; B], [0u32; B]);
     // The band is the last (contiguous) axis of the patch layout.
     for (values, measured) in m.values.as_chunks::<B>().0.iter().zip(m.measured.as_chunks::<B>().0) {
@@ -457,9 +465,17 @@ fn short_path<const PS: usize, const PT: usize, const PU: usize, const PV: usize
     if (0..B).any(|b| count[b] == 0 || hi[b] - lo[b] > cfg.flat) {
         return None;
     }
-    let mean: [f32; B] = core::array::from_fn(|b| sum[b] / count[b] as f32);
+    let mut mean: [f32; B] = core::array::from_fn(|b| sum[b] / count[b] as f32);
     if mean.iter().any(|v| !v.is_finite()) {
         return None; // a sum past f32's range: the solve reports it
+    }
+    if !response.is_identity() {
+        // The means are `R x` of the patch's one spectrum: every value is `R^-1` of them.
+        response.balanced(&m.gains).unmix(&mut mean);
+        for x in signal.as_chunks_mut::<B>().0 {
+            *x = mean;
+        }
+        return Some(Outcome { iterations: 0, levels: 0, sigma0: 0.0, residual: 0.0, ended: Ended::Flat });
     }
     for ((x, values), measured) in
         signal.as_chunks_mut::<B>().0.iter_mut().zip(m.values.as_chunks::<B>().0).zip(m.measured.as_chunks::<B>().0)
@@ -550,8 +566,12 @@ pub fn seed<const PS: usize, const PT: usize, const PU: usize, const PV: usize, 
 ) -> Result<Option<Outcome>, SolveError> {
     start::<B, N>(cfg, &ws.measurements)?;
     let exact = Ball::new(0.0, 0.0, ws.measurements.count, 0);
+    let mixed = !ws.response.is_identity();
     if !ws.measurements.half.is_none() {
-        let Workspace { coeffs, signal, measurements: m } = ws;
+        if mixed {
+            return Err(SolveError::MixedHalfViews);
+        }
+        let Workspace { coeffs, signal, measurements: m, .. } = ws;
         analyze(dict, signal, coeffs);
         project_fractional(dict, coeffs, signal, m, &exact);
         synthesize(dict, coeffs, signal);
@@ -560,7 +580,11 @@ pub fn seed<const PS: usize, const PT: usize, const PU: usize, const PV: usize, 
     if let Some(outcome) = short_path(cfg, ws) {
         return Ok(Some(outcome));
     }
-    project::<B, N>(&mut ws.signal, &ws.measurements, &exact);
+    if mixed {
+        put_back_onto(dict, ws, &exact);
+    } else {
+        project::<B, N>(&mut ws.signal, &ws.measurements, &exact);
+    }
     Ok(None)
 }
 
@@ -626,17 +650,50 @@ fn descend<const PS: usize, const PT: usize, const PU: usize, const PV: usize, c
     ball: &Ball,
     plan: Plan<'_, PS, PT, PU, PV, B>,
 ) -> Result<Outcome, SolveError> {
-    let Workspace { coeffs, signal, measurements: m } = ws;
+    if ws.response.is_identity() {
+        return descend_with(dict, cfg, ws, ball, plan, None);
+    }
+    descend_mixed(dict, cfg, ws, ball, plan)
+}
+
+/// [`descend`] with a response that mixes bands: its [`BandModel`] (2 KB) in a frame of its
+/// own, so the one-hot solve's stack does not carry it.
+#[inline(never)]
+fn descend_mixed<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
+    dict: &Dictionary<PS, PT, PU, PV, B>,
+    cfg: &Sl0Config,
+    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ball: &Ball,
+    plan: Plan<'_, PS, PT, PU, PV, B>,
+) -> Result<Outcome, SolveError> {
+    if !ws.measurements.half.is_none() {
+        return Err(SolveError::MixedHalfViews);
+    }
+    let model = BandModel::new(&ws.response.balanced(&ws.measurements.gains), &dict.d.m5);
+    descend_with(dict, cfg, ws, ball, plan, Some(&model))
+}
+
+/// [`descend`]'s body: projections onto the mixed measurements of `mixing` if given.
+fn descend_with<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
+    dict: &Dictionary<PS, PT, PU, PV, B>,
+    cfg: &Sl0Config,
+    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ball: &Ball,
+    plan: Plan<'_, PS, PT, PU, PV, B>,
+    mixing: Option<&BandModel<B>>,
+) -> Result<Outcome, SolveError> {
+    let Workspace { coeffs, signal, measurements: m, .. } = ws;
+    let selection = m.half.is_none();
     analyze(dict, signal, coeffs);
     let top = max_abs(coeffs);
-
-    let selection = m.half.is_none();
     let mut step = |inv: f32, mu: f32, weights: Option<&Weights<PS, PT, PU, PV, B>>| {
         let step2 = match weights {
             Some(w) => ascend_weighted(coeffs, mu, inv, w),
             None => ascend(coeffs, mu, inv),
         };
-        let residual = if selection {
+        let residual = if let Some(model) = mixing {
+            project_mixed(dict, model, coeffs, signal, m, ball)
+        } else if selection {
             project_coefficients(dict, coeffs, signal, m, ball)
         } else {
             project_fractional(dict, coeffs, signal, m, ball)
@@ -646,7 +703,8 @@ fn descend<const PS: usize, const PT: usize, const PU: usize, const PV: usize, c
         // is orthonormal: |moved|^2 = |d|^2 - residual^2, with no extra pass. With a noise
         // ball, or measurements that interpolate (their residual is not the step's part
         // the projection removes), |d| bounds it.
-        let moved2 = if ball.is_exact() && selection { step2 - residual * residual } else { step2 };
+        // Mixed measurements' rows are not orthonormal either: |d| bounds it.
+        let moved2 = if ball.is_exact() && selection && mixing.is_none() { step2 - residual * residual } else { step2 };
         Step { residual, moved: libm::sqrtf(moved2.max(0.0)) }
     };
     let outcome = match plan {
@@ -655,7 +713,10 @@ fn descend<const PS: usize, const PT: usize, const PU: usize, const PV: usize, c
     };
 
     synthesize(dict, coeffs, signal);
-    if selection {
+    if let Some(model) = mixing {
+        // A measured entry is not its measurement: the per-pixel projection puts them back.
+        project_signal(model, signal, m, ball);
+    } else if selection {
         // Rounding of the transforms aside the patch meets the measurements; put them back
         // exactly (interpolating ones: the last step's projection is the last word).
         project::<B, N>(signal, m, ball);
@@ -664,4 +725,62 @@ fn descend<const PS: usize, const PT: usize, const PU: usize, const PV: usize, c
         return Err(SolveError::NonFiniteResult);
     }
     Ok(outcome)
+}
+
+/// The cold start with a response that mixes bands: the minimum-norm start `R_F^+ y` per
+/// pixel, or the fill moved onto the measurements by the same per-pixel projection
+/// (unmixing the fill by `R^-1` instead amplifies its errors: balanced, `R`'s leaks scale
+/// by the bands' gain ratios). Out of line: its [`BandModel`] stays off the one-hot
+/// solve's stack.
+#[inline(never)]
+fn mixed_start<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
+    dict: &Dictionary<PS, PT, PU, PV, B>,
+    response: &Response<B>,
+    m: &Measurements<N>,
+    signal: &mut [f32; N],
+    fill: bool,
+) {
+    let model = BandModel::new(&response.balanced(&m.gains), &dict.d.m5);
+    if fill {
+        fill_bands::<B, N>(m, signal);
+        project_signal(&model, signal, m, &Ball::new(0.0, 0.0, m.count, 0));
+    } else {
+        min_norm(&model, m, signal);
+    }
+}
+
+/// After a blend of two solutions' unmeasured entries ([`crate::solver::choice`]'s weighted
+/// mean): with mixed measurements the measured entries are the second solution's, not the
+/// measurements, so the blend is moved back onto them (onto `cfg`'s ball) by the per-pixel
+/// projection. With one-hot filters the blend meets them already and nothing is done.
+pub(crate) fn put_back<
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+    const N: usize,
+>(
+    dict: &Dictionary<PS, PT, PU, PV, B>,
+    cfg: &Sl0Config,
+    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+) -> Result<(), SolveError> {
+    if ws.response.is_identity() {
+        return Ok(());
+    }
+    let ball = start::<B, N>(cfg, &ws.measurements)?;
+    put_back_onto(dict, ws, &ball);
+    Ok(())
+}
+
+/// The patch in `ws.signal` moved onto its mixed measurements (onto `ball`) by the
+/// per-pixel projection. Out of line: its [`BandModel`] stays off the callers' stack.
+#[inline(never)]
+fn put_back_onto<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
+    dict: &Dictionary<PS, PT, PU, PV, B>,
+    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ball: &Ball,
+) {
+    let model = BandModel::new(&ws.response.balanced(&ws.measurements.gains), &dict.d.m5);
+    project_signal(&model, &mut ws.signal, &ws.measurements, ball);
 }

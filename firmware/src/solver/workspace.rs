@@ -7,6 +7,7 @@
 
 use crate::operators::disparity::HalfViews;
 use crate::operators::shape::{MAX_BANDS, PatchShape};
+use crate::sensor::response::Response;
 use crate::solver::error::SolveError;
 
 /// The measurements of one patch, dense in the patch layout: entry `i` is measured (with
@@ -171,6 +172,10 @@ pub struct Workspace<const PS: usize, const PT: usize, const PU: usize, const PV
     pub(crate) coeffs: [f32; N],
     pub(crate) signal: [f32; N],
     pub(crate) measurements: Measurements<N>,
+    /// The filters' response matrix the measurements are taken through (in the sensor's
+    /// units; the solve balances it by the measurements' gains): the identity for one-hot
+    /// filters ([`crate::solver::mixing`]).
+    pub(crate) response: Response<B>,
 }
 
 impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
@@ -179,7 +184,20 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
     /// A zeroed workspace.
     pub const fn new() -> Self {
         const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
-        Self { coeffs: [0.0; N], signal: [0.0; N], measurements: Measurements::new() }
+        Self { coeffs: [0.0; N], signal: [0.0; N], measurements: Measurements::new(), response: Response::IDENTITY }
+    }
+
+    /// Sets the response matrix the next solves take the measurements through (kept by
+    /// [`Measurements::clear`]: a property of the sensor, not of a patch). The identity, as
+    /// new, is the one-hot model. Half-pixel shears ([`Measurements::set_half_views`]) need
+    /// the identity: a solve with both is [`SolveError::MixedHalfViews`].
+    pub fn set_response(&mut self, response: &Response<B>) {
+        self.response = *response;
+    }
+
+    /// The response matrix the solves take the measurements through.
+    pub fn response(&self) -> &Response<B> {
+        &self.response
     }
 
     /// The measurements the next solve uses.

@@ -21,7 +21,7 @@ use slf_firmware::disparity::Disparity;
 use slf_firmware::tile::PatchSeed;
 use slf_firmware::{
     Dictionary, DisparityRange, Ended, FrameSource, PatchModel, PatchOrigin, PatchReport, PatchShape, PatchSink,
-    Sl0Config, SolveError, Tile, TileDecoder, TileReport, Workspace,
+    Response, ResponseModel, Sl0Config, SolveError, Tile, TileDecoder, TileReport, Workspace,
 };
 
 use crate::io::capture::Capture;
@@ -353,6 +353,10 @@ pub struct DecodeOptions {
     /// The solves' schedule: a blob's trained ones (the default), or the hand-set one of
     /// [`Self::sl0`].
     pub schedule: SolveSchedule,
+    /// The filters' response matrix (row-major, filter x band) and where the decode puts
+    /// it ([`slf_firmware::response`], [`ResponseModel`]): a calibration's, whose leaked
+    /// light the decode then separates. `None`: one-hot filters.
+    pub response: Option<(Response<13>, ResponseModel)>,
 }
 
 /// Which schedule the solves take.
@@ -383,6 +387,7 @@ impl Default for DecodeOptions {
             seeded: true,
             schedule: SolveSchedule::Trained,
             patch_views: None,
+            response: None,
         }
     }
 }
@@ -452,9 +457,16 @@ impl DecodeOptions {
 /// A capture the decoder cannot take, or gains outside `[1/64, 64]`.
 pub fn tile_decoder<'a, const PU: usize, const PV: usize, const N: usize>(
     capture: &'a Capture,
-    opts: &DecodeOptions,
+    opts: &'a DecodeOptions,
 ) -> Result<TileDecoder<'a, 5, 5, PU, PV, 13, N>> {
     let decoder = capture.decoder::<PU, PV, N>(opts.solver_config(capture))?;
+    // The response first: the white balance's gains are of the unmixed spectrum.
+    let decoder = match &opts.response {
+        Some((response, model)) => {
+            decoder.with_response(response, *model).map_err(|e| anyhow!("{}: {e}", capture.source()))?
+        }
+        None => decoder,
+    };
     let gains = match opts.balance {
         Balance::Off => [1.0; 13],
         Balance::GreyWorld => {

@@ -17,10 +17,14 @@ use std::path::Path;
 use anyhow::{Context, Result, bail, ensure};
 use slf_firmware::{
     ChoiceRule, DEFAULT_FULL_VIEW_ENSEMBLE, Ensemble, EnsembleModel, FrameSource, MemberChoice, PatchOrigin,
-    PatchReport, PatchSink,
+    PatchReport, PatchSink, Pixel,
 };
 
+use crate::decode::calibrate::calibrate;
+use crate::io::calibration::Calibration;
 use crate::io::capture::Capture;
+use crate::io::sensor::{FilterDescription, SensorDescription};
+use crate::sim::calibration::calibration_captures;
 use crate::sim::camera::{CameraConfig, simulate};
 use crate::sim::scene::{self, SceneSize};
 
@@ -59,9 +63,121 @@ pub fn write_capture(dir: &Path) -> Result<()> {
         noise,
         shot
     );
+    let consts = consts + &write_sensor_capture(&truth, dir)?;
     crate::io::output::write_bytes(&dir.join("capture.rs"), consts.as_bytes())?;
     println!("wrote {} ({} frames)", dir.display(), capture.frames.len());
     Ok(())
+}
+
+/// The real sensor the device's calibrated decode is checked on (issue 43): 10 % leakage,
+/// vignetting to 30 %, a 3 DN dark spread, 1 % PRNU, 0.2 % hot pixels.
+fn real_sensor() -> SensorDescription {
+    SensorDescription {
+        filters: FilterDescription { leakage: 0.1, ..FilterDescription::IDEAL },
+        dark_sd_dn: 3.0,
+        hot_fraction: 0.002,
+        prnu: 0.01,
+        vignetting: 0.3,
+        seed: 5,
+    }
+}
+
+/// The real sensor's capture of `truth` (`dir/capture-sensor`) and its calibration from
+/// simulated calibration captures (`dir/calibration`); returns the constants of the
+/// compact calibration the device holds in flash: the dark level (the mean of the working
+/// pixels' dark levels, as the raw black), a flat per view, the hot pixels as defects and
+/// the response matrix. The host's check reads the same from `dir/calibration`
+/// ([`Compact::of`]).
+fn write_sensor_capture(truth: &crate::io::lightfield::LightField, dir: &Path) -> Result<String> {
+    let mut cam = CameraConfig::pixel(7, 3);
+    cam.frame_ext = "npy".into();
+    cam.sensor = real_sensor();
+    let capture = simulate(truth, &cam)?;
+    capture.save(&dir.join(SENSOR_CAPTURE))?;
+    let views = [capture.description.views[0], capture.description.views[1]];
+    let lenslets = [capture.description.lenslets[0], capture.description.lenslets[1]];
+    let captures = calibration_captures(&cam, lenslets, views, 13, 8)?;
+    let (cal, _) = calibrate(&captures, None)?;
+    cal.save(&dir.join(CALIBRATION))?;
+    let c = Compact::of(&cal)?;
+    let list = |v: &[f32]| v.iter().map(|x| format!("{x:?}")).collect::<Vec<_>>().join(", ");
+    let response = c.response.iter().map(|r| format!("[{}]", list(r))).collect::<Vec<_>>().join(",\n    ");
+    let defects =
+        c.defects.iter().map(|p| format!("Pixel {{ row: {}, col: {} }}", p.row, p.col)).collect::<Vec<_>>().join(", ");
+    Ok(format!(
+        "// The real sensor's capture in ./capture-sensor and its compact calibration (from\n\
+         // ./calibration): the dark level as the raw black, a flat per view, the hot pixels, and\n\
+         // the filters' response matrix.\n\
+         pub const SENSOR_BLACK: f32 = {:?};\n\
+         pub const SENSOR_WHITE: f32 = {:?};\n\
+         pub const SENSOR_VIEW_GAINS: [f32; {}] = [{}];\n\
+         pub const SENSOR_DEFECTS: [Pixel; {}] = [{}];\n\
+         pub const SENSOR_RESPONSE: [[f32; 13]; 13] = [\n    {}\n];\n",
+        c.black,
+        c.white,
+        c.view_gains.len(),
+        list(&c.view_gains),
+        c.defects.len(),
+        defects,
+        response
+    ))
+}
+
+/// The real sensor's capture next to the device's capture.
+pub const SENSOR_CAPTURE: &str = "capture-sensor";
+/// Its calibration folder.
+pub const CALIBRATION: &str = "calibration";
+
+/// The compact calibration a device holds in flash in place of a dark level and a flat per
+/// pixel (8 bytes a pixel, 96 MB for a 12-megapixel sensor): one dark level, the flat of
+/// each view of a lenslet (vignetting; a pixel's own gain, PRNU, and the vignetting's drift
+/// across the sensor are left in), the hot and dead pixels as a defect list, and the
+/// response matrix (676 bytes).
+pub struct Compact {
+    /// The raw black: the working pixels' mean dark level, DN.
+    pub black: f32,
+    /// `black` plus the calibration's white above its black, DN.
+    pub white: f32,
+    /// View `(u, v)`'s flat at `u * V + v`.
+    pub view_gains: Vec<f32>,
+    /// Sorted.
+    pub defects: Vec<Pixel>,
+    pub response: [[f32; 13]; 13],
+}
+
+impl Compact {
+    /// The compact model of `cal`.
+    ///
+    /// # Errors
+    /// A calibration of other than 13 bands, or whose pixels do not fit the device's
+    /// 16-bit coordinates.
+    pub fn of(cal: &Calibration) -> Result<Self> {
+        let d = &cal.description;
+        let rows: Vec<[f32; 13]> = d.response.iter().filter_map(|r| r.as_slice().try_into().ok()).collect();
+        let response: [[f32; 13]; 13] =
+            rows.try_into().map_err(|_| anyhow::anyhow!("the device decodes 13 bands; the calibration has other"))?;
+        let hot: std::collections::BTreeSet<(u16, u16)> = d
+            .hot_pixels
+            .iter()
+            .map(|&[r, c]| Ok((u16::try_from(r)?, u16::try_from(c)?)))
+            .collect::<Result<_, std::num::TryFromIntError>>()?;
+        let (_, cols) = cal.frame_size();
+        let working: Vec<f32> = cal
+            .dark
+            .iter()
+            .enumerate()
+            .filter(|(p, _)| !hot.contains(&((p / cols) as u16, (p % cols) as u16)))
+            .map(|(_, &x)| x)
+            .collect();
+        let black = (working.iter().map(|&x| f64::from(x)).sum::<f64>() / working.len().max(1) as f64) as f32;
+        Ok(Self {
+            black,
+            white: black + (d.white_level - d.black_level),
+            view_gains: d.vignetting.iter().flatten().copied().collect(),
+            defects: hot.into_iter().map(|(row, col)| Pixel { row, col }).collect(),
+            response,
+        })
+    }
 }
 
 /// One decoded patch as the device printed it.
@@ -79,6 +195,9 @@ struct DeviceLog {
     count: usize,
     /// The white balance's band gains.
     gains: Vec<f32>,
+    /// The real sensor's calibrated decode: its patches and white balance.
+    calibrated: HashMap<PatchOrigin, DevicePatch>,
+    calibrated_gains: Vec<f32>,
 }
 
 /// Which printed block the `data` lines belong to.
@@ -93,13 +212,18 @@ fn parse(log: &str) -> Result<DeviceLog> {
     let mut current: Option<Block> = None;
     let mut done = None;
     let mut gains = Vec::new();
+    let (mut calibrated, mut calibrated_gains) = (HashMap::new(), Vec::new());
+    // After the `calibrated gains` line, patches are the real sensor's calibrated decode.
+    let mut in_calibrated = false;
     for (i, line) in log.lines().enumerate() {
         let w: Vec<&str> = line.split_whitespace().collect();
         match w.first().copied() {
-            Some("gains") => {
-                for h in &w[1..] {
+            Some("gains") | Some("calibrated") if w.get(1) != Some(&"patches") => {
+                in_calibrated |= w[0] == "calibrated";
+                let (out, skip) = if in_calibrated { (&mut calibrated_gains, 2) } else { (&mut gains, 1) };
+                for h in w.iter().skip(skip) {
                     let bits = u32::from_str_radix(h, 16).with_context(|| format!("line {}: bad hex {h:?}", i + 1))?;
-                    gains.push(f32::from_bits(bits));
+                    out.push(f32::from_bits(bits));
                 }
             }
             Some("patch") => {
@@ -113,7 +237,8 @@ fn parse(log: &str) -> Result<DeviceLog> {
                     view_col: n(4)? as u8,
                     disparity: slf_firmware::disparity::Disparity::ZERO,
                 };
-                patches.insert(o, DevicePatch { member: n(6)?, values: Vec::new() });
+                let into = if in_calibrated { &mut calibrated } else { &mut patches };
+                into.insert(o, DevicePatch { member: n(6)?, values: Vec::new() });
                 current = Some(Block::Patch(o));
             }
             Some("row") => {
@@ -126,6 +251,7 @@ fn parse(log: &str) -> Result<DeviceLog> {
             }
             Some("data") => {
                 let values = match current.as_ref().with_context(|| format!("line {}: data before any patch", i + 1))? {
+                    Block::Patch(o) if in_calibrated => &mut calibrated.get_mut(o).context("patch")?.values,
                     Block::Patch(o) => &mut patches.get_mut(o).context("patch")?.values,
                     Block::Row(at) => rows.get_mut(at).context("row")?,
                 };
@@ -141,7 +267,7 @@ fn parse(log: &str) -> Result<DeviceLog> {
         }
     }
     let count = done.context("the device log has no `done` line: the run did not finish")?;
-    Ok(DeviceLog { patches, rows, count, gains })
+    Ok(DeviceLog { patches, rows, count, gains, calibrated, calibrated_gains })
 }
 
 struct Collect(HashMap<PatchOrigin, (u16, Vec<f32>)>);
@@ -176,7 +302,7 @@ pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
     // A log is read whole only if it is a regular file of a log's size: a FIFO would block,
     // /dev/zero never end.
     let text = crate::io::capture::read_small_file(log, MAX_LOG)?;
-    let DeviceLog { patches: device, rows, count, gains } = parse(&text)?;
+    let DeviceLog { patches: device, rows, count, gains, calibrated, calibrated_gains } = parse(&text)?;
     let capture = Capture::load(capture_dir)?;
     // The device decodes full-view patches with the shipped full-view ensemble.
     let ensemble = Ensemble::<5, 5, 5, 5, 13>::new(DEFAULT_FULL_VIEW_ENSEMBLE).map_err(|e| anyhow::anyhow!("{e}"))?;
@@ -220,7 +346,77 @@ pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
     if !within(worst) {
         bail!("the device's patches differ from the host's by {worst:.2e} relative");
     }
-    check_rows(&rows, &capture, &model)
+    check_rows(&rows, &capture, &model)?;
+    let dir = capture_dir.parent().unwrap_or(Path::new("."));
+    check_calibrated(&calibrated, &calibrated_gains, &dir.join(SENSOR_CAPTURE), &dir.join(CALIBRATION), &model)
+}
+
+/// The device's calibrated decode of the real sensor's capture against the host's decode of
+/// the same tiles with the same compact calibration ([`Compact::of`] the calibration
+/// folder), through the same firmware code.
+fn check_calibrated(
+    device: &HashMap<PatchOrigin, DevicePatch>,
+    gains: &[f32],
+    capture_dir: &Path,
+    calibration: &Path,
+    model: &EnsembleModel<'_, 5, 5, 5, 5, 13>,
+) -> Result<()> {
+    let capture = Capture::load(capture_dir)?;
+    let c = Compact::of(&Calibration::load(calibration)?)?;
+    let unsheared =
+        crate::decode::cs::DecodeOptions { disparities: Some(slf_firmware::DisparityRange::OFF), ..Default::default() };
+    let plain = crate::decode::cs::tile_decoder::<5, 5, 8125>(&capture, &unsheared)?;
+    let raw = capture.raw_frames()?;
+    let err = |e: slf_firmware::ConfigError| anyhow::anyhow!("{e}");
+    let defects = slf_firmware::DefectList::new(&c.defects).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let response = slf_firmware::Response::new(&c.response).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let raw_format = slf_firmware::RawFormat { black: c.black, white: c.white, ..plain.config().raw };
+    let decoder = slf_firmware::TileDecoder::<5, 5, 5, 5, 13, 8125>::new(slf_firmware::DecoderConfig {
+        raw: raw_format,
+        defects,
+        ..*plain.config()
+    })
+    .map_err(err)?
+    .with_response(&response, slf_firmware::ResponseModel::Unmix)
+    .map_err(err)?
+    .with_view_gains(Some(&c.view_gains))
+    .map_err(err)?;
+    let host_gains = decoder
+        .estimate_gains(&mut FrameSource::new(&raw))
+        .map_err(|e| anyhow::anyhow!("{}: {e:?}", capture.source()))?;
+    let decoder = decoder.with_gains(&host_gains).map_err(err)?;
+    ensure!(gains.len() == 13, "the device printed {} calibrated gains, not 13", gains.len());
+    let worst_gain = gains.iter().zip(&host_gains).map(|(a, b)| f64::from((a - b).abs() / b)).fold(0.0, worse);
+    ensure!(within(worst_gain), "the device's calibrated gains {gains:?} differ from the host's {host_gains:?}");
+    let mut host = Collect(HashMap::new());
+    let mut ws = Box::new(slf_firmware::FullViewWorkspace::new());
+    for tile in decoder.tiles((1, 1)) {
+        decoder
+            .decode_tile(model, tile, &mut FrameSource::new(&raw), &mut host, &mut ws)
+            .map_err(|e| anyhow::anyhow!("{e}"))?;
+    }
+    ensure!(
+        device.len() == host.0.len(),
+        "the device printed {} calibrated patches, the host decoded {}",
+        device.len(),
+        host.0.len()
+    );
+    let mut worst = 0.0f64;
+    for (o, (member, h)) in &host.0 {
+        let d = device.get(o).with_context(|| format!("the device did not print calibrated patch {o:?}"))?;
+        ensure!(d.values.len() == h.len(), "calibrated patch {o:?}: {} values from the device", d.values.len());
+        ensure!(d.member == *member, "calibrated patch {o:?}: device member {}, host member {member}", d.member);
+        let scale = h.iter().fold(0.0f32, |m, x| m.max(x.abs())).max(f32::MIN_POSITIVE);
+        worst = worse(worst, d.values.iter().zip(h).map(|(a, b)| f64::from((a - b).abs() / scale)).fold(0.0, worse));
+    }
+    println!(
+        "device vs host, calibrated real sensor ({} hot pixels, a flat per view, the response unmixed): {} patches, \
+         largest relative difference {worst:.2e} (limit 1e-5); gains {worst_gain:.2e}",
+        c.defects.len(),
+        host.0.len()
+    );
+    ensure!(within(worst), "the device's calibrated patches differ from the host's by {worst:.2e} relative");
+    Ok(())
 }
 
 /// The device's overlapped decode (strip rows) against the host's default decode.

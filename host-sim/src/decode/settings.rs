@@ -14,7 +14,7 @@ use std::path::PathBuf;
 use anyhow::{Result, anyhow, bail, ensure};
 use clap::{Args, ValueEnum};
 use slf_firmware::disparity::MAX_DISPARITY;
-use slf_firmware::{ChoiceRule, DisparityRange, MemberChoice, Sl0Config, SolveError, gains};
+use slf_firmware::{ChoiceRule, DisparityRange, MemberChoice, Response, ResponseModel, Sl0Config, SolveError, gains};
 
 use crate::decode::baselines::{Baseline, BaselineReport};
 use crate::decode::calibrate::{corrected, unmix, unmixing};
@@ -345,10 +345,14 @@ pub struct DecodeSettings {
     #[arg(long)]
     pub adaptive: Option<f32>,
     /// A calibration folder (`slf calibrate`): the capture corrected for each pixel's dark
-    /// level and flat (gain and vignetting), its hot pixels left out, and the decoded
-    /// spectra unmixed by the inverse of the filters' response matrix. Baselines too.
+    /// level and flat (gain and vignetting), its hot pixels left out, and the filters'
+    /// leaked light separated by their response matrix (--response-model). Baselines too
+    /// (their spectra unmixed by its inverse).
     #[arg(long)]
     pub calibration: Option<std::path::PathBuf>,
+    /// With --calibration, where the decode puts the filters' response matrix.
+    #[arg(long, value_enum, default_value_t = ResponseChoice::Unmix, requires = "calibration")]
+    pub response_model: ResponseChoice,
     /// White balance: each band divided by a gain before the solve and multiplied back
     /// (grey: each band's mean over the frame, as the device does it).
     #[arg(long, value_enum, default_value_t = WhiteBalance::Grey)]
@@ -396,7 +400,7 @@ pub struct Decoded {
 pub enum Outcome {
     /// Compressed sensing: the options it ran with (presets and flags resolved) and its
     /// report.
-    Cs { options: DecodeOptions, report: Box<DecodeReport> },
+    Cs { options: Box<DecodeOptions>, report: Box<DecodeReport> },
     /// A baseline's report.
     Baseline { method: Method, report: BaselineReport },
 }
@@ -562,16 +566,28 @@ impl DecodeSettings {
             "every pixel of every frame is at or below the black level ({black} DN): no light was recorded"
         );
         let calibrated;
-        let (capture, inverse) = match &self.calibration {
+        let (capture, inverse, response) = match &self.calibration {
             Some(dir) => {
                 let cal = Calibration::load(dir)?;
                 calibrated = corrected(capture, &cal)?;
-                (&calibrated, Some(unmixing(&cal).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?))
+                let inverse = unmixing(&cal).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
+                (&calibrated, Some(inverse), Some(cal.description.response))
             }
-            None => (capture, None),
+            None => (capture, None, None),
         };
-        let mut decoded = self.run_corrected(capture, progress, observer)?;
-        if let Some(inverse) = &inverse {
+        // Compressed sensing puts the response in the firmware's decode; baselines unmix
+        // their spectra here.
+        let rows: Option<Vec<[f32; PATCH_BANDS]>> =
+            response.map(|r| r.iter().filter_map(|row| row.as_slice().try_into().ok()).collect());
+        let modelled = match rows.and_then(|rows| <[[f32; PATCH_BANDS]; PATCH_BANDS]>::try_from(rows).ok()) {
+            Some(r) if self.method.baseline().is_none() => Some((
+                Response::new(&r).map_err(|e| anyhow::anyhow!("the calibration's response matrix: {e}"))?,
+                self.response_model.model(),
+            )),
+            _ => None,
+        };
+        let mut decoded = self.run_corrected(capture, modelled, progress, observer)?;
+        if let (Some(inverse), None) = (&inverse, modelled) {
             unmix(&mut decoded.light_field, inverse);
         }
         Ok(decoded)
@@ -581,6 +597,7 @@ impl DecodeSettings {
     fn run_corrected(
         &self,
         capture: &Capture,
+        response: Option<(Response<PATCH_BANDS>, ResponseModel)>,
         progress: bool,
         observer: &(dyn Fn(usize, usize) + Sync),
     ) -> Result<Decoded> {
@@ -597,7 +614,7 @@ impl DecodeSettings {
             return Ok(Decoded { light_field, outcome: Outcome::Baseline { method: self.method, report } });
         }
         let (basis, options) = self.resolve()?;
-        let options = DecodeOptions { progress, ..options };
+        let options = DecodeOptions { progress, response, ..options };
         let (light_field, report) = decode_with_observer(capture, &basis, &options, observer)?;
         let p = &report.patches;
         if p.decoded == 0 {
@@ -609,7 +626,7 @@ impl DecodeSettings {
                 report.tiles
             );
         }
-        Ok(Decoded { light_field, outcome: Outcome::Cs { options, report: Box::new(report) } })
+        Ok(Decoded { light_field, outcome: Outcome::Cs { options: Box::new(options), report: Box::new(report) } })
     }
 }
 
@@ -631,6 +648,29 @@ impl Decoded {
 
 /// Bands of the decoder's patch (the camera's 13).
 const PATCH_BANDS: usize = 13;
+
+/// `--response-model`: where a calibrated decode puts the filters' response matrix
+/// ([`ResponseModel`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum ResponseChoice {
+    /// Decode as if the filters were one-hot, then unmix each decoded spectrum by the
+    /// response's inverse (the sparse prior on the spectra the filters saw).
+    #[default]
+    Unmix,
+    /// Each pixel's measurements as rows of the response in every projection of the
+    /// solve (the sparse prior on the scene's spectra; whole-pixel shears only).
+    Projection,
+}
+
+impl ResponseChoice {
+    /// The firmware's.
+    pub fn model(self) -> ResponseModel {
+        match self {
+            Self::Unmix => ResponseModel::Unmix,
+            Self::Projection => ResponseModel::Projection,
+        }
+    }
+}
 
 /// A decode warns when more than this fraction of patches failed or were flagged.
 pub const WARN_FRACTION: f64 = 0.01;

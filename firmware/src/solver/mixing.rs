@@ -1,0 +1,270 @@
+//! Measurements that mix bands: SL0's projection for filters with a response matrix.
+//!
+//! A pixel behind filters `F` (one per snapshot) measures `y = R_F x` of its spectrum `x`
+//! ([`crate::sensor::response`]): `k` rows of the response matrix, not `k` of the
+//! spectrum's entries. The patch's measurement operator is then `M D` with `D` the
+//! orthonormal dictionary and `M` block diagonal, one `k x 13` block `R_F` per pixel, so
+//! SL0's projection `S <- S + A^+ (y - A S)` with `A^+ = D^T M^T (M M^T)^-1` stays per
+//! pixel: `(M M^T)^-1` is one `k x k` inverse of the Gram matrix `R_F R_F^T` per pixel,
+//! read off `R R^T` (one `B x B` product per solve) and solved in place ([`BandModel::solve`]:
+//! a division at `k = 1`, `L D L^T` above). Between the pixel modes' synthesis and analysis
+//! the fast path already does, the band step reads each measurement as a dot product with a
+//! row of `R D5` instead of `D5` (one `B x B x B` product per solve) and adds back
+//! `R D5`'s rows weighted by the solved residuals: `2 B` multiply-adds a measurement as
+//! before, plus the pixel's `k x k` solve. With the identity response it is the fast path.
+//!
+//! The solve's other steps change with it: the minimum-norm start is `R_F^T (R_F R_F^T)^-1 y`
+//! per pixel, the band-gain fill and a flat patch's band means estimate `R x` and are
+//! unmixed by `R^-1`, and the final put-back of the measurements is the per-pixel
+//! projection ([`project_signal`]), since a measured entry is no longer the measurement.
+
+use crate::operators::dictionary::Dictionary;
+use crate::operators::shape::PatchShape;
+use crate::operators::transform::{Slice, flat, mode_rows, slice};
+use crate::sensor::response::Response;
+use crate::solver::ball::{Ball, Move};
+use crate::solver::projection::{apply_move, band_bits, dot, slice_analysis, slice_synthesis};
+use crate::solver::workspace::Measurements;
+
+/// What one solve needs of a response in the decode's (white-balanced) units: the response
+/// itself, its rows through the dictionary's band mode, and its Gram matrix.
+pub struct BandModel<const B: usize> {
+    /// `R`: filter `f`'s transmission of each band (signal space).
+    r: [[f32; B]; B],
+    /// `R D5`: filter `f`'s measurement of the band coefficients (coefficient space).
+    rows: [[f32; B]; B],
+    /// `R R^T`.
+    gram: [[f32; B]; B],
+}
+
+impl<const B: usize> BandModel<B> {
+    /// The model of `response` (already balanced, [`Response::balanced`]) for a
+    /// dictionary whose band mode's synthesis rows are `m5` (value `b` = `m5[b] . c`).
+    pub fn new(response: &Response<B>, m5: &[[f32; B]; B]) -> Self {
+        let r = response.matrix();
+        let rows = core::array::from_fn(|f| {
+            let mut row = [0.0f32; B];
+            for (&w, m) in r[f].iter().zip(m5) {
+                for (o, &x) in row.iter_mut().zip(m) {
+                    *o += w * x;
+                }
+            }
+            row
+        });
+        let gram = core::array::from_fn(|i| core::array::from_fn(|j| dot(&r[i], &r[j])));
+        Self { r, rows, gram }
+    }
+
+    /// Solves `(R_F R_F^T) w = res` in place for the filters `filters` (the first `k` of
+    /// `res`): a division at `k = 1`, an `L D L^T` factorisation on the stack above. A
+    /// pivot that is not positive (it cannot be for distinct filters of a checked response;
+    /// rounding could only make one tiny) zeroes its unknown.
+    #[allow(clippy::needless_range_loop)] // the factorisation reads best with its indices
+    pub fn solve(&self, filters: &[u8], res: &mut [f32]) {
+        let n = filters.len().min(res.len()).min(B);
+        let g = |i: usize, j: usize| {
+            let (Some(&a), Some(&b)) = (filters.get(i), filters.get(j)) else { return 0.0 };
+            self.gram.get(usize::from(a)).and_then(|row| row.get(usize::from(b))).copied().unwrap_or(0.0)
+        };
+        if n == 1 {
+            let d = g(0, 0);
+            if let Some(x) = res.first_mut() {
+                *x = if d > f32::MIN_POSITIVE { *x / d } else { 0.0 };
+            }
+            return;
+        }
+        let mut l = [[0.0f32; B]; B];
+        let (mut d, mut inv) = ([0.0f32; B], [0.0f32; B]);
+        for j in 0..n {
+            let mut pivot = g(j, j);
+            for k in 0..j {
+                pivot -= l[j][k] * l[j][k] * d[k];
+            }
+            if pivot > f32::MIN_POSITIVE {
+                (d[j], inv[j]) = (pivot, 1.0 / pivot);
+            }
+            for i in j + 1..n {
+                let mut x = g(i, j);
+                for k in 0..j {
+                    x -= l[i][k] * l[j][k] * d[k];
+                }
+                l[i][j] = x * inv[j];
+            }
+        }
+        let Some(res) = res.get_mut(..n) else { return };
+        for i in 0..n {
+            let mut x = res[i];
+            for k in 0..i {
+                x -= l[i][k] * res[k];
+            }
+            res[i] = x;
+        }
+        for i in (0..n).rev() {
+            let mut x = res[i] * inv[i];
+            for k in i + 1..n {
+                x -= l[k][i] * res[k];
+            }
+            res[i] = if inv[i] > 0.0 { x } else { 0.0 };
+        }
+    }
+
+    /// One pixel's residuals `y - R_F x` (signal space `x`) in filter order, with the
+    /// filters; returns how many.
+    fn residuals(&self, x: &[f32; B], ys: &[f32], bits: u64, filters: &mut [u8; B], res: &mut [f32; B]) -> usize {
+        let mut bits = bits;
+        let mut k = 0;
+        while bits != 0 {
+            let f = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            let (Some(row), Some(&y), Some(o), Some(r)) =
+                (self.r.get(f), ys.get(f), filters.get_mut(k), res.get_mut(k))
+            else {
+                break;
+            };
+            (*o, *r) = (f as u8, y - dot(row, x));
+            k += 1;
+        }
+        k
+    }
+
+    /// `x += scale R_F^T w` for solved residuals `w` of `filters`.
+    fn add_rows(rows: &[[f32; B]; B], x: &mut [f32; B], filters: &[u8], w: &[f32], scale: f32) {
+        for (&f, &w) in filters.iter().zip(w) {
+            if let Some(row) = rows.get(usize::from(f)) {
+                for (o, &a) in x.iter_mut().zip(row) {
+                    *o += scale * w * a;
+                }
+            }
+        }
+    }
+}
+
+/// The minimum-norm start in signal space: each pixel `R_F^T (R_F R_F^T)^-1 y`, zero where
+/// nothing is measured.
+pub fn min_norm<const B: usize, const N: usize>(model: &BandModel<B>, m: &Measurements<N>, signal: &mut [f32; N]) {
+    let pixels = signal.as_chunks_mut::<B>().0.iter_mut().zip(m.values.as_chunks::<B>().0);
+    for ((x, ys), measured) in pixels.zip(m.measured.as_chunks::<B>().0) {
+        *x = [0.0; B];
+        let (mut filters, mut res) = ([0u8; B], [0.0f32; B]);
+        let k = model.residuals(x, ys, band_bits(measured), &mut filters, &mut res);
+        let (Some(filters), Some(res)) = (filters.get(..k), res.get_mut(..k)) else { continue };
+        model.solve(filters, res);
+        BandModel::add_rows(&model.r, x, filters, res, 1.0);
+    }
+}
+
+/// Every pixel's `B` values unmixed by `response` (balanced): an estimate of `R x` (the
+/// band-gain fill, a flat patch's band means) made an estimate of `x`.
+pub fn unmix_all<const B: usize, const N: usize>(response: &Response<B>, signal: &mut [f32; N]) {
+    for x in signal.as_chunks_mut::<B>().0 {
+        response.unmix(x);
+    }
+}
+
+/// Every pixel's spectrum as its filters see it ([`Response::mix`]): an estimate of `x` (a
+/// seed from decoded neighbours) made one of `R x`, for a decode of `R x`.
+pub fn mix_all<const B: usize, const N: usize>(response: &Response<B>, signal: &mut [f32; N]) {
+    for x in signal.as_chunks_mut::<B>().0 {
+        response.mix(x);
+    }
+}
+
+/// The projection of a patch in signal space onto its mixed measurements (exactly, or onto
+/// the noise [`Ball`]): per pixel `x += scale R_F^T (R_F R_F^T)^-1 (y - R_F x)`. Returns
+/// the residual norm before the move. The put-back after a solve and before a seeded one.
+pub fn project_signal<const B: usize, const N: usize>(
+    model: &BandModel<B>,
+    x: &mut [f32; N],
+    m: &Measurements<N>,
+    ball: &Ball,
+) -> f32 {
+    let (mut r2, mut w2) = (0.0f32, 0.0f32);
+    let weighted = ball.is_weighted();
+    let pixels = || x.as_chunks::<B>().0.iter().zip(m.values.as_chunks::<B>().0).zip(m.measured.as_chunks::<B>().0);
+    for ((x, ys), measured) in pixels() {
+        let (mut filters, mut res) = ([0u8; B], [0.0f32; B]);
+        let k = model.residuals(x, ys, band_bits(measured), &mut filters, &mut res);
+        for (&f, &r) in filters.iter().zip(&res).take(k) {
+            r2 += r * r;
+            if weighted {
+                let f = usize::from(f);
+                w2 += r * r * ball.weight(ys.get(f).copied().unwrap_or(0.0), m.gains.get(f).copied().unwrap_or(1.0));
+            }
+        }
+    }
+    let scale = match ball.move_for(r2, w2) {
+        Move::Scale(scale) => scale,
+        Move::Stay => return libm::sqrtf(r2),
+    };
+    let pixels = x.as_chunks_mut::<B>().0.iter_mut().zip(m.values.as_chunks::<B>().0);
+    for ((x, ys), measured) in pixels.zip(m.measured.as_chunks::<B>().0) {
+        let (mut filters, mut res) = ([0u8; B], [0.0f32; B]);
+        let k = model.residuals(x, ys, band_bits(measured), &mut filters, &mut res);
+        let (Some(filters), Some(res)) = (filters.get(..k), res.get_mut(..k)) else { continue };
+        model.solve(filters, res);
+        BandModel::add_rows(&model.r, x, filters, res, scale);
+    }
+    libm::sqrtf(r2)
+}
+
+/// [`crate::solver::projection::project_coefficients`] for mixed measurements: moves the
+/// coefficients `coeffs` (of `dict`) onto the measurements `m` under `model` (exactly, or
+/// onto the noise [`Ball`]); `scratch` is clobbered. Returns the residual norm before the
+/// move. Out of line, as the fast path's projection is.
+#[inline(never)]
+pub fn project_mixed<
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+    const N: usize,
+>(
+    dict: &Dictionary<PS, PT, PU, PV, B>,
+    model: &BandModel<B>,
+    coeffs: &mut [f32; N],
+    scratch: &mut [f32; N],
+    m: &Measurements<N>,
+    ball: &Ball,
+) -> f32 {
+    const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
+    let part_len = PT * PU * PV * B;
+    mode_rows(&dict.d.m1, dict.synthesis_folds()[0], coeffs, scratch, part_len);
+    let (mut r2, mut w2) = (0.0f32, 0.0f32);
+    let weighted = ball.is_weighted();
+    let mut tmp: Slice<PT, PU, PV, B> = slice();
+    let parts = scratch.chunks_exact_mut(part_len).zip(m.values.chunks_exact(part_len));
+    for ((part, values), measured) in parts.zip(m.measured.chunks_exact(part_len)) {
+        let tmp = flat(&mut tmp);
+        slice_synthesis(dict, part, tmp);
+        let fibres = tmp.as_chunks_mut::<B>().0;
+        for ((fibre, ys), measured) in fibres.iter_mut().zip(values.as_chunks::<B>().0).zip(measured.as_chunks::<B>().0)
+        {
+            let (mut filters, mut res) = ([0u8; B], [0.0f32; B]);
+            let mut bits = band_bits(measured);
+            let mut k = 0;
+            while bits != 0 {
+                let f = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                let (Some(row), Some(&y), Some(o), Some(r)) =
+                    (model.rows.get(f), ys.get(f), filters.get_mut(k), res.get_mut(k))
+                else {
+                    break;
+                };
+                let e = y - dot(row, fibre);
+                r2 += e * e;
+                if weighted {
+                    w2 += e * e * ball.weight(y, m.gains.get(f).copied().unwrap_or(1.0));
+                }
+                (*o, *r) = (f as u8, e);
+                k += 1;
+            }
+            *fibre = [0.0; B];
+            let (Some(filters), Some(res)) = (filters.get(..k), res.get_mut(..k)) else { continue };
+            model.solve(filters, res);
+            BandModel::add_rows(&model.rows, fibre, filters, res, 1.0);
+        }
+        slice_analysis(dict, tmp, part);
+    }
+    apply_move(dict, ball, (r2, w2), scratch, coeffs)
+}
