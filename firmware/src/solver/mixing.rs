@@ -19,11 +19,9 @@
 //! projection ([`project_signal`]), since a measured entry is no longer the measurement.
 
 use crate::operators::dictionary::Dictionary;
-use crate::operators::shape::PatchShape;
-use crate::operators::transform::{Slice, flat, mode_rows, slice};
 use crate::sensor::response::Response;
 use crate::solver::ball::{Ball, Move};
-use crate::solver::projection::{apply_move, band_bits, dot, slice_analysis, slice_synthesis};
+use crate::solver::projection::{band_bits, dot, project_slices};
 use crate::solver::workspace::Measurements;
 
 /// What one solve needs of a response in the decode's (white-balanced) units: the response
@@ -210,8 +208,9 @@ pub fn project_signal<const B: usize, const N: usize>(
 /// [`crate::solver::projection::project_coefficients`] for mixed measurements: moves the
 /// coefficients `coeffs` (of `dict`) onto the measurements `m` under `model` (exactly, or
 /// onto the noise [`Ball`]); `scratch` is clobbered. Returns the residual norm before the
-/// move. Out of line, as the fast path's projection is.
-#[inline(never)]
+/// move. The pixel modes' transforms are the fast path's ([`project_slices`]); the band
+/// step reads each measurement through a row of `R D5` and solves the pixel's `k x k`
+/// Gram system.
 pub fn project_mixed<
     const PS: usize,
     const PT: usize,
@@ -227,17 +226,9 @@ pub fn project_mixed<
     m: &Measurements<N>,
     ball: &Ball,
 ) -> f32 {
-    const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
-    let part_len = PT * PU * PV * B;
-    mode_rows(&dict.d.m1, dict.synthesis_folds()[0], coeffs, scratch, part_len);
-    let (mut r2, mut w2) = (0.0f32, 0.0f32);
     let weighted = ball.is_weighted();
-    let mut tmp: Slice<PT, PU, PV, B> = slice();
-    let parts = scratch.chunks_exact_mut(part_len).zip(m.values.chunks_exact(part_len));
-    for ((part, values), measured) in parts.zip(m.measured.chunks_exact(part_len)) {
-        let tmp = flat(&mut tmp);
-        slice_synthesis(dict, part, tmp);
-        let fibres = tmp.as_chunks_mut::<B>().0;
+    let mut step = |fibres: &mut [[f32; B]], values: &[f32], measured: &[bool]| {
+        let (mut r2, mut w2) = (0.0f32, 0.0f32);
         for ((fibre, ys), measured) in fibres.iter_mut().zip(values.as_chunks::<B>().0).zip(measured.as_chunks::<B>().0)
         {
             let (mut filters, mut res) = ([0u8; B], [0.0f32; B]);
@@ -264,7 +255,7 @@ pub fn project_mixed<
             model.solve(filters, res);
             BandModel::add_rows(&model.rows, fibre, filters, res, 1.0);
         }
-        slice_analysis(dict, tmp, part);
-    }
-    apply_move(dict, ball, (r2, w2), scratch, coeffs)
+        (r2, w2)
+    };
+    project_slices(dict, coeffs, scratch, m, ball, &mut step)
 }

@@ -60,23 +60,55 @@ pub fn project_coefficients<
     m: &Measurements<N>,
     ball: &Ball,
 ) -> f32 {
+    let weighted = ball.is_weighted();
+    let mut step = |fibres: &mut [[f32; B]], values: &[f32], measured: &[bool]| {
+        if weighted {
+            band_step::<B, true>(&dict.d.m5, fibres, values, measured, ball, &m.gains)
+        } else {
+            band_step::<B, false>(&dict.d.m5, fibres, values, measured, ball, &m.gains)
+        }
+    };
+    project_slices(dict, coeffs, scratch, m, ball, &mut step)
+}
+
+/// A band step: one spatial slice's pixels, their band coefficients in `fibres` (after the
+/// pixel modes' synthesis), become the correction's; `values` / `measured` are the
+/// slice's measurements in patch order. Returns the sums of squared residuals, plain and
+/// weighted ([`Ball::weight`]).
+pub(crate) type BandStep<'s, const B: usize> = dyn FnMut(&mut [[f32; B]], &[f32], &[bool]) -> (f32, f32) + 's;
+
+/// The projection's frame shared by the one-hot band step ([`project_coefficients`]) and
+/// the mixed one ([`crate::solver::mixing::project_mixed`]): the pixel modes' synthesis,
+/// `step` per spatial slice, the analysis and the ball's move. The band step is called
+/// through a pointer (five calls a projection), so the transforms are compiled once: with
+/// a copy per band step the mixed projection added 20 KB of flash to the device image.
+#[inline(never)]
+pub(crate) fn project_slices<
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+    const N: usize,
+>(
+    dict: &Dictionary<PS, PT, PU, PV, B>,
+    coeffs: &mut [f32; N],
+    scratch: &mut [f32; N],
+    m: &Measurements<N>,
+    ball: &Ball,
+    step: &mut BandStep<'_, B>,
+) -> f32 {
     const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
     let part_len = PT * PU * PV * B;
     mode_rows(&dict.d.m1, dict.synthesis_folds()[0], coeffs, scratch, part_len);
     let (mut r2, mut w2) = (0.0f32, 0.0f32);
-    let weighted = ball.is_weighted();
     let mut tmp: Slice<PT, PU, PV, B> = slice();
     let parts = scratch.chunks_exact_mut(part_len).zip(m.values.chunks_exact(part_len));
     for ((part, values), measured) in parts.zip(m.measured.chunks_exact(part_len)) {
         let tmp = flat(&mut tmp);
         slice_synthesis(dict, part, tmp);
-        let fibres = tmp.as_chunks_mut::<B>().0;
-        if weighted {
-            let (r, w) = band_step::<B, true>(&dict.d.m5, fibres, values, measured, ball, &m.gains);
-            (r2, w2) = (r2 + r, w2 + w);
-        } else {
-            r2 += band_step::<B, false>(&dict.d.m5, fibres, values, measured, ball, &m.gains).0;
-        }
+        let (r, w) = step(tmp.as_chunks_mut::<B>().0, values, measured);
+        (r2, w2) = (r2 + r, w2 + w);
         slice_analysis(dict, tmp, part);
     }
     apply_move(dict, ball, (r2, w2), scratch, coeffs)
