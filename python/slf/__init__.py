@@ -301,6 +301,7 @@ def decode(
     choice: Optional[str] = None,
     blob: Optional[PathLike] = None,
     calibration: Optional[PathLike] = None,
+    response_model: Optional[str] = None,
     balance: Optional[str] = None,
     gains: Optional[Sequence[float]] = None,
     adaptive: Optional[float] = None,
@@ -345,7 +346,9 @@ def decode(
     full-view patch; default 5 for lenslets of 5 x 5 views), ``dictionary`` dct or ensemble,
     ``choice``, ``blob`` (an ensemble file), ``calibration`` (a folder ``slf calibrate``
     wrote: dark levels, flats, hot pixels and the filters' response corrected, baselines
-    too), ``balance`` grey or off, ``gains`` (13),
+    too), ``response_model`` unmix (the default: each decoded spectrum unmixed by the
+    response's inverse) or projection (the response in every projection of the solve),
+    ``balance`` grey or off, ``gains`` (13),
     ``adaptive`` and the solver's ``sigma_f`` ... ``min_bands``.
 
     ``threads``: threads of this decode (None: one per core; 1 inside a Dask task).
@@ -377,6 +380,7 @@ def decode(
         choice=choice,
         blob=blob,
         calibration=calibration,
+        response_model=response_model,
         balance=balance,
         gains=gains,
         adaptive=adaptive,

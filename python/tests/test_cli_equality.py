@@ -60,6 +60,11 @@ def test_a_calibrated_decode_equals_cli(tmp_path, slf_bin, depth):
         run([slf_bin, "decode", tmp_path / "cap", "-o", tmp_path / "cli.npy", "--method", method, "--calibration", tmp_path / "calibration"])
         ours = slf.decode(tmp_path / "cap", method=method, calibration=tmp_path / "calibration")
         assert np.array_equal(ours, np.load(tmp_path / "cli.npy")), method
+    # The response in the solve's projection, by keyword as by flag.
+    run([slf_bin, "decode", tmp_path / "cap", "-o", tmp_path / "cli.npy", "--calibration", tmp_path / "calibration", "--response-model", "projection"])
+    projected = slf.decode(tmp_path / "cap", calibration=tmp_path / "calibration", response_model="projection")
+    assert np.array_equal(projected, np.load(tmp_path / "cli.npy"))
+    assert not np.array_equal(projected, slf.decode(tmp_path / "cap", calibration=tmp_path / "calibration"))
     plain = slf.decode(tmp_path / "cap", method="demosaic")
     assert not np.array_equal(plain, ours)
 
