@@ -189,6 +189,8 @@ def simulate(
     prnu: Optional[float] = None,
     vignetting: Optional[float] = None,
     sensor_seed: Optional[int] = None,
+    calibration_captures: Optional[PathLike] = None,
+    exposures: int = 8,
 ) -> Capture:
     """Records the light field ``lf`` ``(U, V, H, W, B)`` with the camera, as ``slf simulate``.
 
@@ -205,7 +207,10 @@ def simulate(
     ``secondary_nm`` and ``leak_floor``; ``dark_sd`` (DN) and ``hot_pixels`` (fraction),
     ``prnu`` (gain spread), ``vignetting`` (light the corner view loses) and ``sensor_seed``
     (one sensor for every capture made with it). Such a capture records its sensor in its
-    description's ``simulated_sensor`` (format version 2).
+    description's ``simulated_sensor`` (format version 2). ``calibration_captures``: a
+    folder to write the sensor's dark, flat and band-sweep captures into, ``exposures``
+    (1..=256) of each, as ``--calibration-captures DIR --exposures N`` does, for
+    :func:`calibrate`.
     """
     arr = _as_float32(lf, "lf", "(U, V, H, W, B)")
     args = _flags(
@@ -229,7 +234,8 @@ def simulate(
         vignetting=vignetting,
         sensor_seed=sensor_seed,
     )
-    frames, text, notes = _slf.simulate(arr, args)
+    cal = None if calibration_captures is None else os.fspath(calibration_captures)
+    frames, text, notes = _slf.simulate(arr, args, cal, exposures)
     for n in notes:
         warnings.warn(f"slf: {n}", stacklevel=2)
     return _from_parts((frames, text))

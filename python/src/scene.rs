@@ -34,16 +34,40 @@ pub fn scene<'py>(
 }
 
 /// Records `lf` with the camera `slf simulate` would use with these flags: `(frames,
-/// description JSON, notes)`.
+/// description JSON, notes)`. With `calibration_captures`, also writes the sensor's
+/// calibration captures there, `exposures` of each kind, as `slf simulate
+/// --calibration-captures DIR --exposures N` does.
 #[pyfunction]
+#[pyo3(signature = (lf, args, calibration_captures=None, exposures=8))]
 pub fn simulate<'py>(
     py: Python<'py>,
     lf: PyReadonlyArrayDyn<'py, f32>,
     args: Vec<String>,
+    calibration_captures: Option<std::path::PathBuf>,
+    exposures: usize,
 ) -> PyResult<(Bound<'py, PyArrayDyn<u16>>, String, Vec<String>)> {
     let settings = SimulateSettings::from_flags(&args).map_err(flags)?;
     let lf = light_field(&lf, "lf")?;
-    let simulated = py.detach(|| settings.run(lf, "lf")).or_py()?;
+    let simulated = py
+        .detach(|| -> anyhow::Result<_> {
+            let simulated = settings.run(lf, "lf")?;
+            if let Some(dir) = &calibration_captures {
+                let d = &simulated.capture.description;
+                let captures = slf_host::sim::calibration::calibration_captures(
+                    &settings.camera(),
+                    d.lenslets,
+                    d.views,
+                    d.bands_nm.len(),
+                    exposures,
+                )?;
+                let outputs =
+                    slf_host::sim::calibration::with_outputs(slf_host::io::output::Outputs::new(), &captures, dir);
+                outputs.check_distinct()?;
+                slf_host::sim::calibration::save(&captures, dir)?;
+            }
+            Ok(simulated)
+        })
+        .or_py()?;
     let (frames, json) = to_parts(py, simulated.capture)?;
     Ok((frames, json, simulated.notes))
 }

@@ -49,6 +49,14 @@ def test_a_calibrated_decode_equals_cli(tmp_path, slf_bin, depth):
     flags = ["--leakage", "0.1", "--vignetting", "0.4", "--dark-sd", "2", "--hot-pixels", "0.001"]
     run([slf_bin, "simulate", tmp_path / "lf.npy", "-o", tmp_path / "cap", *flags, "--calibration-captures", tmp_path / "cal", "--exposures", "2"])
     run([slf_bin, "calibrate", tmp_path / "cal", "-o", tmp_path / "calibration"])
+    # The package's calibration captures are the command's, file for file.
+    sensor = dict(leakage=0.1, vignetting=0.4, dark_sd=2, hot_pixels=0.001)
+    slf.simulate(depth, calibration_captures=tmp_path / "py-cal", exposures=2, **sensor)
+    cli_files = sorted(p.relative_to(tmp_path / "cal") for p in (tmp_path / "cal").rglob("*") if p.is_file())
+    py_files = sorted(p.relative_to(tmp_path / "py-cal") for p in (tmp_path / "py-cal").rglob("*") if p.is_file())
+    assert cli_files == py_files and len(cli_files) > 0
+    for f in cli_files:
+        assert (tmp_path / "cal" / f).read_bytes() == (tmp_path / "py-cal" / f).read_bytes(), f
     # The package's calibration is the command's, file for file.
     lines = slf.calibrate(tmp_path / "cal", tmp_path / "py-calibration")
     assert len(lines) == 2 and "calibration:" in lines[0]

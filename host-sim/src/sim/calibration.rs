@@ -11,10 +11,13 @@
 //! `NN` counts exposures: each exposure draws its own noise, and `slf calibrate` averages
 //! them.
 
+use std::path::Path;
+
 use anyhow::{Result, ensure};
 
 use crate::io::capture::{Capture, Light};
 use crate::io::lightfield::LightField;
+use crate::io::output::Outputs;
 use crate::sim::camera::{CameraConfig, simulate_under};
 
 /// The flat's and the sweep's light, a fraction of white: bright for a good signal, below
@@ -61,4 +64,23 @@ pub fn calibration_captures(
         }
     }
     Ok(out)
+}
+
+/// `outputs` with the files of `captures` written into `dir` (one folder each, by name), so
+/// that [`Outputs::check_distinct`] refuses a calibration capture over an input or the scene
+/// capture before anything is written.
+pub fn with_outputs(outputs: Outputs, captures: &[(String, Capture)], dir: &Path) -> Outputs {
+    captures.iter().fold(outputs, |o, (name, c)| o.outputs(c.files_in(&dir.join(name)), "a calibration capture's file"))
+}
+
+/// Writes `captures` into `dir`, one capture folder each, by name (what `slf calibrate DIR`
+/// reads).
+///
+/// # Errors
+/// I/O errors.
+pub fn save(captures: &[(String, Capture)], dir: &Path) -> Result<()> {
+    for (name, c) in captures {
+        c.save(&dir.join(name))?;
+    }
+    Ok(())
 }

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 use slf_host::io::lightfield::read_npy;
 use slf_host::io::output::Outputs;
-use slf_host::sim::calibration::calibration_captures as calibration_captures_for;
+use slf_host::sim::calibration::{self, calibration_captures as calibration_captures_for};
 use slf_host::sim::settings::SimulateSettings;
 
 #[derive(clap::Args)]
@@ -43,17 +43,13 @@ pub fn run(args: Args) -> Result<()> {
         .input(&input, "the light field")
         .outputs(simulated.capture.files_in(&output), "a file of the capture -o");
     if let Some(dir) = &calibration_captures {
-        for (name, c) in &calibration {
-            outputs = outputs.outputs(c.files_in(&dir.join(name)), "a calibration capture's file");
-        }
+        outputs = calibration::with_outputs(outputs, &calibration, dir);
     }
     outputs.check_distinct()?;
     simulated.capture.save(&output)?;
     println!("wrote {} ({} snapshots)", output.display(), simulated.capture.frames.len());
     if let Some(dir) = &calibration_captures {
-        for (name, c) in &calibration {
-            c.save(&dir.join(name))?;
-        }
+        calibration::save(&calibration, dir)?;
         println!("wrote {} calibration captures into {}", calibration.len(), dir.display());
     }
     Ok(())
