@@ -77,7 +77,7 @@ print(f"| instructions for the white balance (one pass over the frame, every sna
 print(f"| instructions per patch, 5D DCT | {dct:,.0f} | |")
 print(f"| instructions per patch, 5D DCT sheared to disparity 1 ({steps_whole:.0f} steps) / 1/2 ({steps_half:.0f} steps) | {dct_whole:,.0f} / {dct_half:,.0f} | |")
 print(f"| instructions per patch, ensemble (8 members), screened | {ens:,.0f} | |")
-print(f"| instructions per patch, ensemble, a real sensor's capture (10 % leakage, 30 % vignetting): uncalibrated / with the compact calibration (dark level, a flat per view, hot pixels, the response unmixed) | {plain:,.0f} / {calibrated:,.0f} ({calibrated / plain:.3f}x) | 1.2x |")
+print(f"| instructions per patch, ensemble, a real sensor's capture (10 % leakage, 30 % vignetting): uncalibrated / with the compact calibration (dark level, a flat per view and region, hot pixels, the response unmixed) | {plain:,.0f} / {calibrated:,.0f} ({calibrated / plain:.3f}x) | 1.2x |")
 print(f"| instructions to choose one block's disparity (-1..1: 3 candidates x 625 pixels x k samples) | {choose:,} | |")
 print(f"| instructions per frame, stride 3 tapered, disparities -1..1, screened ensemble ({ov_patches} patch solves in {ov_bands} band; {frame_patches} with a full-width strip; disjoint: {patches}) | {frame:,} ({frame / patches:,.0f} per disjoint patch) | 3,000 M |")
 # The frame figure of a camera-sized sensor: 100 x 100 lenslets, 5 x 5 views, 20 x 20

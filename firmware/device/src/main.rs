@@ -126,7 +126,7 @@ mod device {
         let calibrated = TileDecoder::<5, 5, 5, 5, 13, 8125>::new(DecoderConfig { raw, defects, ..*config })
             .ok()
             .and_then(|d| d.with_response(&response, ResponseModel::Unmix).ok())
-            .and_then(|d| d.with_view_gains(Some(&VIEW_GAINS)).ok())
+            .and_then(|d| d.with_view_gains(Some((&VIEW_GAINS, SENSOR_REGIONS))).ok())
             .and_then(|d| d.estimate_gains(&mut FrameSource::new(&frames)).ok().and_then(|g| d.with_gains(&g).ok()));
         let (Some(plain), Some(calibrated)) = (plain, calibrated) else {
             hprintln!("error: the real sensor's decoders were rejected");

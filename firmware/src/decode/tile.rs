@@ -370,7 +370,7 @@ pub struct TileDecoder<
     /// 1.35 KB larger, 9.7 KB more stack in the device's run.
     response: &'a Response<B>,
     response_model: ResponseModel,
-    view_gains: Option<&'a [f32]>,
+    view_gains: Option<(&'a [f32], (u16, u16))>,
 }
 
 /// Where a decode puts the filters' response matrix ([`TileDecoder::with_response`]).
@@ -509,27 +509,35 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         }
     }
 
-    /// This decoder with every sample of view `(u, v)` of a lenslet divided by
-    /// `gains[u * lenslet_cols + v]`: a flat field per view (vignetting: the outer views of
-    /// a lenslet see a fraction of the centre's light), the compact calibration a device
-    /// holds in flash in place of a gain per pixel ([`crate::sensor::response`]'s module
-    /// docs say what the two cost). `None`: every view as bright as the centre.
+    /// This decoder with every sample divided by its view's flat field in its region of the
+    /// sensor: the lenslets cut into `regions = (rows, cols)` equal rectangles (region
+    /// `(i, j)` holds lenslet row `r` when `r * rows / lenslet_rows == i`), and view `(u, v)`
+    /// of a lenslet in region `(i, j)` divided by `gains[((i * cols + j) * U + u) * V + v]`.
+    /// Vignetting: the outer views of a lenslet see a fraction of the centre's light, and
+    /// the fraction drifts across the sensor with the micro-image's centre; one table per
+    /// region is the compact calibration a device holds in flash in place of a gain per
+    /// pixel (`docs/design.md` says what each costs and loses). `None`: every view as
+    /// bright as the centre.
     ///
     /// # Errors
-    /// [`ConfigError::ViewGains`] for a table whose length is not the lenslet's views or a
-    /// gain outside `[1 / MAX_RATIO, MAX_RATIO]`.
-    pub fn with_view_gains(self, gains: Option<&'a [f32]>) -> Result<Self, ConfigError> {
-        let lenslet = self.config.sensor.lenslet;
-        if let Some(g) = gains
-            && (g.len() != usize::from(lenslet.rows) * usize::from(lenslet.cols) || !crate::sensor::gains::valid(g))
-        {
-            return Err(ConfigError::ViewGains);
+    /// [`ConfigError::ViewGains`] for a region count of 0 or above the lenslets', a table
+    /// whose length is not the regions' views, or a gain outside `[1 / MAX_RATIO, MAX_RATIO]`.
+    pub fn with_view_gains(self, gains: Option<(&'a [f32], (u16, u16))>) -> Result<Self, ConfigError> {
+        let (lenslet, lenslets) = (self.config.sensor.lenslet, self.config.sensor.lenslets);
+        if let Some((g, (rows, cols))) = gains {
+            let views = usize::from(lenslet.rows) * usize::from(lenslet.cols);
+            if rows == 0 || cols == 0 || rows > lenslets.0 || cols > lenslets.1 {
+                return Err(ConfigError::ViewGains);
+            }
+            if g.len() != usize::from(rows) * usize::from(cols) * views || !crate::sensor::gains::valid(g) {
+                return Err(ConfigError::ViewGains);
+            }
         }
         Ok(Self { view_gains: gains, ..self })
     }
 
-    /// The flat field per view the decode divides out, if any.
-    pub fn view_gains(&self) -> Option<&'a [f32]> {
+    /// The flat field per view and region the decode divides out, if any.
+    pub fn view_gains(&self) -> Option<(&'a [f32], (u16, u16))> {
         self.view_gains
     }
 
@@ -620,9 +628,11 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             // spectrum (leaked light from a bright band would otherwise inflate a dark
             // band's gain and tilt the balanced spectra: measured on the office scene at 10 %
             // leakage, 2.6 dB lost with the DCT).
-            let mut means: [f32; B] = core::array::from_fn(|b| sums[b] / counts[b].max(1) as f32);
+            let (mut means, mut ones) = ([0.0f32; B], [0u32; B]);
+            for (((m, o), &s), &n) in means.iter_mut().zip(&mut ones).zip(&sums).zip(&counts) {
+                (*m, *o) = (s / n.max(1) as f32, u32::from(n > 0));
+            }
             self.response.unmix(&mut means);
-            let ones: [u32; B] = core::array::from_fn(|b| u32::from(counts[b] > 0));
             return Ok(crate::sensor::gains::gains_from_sums(&means, &ones));
         }
         Ok(crate::sensor::gains::gains_from_sums(&sums, &counts))
@@ -760,11 +770,19 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     /// without one.
     #[inline(always)]
     fn view_gain(&self, row: usize, col: usize) -> f32 {
-        let Some(table) = self.view_gains else { return 1.0 };
-        let lenslet = self.config.sensor.lenslet;
+        let Some((table, (rr, rc))) = self.view_gains else { return 1.0 };
+        let (lenslet, lenslets) = (self.config.sensor.lenslet, self.config.sensor.lenslets);
         let (lu, lv) = (usize::from(lenslet.rows), usize::from(lenslet.cols));
         let (u, v) = (row.checked_rem(lu).unwrap_or(0), col.checked_rem(lv).unwrap_or(0));
-        table.get(u * lv + v).copied().unwrap_or(1.0)
+        let region = |pixel: usize, views: usize, count: u16, regions: u16| {
+            let l = pixel.checked_div(views).unwrap_or(0);
+            (l * usize::from(regions))
+                .checked_div(usize::from(count))
+                .unwrap_or(0)
+                .min(usize::from(regions).saturating_sub(1))
+        };
+        let (i, j) = (region(row, lu, lenslets.0, rr), region(col, lv, lenslets.1, rc));
+        table.get(((i * usize::from(rc) + j) * lu + u) * lv + v).copied().unwrap_or(1.0)
     }
 
     /// Sensor pixel `(row, col)`'s samples (`sample(j)` of snapshot `j`) as measurements

@@ -62,7 +62,7 @@ impl<const B: usize> Response<B> {
         if !condition.is_finite() || condition > MAX_CONDITION || !inverse.iter().flatten().all(|x| x.is_finite()) {
             return Err(SensingError::Response);
         }
-        let less = |m: &[[f32; B]; B]| core::array::from_fn(|i| core::array::from_fn(|j| m[i][j] - id(i, j)));
+        let less = |m: &[[f32; B]; B]| map(m, |i, j, x| x - id(i, j));
         let mixed = (0..B).any(|i| (0..B).any(|j| r[i][j] != id(i, j)));
         Ok(Self { leak: less(r), unleak: less(&inverse), mixed })
     }
@@ -74,12 +74,12 @@ impl<const B: usize> Response<B> {
 
     /// The matrix, row `f` for filter `f`.
     pub fn matrix(&self) -> [[f32; B]; B] {
-        core::array::from_fn(|i| core::array::from_fn(|j| self.leak[i][j] + id(i, j)))
+        map(&self.leak, |i, j, x| x + id(i, j))
     }
 
     /// Its inverse: `x = R^-1 z` for `z` one value per filter.
     pub fn inverse(&self) -> [[f32; B]; B] {
-        core::array::from_fn(|i| core::array::from_fn(|j| self.unleak[i][j] + id(i, j)))
+        map(&self.unleak, |i, j, x| x + id(i, j))
     }
 
     /// The response in white-balanced units, for band gains `g` (each positive, as
@@ -90,7 +90,7 @@ impl<const B: usize> Response<B> {
             return *self;
         }
         let gain = |b: usize| g.get(b).copied().unwrap_or(1.0);
-        let scale = |m: &[[f32; B]; B]| core::array::from_fn(|f| core::array::from_fn(|b| m[f][b] * gain(b) / gain(f)));
+        let scale = |m: &[[f32; B]; B]| map(m, |f, b, x| x * gain(b) / gain(f));
         Self { leak: scale(&self.leak), unleak: scale(&self.unleak), mixed: true }
     }
 
@@ -111,7 +111,23 @@ impl<const B: usize> Response<B> {
 
 /// `(I + d) x`.
 fn apply<const B: usize>(d: &[[f32; B]; B], x: &[f32; B]) -> [f32; B] {
-    core::array::from_fn(|i| x[i] + d[i].iter().zip(x).map(|(a, v)| a * v).sum::<f32>())
+    let mut out = *x;
+    for (o, row) in out.iter_mut().zip(d) {
+        *o += row.iter().zip(x).map(|(a, v)| a * v).sum::<f32>();
+    }
+    out
+}
+
+/// `f(i, j, m[i][j])` for every entry, by iterators: indexing inside `array::from_fn`
+/// left bounds checks (panic call sites) in the device's release build.
+fn map<const B: usize, T: Copy, U: Copy + Default>(m: &[[T; B]; B], f: impl Fn(usize, usize, T) -> U) -> [[U; B]; B] {
+    let mut out = [[U::default(); B]; B];
+    for (i, (o, row)) in out.iter_mut().zip(m).enumerate() {
+        for (j, (x, &v)) in o.iter_mut().zip(row).enumerate() {
+            *x = f(i, j, v);
+        }
+    }
+    out
 }
 
 /// Entry `(i, j)` of the identity.
@@ -129,8 +145,8 @@ fn norm1<const B: usize>(m: &[[f32; B]; B]) -> f32 {
 /// pivot below `1e-12` of the matrix's largest entry.
 #[allow(clippy::needless_range_loop)] // elimination reads best with its indices
 fn invert<const B: usize>(m: &[[f32; B]; B]) -> Option<[[f32; B]; B]> {
-    let mut a: [[f64; B]; B] = core::array::from_fn(|i| core::array::from_fn(|j| f64::from(m[i][j])));
-    let mut inv: [[f64; B]; B] = core::array::from_fn(|i| core::array::from_fn(|j| if i == j { 1.0 } else { 0.0 }));
+    let mut a: [[f64; B]; B] = map(m, |_, _, x| f64::from(x));
+    let mut inv: [[f64; B]; B] = map(m, |i, j, _| if i == j { 1.0 } else { 0.0 });
     let top = a.iter().flatten().fold(0.0f64, |t, x| if x.abs() > t { x.abs() } else { t });
     for c in 0..B {
         let mut p = c;
@@ -161,5 +177,5 @@ fn invert<const B: usize>(m: &[[f32; B]; B]) -> Option<[[f32; B]; B]> {
             }
         }
     }
-    Some(core::array::from_fn(|i| core::array::from_fn(|j| inv[i][j] as f32)))
+    Some(map(&inv, |_, _, x| x as f32))
 }

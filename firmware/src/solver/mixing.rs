@@ -40,16 +40,20 @@ impl<const B: usize> BandModel<B> {
     /// dictionary whose band mode's synthesis rows are `m5` (value `b` = `m5[b] . c`).
     pub fn new(response: &Response<B>, m5: &[[f32; B]; B]) -> Self {
         let r = response.matrix();
-        let rows = core::array::from_fn(|f| {
-            let mut row = [0.0f32; B];
-            for (&w, m) in r[f].iter().zip(m5) {
+        let mut rows = [[0.0f32; B]; B];
+        for (row, rf) in rows.iter_mut().zip(&r) {
+            for (&w, m) in rf.iter().zip(m5) {
                 for (o, &x) in row.iter_mut().zip(m) {
                     *o += w * x;
                 }
             }
-            row
-        });
-        let gram = core::array::from_fn(|i| core::array::from_fn(|j| dot(&r[i], &r[j])));
+        }
+        let mut gram = [[0.0f32; B]; B];
+        for (g, ri) in gram.iter_mut().zip(&r) {
+            for (o, rj) in g.iter_mut().zip(&r) {
+                *o = dot(ri, rj);
+            }
+        }
         Self { r, rows, gram }
     }
 
