@@ -212,7 +212,7 @@ pub fn project_signal<const B: usize, const N: usize>(
 /// [`crate::solver::projection::project_coefficients`] for mixed measurements: moves the
 /// coefficients `coeffs` (of `dict`) onto the measurements `m` under `model` (exactly, or
 /// onto the noise [`Ball`]); `scratch` is clobbered. Returns the residual norm before the
-/// move. The pixel modes' transforms are the fast path's ([`project_slices`]); the band
+/// move. The pixel modes' transforms are the fast path's (one frame shared with it); the band
 /// step reads each measurement through a row of `R D5` and solves the pixel's `k x k`
 /// Gram system.
 pub fn project_mixed<
