@@ -110,16 +110,22 @@ impl<const B: usize> BandModel<B> {
         }
     }
 
-    /// One pixel's residuals `y - R_F x` (signal space `x`) in filter order, with the
-    /// filters; returns how many.
-    fn residuals(&self, x: &[f32; B], ys: &[f32], bits: u64, filters: &mut [u8; B], res: &mut [f32; B]) -> usize {
+    /// One pixel's residuals `y - rows_F x` in filter order, with the filters; returns how
+    /// many. `rows` is `R` for a spectrum `x`, `R D5` for its band coefficients.
+    fn residuals(
+        rows: &[[f32; B]; B],
+        x: &[f32; B],
+        ys: &[f32],
+        bits: u64,
+        filters: &mut [u8; B],
+        res: &mut [f32; B],
+    ) -> usize {
         let mut bits = bits;
         let mut k = 0;
         while bits != 0 {
             let f = bits.trailing_zeros() as usize;
             bits &= bits - 1;
-            let (Some(row), Some(&y), Some(o), Some(r)) =
-                (self.r.get(f), ys.get(f), filters.get_mut(k), res.get_mut(k))
+            let (Some(row), Some(&y), Some(o), Some(r)) = (rows.get(f), ys.get(f), filters.get_mut(k), res.get_mut(k))
             else {
                 break;
             };
@@ -148,7 +154,7 @@ pub fn min_norm<const B: usize, const N: usize>(model: &BandModel<B>, m: &Measur
     for ((x, ys), measured) in pixels.zip(m.measured.as_chunks::<B>().0) {
         *x = [0.0; B];
         let (mut filters, mut res) = ([0u8; B], [0.0f32; B]);
-        let k = model.residuals(x, ys, band_bits(measured), &mut filters, &mut res);
+        let k = BandModel::residuals(&model.r, x, ys, band_bits(measured), &mut filters, &mut res);
         let (Some(filters), Some(res)) = (filters.get(..k), res.get_mut(..k)) else { continue };
         model.solve(filters, res);
         BandModel::add_rows(&model.r, x, filters, res, 1.0);
@@ -185,7 +191,7 @@ pub fn project_signal<const B: usize, const N: usize>(
     let pixels = || x.as_chunks::<B>().0.iter().zip(m.values.as_chunks::<B>().0).zip(m.measured.as_chunks::<B>().0);
     for ((x, ys), measured) in pixels() {
         let (mut filters, mut res) = ([0u8; B], [0.0f32; B]);
-        let k = model.residuals(x, ys, band_bits(measured), &mut filters, &mut res);
+        let k = BandModel::residuals(&model.r, x, ys, band_bits(measured), &mut filters, &mut res);
         for (&f, &r) in filters.iter().zip(&res).take(k) {
             r2 += r * r;
             if weighted {
@@ -201,7 +207,7 @@ pub fn project_signal<const B: usize, const N: usize>(
     let pixels = x.as_chunks_mut::<B>().0.iter_mut().zip(m.values.as_chunks::<B>().0);
     for ((x, ys), measured) in pixels.zip(m.measured.as_chunks::<B>().0) {
         let (mut filters, mut res) = ([0u8; B], [0.0f32; B]);
-        let k = model.residuals(x, ys, band_bits(measured), &mut filters, &mut res);
+        let k = BandModel::residuals(&model.r, x, ys, band_bits(measured), &mut filters, &mut res);
         let (Some(filters), Some(res)) = (filters.get(..k), res.get_mut(..k)) else { continue };
         model.solve(filters, res);
         BandModel::add_rows(&model.r, x, filters, res, scale);
@@ -236,23 +242,14 @@ pub fn project_mixed<
         for ((fibre, ys), measured) in fibres.iter_mut().zip(values.as_chunks::<B>().0).zip(measured.as_chunks::<B>().0)
         {
             let (mut filters, mut res) = ([0u8; B], [0.0f32; B]);
-            let mut bits = band_bits(measured);
-            let mut k = 0;
-            while bits != 0 {
-                let f = bits.trailing_zeros() as usize;
-                bits &= bits - 1;
-                let (Some(row), Some(&y), Some(o), Some(r)) =
-                    (model.rows.get(f), ys.get(f), filters.get_mut(k), res.get_mut(k))
-                else {
-                    break;
-                };
-                let e = y - dot(row, fibre);
+            let k = BandModel::residuals(&model.rows, fibre, ys, band_bits(measured), &mut filters, &mut res);
+            for (&f, &e) in filters.iter().zip(&res).take(k) {
                 r2 += e * e;
                 if weighted {
-                    w2 += e * e * ball.weight(y, m.gains.get(f).copied().unwrap_or(1.0));
+                    let f = usize::from(f);
+                    w2 +=
+                        e * e * ball.weight(ys.get(f).copied().unwrap_or(0.0), m.gains.get(f).copied().unwrap_or(1.0));
                 }
-                (*o, *r) = (f as u8, e);
-                k += 1;
             }
             *fibre = [0.0; B];
             let (Some(filters), Some(res)) = (filters.get(..k), res.get_mut(..k)) else { continue };
