@@ -18,7 +18,7 @@ cd "$(dirname "$0")/.."
 cargo build --release -q -p slf-host
 slf=${SLF_BIN:-./target/release/slf}
 size=${SLF_SIZE:-64}
-scenes=${SLF_SCENES:-mosaic mosaic-2 field print speculars narrow dim}
+scenes=${SLF_SCENES:-mosaic mosaic-2 field print speculars narrow dim canopy canopy-dim}
 methods="demosaic=--method,demosaic ppid=--method,ppid preview=--preset,preview default=--preset,default best=--preset,best"
 mkdir -p "$out"
 echo "# The hard-case set"

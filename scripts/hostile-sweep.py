@@ -159,6 +159,11 @@ def main():
     for v in ["5:1", "1e9:1e9", "-1:1:0", "nan:1", "-1:1:0.3", "x"]:
         s.run(["decode", "cap", "-o", "x.npy", "-q", f"--disparities={v}"], f"decode --disparities={v}",
               keep=capture_files)
+    for v in ["0.5:0", "2:-1", "nan:0.1", "inf:0", "1e39:0", "2", "2:0.1:3", "", "x", "on"]:
+        s.run(["decode", "cap", "-o", "x.npy", "-q", f"--plausible={v}"], f"decode --plausible={v}",
+              keep=capture_files)
+    for extra in [["--error-map", "cap/capture.json"], ["--error-map", "x.npy"], ["--method", "ppid", "--estimate"]]:
+        s.run(["decode", "cap", "-o", "x.npy", "-q", *extra], f"decode {' '.join(extra)}", keep=capture_files)
 
     # Outputs over inputs, and over each other.
     for out, extra in [("cap/capture.json", []), ("cap/snapshot_0.npy", []),

@@ -29,7 +29,7 @@
 //!   synthesis and analysis transforms.
 //! - **solver** ([`solver`]: [`error`](solver::error), [`workspace`], [`sl0`], [`ascent`],
 //!   [`ball`], [`projection`], [`mixing`], [`fractional`], [`pinv`], [`fill`](solver::fill), [`choice`],
-//!   [`interpolate`]): the caller-owned workspace every path works in, nD SL0 (its hand-set
+//!   [`interpolate`], [`plausible`], [`holdout`]): the caller-owned workspace every path works in, nD SL0 (its hand-set
 //!   schedule, or the trained ones a blob carries) with the
 //!   orthonormal fast path and its cold start from the band-gain fill, the
 //!   noise ball a projection moves onto, the projection for filters whose response mixes
@@ -37,7 +37,9 @@
 //!   measurements interpolate them), the paper's general pseudo-inverse path for kronecker
 //!   masks, the choice of an ensemble member per patch (exhaustive or screened, or seeded:
 //!   one solve from an estimate of the patch), and per-pixel spectral interpolation for
-//!   patches that measure too few distinct bands.
+//!   patches that measure too few distinct bands; the plausibility check of a decoded
+//!   patch against what its measurements allow; and a patch's estimate of its own error
+//!   from measurements held out of a solve.
 //! - **decode** ([`decode`]: [`tile`], [`overlap`]): a rectangle of the raw frame, patch by
 //!   patch, from a [`TileSource`] to a [`PatchSink`], into a caller-owned [`Workspace`]
 //!   (each patch from nothing, or from a [`PatchSeed`]'s estimate); and
@@ -119,7 +121,9 @@ pub mod solver;
 pub use decode::{overlap, tile};
 pub use operators::{blob, dct, dictionary, disparity, schedule, shape, transform};
 pub use sensor::{defects, gains, mask, raw, response, spi};
-pub use solver::{ascent, ball, choice, fractional, interpolate, mixing, pinv, projection, sl0, workspace};
+pub use solver::{
+    ascent, ball, choice, fractional, holdout, interpolate, mixing, pinv, plausible, projection, sl0, workspace,
+};
 
 pub mod prelude;
 
@@ -128,8 +132,8 @@ pub mod prelude;
 // `blob::write_blob`, `pinv::solve_pinv`, `sl0::solve_warm`, ...) stay in their modules.
 pub use decode::overlap::{Overlap, OverlapDecoder, OverlapError, OverlapReport, RowSink, Window};
 pub use decode::tile::{
-    ConfigError, DecoderConfig, FrameReport, NoSeed, PatchFlags, PatchOrigin, PatchReport, PatchSeed, PatchSink,
-    ResponseModel, SensorGeometry, Tile, TileDecoder, TileError, TileReport,
+    Checked, ConfigError, DecoderConfig, FrameReport, NoSeed, PatchFlags, PatchOrigin, PatchReport, PatchSeed,
+    PatchSink, ResponseModel, SensorGeometry, Tile, TileDecoder, TileError, TileReport,
 };
 pub use operators::blob::{DEFAULT_ENSEMBLE, DEFAULT_FULL_VIEW_ENSEMBLE, Ensemble};
 pub use operators::dictionary::{Dictionary, DictionaryError};
@@ -143,5 +147,7 @@ pub use sensor::response::Response;
 pub use sensor::source::TileSource;
 pub use sensor::spi::{SpiFrameBuffer, SpiSourceError};
 pub use solver::choice::{ChoiceRule, EnsembleModel, MemberChoice, ModelOutcome, PatchModel, ScheduledDictionary};
+pub use solver::holdout::HoldOut;
+pub use solver::plausible::Plausibility;
 pub use solver::sl0::{Ended, Outcome, Sl0Config, SolveError, solve};
 pub use solver::workspace::{FullViewWorkspace, Measurements, PaperWorkspace, Workspace};

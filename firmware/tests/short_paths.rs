@@ -216,11 +216,13 @@ fn the_band_gain_fill_is_its_definition_and_exact_for_one_spectrum() {
     let mean: Vec<f64> = (0..13).map(|b| sum[b] / f64::from(count[b])).collect();
     for p in 0..400 {
         let own: Vec<usize> = (0..13).filter(|&b| m.get(p * 13 + b).is_some()).collect();
+        // The ratio of the pixel's measurements to its bands' means, each plus FLOOR a band.
+        let floor = f64::from(slf_firmware::solver::fill::FLOOR) * own.len() as f64;
         let gain = if own.is_empty() {
             1.0
         } else {
-            own.iter().map(|&b| f64::from(m.get(p * 13 + b).unwrap())).sum::<f64>()
-                / own.iter().map(|&b| mean[b]).sum::<f64>()
+            (own.iter().map(|&b| f64::from(m.get(p * 13 + b).unwrap())).sum::<f64>() + floor)
+                / (own.iter().map(|&b| mean[b]).sum::<f64>() + floor)
         };
         for b in 0..13 {
             let want = m.get(p * 13 + b).map_or(gain * mean[b], f64::from);
@@ -228,6 +230,18 @@ fn the_band_gain_fill_is_its_definition_and_exact_for_one_spectrum() {
             assert!((got - want).abs() <= 1e-5 * want.abs().max(1.0), "pixel {p} band {b}: {got} vs {want}");
         }
     }
+
+    // A dark patch: noise about the black level (some of it below) in most bands, one
+    // band bright. A pixel whose bands' means are near nothing is filled near the patch's
+    // means, not at its noise over theirs (issue 49: 200 times, the start of a diverged
+    // solve).
+    let dark: Vec<f32> = (0..5200)
+        .map(|i| if i % 13 == 12 { 0.3 } else { 0.004 * (((i / 13 * 7919) % 1009) as f32 / 1009.0 - 0.5) })
+        .collect();
+    let ws = measured(&dark, 1);
+    fill_bands::<13, 5200>(ws.measurements(), &mut out);
+    let top = out.iter().fold(0.0f32, |a, &x| a.max(x.abs()));
+    assert!(top <= 0.6, "the dark patch is filled up to {top}");
 }
 
 /// A cold solve from the fill (`cold_start` 0.05 and below: the fill's DC is about 13 times

@@ -1008,3 +1008,67 @@ fn simulate_calibration_captures_then_calibrate() {
     let e = failure(slf().arg("simulate").arg(p("lf.npy")).arg("-o").arg(p("y")).args(["--exposures", "2"]));
     assert!(e.contains("--calibration-captures"), "{e}");
 }
+
+/// `--error-map` writes a lenslet map in the output's units without changing the decode,
+/// `slf eval --error-map` compares it with the truth, `--plausible` takes its range.
+#[test]
+fn the_error_map_and_the_plausibility_check_from_the_command_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    stdout(slf().args(["scene", "texture", "--size", "20", "-o"]).arg(p("truth.npy")));
+    stdout(slf().arg("simulate").arg(p("truth.npy")).arg("-o").arg(p("cap")).args(["-s", "3"]));
+    let plain = stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("plain.npy")).arg("-q"));
+    assert!(
+        plain.contains("plausibility: ") && plain.contains("+ 0.05)") && !plain.contains("error estimate"),
+        "{plain}"
+    );
+    let out = stdout(
+        slf().arg("decode").arg(p("cap")).arg("-o").arg(p("r.npy")).arg("-q").arg("--error-map").arg(p("e.npy")),
+    );
+    assert!(out.contains("error estimate: ") && out.contains("estimated PSNR "), "{out}");
+    assert_eq!(std::fs::read(p("r.npy")).unwrap(), std::fs::read(p("plain.npy")).unwrap(), "the same decode");
+    let map = slf_host::io::lightfield::read_npy_f32_2d(&p("e.npy"), (20, 20)).unwrap();
+    assert!(map.iter().all(|e| e.is_finite() && *e > 0.0 && *e < 0.5), "{map:?}");
+    let eval = stdout(slf().arg("eval").arg(p("truth.npy")).arg(p("r.npy")).arg("--error-map").arg(p("e.npy")));
+    assert!(
+        eval.contains("estimate PSNR ") && eval.contains("rank correlation") && eval.contains("(16 blocks)"),
+        "{eval}"
+    );
+    assert!(eval.contains("over 0 of 16 blocks of 5 x 5 lenslets"), "{eval}");
+    // A map of another frame is refused in one line.
+    stdout(slf().args(["scene", "smooth", "--size", "25", "-o"]).arg(p("big.npy")));
+    let err = failure(slf().arg("eval").arg(p("big.npy")).arg(p("big.npy")).arg("--error-map").arg(p("e.npy")));
+    assert!(err.contains("want a map of 25 x 25 lenslets") && err.lines().count() == 1, "{err}");
+    // The check's flag: off, or in range.
+    let off = stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("o.npy")).args(["-q", "--plausible", "off"]));
+    assert!(off.contains("plausibility: off"), "{off}");
+    for bad in ["0.5:0.05", "2:-1", "2", "x:y", "nan:0.1"] {
+        let err = failure(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("o.npy")).args(["--plausible", bad]));
+        assert!(err.contains("want FACTOR:MARGIN") && err.lines().count() == 1, "{bad}: {err}");
+    }
+    let err = failure(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("o.npy")).args([
+        "--method",
+        "demosaic",
+        "--estimate",
+    ]));
+    assert!(err.contains("need --method cs"), "{err}");
+}
+
+/// Issue 49's blow-up: dark shade and water beside a bright canopy, decoded by the DCT alone
+/// (the alone schedule from the band-gain fill) with the plausibility check off: no block of
+/// 5 x 5 lenslets above twice its truth + 0.05 (13 of 64 were, at the output's clamp, while a
+/// dark pixel's fill gain was its noise over its bands' noise).
+#[test]
+fn a_dark_canopy_decodes_without_a_blow_up_even_unchecked() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    stdout(slf().args(["scene", "canopy-dim", "--size", "40", "-o"]).arg(p("truth.npy")));
+    stdout(slf().arg("simulate").arg(p("truth.npy")).arg("-o").arg(p("cap")).args(["--seed", "1"]));
+    for flags in [&["--dictionary", "dct", "--plausible", "off"][..], &["--preset", "preview", "--plausible", "off"]] {
+        stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("r.npy")).arg("-q").args(flags));
+        let eval = stdout(slf().arg("eval").arg(p("truth.npy")).arg(p("r.npy")));
+        assert!(eval.contains("over 0 of 64 blocks"), "{flags:?}: {eval}");
+        let psnr: f64 = eval.split_whitespace().nth(1).unwrap().parse().unwrap();
+        assert!(psnr > 20.0, "{flags:?}: {eval}");
+    }
+}

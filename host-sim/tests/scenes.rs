@@ -288,6 +288,13 @@ fn hard_cases_are_what_they_are_named() {
     for (d, o) in dim.data.iter().zip(&outdoor.data) {
         assert!((d - 0.03 * o).abs() <= 1e-6 + 1e-5 * o, "{d} vs {o}");
     }
+    // The dim canopy is the canopy at 10 % of its exposure; half its cells nearly black.
+    let (dim, canopy) = (render("canopy-dim"), render("canopy"));
+    for (d, c) in dim.data.iter().zip(&canopy.data) {
+        assert!((d - 0.1 * c).abs() <= 1e-6 + 1e-5 * c, "{d} vs {c}");
+    }
+    let dark = canopy.data.chunks(13).filter(|s| s.iter().all(|&x| x < 0.04)).count();
+    assert!(dark * 4 > canopy.data.len() / 13 && canopy.max() > 0.5, "{dark} dark pixels");
     // Narrow light: most of the energy in the three lines' bands.
     let narrow = render("narrow");
     let line: f64 = narrow.data.chunks(13).map(|s| f64::from(s[2] + s[5] + s[9])).sum();

@@ -327,6 +327,8 @@ def decode(
     cold_start: Optional[float] = None,
     flat: Optional[float] = None,
     min_bands: Optional[int] = None,
+    plausible: Union[None, str, Tuple[float, float]] = None,
+    error_map: bool = False,
     threads: Optional[int] = None,
     progress: Any = None,
     report: bool = False,
@@ -368,6 +370,8 @@ def decode(
         edge_fallback = "true" if edge_fallback else "false"  # type: ignore[assignment]
     if seeded is not None:
         seeded = "true" if seeded else "false"  # type: ignore[assignment]
+    if isinstance(plausible, (list, tuple)):
+        plausible = ":".join(f"{p:g}" for p in plausible)
     if blob is not None:
         blob = os.fspath(blob)
     if calibration is not None:
@@ -406,12 +410,14 @@ def decode(
         cold_start=cold_start,
         flat=flat,
         min_bands=min_bands,
+        plausible=plausible,
+        estimate=True if error_map else None,
     )
     frames = _raw_frames(cap.frames)
     lf, rep = _slf.decode(frames, json.dumps(cap.description), args, threads, _progress_callback(progress))
     if "warning" in rep:
         warnings.warn(f"slf: {rep['warning']}", stacklevel=2)
-    return (lf, rep) if report else lf
+    return (lf, rep) if report or error_map else lf
 
 
 def evaluate(truth: np.ndarray, recon: np.ndarray) -> Dict[str, float]:

@@ -7,7 +7,7 @@ use numpy::{PyArrayDyn, PyReadonlyArrayDyn};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use slf_host::decode::cs::{PatchViews, disparity_per_lenslet};
+use slf_host::decode::cs::{PatchViews, disparity_per_lenslet, error_per_lenslet, estimated_psnr};
 use slf_host::decode::settings::{DecodeSettings, Outcome};
 
 use crate::arrays::{plane, to_array};
@@ -89,6 +89,8 @@ pub fn decode<'py>(
             report.set_item("solved", r.patches.solved())?;
             report.set_item("interpolated", r.patches.interpolated)?;
             report.set_item("flat", r.patches.flat)?;
+            report.set_item("implausible", r.patches.implausible)?;
+            report.set_item("clipped", r.patches.clipped)?;
             report.set_item("tiles", r.tiles)?;
             report.set_item("failed_tiles", r.failed_tiles)?;
             report.set_item("solves", r.solves)?;
@@ -105,6 +107,13 @@ pub fn decode<'py>(
                 let (rows, cols) = (d.lenslets[0], d.lenslets[1]);
                 let map = disparity_per_lenslet(&r.disparity_map, rows, cols);
                 report.set_item("disparity", plane(py, map, rows, cols)?)?;
+            }
+            if !r.error_map.is_empty() {
+                let (rows, cols) = (d.lenslets[0], d.lenslets[1]);
+                let map = error_per_lenslet(&r.error_map, rows, cols);
+                let peak = f64::from(decoded.light_field.max());
+                report.set_item("estimated_psnr", estimated_psnr(&map, peak))?;
+                report.set_item("error_map", plane(py, map, rows, cols)?)?;
             }
         }
     }

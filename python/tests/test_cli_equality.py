@@ -88,6 +88,8 @@ def test_a_calibrated_decode_equals_cli(tmp_path, slf_bin, depth):
         (["--schedule", "annealed"], {"schedule": "annealed"}),
         (["--patch-views", "4"], {"patch_views": 4}),
         (["--patch-views", "5", "--preset", "preview"], {"patch_views": 5, "preset": "preview"}),
+        (["--plausible", "off", "--dictionary", "dct"], {"plausible": "off", "dictionary": "dct"}),
+        (["--plausible", "2:0.1"], {"plausible": (2, 0.1)}),
         (["--method", "demosaic"], {"method": "demosaic"}),
         (["--method", "ppid"], {"method": "ppid"}),
     ],
@@ -108,6 +110,25 @@ def test_disparity_map_equals_cli(tmp_path, slf_bin, capture):
     run([slf_bin, "decode", tmp_path / "cap", "-o", tmp_path / "o.npy", "-q", "--preset", "preview", "--disparity-map", tmp_path / "d.npy"])
     _, report = slf.decode(capture, preset="preview", report=True)
     assert np.array_equal(report["disparity"], np.load(tmp_path / "d.npy"))
+
+
+def test_error_map_equals_cli(tmp_path, slf_bin, depth, capture):
+    capture.save(tmp_path / "cap")
+    out = run([slf_bin, "decode", tmp_path / "cap", "-o", tmp_path / "o.npy", "-q", "--error-map", tmp_path / "e.npy"]).stdout
+    lf, report = slf.decode(capture, error_map=True)
+    # The same decode with or without the estimate; the same map as the command's.
+    assert np.array_equal(lf, np.load(tmp_path / "o.npy")) and np.array_equal(lf, slf.decode(capture))
+    emap = report["error_map"]
+    assert emap.shape == (20, 20) and emap.dtype == np.float32
+    assert np.array_equal(emap, np.load(tmp_path / "e.npy"), equal_nan=True)
+    assert f"estimated PSNR {report['estimated_psnr']:.2f} dB" in out
+    # In the output's units: within a factor of 10 of the true RMS error of the frame.
+    true_rms = float(np.sqrt(np.mean((lf - depth) ** 2)))
+    est_rms = float(np.sqrt(np.nanmean(emap**2)))
+    assert true_rms / 10 < est_rms < 10 * true_rms, (est_rms, true_rms)
+    np.save(tmp_path / "t.npy", depth)
+    printed = run([slf_bin, "eval", tmp_path / "t.npy", tmp_path / "o.npy", "--error-map", tmp_path / "e.npy"]).stdout
+    assert re.search(r"estimate PSNR [0-9.]+ dB \(true [0-9.]+\); blocks of 5 x 5 lenslets: rank correlation", printed)
 
 
 def test_evaluate_equals_cli(tmp_path, slf_bin, depth, capture):

@@ -31,9 +31,11 @@ use crate::sensor::raw::{Invalid, RawFormat};
 use crate::sensor::response::Response;
 use crate::solver::choice::{ModelOutcome, PatchModel};
 use crate::solver::fractional::{MAX_GRID, from_sensor, to_sensor};
+use crate::solver::holdout::{HoldOut, estimate, hold_out};
 use crate::solver::interpolate::{bands_measured, interpolate_bands};
 use crate::solver::mixing::{mix_all, unmix_all};
-use crate::solver::sl0::{Ended, Outcome, Sl0Config, SolveError};
+use crate::solver::plausible::{Plausibility, clip, implausible};
+use crate::solver::sl0::{Ended, Outcome, Sl0Config, SolveError, solve};
 use crate::solver::workspace::Workspace;
 
 /// The source trait lives with the raw frames (the sensor layer); named here too, where the
@@ -217,6 +219,29 @@ pub struct PatchReport {
     /// is only there for the views no sheared patch reached, and a sink weighs it by
     /// [`crate::operators::disparity::FALLBACK_WEIGHT`].
     pub fallback: bool,
+    /// What the plausibility check ([`crate::solver::plausible`]) did with the patch.
+    pub checked: Checked,
+    /// The patch's error estimate from held-out measurements ([`crate::solver::holdout`]):
+    /// an RMS error per value in the output's units; `None` unless the decoder estimates
+    /// ([`TileDecoder::with_error_estimate`]), and for patches it cannot estimate
+    /// (interpolated, or too few measurements to hold any out).
+    pub error: Option<f32>,
+}
+
+/// What the plausibility check did with a decoded patch ([`TileDecoder::with_plausibility`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Checked {
+    /// Every value within its pixel's bound (or the check is off, the patch was not solved
+    /// (interpolated or flat), or saturated samples were left out of it: its light is
+    /// brighter than its measurements say).
+    #[default]
+    Plausible,
+    /// The model's decode broke the bounds; the patch was decoded again by the safe path
+    /// (the DCT's hand-set schedule from the minimum-norm start), which kept within them.
+    Redecoded,
+    /// The safe path broke them too: its values above a bound were set to the bound.
+    Clipped,
 }
 
 /// Counts for one tile or frame.
@@ -236,6 +261,11 @@ pub struct TileReport {
     /// Of the decoded, patches flat within [`Sl0Config::flat`], each band its mean
     /// ([`Ended::Flat`]), not solved.
     pub flat: u32,
+    /// Of the decoded, patches whose model's decode broke the plausibility check and was
+    /// replaced ([`Checked::Redecoded`] or [`Checked::Clipped`]).
+    pub implausible: u32,
+    /// Of those, patches whose safe decode broke it too and was clipped to the bounds.
+    pub clipped: u32,
 }
 
 impl TileReport {
@@ -246,6 +276,8 @@ impl TileReport {
         self.failed += o.failed;
         self.interpolated += o.interpolated;
         self.flat += o.flat;
+        self.implausible += o.implausible;
+        self.clipped += o.clipped;
     }
 
     /// Patches solved by SL0: the decoded less the interpolated and the flat.
@@ -280,6 +312,10 @@ pub enum ConfigError {
     /// A flat field per view whose length is not the lenslet's views, or with a gain
     /// outside `[1 / MAX_RATIO, MAX_RATIO]`.
     ViewGains,
+    /// A plausibility bound with a factor below 1, a negative margin, or a NaN.
+    Plausibility,
+    /// Held-out measurements of a fold below 2.
+    HoldOut,
 }
 
 impl fmt::Display for ConfigError {
@@ -295,6 +331,8 @@ impl fmt::Display for ConfigError {
             Self::Gains => f.write_str("band gains must each be in [1/64, 64]"),
             Self::Response => f.write_str("a response matrix that mixes bands needs a pixel or lenslet mask"),
             Self::ViewGains => f.write_str("view gains: one per view of a lenslet, each in [1/64, 64]"),
+            Self::Plausibility => f.write_str("plausibility bound: factor >= 1 and margin >= 0"),
+            Self::HoldOut => f.write_str("held-out measurements: one in 2 or more"),
         }
     }
 }
@@ -371,6 +409,8 @@ pub struct TileDecoder<
     response: &'a Response<B>,
     response_model: ResponseModel,
     view_gains: Option<(&'a [f32], (u16, u16))>,
+    plausibility: Plausibility,
+    holdout: Option<HoldOut>,
 }
 
 /// Where a decode puts the filters' response matrix ([`TileDecoder::with_response`]).
@@ -452,6 +492,8 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             response: &Response::IDENTITY,
             response_model: ResponseModel::Unmix,
             view_gains: None,
+            plausibility: Plausibility::DEFAULT,
+            holdout: None,
         })
     }
 
@@ -540,6 +582,121 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     /// The flat field per view and region the decode divides out, if any.
     pub fn view_gains(&self) -> Option<(&'a [f32], (u16, u16))> {
         self.view_gains
+    }
+
+    /// This decoder with `bound` as its plausibility check ([`crate::solver::plausible`];
+    /// [`Plausibility::DEFAULT`] unless set): a solved patch with a value above its
+    /// lenslet's bound is decoded again by the safe path (the DCT's hand-set schedule from
+    /// the minimum-norm start), and what the safe path leaves above a bound is clipped to
+    /// it; [`PatchReport::checked`] and [`TileReport::implausible`] say so.
+    /// [`Plausibility::OFF`] never checks.
+    ///
+    /// # Errors
+    /// [`ConfigError::Plausibility`] for a factor below 1, a negative margin, or a NaN.
+    pub fn with_plausibility(self, bound: Plausibility) -> Result<Self, ConfigError> {
+        if !bound.is_valid() {
+            return Err(ConfigError::Plausibility);
+        }
+        Ok(Self { plausibility: bound, ..self })
+    }
+
+    /// The plausibility check the decode applies.
+    pub fn plausibility(&self) -> Plausibility {
+        self.plausibility
+    }
+
+    /// This decoder with (`Some`) or without (`None`, the default) an error estimate for
+    /// each solved patch ([`PatchReport::error`], [`crate::solver::holdout`]): before the
+    /// decode, one solve by the model's [`PatchModel::estimating_solve`] with the held-out
+    /// measurements left out, their prediction error, and the patch read again. The decode
+    /// itself is the same bit for bit; the estimate costs that solve and a second read. No
+    /// estimate with the response in the projection ([`ResponseModel::Projection`]): its
+    /// measurements are not values of the patch.
+    ///
+    /// # Errors
+    /// [`ConfigError::HoldOut`] for a fold below 2.
+    pub fn with_error_estimate(self, hold: Option<HoldOut>) -> Result<Self, ConfigError> {
+        if hold.is_some_and(|h| h.fold < 2) {
+            return Err(ConfigError::HoldOut);
+        }
+        Ok(Self { holdout: hold, ..self })
+    }
+
+    /// The held-out measurements the error estimate takes, if the decoder estimates.
+    pub fn error_estimate(&self) -> Option<HoldOut> {
+        self.holdout
+    }
+
+    /// The error estimate of the patch at `origin`, whose measurements are in `ws`
+    /// ([`Self::with_error_estimate`]), and the solves it took; the measurements are read
+    /// again from `source` after the estimating solve, and `ws.patch()` is clobbered.
+    /// Out of line: its frame is not on the decode's stack when the estimate is off.
+    ///
+    /// # Errors
+    /// The source's error.
+    #[inline(never)]
+    fn estimate_error<M: PatchModel<PS, PT, PU, PV, B, N>, S: TileSource>(
+        &self,
+        model: &M,
+        hold: &HoldOut,
+        origin: PatchOrigin,
+        source: &mut S,
+        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ) -> Result<(Option<f32>, u16), S::Error> {
+        if !self.solved_response().is_identity() || hold_out::<PS, PT, PU, PV, B, N>(hold, &mut ws.measurements) == 0 {
+            return Ok((None, 0));
+        }
+        let solved = model.estimating_solve(&self.config.sl0, ws);
+        self.read_patch(origin, source, ws)?;
+        let Ok(solves) = solved else { return Ok((None, 0)) };
+        let half = ws.measurements().half_views();
+        if !half.is_none() {
+            to_sensor::<PS, PT, PU, PV, B, N>(half, &mut ws.signal);
+        }
+        let cfg = &self.config.sl0;
+        Ok((estimate::<PS, PT, PU, PV, B, N>(hold, ws.measurements(), ws.patch(), cfg.noise, cfg.shot), solves))
+    }
+
+    /// The plausibility check on the solved patch in `ws` (the solve's units and frame):
+    /// within the bounds it is left as it is; otherwise decoded again by the safe path, and
+    /// clipped to the bounds if that breaks them too (or fails). `done` counts the solve.
+    /// Out of line: the safe path's DCT (2 KB) stays off the decode's stack.
+    #[inline(never)]
+    fn check_plausible(
+        &self,
+        cfg: &Sl0Config,
+        flags: PatchFlags,
+        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+        done: &mut ModelOutcome,
+    ) -> Checked {
+        // A patch with saturated samples left out is brighter than it measured: no bound.
+        if self.plausibility.is_off()
+            || flags.contains(PatchFlags::OVER_RANGE)
+            || matches!(done.outcome.ended, Ended::Interpolated | Ended::Flat)
+        {
+            return Checked::Plausible;
+        }
+        let bounds = self.plausibility.bounds::<PS, PT, PU, PV, B, N>(ws.measurements());
+        if implausible::<PS, PT, PU, PV, B, N>(&bounds, ws.patch()) == 0 {
+            return Checked::Plausible;
+        }
+        let safe = Sl0Config { cold_start: 1.0, ..*cfg };
+        done.solves = done.solves.saturating_add(1);
+        match solve(&crate::operators::dictionary::Dictionary::dct(), &safe, ws) {
+            Ok(outcome) => {
+                done.outcome = outcome;
+                if implausible::<PS, PT, PU, PV, B, N>(&bounds, ws.patch()) == 0 {
+                    return Checked::Redecoded;
+                }
+            }
+            Err(_) => {
+                // Nothing finite to keep: the band-gain fill holds the measurements.
+                let Workspace { signal, measurements, .. } = ws;
+                crate::solver::fill::fill_bands::<B, N>(measurements, signal);
+            }
+        }
+        clip::<PS, PT, PU, PV, B, N>(&bounds, &mut ws.signal);
+        Checked::Clipped
     }
 
     /// This decoder with each spatial block sheared to the disparity of `range` its
@@ -969,6 +1126,12 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let (flags, excluded) = self.read_patch(origin, source, ws).map_err(TileError::Source)?;
         let cfg = &self.config.sl0;
         let bands = bands_measured::<B, N>(ws.measurements());
+        let (error, estimating) = match &self.holdout {
+            Some(hold) if bands >= u32::from(cfg.min_bands) => {
+                self.estimate_error(model, hold, origin, source, ws).map_err(TileError::Source)?
+            }
+            _ => (None, 0),
+        };
         // No band at all is no measurement: the model reports it.
         let decoded = if bands > 0 && bands < u32::from(cfg.min_bands) {
             let Workspace { signal, measurements, .. } = ws;
@@ -992,7 +1155,8 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             model.decode(cfg, ws)
         };
         match decoded {
-            Ok(done) => {
+            Ok(mut done) => {
+                let checked = self.check_plausible(cfg, flags, ws, &mut done);
                 let half = ws.measurements().half_views();
                 if !half.is_none() {
                     to_sensor::<PS, PT, PU, PV, B, N>(half, &mut ws.signal);
@@ -1006,12 +1170,19 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                 let r = PatchReport {
                     outcome: done.outcome,
                     member: done.member,
-                    solves: done.solves,
+                    solves: done.solves.saturating_add(estimating),
                     flags,
                     measured: ws.measurements().count() as u16,
                     excluded,
                     fallback,
+                    checked,
+                    error,
                 };
+                if checked != Checked::Plausible {
+                    report.implausible += 1;
+                    report.clipped += u32::from(checked == Checked::Clipped);
+                    log!(warn, "patch implausible: decoded again");
+                }
                 if !flags.is_empty() {
                     report.flagged += 1;
                     log!(warn, "patch flagged: {} samples left out", excluded);

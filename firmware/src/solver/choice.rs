@@ -223,6 +223,17 @@ pub trait PatchModel<const PS: usize, const PT: usize, const PU: usize, const PV
     ) -> Result<ModelOutcome, SolveError> {
         self.decode(cfg, ws)
     }
+
+    /// The solve whose predictions of held-out measurements estimate the patch's error
+    /// ([`crate::solver::holdout`]): one solve from the measurements in `ws` alone, the
+    /// cheapest the model has (an ensemble's: its DCT with the alone schedule). The default
+    /// is [`decode`](Self::decode).
+    ///
+    /// # Errors
+    /// As [`solve`].
+    fn estimating_solve(&self, cfg: &Sl0Config, ws: &mut Workspace<PS, PT, PU, PV, B, N>) -> Result<u16, SolveError> {
+        self.decode(cfg, ws).map(|d| d.solves)
+    }
 }
 
 impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
@@ -543,6 +554,14 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
             MemberChoice::ScreenedResolve(rule) => (rule, true),
         };
         self.screened(&rule, cfg, ws, resolve)
+    }
+
+    fn estimating_solve(&self, cfg: &Sl0Config, ws: &mut Workspace<PS, PT, PU, PV, B, N>) -> Result<u16, SolveError> {
+        match &self.schedules {
+            Some(s) => solve_scheduled(&self.screen, cfg, &s.alone, ws),
+            None => solve(&self.screen, cfg, ws),
+        }
+        .map(|_| 1)
     }
 
     fn decode_seeded(

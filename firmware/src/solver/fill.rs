@@ -19,6 +19,11 @@
 
 use crate::solver::workspace::Measurements;
 
+/// What a pixel's gain adds to its own measurements and to its bands' means, per measured
+/// band (normalised units, white = 1: 20 times a 12-bit sensor's 2 DN read noise), so a
+/// dark pixel's gain is about 1 and a bright one's its ratio.
+pub const FLOOR: f32 = 0.01;
+
 /// Writes the band-gain fill of `m` into `signal` (`B` bands per pixel, the last axis):
 /// measured values as they are, every other value its pixel's gain times its band's mean.
 /// A band no pixel measures takes the mean of all measurements; a pixel with no
@@ -44,7 +49,14 @@ pub fn fill_bands<const B: usize, const N: usize>(m: &Measurements<N>, signal: &
                 expected += mean[b];
             }
         }
-        let gain = if expected > f32::MIN_POSITIVE && (own / expected).is_finite() { own / expected } else { 1.0 };
+        // The ratio pulled towards 1 by `FLOOR` a measured band: where the pixel's bands'
+        // means are near nothing (a dark patch: noise about the black level, some of it
+        // below), `own / expected` alone is noise over noise, and one such pixel filled at
+        // 200 times the patch's brighter bands started the dark canopy's solves at the
+        // output's clamp (issue 49).
+        let floor = FLOOR * measured.iter().filter(|&&k| k).count() as f32;
+        let ratio = (own + floor) / (expected + floor);
+        let gain = if expected + floor > f32::MIN_POSITIVE && ratio.is_finite() && ratio > 0.0 { ratio } else { 1.0 };
         for b in 0..B {
             x[b] = if measured[b] { values[b] } else { gain * mean[b] };
         }

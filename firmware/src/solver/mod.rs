@@ -14,6 +14,9 @@
 //! - [`pinv`]: the paper's general pseudo-inverse path for kronecker masks;
 //! - [`fill`]: the band-gain fill, a start for the cold solve that holds the patch's
 //!   brightness and colour;
+//! - [`holdout`]: held-out measurements, a patch's estimate of its own decode's error;
+//! - [`plausible`]: the plausibility check, a decoded patch against the brightest
+//!   measurements of its lenslets' neighbourhoods;
 //! - [`sl0`]: Algorithm 1, its configuration and how a solve ended;
 //! - [`choice`]: the ensemble's member choice per patch (exhaustive or screened);
 //! - [`interpolate`]: per-pixel spectral interpolation, for a patch that measures too few
@@ -27,9 +30,11 @@ pub mod choice;
 pub mod error;
 pub mod fill;
 pub mod fractional;
+pub mod holdout;
 pub mod interpolate;
 pub mod mixing;
 pub mod pinv;
+pub mod plausible;
 pub mod projection;
 pub mod sl0;
 pub mod workspace;

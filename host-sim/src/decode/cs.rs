@@ -20,8 +20,8 @@ use rayon::prelude::*;
 use slf_firmware::disparity::Disparity;
 use slf_firmware::tile::PatchSeed;
 use slf_firmware::{
-    Dictionary, DisparityRange, Ended, FrameSource, PatchModel, PatchOrigin, PatchReport, PatchShape, PatchSink,
-    Response, ResponseModel, Sl0Config, SolveError, Tile, TileDecoder, TileReport, Workspace,
+    Dictionary, DisparityRange, Ended, FrameSource, HoldOut, PatchModel, PatchOrigin, PatchReport, PatchShape,
+    PatchSink, Plausibility, Response, ResponseModel, Sl0Config, SolveError, Tile, TileDecoder, TileReport, Workspace,
 };
 
 use crate::io::capture::Capture;
@@ -357,6 +357,13 @@ pub struct DecodeOptions {
     /// it ([`slf_firmware::response`], [`ResponseModel`]): a calibration's, whose leaked
     /// light the decode then separates. `None`: one-hot filters.
     pub response: Option<(Response<13>, ResponseModel)>,
+    /// The plausibility check of every solved patch ([`TileDecoder::with_plausibility`]):
+    /// [`Plausibility::DEFAULT`] unless set.
+    pub plausibility: Plausibility,
+    /// Whether each solved patch's error is estimated from held-out measurements
+    /// ([`TileDecoder::with_error_estimate`], [`DecodeReport::error_map`]). Off by default:
+    /// a solve more a patch.
+    pub error_estimate: bool,
 }
 
 /// Which schedule the solves take.
@@ -388,6 +395,8 @@ impl Default for DecodeOptions {
             schedule: SolveSchedule::Trained,
             patch_views: None,
             response: None,
+            plausibility: Plausibility::DEFAULT,
+            error_estimate: false,
         }
     }
 }
@@ -478,6 +487,11 @@ pub fn tile_decoder<'a, const PU: usize, const PV: usize, const N: usize>(
         Balance::Gains(g) => g,
     };
     let decoder = decoder.with_gains(&gains).map_err(|e| anyhow!("gains {gains:?}: {e}"))?;
+    let decoder = decoder
+        .with_error_estimate(opts.error_estimate.then_some(HoldOut::DEFAULT))
+        .map_err(|e| anyhow!("{e}"))?
+        .with_plausibility(opts.plausibility)
+        .map_err(|e| anyhow!("--plausible {}:{}: {e}", opts.plausibility.factor, opts.plausibility.margin))?;
     Ok(decoder.with_disparities(opts.disparities_for(capture)).with_edge_fallback(opts.edge_fallback))
 }
 
@@ -573,6 +587,9 @@ pub struct DecodeReport {
     pub gains: [f32; 13],
     /// The patch it decoded with (`None` only in a report made by hand).
     pub patch_views: Option<PatchViews>,
+    /// Each estimated patch's error estimate (RMS per value, the output's units), by
+    /// origin ([`DecodeOptions::error_estimate`]; empty without it).
+    pub error_map: Vec<(PatchOrigin, f32)>,
 }
 
 /// Weighted sums of the patch estimates over one tile's lenslets and the halo a sheared
@@ -588,6 +605,7 @@ struct TileSums<const PU: usize, const PV: usize> {
     solves: u64,
     members: Vec<(PatchOrigin, PatchDecoder)>,
     disparities: Vec<(PatchOrigin, Disparity)>,
+    errors: Vec<(PatchOrigin, f32)>,
 }
 
 impl<const PU: usize, const PV: usize> TileSums<PU, PV> {
@@ -606,6 +624,7 @@ impl<const PU: usize, const PV: usize> TileSums<PU, PV> {
             solves: 0,
             members: Vec::new(),
             disparities: Vec::new(),
+            errors: Vec::new(),
         }
     }
 
@@ -629,6 +648,9 @@ impl<const PU: usize, const PV: usize, const N: usize> PatchSink<N> for TileSums
         self.members.push((o, PatchDecoder::of(report)));
         if (o.view_row, o.view_col) == (0, 0) && self.halo > 0 && !report.fallback {
             self.disparities.push((o, o.disparity));
+        }
+        if let (Some(e), false) = (report.error, report.fallback) {
+            self.errors.push((o, e));
         }
         let scale = if report.fallback { slf_firmware::disparity::FALLBACK_WEIGHT } else { 1.0 };
         // The halo's corner, in sensor lenslets.
@@ -835,6 +857,7 @@ fn aggregate<const PU: usize, const PV: usize>(
         report.solves += sums.solves;
         report.member_map.extend_from_slice(&sums.members);
         report.disparity_map.extend_from_slice(&sums.disparities);
+        report.error_map.extend_from_slice(&sums.errors);
         let tile = sums.tile;
         let (rows, cols) = sums.extent();
         for s in 0..rows {
@@ -914,6 +937,35 @@ pub fn disparity_per_lenslet(blocks: &[(PatchOrigin, Disparity)], rows: usize, c
         }
     }
     sum.iter().zip(&count).map(|(&s, &n)| if n > 0 { s / n as f32 } else { f32::NAN }).collect()
+}
+
+/// The error estimate per lenslet (row-major, `rows x cols`) from a decode's
+/// [`DecodeReport::error_map`]: the RMS of the estimates of the patches whose 5 x 5
+/// lenslets cover it (every angular window, every overlapping patch), NaN where none does.
+pub fn error_per_lenslet(patches: &[(PatchOrigin, f32)], rows: usize, cols: usize) -> Vec<f32> {
+    let mut sum = vec![0.0f64; rows * cols];
+    let mut count = vec![0u32; rows * cols];
+    for (o, e) in patches {
+        for r in o.lenslet_row as usize..(o.lenslet_row as usize + 5).min(rows) {
+            for c in o.lenslet_col as usize..(o.lenslet_col as usize + 5).min(cols) {
+                sum[r * cols + c] += f64::from(*e) * f64::from(*e);
+                count[r * cols + c] += 1;
+            }
+        }
+    }
+    sum.iter().zip(&count).map(|(&s, &n)| if n > 0 { (s / f64::from(n)).sqrt() as f32 } else { f32::NAN }).collect()
+}
+
+/// The PSNR an error map estimates for a light field whose values span `data_range`: the
+/// mean squared error is the mean of the lenslets' squared estimates (NaN ones left out);
+/// `None` if none is finite.
+pub fn estimated_psnr(map: &[f32], data_range: f64) -> Option<f64> {
+    let (mut sum, mut n) = (0.0f64, 0usize);
+    for e in map.iter().filter(|e| e.is_finite()) {
+        sum += f64::from(*e) * f64::from(*e);
+        n += 1;
+    }
+    (n > 0).then(|| 10.0 * (data_range * data_range / (sum / n as f64).max(1e-20)).log10())
 }
 
 /// Steps between neighbouring lenslets of a decoded light field (mean absolute difference

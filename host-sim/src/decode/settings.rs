@@ -14,7 +14,9 @@ use std::path::PathBuf;
 use anyhow::{Result, anyhow, bail, ensure};
 use clap::{Args, ValueEnum};
 use slf_firmware::disparity::MAX_DISPARITY;
-use slf_firmware::{ChoiceRule, DisparityRange, MemberChoice, Response, ResponseModel, Sl0Config, SolveError, gains};
+use slf_firmware::{
+    ChoiceRule, DisparityRange, MemberChoice, Plausibility, Response, ResponseModel, Sl0Config, SolveError, gains,
+};
 
 use crate::decode::baselines::{Baseline, BaselineReport};
 use crate::decode::calibrate::{corrected, unmix, unmixing};
@@ -384,6 +386,38 @@ pub struct DecodeSettings {
     /// --sigma-f, --steps, --mu, --tolerance, --warm-*, --seed-sigma-f and --cold-start set).
     #[arg(long, value_enum, default_value_t = SolveSchedule::Trained)]
     pub schedule: SolveSchedule,
+    /// The plausibility check of every solved patch: FACTOR:MARGIN (a value above FACTOR
+    /// times the brightest white-balanced measurement of its pixel's 3 x 3 x 3 x 3
+    /// neighbourhood plus MARGIN is implausible; FACTOR >= 1, MARGIN in [0, 1]), or off. An
+    /// implausible patch is decoded again by the DCT's hand-set schedule from the
+    /// minimum-norm start, and clipped to the bounds if that breaks them too; the summary
+    /// counts both [default: 3:0.05].
+    #[arg(long, value_parser = plausibility, value_name = "FACTOR:MARGIN|off")]
+    pub plausible: Option<Plausibility>,
+    /// Estimate each solved patch's error from measurements held out of one more solve
+    /// (one in eight; the DCT from the measurements alone), in the output's units: the
+    /// summary's estimated PSNR, and `slf decode --error-map` writes it per lenslet. The
+    /// decode itself is the same bit for bit; the estimate costs a solve a patch.
+    #[arg(long)]
+    pub estimate: bool,
+}
+
+/// Parses `--plausible`: `FACTOR:MARGIN` or `off`.
+///
+/// # Errors
+/// Anything else, or a value out of range, in one line.
+pub fn plausibility(s: &str) -> Result<Plausibility, String> {
+    if s.trim() == "off" {
+        return Ok(Plausibility::OFF);
+    }
+    let bad =
+        || format!("{s:?}: want FACTOR:MARGIN with FACTOR in [1, 1000] and MARGIN in [0, 1] (e.g. 3:0.05), or off");
+    let (f, m) = s.split_once(':').ok_or_else(bad)?;
+    let (factor, margin) = (f.trim().parse::<f32>().map_err(|_| bad())?, m.trim().parse::<f32>().map_err(|_| bad())?);
+    if !((1.0..=1000.0).contains(&factor) && (0.0..=1.0).contains(&margin)) {
+        return Err(bad());
+    }
+    Ok(Plausibility { factor, margin })
 }
 
 /// A decode's light field and what it reports.
@@ -456,6 +490,8 @@ impl DecodeSettings {
             disparities: self.disparities.or(base.disparities),
             edge_fallback: self.edge_fallback.unwrap_or(base.edge_fallback),
             seeded: self.seeded.unwrap_or(base.seeded),
+            plausibility: self.plausible.unwrap_or(base.plausibility),
+            error_estimate: self.estimate || base.error_estimate,
             patch_views: self.basis.patch_views.or(base.patch_views),
             schedule: self.schedule,
             ..base
@@ -545,6 +581,7 @@ impl DecodeSettings {
             (self.edge_fallback == d.edge_fallback, "--edge-fallback"),
             (self.seeded == d.seeded, "--seeded"),
             (self.schedule == d.schedule, "--schedule"),
+            (self.plausible == d.plausible, "--plausible"),
         ]
         .into_iter()
         .filter_map(|(same, name)| (!same).then_some(name))

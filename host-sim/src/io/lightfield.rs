@@ -262,6 +262,27 @@ fn write_npy_2d<T: npyz::AutoSerialize + Copy>(
     })
 }
 
+/// Reads an f32 2D `.npy` array of `rows x cols` (an error map `slf decode` wrote); a
+/// header of another rank, type or size is refused before the body is read.
+///
+/// # Errors
+/// [`NpyError`]: what is wrong and where.
+pub fn read_npy_f32_2d(path: &Path, (rows, cols): (usize, usize)) -> Result<Vec<f32>, NpyError> {
+    let a = npy::read_checked(path, |s, element| {
+        if s != [rows, cols] {
+            return Err(format!("want a map of {rows} x {cols} lenslets, this array is {s:?}"));
+        }
+        if element == npy::Element::U16 {
+            return Err("a map holds float32 ('<f4') values, this array uint16".into());
+        }
+        Ok(())
+    })?;
+    match a.values {
+        Values::F32(v) => Ok(v),
+        Values::U16(_) => Err(NpyError::new(path, NpyErrorKind::Shape("a map holds float32 ('<f4') values".into()))),
+    }
+}
+
 /// Reads a uint16 2D `.npy` array (a raw frame): `(data, rows, cols)`; with `expect`, a
 /// header of another size is refused before the body is read.
 ///

@@ -16,7 +16,14 @@
 //! - `narrow`: a colour-checker mosaic in 4-pixel cells under three narrow LED lines (450,
 //!   525 and 625 nm), spiky light that leaves most bands dark;
 //! - `dim`: the realistic outdoor scene at 3 % of its exposure: once simulated, a dark and
-//!   noisy capture.
+//!   noisy capture;
+//! - `canopy`: an airborne view of vegetation (a steep red edge at 675-700 nm), bare soil
+//!   and a few bright roofs beside water and deep shadow at 0.3-3 % reflectance, in cells of
+//!   4 to 12 pixels: nearly black blocks beside bright ones, where a solve from the band-gain
+//!   fill after grey white balance once diverged to the output's clamp (issue 49);
+//! - `canopy-dim`: the canopy at 10 % of its exposure, where it did: the shade and water at
+//!   the black level's noise, in which the fill's gain of a pixel was noise over noise
+//!   (`--dictionary dct` decoded 13 of 256 blocks at the clamp, 6.7 dB, before the fix).
 //!
 //! `scripts/hard-cases.sh` renders them with the real content the project evaluates and
 //! tabulates every preset and baseline on them.
@@ -26,7 +33,8 @@ use crate::sim::scene::{Highlight, Layer, Mosaic, Scene, Shape, Texture};
 use crate::sim::spectra::{MEASURED, Spectrum, illuminant};
 
 /// The hard-case scenes' names.
-pub const NAMES: [&str; 7] = ["mosaic", "mosaic-2", "field", "print", "speculars", "narrow", "dim"];
+pub const NAMES: [&str; 9] =
+    ["mosaic", "mosaic-2", "field", "print", "speculars", "narrow", "dim", "canopy", "canopy-dim"];
 
 /// A hard-case scene ([`NAMES`]); `None` for another name.
 pub fn named(name: &str) -> Option<Scene> {
@@ -88,6 +96,28 @@ pub fn named(name: &str) -> Option<Scene> {
                 lines(),
             )
         }
+        "canopy" => {
+            // Dark cells are half the palette: water (falling into the red), shadow on grass
+            // (the vegetation's shape at 3 %) and shadow on soil.
+            let (veg, dry, ground, roof) = (vegetation(1.0), vegetation(0.7), soil(), [0.9f32; 13]);
+            let (pond, shade, shade_soil) = (water(), vegetation(0.02), ground.map(|r| 0.02 * r));
+            let palette = vec![veg, dry, ground, roof, veg, pond, shade, shade_soil, pond, shade];
+            let coarse = plane(
+                0.4,
+                Some(Mosaic { cell: 16.0, seed: 48, palette: palette.clone() }),
+                Texture::Flat,
+                [grey, grey],
+            );
+            let fine = Layer {
+                mosaic: Some(Mosaic { cell: 4.0, seed: 49, palette }),
+                ..Layer::flat(0.4, Shape::Rect { y0: 0.3, x0: 0.3, y1: 0.7, x1: 0.7 }, Texture::Flat, [grey, grey])
+            };
+            scene(vec![fine, coarse], d65)
+        }
+        "canopy-dim" => {
+            let canopy = named("canopy")?;
+            Scene { name: name.into(), gain: 0.1 * canopy.gain, ..canopy }
+        }
         "dim" => {
             let outdoor = realistic::named("outdoor")?;
             Scene { name: name.into(), gain: 0.03 * outdoor.gain, ..outdoor }
@@ -116,6 +146,22 @@ fn lines() -> Spectrum {
         5 => 0.8,
         _ => 0.02,
     })
+}
+
+/// Green vegetation at `scale`: chlorophyll's green peak, its red absorption, and the red
+/// edge's steep rise from 675 to 700 nm (shapes of USGS splib07 grass spectra).
+fn vegetation(scale: f32) -> Spectrum {
+    [0.04, 0.045, 0.05, 0.06, 0.09, 0.13, 0.12, 0.08, 0.06, 0.05, 0.045, 0.12, 0.65].map(|r| scale * r)
+}
+
+/// Bare dry soil: dull, rising steadily into the red.
+fn soil() -> Spectrum {
+    core::array::from_fn(|b| 0.12 + 0.018 * b as f32)
+}
+
+/// Clear deep water: a few per cent in the blue, falling towards nothing in the red.
+fn water() -> Spectrum {
+    [0.03, 0.03, 0.025, 0.02, 0.02, 0.015, 0.01, 0.008, 0.006, 0.005, 0.004, 0.004, 0.003]
 }
 
 /// A reflectance that peaks in the green (500..=575 nm) over a darker blue and red.

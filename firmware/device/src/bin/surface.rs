@@ -209,6 +209,16 @@ mod device {
                             &mut sink,
                             full_ws,
                         );
+                        // The error estimate from held-out measurements, and a tight
+                        // plausibility bound (every patch decoded again and clipped).
+                        let tight = slf_firmware::Plausibility { factor: black_box(1.0), margin: 0.0 };
+                        if let Ok(estimating) = decoder
+                            .with_error_estimate(Some(slf_firmware::HoldOut::DEFAULT))
+                            .and_then(|d| d.with_plausibility(tight))
+                        {
+                            let _ = estimating.decode_tile(&model, tile, source, &mut sink, full_ws);
+                            let _ = estimating.decode_tile(&full_dct, tile, source, &mut sink, full_ws);
+                        }
                     }
                 }
                 let overlap = Overlap { stride: (black_box(3), 3), window: Window::Tapered };

@@ -5,7 +5,9 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use slf_host::decode::cs::{Balance, NoiseSource, PatchDecoder, disparity_per_lenslet};
+use slf_host::decode::cs::{
+    Balance, NoiseSource, PatchDecoder, disparity_per_lenslet, error_per_lenslet, estimated_psnr,
+};
 use slf_host::decode::settings::{DecodeSettings, Outcome};
 use slf_host::firmware::disparity::Disparity;
 use slf_host::io::calibration::Calibration;
@@ -33,6 +35,12 @@ pub struct Args {
     /// mean over the blocks that cover it); not with --disparities 0:0.
     #[arg(long)]
     pub disparity_map: Option<PathBuf>,
+    /// Also write each lenslet's error estimate (.npy, lenslet rows x cols, f32, the
+    /// output's units: the RMS error per value the patches covering it estimate from
+    /// measurements held out of one more solve; NaN where no patch was estimated). Implies
+    /// --estimate.
+    #[arg(long)]
+    pub error_map: Option<PathBuf>,
     /// Stored dtype.
     #[arg(long, value_enum, default_value_t = Dtype::F32)]
     pub dtype: Dtype,
@@ -42,7 +50,8 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let Args { capture, output, settings, member_map, disparity_map, dtype, quiet } = args;
+    let Args { capture, output, mut settings, member_map, disparity_map, error_map, dtype, quiet } = args;
+    settings.estimate |= error_map.is_some();
     let cap = Capture::load(&capture)?;
     // Where the results go is checked before the decode, not found unwritable after it, and
     // no result may be written over a file the decode reads or another result.
@@ -53,9 +62,14 @@ pub fn run(args: Args) -> Result<()> {
         .output(&output, "-o")
         .outputs(member_map.as_deref(), "--member-map")
         .outputs(disparity_map.as_deref(), "--disparity-map")
+        .outputs(error_map.as_deref(), "--error-map")
         .check()?;
     let cs = settings.method.baseline().is_none();
     anyhow::ensure!(cs || member_map.is_none(), "--member-map needs --method cs (baselines use no ensemble)");
+    anyhow::ensure!(
+        cs || !settings.estimate,
+        "--error-map and --estimate need --method cs (baselines solve nothing to hold out of)"
+    );
     anyhow::ensure!(
         cs || disparity_map.is_none(),
         "--disparity-map needs --method cs (baselines choose no disparity; nothing would be written)"
@@ -109,6 +123,11 @@ pub fn run(args: Args) -> Result<()> {
         let map = disparity_per_lenslet(&r.disparity_map, rows, cols);
         write_npy_f32_2d(&path, &map, rows, cols).with_context(|| format!("cannot write {}", path.display()))?;
     }
+    let (rows, cols) = (cap.description.lenslets[0], cap.description.lenslets[1]);
+    let errors = (!r.error_map.is_empty()).then(|| error_per_lenslet(&r.error_map, rows, cols));
+    if let (Some(path), Some(map)) = (&error_map, &errors) {
+        write_npy_f32_2d(path, map, rows, cols).with_context(|| format!("cannot write {}", path.display()))?;
+    }
     write_npy(&output, lf, dtype)?;
     let used = opts.solver_config(&cap);
     let ball = match (opts.noise, used.noise > 0.0 || used.shot > 0.0) {
@@ -139,6 +158,26 @@ pub fn run(args: Args) -> Result<()> {
             "disparity: blocks per disparity {}; {} values of views no sheared patch reached, from their lenslet's other views",
             counts.join(", "),
             r.filled
+        );
+    }
+    let p = opts.plausibility;
+    if p.is_off() {
+        println!("plausibility: off");
+    } else {
+        println!(
+            "plausibility: {} implausible patches decoded again, {} of them clipped (a value above {} x its \
+             neighbourhood's brightest measurement + {})",
+            r.patches.implausible, r.patches.clipped, p.factor, p.margin
+        );
+    }
+    if let Some(map) = &errors {
+        let peak = f64::from(lf.max());
+        let psnr = estimated_psnr(map, peak).map_or("none".into(), |p| format!("{p:.2} dB"));
+        println!(
+            "error estimate: {} of {} patches from held-out measurements; estimated PSNR {psnr} (data range {peak:.4} = the \
+             decode's maximum)",
+            r.error_map.len(),
+            r.patches.decoded
         );
     }
     let per = |n: u64| n as f64 / f64::from(r.patches.decoded.max(1));
