@@ -31,9 +31,7 @@ echo "| --- | --- | --- | --- | --- | --- | --- | --- |"
 for token in $scenes; do
   scene_light_field "$token"
   for s in ${SLF_SETTINGS:-pixel:1 pixel:3 lenslet:3}; do
-    mask=${s%:*}; k=${s#*:}
-    cap="$out/cap-$scene-$mask-$k"
-    [ -d "$cap" ] || "$slf" simulate "$lf" -o "$cap" --mask "$mask" -s "$k" --seed 1 > /dev/null 2>&1
+    scene_capture "$s" 1
     for preset in default preview; do
       t0=$("$slf" decode "$cap" -o "$out/plain.npy" --quiet --preset "$preset" | sed -n 's/.* in \([0-9.]*\) s; wrote.*/\1/p')
       t1=$("$slf" decode "$cap" -o "$out/rec.npy" --quiet --preset "$preset" --error-map "$out/map.npy" |

@@ -33,3 +33,12 @@ decode_eval() {
   t=$(echo "$log" | awk '/ in [0-9.]+ s/ { for (i = 1; i < NF; i++) if ($i == "in") print $(i + 1) }')
   read -r p q a < <("$slf" eval "$lf" "$rec" | awk '/^PSNR/ { p = $2 } /^SSIM/ { q = $2 } /^SA/ { a = $2 } END { print p, q, a }')
 }
+
+# scene_capture SETTING SEED: sets $mask, $k (from SETTING, MASK:K) and $cap, the capture of $lf
+# with that mask and seed, simulated into $out once.
+scene_capture() {
+  mask=${1%:*}; k=${1#*:}
+  cap="$out/cap-$scene-$mask-$k"
+  [ -d "$cap" ] || "$slf" simulate "$lf" -o "$cap" --mask "$mask" -s "$k" --seed "$2" > /dev/null 2>&1
+  return 0
+}

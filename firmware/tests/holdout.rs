@@ -107,28 +107,11 @@ fn capture(l: &[f32], mask: &Mask) -> Vec<Vec<f32>> {
         .collect()
 }
 
-#[derive(Default)]
-struct Collect(Vec<(PatchOrigin, Vec<f32>, PatchReport)>);
-
-impl PatchSink<5200> for Collect {
-    type Error = ();
-    fn accept(&mut self, o: PatchOrigin, patch: &[f32; 5200], r: &PatchReport) -> Result<(), ()> {
-        self.0.push((o, patch.to_vec(), *r));
-        Ok(())
-    }
-}
-
-fn decode(frames: &[Vec<f32>], mask: Mask<'static>, hold: Option<HoldOut>) -> Collect {
-    let config = DecoderConfig {
-        sensor: SensorGeometry { lenslets: (10, 15), lenslet: L5 },
-        mask,
-        raw: RawFormat::NORMALISED,
-        defects: DefectList::EMPTY,
-        sl0: Sl0Config::DEFAULT,
-    };
+fn decode(frames: &[Vec<f32>], mask: Mask<'static>, hold: Option<HoldOut>) -> Patches {
+    let config = decoder_config((10, 15), mask);
     let dec = TileDecoder::<5, 5, 4, 4, 13, 5200>::new(config).unwrap().with_error_estimate(hold).unwrap();
     let raw: Vec<RawFrame<f32>> = frames.iter().map(|f| RawFrame::new(f, 50, 75).unwrap()).collect();
-    let mut sink = Collect::default();
+    let mut sink = Patches::default();
     let mut ws = Box::new(Ws::new());
     let r = dec.decode_frame(&Dictionary::dct(), (2, 3), &mut FrameSource::new(&raw), &mut sink, &mut ws);
     assert_eq!((r.failed_tiles, r.patches.decoded), (0, 24));
@@ -179,13 +162,7 @@ fn the_estimate_leaves_the_decode_as_it_was_and_follows_the_true_error() {
 
 #[test]
 fn a_fold_below_two_is_refused() {
-    let config = DecoderConfig {
-        sensor: SensorGeometry { lenslets: (10, 15), lenslet: L5 },
-        mask: Mask::pixel(4, 3, 13, L5).unwrap(),
-        raw: RawFormat::NORMALISED,
-        defects: DefectList::EMPTY,
-        sl0: Sl0Config::DEFAULT,
-    };
+    let config = decoder_config((10, 15), Mask::pixel(4, 3, 13, L5).unwrap());
     let dec = TileDecoder::<5, 5, 4, 4, 13, 5200>::new(config).unwrap();
     assert_eq!(dec.error_estimate(), None);
     for fold in [0, 1] {
@@ -209,9 +186,9 @@ fn the_unit_held_out_follows_the_mask() {
         for p in 0..400 {
             let [s, t, u, v, _] = PaperShape::coordinates(p * 13);
             let (row, col) = (s * 5 + u, t * 5 + v);
-            for j in 0..mask.snapshots() {
+            for (j, frame) in frames.iter().enumerate() {
                 let b = mask.band(j, row, col).unwrap() as usize;
-                ws.measurements_mut().set(p * 13 + b, frames[j][row * 75 + col]).unwrap();
+                ws.measurements_mut().set(p * 13 + b, frame[row * 75 + col]).unwrap();
             }
         }
         assert_eq!(Unit::of::<5, 5, 4, 4, 13, 5200>(ws.measurements()), unit, "{:?}", mask.family());

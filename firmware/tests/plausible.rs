@@ -94,17 +94,6 @@ impl PatchModel<5, 5, 4, 4, 13, 5200> for Diverging {
     }
 }
 
-#[derive(Default)]
-struct Collect(Vec<(PatchOrigin, Vec<f32>, PatchReport)>);
-
-impl PatchSink<5200> for Collect {
-    type Error = ();
-    fn accept(&mut self, o: PatchOrigin, patch: &[f32; 5200], r: &PatchReport) -> Result<(), ()> {
-        self.0.push((o, patch.to_vec(), *r));
-        Ok(())
-    }
-}
-
 const L5: LensletSize = LensletSize { rows: 5, cols: 5 };
 
 /// A dark frame (every value 0.01 to 0.02, varying in space: no patch is flat) of 10 x 10
@@ -119,19 +108,13 @@ fn dark_frame(mask: &Mask) -> Vec<f32> {
         .collect()
 }
 
-fn decode_dark(bound: Plausibility) -> (Collect, TileReport) {
+fn decode_dark(bound: Plausibility) -> (Patches, TileReport) {
     let mask = Mask::pixel(5, 1, 13, L5).unwrap();
     let frame = dark_frame(&mask);
-    let config = DecoderConfig {
-        sensor: SensorGeometry { lenslets: (10, 10), lenslet: L5 },
-        mask,
-        raw: RawFormat::NORMALISED,
-        defects: DefectList::EMPTY,
-        sl0: Sl0Config::DEFAULT,
-    };
+    let config = decoder_config((10, 10), mask);
     let dec = TileDecoder::<5, 5, 4, 4, 13, 5200>::new(config).unwrap().with_plausibility(bound).unwrap();
     let raw = [RawFrame::new(&frame, 50, 50).unwrap()];
-    let mut sink = Collect::default();
+    let mut sink = Patches::default();
     let mut ws = Box::new(Ws::new());
     let r = dec.decode_frame(&Diverging(Dictionary::dct()), (2, 2), &mut FrameSource::new(&raw), &mut sink, &mut ws);
     assert_eq!(r.failed_tiles, 0, "{:?}", r.first_failure);
@@ -158,13 +141,7 @@ fn a_dark_patch_decoded_bright_is_decoded_again_and_never_passed_on_bright() {
 
 #[test]
 fn a_bound_out_of_range_is_refused() {
-    let config = DecoderConfig {
-        sensor: SensorGeometry { lenslets: (10, 10), lenslet: L5 },
-        mask: Mask::pixel(5, 1, 13, L5).unwrap(),
-        raw: RawFormat::NORMALISED,
-        defects: DefectList::EMPTY,
-        sl0: Sl0Config::DEFAULT,
-    };
+    let config = decoder_config((10, 10), Mask::pixel(5, 1, 13, L5).unwrap());
     let dec = TileDecoder::<5, 5, 4, 4, 13, 5200>::new(config).unwrap();
     assert_eq!(dec.plausibility(), Plausibility::DEFAULT);
     for bad in [

@@ -204,7 +204,8 @@ pub fn implausible<
     let mut above = 0u32;
     for (run, bound) in patch.as_chunks::<B>().0.iter().zip(bounds.per_pixel::<B>()) {
         for (&x, &bound) in run.iter().zip(&bound) {
-            above += u32::from(!(x <= bound));
+            // Above, or NaN (which no bound holds).
+            above += u32::from(x > bound || x.is_nan());
         }
     }
     above

@@ -229,3 +229,32 @@ pub fn sparse_in(dict: &Dictionary<5, 5, 4, 4, 13>, seed: u64) -> Vec<f32> {
     slf_firmware::transform::synthesize(dict, &mut s, &mut x);
     x.to_vec()
 }
+
+/// A decoder config of `lenslets` lenslets of 5 x 5 views through `mask`: normalised raw
+/// samples, no defects, the default solver.
+pub fn decoder_config(lenslets: (u16, u16), mask: Mask<'static>) -> slf_firmware::DecoderConfig<'static> {
+    slf_firmware::DecoderConfig {
+        sensor: slf_firmware::SensorGeometry { lenslets, lenslet: slf_firmware::LensletSize { rows: 5, cols: 5 } },
+        mask,
+        raw: slf_firmware::RawFormat::NORMALISED,
+        defects: slf_firmware::DefectList::EMPTY,
+        sl0: slf_firmware::Sl0Config::DEFAULT,
+    }
+}
+
+/// Every accepted patch of the paper's shape, with its origin and report.
+#[derive(Default)]
+pub struct Patches(pub Vec<(slf_firmware::PatchOrigin, Vec<f32>, slf_firmware::PatchReport)>);
+
+impl slf_firmware::PatchSink<5200> for Patches {
+    type Error = ();
+    fn accept(
+        &mut self,
+        o: slf_firmware::PatchOrigin,
+        patch: &[f32; 5200],
+        r: &slf_firmware::PatchReport,
+    ) -> Result<(), ()> {
+        self.0.push((o, patch.to_vec(), *r));
+        Ok(())
+    }
+}

@@ -926,34 +926,35 @@ fn aggregate<const PU: usize, const PV: usize>(
 /// [`DecodeReport::disparity_map`]: the mean of the chosen disparities of the 5 x 5 blocks
 /// that cover the lenslet (overlapping blocks at a stride below 5), NaN where none does.
 pub fn disparity_per_lenslet(blocks: &[(PatchOrigin, Disparity)], rows: usize, cols: usize) -> Vec<f32> {
-    let mut sum = vec![0.0f32; rows * cols];
+    per_lenslet(blocks.iter().map(|(o, d)| (o, f64::from(d.as_f32()))), rows, cols, |mean| mean)
+}
+
+/// `finish` of the mean of the values of the 5 x 5-lenslet blocks (by their origins) that
+/// cover each lenslet (row-major, `rows x cols`), NaN where none does.
+fn per_lenslet<'a>(
+    blocks: impl Iterator<Item = (&'a PatchOrigin, f64)>,
+    rows: usize,
+    cols: usize,
+    finish: impl Fn(f64) -> f64,
+) -> Vec<f32> {
+    let mut sum = vec![0.0f64; rows * cols];
     let mut count = vec![0u32; rows * cols];
-    for (o, d) in blocks {
+    for (o, x) in blocks {
         for r in o.lenslet_row as usize..(o.lenslet_row as usize + 5).min(rows) {
             for c in o.lenslet_col as usize..(o.lenslet_col as usize + 5).min(cols) {
-                sum[r * cols + c] += d.as_f32();
+                sum[r * cols + c] += x;
                 count[r * cols + c] += 1;
             }
         }
     }
-    sum.iter().zip(&count).map(|(&s, &n)| if n > 0 { s / n as f32 } else { f32::NAN }).collect()
+    sum.iter().zip(&count).map(|(&s, &n)| if n > 0 { finish(s / f64::from(n)) as f32 } else { f32::NAN }).collect()
 }
 
 /// The error estimate per lenslet (row-major, `rows x cols`) from a decode's
 /// [`DecodeReport::error_map`]: the RMS of the estimates of the patches whose 5 x 5
 /// lenslets cover it (every angular window, every overlapping patch), NaN where none does.
 pub fn error_per_lenslet(patches: &[(PatchOrigin, f32)], rows: usize, cols: usize) -> Vec<f32> {
-    let mut sum = vec![0.0f64; rows * cols];
-    let mut count = vec![0u32; rows * cols];
-    for (o, e) in patches {
-        for r in o.lenslet_row as usize..(o.lenslet_row as usize + 5).min(rows) {
-            for c in o.lenslet_col as usize..(o.lenslet_col as usize + 5).min(cols) {
-                sum[r * cols + c] += f64::from(*e) * f64::from(*e);
-                count[r * cols + c] += 1;
-            }
-        }
-    }
-    sum.iter().zip(&count).map(|(&s, &n)| if n > 0 { (s / f64::from(n)).sqrt() as f32 } else { f32::NAN }).collect()
+    per_lenslet(patches.iter().map(|(o, e)| (o, f64::from(*e) * f64::from(*e))), rows, cols, f64::sqrt)
 }
 
 /// The PSNR an error map estimates for a light field whose values span `data_range`: the
