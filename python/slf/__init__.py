@@ -328,6 +328,7 @@ def decode(
     flat: Optional[float] = None,
     min_bands: Optional[int] = None,
     plausible: Union[None, str, Tuple[float, float]] = None,
+    shear_check: bool = False,
     error_map: bool = False,
     threads: Optional[int] = None,
     progress: Any = None,
@@ -411,6 +412,7 @@ def decode(
         flat=flat,
         min_bands=min_bands,
         plausible=plausible,
+        shear_check=shear_check,
         estimate=True if error_map else None,
     )
     frames = _raw_frames(cap.frames)

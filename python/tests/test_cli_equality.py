@@ -90,6 +90,7 @@ def test_a_calibrated_decode_equals_cli(tmp_path, slf_bin, depth):
         (["--patch-views", "5", "--preset", "preview"], {"patch_views": 5, "preset": "preview"}),
         (["--plausible", "off", "--dictionary", "dct"], {"plausible": "off", "dictionary": "dct"}),
         (["--plausible", "2:0.1"], {"plausible": (2, 0.1)}),
+        (["--shear-check"], {"shear_check": True}),
         (["--method", "demosaic"], {"method": "demosaic"}),
         (["--method", "ppid"], {"method": "ppid"}),
     ],

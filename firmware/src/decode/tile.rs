@@ -113,6 +113,10 @@ pub struct Tile {
     pub lenslet_cols: u16,
 }
 
+/// How much smaller a whole disparity's estimated error must be than the half one's for the
+/// shear check ([`TileDecoder::with_shear_check`]) to take it.
+pub const SHEAR_MARGIN: f32 = 0.7;
+
 /// Where a patch sits: its first lenslet, its angular window's first view, and the
 /// disparity it was sheared to ([`crate::operators::disparity`]; zero: unsheared).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -411,6 +415,7 @@ pub struct TileDecoder<
     view_gains: Option<(&'a [f32], (u16, u16))>,
     plausibility: Plausibility,
     holdout: Option<HoldOut>,
+    shear_check: bool,
 }
 
 /// Where a decode puts the filters' response matrix ([`TileDecoder::with_response`]).
@@ -494,6 +499,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             view_gains: None,
             plausibility: Plausibility::DEFAULT,
             holdout: None,
+            shear_check: false,
         })
     }
 
@@ -620,6 +626,53 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             return Err(ConfigError::HoldOut);
         }
         Ok(Self { holdout: hold, ..self })
+    }
+
+    /// This decoder with or without (the default) the shear check: a block whose measurements
+    /// agree best at a half-pixel disparity is decoded at it only if the held-out error
+    /// estimate ([`crate::solver::holdout`]) of its first window's patch there is below that
+    /// of both neighbouring whole disparities; else at the better whole one. Half-pixel
+    /// measurements interpolate the patch, and where the scene's detail is at the pixel
+    /// scale the interpolation aliases (`docs/design.md`). Costs three estimating solves a
+    /// half-pixel block.
+    pub fn with_shear_check(self, on: bool) -> Self {
+        Self { shear_check: on, ..self }
+    }
+
+    /// Whether half-pixel disparities are checked against the whole ones.
+    pub fn shear_check(&self) -> bool {
+        self.shear_check
+    }
+
+    /// [`Self::with_shear_check`]: `half` or the whole disparity next to it whose first
+    /// window's patch at block `(row, col)` estimates the smallest held-out error.
+    ///
+    /// # Errors
+    /// The source's error.
+    #[inline(never)]
+    fn check_shear<M: PatchModel<PS, PT, PU, PV, B, N>, S: TileSource>(
+        &self,
+        model: &M,
+        row: u16,
+        col: u16,
+        half: Disparity,
+        source: &mut S,
+        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ) -> Result<Disparity, S::Error> {
+        let Some((view_row, view_col)) = self.windows().next() else { return Ok(half) };
+        let h = half.in_halves();
+        let mut best = (f32::INFINITY, half);
+        for d in [half, Disparity::halves(h.saturating_sub(1)), Disparity::halves(h.saturating_add(1))] {
+            let origin = PatchOrigin { lenslet_row: row, lenslet_col: col, view_row, view_col, disparity: d };
+            self.read_patch(origin, source, ws)?;
+            let (error, _) = self.estimate_error(model, &HoldOut::DEFAULT, origin, source, ws)?;
+            // A whole disparity must estimate clearly better than the half one.
+            let error = if d == half { error } else { error.map(|e| e / SHEAR_MARGIN) };
+            if let Some(e) = error.filter(|e| *e < best.0) {
+                best = (e, d);
+            }
+        }
+        Ok(best.1)
     }
 
     /// The held-out measurements the error estimate takes, if the decoder estimates.
@@ -1070,7 +1123,11 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         for bs in 0..tile.lenslet_rows as usize / PS {
             for bt in 0..tile.lenslet_cols as usize / PT {
                 let (row, col) = (tile.lenslet_row + (bs * PS) as u16, tile.lenslet_col + (bt * PT) as u16);
-                let disparity = self.choose_disparity(row as usize, col as usize, source).map_err(TileError::Source)?;
+                let mut disparity =
+                    self.choose_disparity(row as usize, col as usize, source).map_err(TileError::Source)?;
+                if self.shear_check && !disparity.is_whole() {
+                    disparity = self.check_shear(model, row, col, disparity, source, ws).map_err(TileError::Source)?;
+                }
                 for (view_row, view_col) in self.windows() {
                     let origin = PatchOrigin { lenslet_row: row, lenslet_col: col, view_row, view_col, disparity };
                     self.decode_patch(model, origin, false, source, seed, sink, ws, &mut report)?;

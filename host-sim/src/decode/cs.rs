@@ -364,6 +364,9 @@ pub struct DecodeOptions {
     /// ([`TileDecoder::with_error_estimate`], [`DecodeReport::error_map`]). Off by default:
     /// a solve more a patch.
     pub error_estimate: bool,
+    /// Whether half-pixel disparities are checked against the whole ones by the held-out
+    /// error estimate ([`TileDecoder::with_shear_check`]). Off by default.
+    pub shear_check: bool,
 }
 
 /// Which schedule the solves take.
@@ -397,6 +400,7 @@ impl Default for DecodeOptions {
             response: None,
             plausibility: Plausibility::DEFAULT,
             error_estimate: false,
+            shear_check: false,
         }
     }
 }
@@ -492,7 +496,10 @@ pub fn tile_decoder<'a, const PU: usize, const PV: usize, const N: usize>(
         .map_err(|e| anyhow!("{e}"))?
         .with_plausibility(opts.plausibility)
         .map_err(|e| anyhow!("--plausible {}:{}: {e}", opts.plausibility.factor, opts.plausibility.margin))?;
-    Ok(decoder.with_disparities(opts.disparities_for(capture)).with_edge_fallback(opts.edge_fallback))
+    Ok(decoder
+        .with_disparities(opts.disparities_for(capture))
+        .with_edge_fallback(opts.edge_fallback)
+        .with_shear_check(opts.shear_check))
 }
 
 /// The tiles of the patch grids shifted by `(dy, dx)` lenslets for every multiple of the

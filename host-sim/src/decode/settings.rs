@@ -400,6 +400,11 @@ pub struct DecodeSettings {
     /// decode itself is the same bit for bit; the estimate costs a solve a patch.
     #[arg(long)]
     pub estimate: bool,
+    /// Check each half-pixel disparity against the whole ones next to it by the held-out
+    /// error estimate of the block's patch at each, and decode at the one estimated best
+    /// (three more solves a half-pixel block).
+    #[arg(long)]
+    pub shear_check: bool,
 }
 
 /// Parses `--plausible`: `FACTOR:MARGIN` or `off`.
@@ -492,6 +497,7 @@ impl DecodeSettings {
             seeded: self.seeded.unwrap_or(base.seeded),
             plausibility: self.plausible.unwrap_or(base.plausibility),
             error_estimate: self.estimate || base.error_estimate,
+            shear_check: self.shear_check || base.shear_check,
             patch_views: self.basis.patch_views.or(base.patch_views),
             schedule: self.schedule,
             ..base

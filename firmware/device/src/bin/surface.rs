@@ -217,7 +217,8 @@ mod device {
                             .and_then(|d| d.with_plausibility(tight))
                         {
                             let _ = estimating.decode_tile(&model, tile, source, &mut sink, full_ws);
-                            let _ = estimating.decode_tile(&full_dct, tile, source, &mut sink, full_ws);
+                            let checking = estimating.with_shear_check(black_box(true));
+                            let _ = checking.decode_tile(&full_dct, tile, source, &mut sink, full_ws);
                         }
                     }
                 }
