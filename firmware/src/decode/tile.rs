@@ -592,7 +592,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
 
     /// This decoder with `bound` as its plausibility check ([`crate::solver::plausible`];
     /// [`Plausibility::DEFAULT`] unless set): a solved patch with a value above its
-    /// lenslet's bound is decoded again by the safe path (the DCT's hand-set schedule from
+    /// pixel's bound is decoded again by the safe path (the DCT's hand-set schedule from
     /// the minimum-norm start), and what the safe path leaves above a bound is clipped to
     /// it; [`PatchReport::checked`] and [`TileReport::implausible`] say so.
     /// [`Plausibility::OFF`] never checks.
