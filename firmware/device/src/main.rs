@@ -9,7 +9,8 @@
 //! patches (stride 3, tapered window) through a strip of lenslet rows, printing each
 //! finished row. `bench_begin` / `bench_end` bracket one synthesis, then each ensemble
 //! tile, then each DCT tile, then the overlapped frame, then one block's disparity
-//! choice, then the DCT tiles sheared to whole and to half-pixel disparities, so the qemu plugin
+//! choice, then the DCT tiles sheared to whole and to half-pixel disparities, then a real
+//! sensor's tiles uncalibrated, calibrated, and with the error estimate, so the qemu plugin
 //! `scripts/wincount/wincount.c` counts instructions per transform and per patch. The
 //! stack is painted at start and scanned at the end for its peak depth.
 //!
@@ -44,7 +45,7 @@ mod device {
     use panic_semihosting as _;
     use slf_firmware::{
         ChoiceRule, DEFAULT_FULL_VIEW_ENSEMBLE, DecoderConfig, DefectList, Dictionary, Disparity, DisparityRange,
-        Ensemble, EnsembleModel, FrameSource, FullViewShape, FullViewWorkspace, LeU16Frame, LensletSize, Mask,
+        Ensemble, EnsembleModel, FrameSource, FullViewShape, FullViewWorkspace, HoldOut, LeU16Frame, LensletSize, Mask,
         MemberChoice, Overlap, OverlapDecoder, PatchModel, PatchOrigin, PatchReport, PatchSink, Pixel, RawFormat,
         Response, ResponseModel, RowSink, SensorGeometry, Sl0Config, TileDecoder,
     };
@@ -153,6 +154,16 @@ mod device {
             failed += r.map_or(1, |t| t.failed);
         }
         hprintln!("calibrated patches {} defects {}", out.patches, DEFECTS.len());
+        // The same tiles uncalibrated with the error estimate from held-out measurements:
+        // its instructions a patch beside the plain decode's (window 8).
+        if let Ok(estimating) = plain.with_error_estimate(Some(HoldOut::DEFAULT)) {
+            for tile in estimating.tiles((1, 1)) {
+                bench_begin(10);
+                let r = estimating.decode_tile(model, tile, &mut FrameSource::new(&frames), &mut quiet, ws);
+                bench_end(10);
+                failed += r.map_or(1, |t| t.failed);
+            }
+        }
         failed
     }
 
