@@ -1,6 +1,11 @@
-# Sourced by the scripts that tabulate decodes per scene (hard-cases.sh, sensor-results.sh):
-# the scene list with the real crops, a scene's light field, and one decode measured.
+# Sourced by the scripts that tabulate decodes per scene (hard-cases.sh, sensor-results.sh,
+# plausible-results.sh, error-map-results.sh, shear-check-results.sh): the scene lists with the
+# real crops, a scene's light field and capture, and one decode measured.
 # They set `slf`, `out` and `size` first.
+
+# Every scene `slf scene` names but `random`: the test scenes, the realistic ones and the hard
+# cases (the issue-49 tables run over all of them).
+all_scenes="smooth texture depth saturated dark outdoor tungsten office led mosaic mosaic-2 field print speculars narrow dim canopy canopy-dim"
 
 # Appends the real content the project evaluates to $scenes when present (scripts/real-eval.sh's
 # crops in $SLF_REAL, default /tmp/hci/real; their licence allows evaluation only).

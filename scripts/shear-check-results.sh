@@ -13,7 +13,7 @@ cd "$(dirname "$0")/.."
 cargo build --release -q -p slf-host
 slf=${SLF_BIN:-./target/release/slf}
 size=${SLF_SIZE:-48}
-scenes=${SLF_SCENES:-smooth texture depth saturated dark outdoor tungsten office led mosaic mosaic-2 field print speculars narrow dim canopy canopy-dim}
+scenes=${SLF_SCENES:-$all_scenes}
 mkdir -p "$out"
 echo "# The shear check"
 echo
