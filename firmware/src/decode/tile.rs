@@ -629,9 +629,10 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     }
 
     /// This decoder with or without (the default) the shear check: a block whose measurements
-    /// agree best at a half-pixel disparity is decoded at it only if the held-out error
-    /// estimate ([`crate::solver::holdout`]) of its first window's patch there is below that
-    /// of both neighbouring whole disparities; else at the better whole one. Half-pixel
+    /// agree best at a half-pixel disparity is decoded at a neighbouring whole disparity if
+    /// the held-out error estimate ([`crate::solver::holdout`]) of its first window's patch
+    /// there is below [`SHEAR_MARGIN`] times the half one's (the better of the two whole ones
+    /// if both are); else at the half one. Half-pixel
     /// measurements interpolate the patch, and where the scene's detail is at the pixel
     /// scale the interpolation aliases (`docs/design.md`). Costs three estimating solves a
     /// half-pixel block.
@@ -644,8 +645,9 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         self.shear_check
     }
 
-    /// [`Self::with_shear_check`]: `half` or the whole disparity next to it whose first
-    /// window's patch at block `(row, col)` estimates the smallest held-out error.
+    /// [`Self::with_shear_check`]: `half`, or the whole disparity next to it whose first
+    /// window's patch at block `(row, col)` estimates a held-out error below
+    /// [`SHEAR_MARGIN`] times `half`'s (the smaller of the two).
     ///
     /// # Errors
     /// The source's error.

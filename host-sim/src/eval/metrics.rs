@@ -14,6 +14,7 @@
 
 use anyhow::{Result, ensure};
 
+use crate::decode::cs::estimated_psnr;
 use crate::io::lightfield::LightField;
 
 /// PSNR, SSIM and spectral angle of one reconstruction.
@@ -116,7 +117,7 @@ pub fn map_accuracy(truth: &LightField, recon: &LightField, map: &[f32]) -> Resu
             n[k] += 1;
         }
     }
-    let (mut est, mut truth_rms, mut all2, mut lenslets) = (Vec::new(), Vec::new(), 0.0f64, 0usize);
+    let (mut est, mut truth_rms) = (Vec::new(), Vec::new());
     for by in 0..rows {
         for bx in 0..cols {
             let mut e2 = 0.0f64;
@@ -135,18 +136,15 @@ pub fn map_accuracy(truth: &LightField, recon: &LightField, map: &[f32]) -> Resu
             }
         }
     }
-    for e in map.iter().filter(|e| e.is_finite()) {
-        all2 += f64::from(*e).powi(2);
-        lenslets += 1;
-    }
     ensure!(!est.is_empty(), "no block of {BLOCK} x {BLOCK} lenslets has an estimate at every lenslet");
     let within = est.iter().zip(&truth_rms).filter(|(e, t)| **e <= 2.0 * **t && **t <= 2.0 * **e).count();
-    let data_range = f64::from(truth.max());
+    // A block with an estimate at every lenslet: the map has a finite value.
+    let estimated_psnr = estimated_psnr(map, f64::from(truth.max())).unwrap_or(f64::NAN);
     Ok(MapAccuracy {
         blocks: est.len(),
         rank_correlation: spearman(&est, &truth_rms),
         within_2x: within as f64 / est.len() as f64,
-        estimated_psnr: 10.0 * (data_range * data_range / (all2 / lenslets.max(1) as f64).max(1e-20)).log10(),
+        estimated_psnr,
     })
 }
 

@@ -118,12 +118,11 @@ pub fn run(args: Args) -> Result<()> {
         }
         write_bytes(&path, csv.as_bytes())?;
     }
+    let (rows, cols) = (cap.description.lenslets[0], cap.description.lenslets[1]);
     if let Some(path) = disparity_map {
-        let (rows, cols) = (cap.description.lenslets[0], cap.description.lenslets[1]);
         let map = disparity_per_lenslet(&r.disparity_map, rows, cols);
         write_npy_f32_2d(&path, &map, rows, cols).with_context(|| format!("cannot write {}", path.display()))?;
     }
-    let (rows, cols) = (cap.description.lenslets[0], cap.description.lenslets[1]);
     let errors = (!r.error_map.is_empty()).then(|| error_per_lenslet(&r.error_map, rows, cols));
     if let (Some(path), Some(map)) = (&error_map, &errors) {
         write_npy_f32_2d(path, map, rows, cols).with_context(|| format!("cannot write {}", path.display()))?;
