@@ -118,11 +118,11 @@ pub mod sensor;
 pub mod solver;
 
 // Every module by its path of before the layer folders, for integrators' code.
-pub use decode::{overlap, tile};
+pub use decode::{overlap, tile, trial};
 pub use operators::{blob, dct, dictionary, disparity, schedule, shape, transform};
 pub use sensor::{defects, gains, mask, raw, response, spi};
 pub use solver::{
-    ascent, ball, choice, fractional, holdout, interpolate, mixing, pinv, plausible, projection, sl0, workspace,
+    ascent, ball, choice, fractional, holdout, interpolate, mixing, picked, pinv, plausible, projection, sl0, workspace,
 };
 
 pub mod prelude;
@@ -135,6 +135,7 @@ pub use decode::tile::{
     Checked, ConfigError, DecoderConfig, FrameReport, NoSeed, PatchFlags, PatchOrigin, PatchReport, PatchSeed,
     PatchSink, ResponseModel, SensorGeometry, Tile, TileDecoder, TileError, TileReport,
 };
+pub use decode::trial::TrialErrors;
 pub use operators::blob::{DEFAULT_ENSEMBLE, DEFAULT_FULL_VIEW_ENSEMBLE, Ensemble};
 pub use operators::dictionary::{Dictionary, DictionaryError};
 pub use operators::disparity::{Disparity, DisparityRange};
@@ -148,6 +149,7 @@ pub use sensor::source::TileSource;
 pub use sensor::spi::{SpiFrameBuffer, SpiSourceError};
 pub use solver::choice::{ChoiceRule, EnsembleModel, MemberChoice, ModelOutcome, PatchModel, ScheduledDictionary};
 pub use solver::holdout::HoldOut;
+pub use solver::picked::{Pick, Picked};
 pub use solver::plausible::Plausibility;
 pub use solver::sl0::{Ended, Outcome, Sl0Config, SolveError, solve};
 pub use solver::workspace::{FullViewWorkspace, Measurements, PaperWorkspace, Workspace};

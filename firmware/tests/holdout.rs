@@ -76,37 +76,6 @@ fn the_estimate_is_the_held_out_error_less_the_noise() {
 
 const L5: LensletSize = LensletSize { rows: 5, cols: 5 };
 
-/// 10 x 15 lenslets: smooth in the left third, rougher to the right (texture at the
-/// lenslet scale whose amplitude grows with the column).
-fn light_field(seed: u64) -> Vec<f32> {
-    let mut r = rng(seed);
-    let (s, t) = (10, 15);
-    let rough: Vec<f32> = (0..s * t * 13).map(|_| r.random_range(-1.0..1.0)).collect();
-    let mut l = vec![0.0; s * t * 25 * 13];
-    for (i, x) in l.iter_mut().enumerate() {
-        let b = i % 13;
-        let tt = (i / 325) % t;
-        let ss = i / (325 * t);
-        let amplitude = 0.25 * (tt / 5) as f32 / 2.0;
-        *x = 0.4 + 0.1 * ((b as f32) * 0.4).cos() + amplitude * rough[(ss * t + tt) * 13 + b];
-    }
-    l
-}
-
-fn capture(l: &[f32], mask: &Mask) -> Vec<Vec<f32>> {
-    (0..mask.snapshots())
-        .map(|j| {
-            (0..50 * 75)
-                .map(|p| {
-                    let (row, col) = (p / 75, p % 75);
-                    let b = mask.band(j, row, col).unwrap() as usize;
-                    l[(((((row / 5) * 15) + col / 5) * 5 + row % 5) * 5 + col % 5) * 13 + b]
-                })
-                .collect()
-        })
-        .collect()
-}
-
 fn decode(frames: &[Vec<f32>], mask: Mask<'static>, hold: Option<HoldOut>) -> Patches {
     let config = decoder_config((10, 15), mask);
     let dec = TileDecoder::<5, 5, 4, 4, 13, 5200>::new(config).unwrap().with_error_estimate(hold).unwrap();
@@ -120,9 +89,9 @@ fn decode(frames: &[Vec<f32>], mask: Mask<'static>, hold: Option<HoldOut>) -> Pa
 
 #[test]
 fn the_estimate_leaves_the_decode_as_it_was_and_follows_the_true_error() {
-    let l = light_field(3);
+    let l = rough_light_field(3);
     let mask = Mask::pixel(4, 3, 13, L5).unwrap();
-    let frames = capture(&l, &mask);
+    let frames = capture_10x15(&l, &mask);
     let plain = decode(&frames, mask, None);
     let estimated = decode(&frames, mask, Some(HoldOut::DEFAULT));
     let (mut est, mut truth) = (Vec::new(), Vec::new());
@@ -175,13 +144,13 @@ fn a_fold_below_two_is_refused() {
 /// band) groups; a pixel mask's holds out single measurements.
 #[test]
 fn the_unit_held_out_follows_the_mask() {
-    let l = light_field(5);
+    let l = rough_light_field(5);
     for (mask, unit) in [
         (Mask::pixel(4, 1, 13, L5).unwrap(), Unit::Measurement),
         (Mask::pixel(4, 3, 13, L5).unwrap(), Unit::Measurement),
         (Mask::lenslet(4, 3, 13, L5).unwrap(), Unit::LensletBand),
     ] {
-        let frames = capture(&l, &mask);
+        let frames = capture_10x15(&l, &mask);
         let mut ws = Box::new(Ws::new());
         for p in 0..400 {
             let [s, t, u, v, _] = PaperShape::coordinates(p * 13);

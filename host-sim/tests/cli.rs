@@ -1104,3 +1104,37 @@ fn the_shear_check_takes_whole_shears_where_half_ones_alias() {
     assert!(checked_halves * 2 < plain_halves, "{plain_halves} -> {checked_halves} half-pixel blocks");
     assert!(checked > plain + 5.0, "{plain:.2} -> {checked:.2} dB");
 }
+
+/// Issue 49, item 2: the model trial. The default decodes the frame with the model whose
+/// held-out error over the pilots it prints is the smaller, and that decode is the model's
+/// own without the trial, bit for bit; `--model-trial false` is the screened ensemble.
+#[test]
+fn the_model_trial_decodes_with_the_model_its_pilots_favour() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    stdout(slf().args(["scene", "texture", "--size", "30", "-o"]).arg(p("truth.npy")));
+    for (k, seed) in [("1", "1"), ("3", "2")] {
+        let cap = p(&format!("cap{k}"));
+        stdout(slf().arg("simulate").arg(p("truth.npy")).arg("-o").arg(&cap).args(["-s", k, "--seed", seed]));
+        let out = stdout(slf().arg("decode").arg(&cap).arg("-o").arg(p("trial.npy")).arg("-q"));
+        let line = out.lines().find_map(|l| l.strip_prefix("model trial: decoded by the ")).unwrap();
+        let number = |after: &str| -> f64 {
+            let rest = &line[line.find(after).unwrap() + after.len()..];
+            rest.split([',', ')']).next().unwrap().trim().parse().unwrap()
+        };
+        let (dct, ensemble) = (number("patches: DCT "), number(", ensemble "));
+        let picked = if line.starts_with("DCT") { "dct" } else { "ensemble" };
+        assert_eq!(picked == "dct", dct < ensemble, "{line}");
+        stdout(slf().arg("decode").arg(&cap).arg("-o").arg(p("alone.npy")).arg("-q").args([
+            "--model-trial",
+            "false",
+            "--dictionary",
+            picked,
+        ]));
+        assert_eq!(std::fs::read(p("trial.npy")).unwrap(), std::fs::read(p("alone.npy")).unwrap(), "k {k}: {line}");
+        let off = stdout(
+            slf().arg("decode").arg(&cap).arg("-o").arg(p("off.npy")).arg("-q").args(["--model-trial", "false"]),
+        );
+        assert!(!off.contains("model trial"), "{off}");
+    }
+}

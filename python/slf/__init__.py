@@ -329,6 +329,7 @@ def decode(
     min_bands: Optional[int] = None,
     plausible: Union[None, str, Tuple[float, float]] = None,
     shear_check: bool = False,
+    model_trial: Optional[bool] = None,
     error_map: bool = False,
     threads: Optional[int] = None,
     progress: Any = None,
@@ -358,7 +359,10 @@ def decode(
     too), ``response_model`` unmix (the default: each decoded spectrum unmixed by the
     response's inverse) or projection (the response in every projection of the solve),
     ``balance`` grey or off, ``gains`` (13),
-    ``adaptive`` and the solver's ``sigma_f`` ... ``min_bands``.
+    ``adaptive`` and the solver's ``sigma_f`` ... ``min_bands``, ``plausible``,
+    ``shear_check``, ``model_trial`` (the ensemble or the DCT for the frame by their
+    held-out errors on pilot patches; default True: ``report["trial"]`` says which and the
+    errors), ``error_map``.
 
     ``threads``: threads of this decode (None: one per core; 1 inside a Dask task).
     ``progress``: True for a bar (tqdm if installed), or a callable ``f(done, total)``
@@ -371,6 +375,8 @@ def decode(
         edge_fallback = "true" if edge_fallback else "false"  # type: ignore[assignment]
     if seeded is not None:
         seeded = "true" if seeded else "false"  # type: ignore[assignment]
+    if model_trial is not None:
+        model_trial = "true" if model_trial else "false"  # type: ignore[assignment]
     if isinstance(plausible, (list, tuple)):
         plausible = ":".join(f"{p:g}" for p in plausible)
     if blob is not None:
@@ -413,6 +419,7 @@ def decode(
         min_bands=min_bands,
         plausible=plausible,
         shear_check=shear_check,
+        model_trial=model_trial,
         estimate=True if error_map else None,
     )
     frames = _raw_frames(cap.frames)

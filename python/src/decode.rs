@@ -108,6 +108,14 @@ pub fn decode<'py>(
                 let map = disparity_per_lenslet(&r.disparity_map, rows, cols);
                 report.set_item("disparity", plane(py, map, rows, cols)?)?;
             }
+            if let Some(t) = &r.trial {
+                let trial = PyDict::new(py);
+                trial.set_item("model", if t.dct { "dct" } else { "ensemble" })?;
+                trial.set_item("pilots", t.pilots)?;
+                trial.set_item("dct_error", t.dct_error)?;
+                trial.set_item("ensemble_error", t.ensemble_error)?;
+                report.set_item("trial", trial)?;
+            }
             if !r.error_map.is_empty() {
                 let (rows, cols) = (d.lenslets[0], d.lenslets[1]);
                 let map = error_per_lenslet(&r.error_map, rows, cols);

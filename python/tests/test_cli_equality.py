@@ -91,6 +91,7 @@ def test_a_calibrated_decode_equals_cli(tmp_path, slf_bin, depth):
         (["--plausible", "off", "--dictionary", "dct"], {"plausible": "off", "dictionary": "dct"}),
         (["--plausible", "2:0.1"], {"plausible": (2, 0.1)}),
         (["--shear-check"], {"shear_check": True}),
+        (["--model-trial", "false"], {"model_trial": False}),
         (["--method", "demosaic"], {"method": "demosaic"}),
         (["--method", "ppid"], {"method": "ppid"}),
     ],
@@ -111,6 +112,23 @@ def test_disparity_map_equals_cli(tmp_path, slf_bin, capture):
     run([slf_bin, "decode", tmp_path / "cap", "-o", tmp_path / "o.npy", "-q", "--preset", "preview", "--disparity-map", tmp_path / "d.npy"])
     _, report = slf.decode(capture, preset="preview", report=True)
     assert np.array_equal(report["disparity"], np.load(tmp_path / "d.npy"))
+
+
+def test_model_trial_report_equals_cli(tmp_path, slf_bin, capture):
+    capture.save(tmp_path / "cap")
+    out = run([slf_bin, "decode", tmp_path / "cap", "-o", tmp_path / "o.npy", "-q"]).stdout
+    lf, report = slf.decode(capture, report=True)
+    t = report["trial"]
+    assert t["model"] in ("dct", "ensemble") and t["pilots"] > 0
+    # The model with the smaller held-out error decodes (the ensemble on a tie).
+    assert (t["model"] == "dct") == (t["dct_error"] < t["ensemble_error"]), t
+    name = "DCT" if t["model"] == "dct" else "ensemble"
+    assert f"model trial: decoded by the {name} (held-out error over {t['pilots']} pilot patches" in out
+    # The frame is the picked model's decode without the trial.
+    alone = slf.decode(capture, model_trial=False, dictionary=t["model"])
+    assert np.array_equal(lf, alone), np.abs(lf - alone).max()
+    _, off = slf.decode(capture, model_trial=False, report=True)
+    assert "trial" not in off
 
 
 def test_error_map_equals_cli(tmp_path, slf_bin, depth, capture):

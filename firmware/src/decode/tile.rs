@@ -667,7 +667,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         for d in [half, Disparity::halves(h.saturating_sub(1)), Disparity::halves(h.saturating_add(1))] {
             let origin = PatchOrigin { lenslet_row: row, lenslet_col: col, view_row, view_col, disparity: d };
             self.read_patch(origin, source, ws)?;
-            let (error, _) = self.estimate_error(model, &HoldOut::DEFAULT, origin, source, ws)?;
+            let (error, _) = self.estimate_error(model, &HoldOut::DEFAULT, origin, source, ws, false)?;
             // A whole disparity must estimate clearly better than the half one.
             let error = if d == half { error } else { error.map(|e| e / SHEAR_MARGIN) };
             if let Some(e) = error.filter(|e| *e < best.0) {
@@ -683,25 +683,32 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     }
 
     /// The error estimate of the patch at `origin`, whose measurements are in `ws`
-    /// ([`Self::with_error_estimate`]), and the solves it took; the measurements are read
+    /// ([`Self::with_error_estimate`]; `full`: from the model's whole decode, not its
+    /// cheapest solve), and the solves it took; the measurements are read
     /// again from `source` after the estimating solve, and `ws.patch()` is clobbered.
     /// Out of line: its frame is not on the decode's stack when the estimate is off.
     ///
     /// # Errors
     /// The source's error.
     #[inline(never)]
-    fn estimate_error<M: PatchModel<PS, PT, PU, PV, B, N>, S: TileSource>(
+    pub(super) fn estimate_error<M: PatchModel<PS, PT, PU, PV, B, N>, S: TileSource>(
         &self,
         model: &M,
         hold: &HoldOut,
         origin: PatchOrigin,
         source: &mut S,
         ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+        full: bool,
     ) -> Result<(Option<f32>, u16), S::Error> {
         if !self.solved_response().is_identity() || hold_out::<PS, PT, PU, PV, B, N>(hold, &mut ws.measurements) == 0 {
             return Ok((None, 0));
         }
-        let solved = model.estimating_solve(&self.config.sl0, ws);
+        // The model's own decode (a model trial), or its cheapest solve (the estimate).
+        let solved = if full {
+            model.decode(&self.config.sl0, ws).map(|d| d.solves)
+        } else {
+            model.estimating_solve(&self.config.sl0, ws)
+        };
         self.read_patch(origin, source, ws)?;
         let Ok(solves) = solved else { return Ok((None, 0)) };
         let half = ws.measurements().half_views();
@@ -1187,7 +1194,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let bands = bands_measured::<B, N>(ws.measurements());
         let (error, estimating) = match &self.holdout {
             Some(hold) if bands >= u32::from(cfg.min_bands) => {
-                self.estimate_error(model, hold, origin, source, ws).map_err(TileError::Source)?
+                self.estimate_error(model, hold, origin, source, ws, false).map_err(TileError::Source)?
             }
             _ => (None, 0),
         };

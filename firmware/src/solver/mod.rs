@@ -19,6 +19,7 @@
 //!   measurements of its lenslets' neighbourhoods;
 //! - [`sl0`]: Algorithm 1, its configuration and how a solve ended;
 //! - [`choice`]: the ensemble's member choice per patch (exhaustive or screened);
+//! - [`picked`]: two models, one of which decodes (the model trial's pick);
 //! - [`interpolate`]: per-pixel spectral interpolation, for a patch that measures too few
 //!   bands for SL0.
 //!
@@ -33,6 +34,7 @@ pub mod fractional;
 pub mod holdout;
 pub mod interpolate;
 pub mod mixing;
+pub mod picked;
 pub mod pinv;
 pub mod plausible;
 pub mod projection;

@@ -258,3 +258,35 @@ impl slf_firmware::PatchSink<5200> for Patches {
         Ok(())
     }
 }
+
+/// 10 x 15 lenslets of 5 x 5 views (13 bands, lenslet-major, band fastest): smooth in the left third, rougher to the right (texture at the
+/// lenslet scale whose amplitude grows with the column).
+pub fn rough_light_field(seed: u64) -> Vec<f32> {
+    let mut r = rng(seed);
+    let (s, t) = (10, 15);
+    let rough: Vec<f32> = (0..s * t * 13).map(|_| r.random_range(-1.0..1.0)).collect();
+    let mut l = vec![0.0; s * t * 25 * 13];
+    for (i, x) in l.iter_mut().enumerate() {
+        let b = i % 13;
+        let tt = (i / 325) % t;
+        let ss = i / (325 * t);
+        let amplitude = 0.25 * (tt / 5) as f32 / 2.0;
+        *x = 0.4 + 0.1 * ((b as f32) * 0.4).cos() + amplitude * rough[(ss * t + tt) * 13 + b];
+    }
+    l
+}
+
+/// The raw frames of [`rough_light_field`] through `mask`, one a snapshot (50 x 75 pixels).
+pub fn capture_10x15(l: &[f32], mask: &Mask) -> Vec<Vec<f32>> {
+    (0..mask.snapshots())
+        .map(|j| {
+            (0..50 * 75)
+                .map(|p| {
+                    let (row, col) = (p / 75, p % 75);
+                    let b = mask.band(j, row, col).unwrap() as usize;
+                    l[(((((row / 5) * 15) + col / 5) * 5 + row % 5) * 5 + col % 5) * 13 + b]
+                })
+                .collect()
+        })
+        .collect()
+}

@@ -21,9 +21,11 @@ use slf_firmware::disparity::Disparity;
 use slf_firmware::tile::PatchSeed;
 use slf_firmware::{
     Dictionary, DisparityRange, Ended, FrameSource, HoldOut, PatchModel, PatchOrigin, PatchReport, PatchShape,
-    PatchSink, Plausibility, Response, ResponseModel, Sl0Config, SolveError, Tile, TileDecoder, TileReport, Workspace,
+    PatchSink, Pick, Picked, Plausibility, Response, ResponseModel, Sl0Config, SolveError, Tile, TileDecoder,
+    TileReport, Workspace,
 };
 
+use crate::decode::trial::frame_trial;
 use crate::io::capture::Capture;
 use crate::io::lightfield::LightField;
 
@@ -220,7 +222,18 @@ fn decode_basis<const PU: usize, const PV: usize, const N: usize>(
             let ensemble = ensemble::<PU, PV>(blob.as_deref())?;
             let model = slf_firmware::EnsembleModel::new(ensemble, *choice);
             let model = if trained { model } else { model.with_schedules(None) };
-            decode_observed::<PU, PV, N, _>(capture, &model, opts, observer)
+            if !opts.model_trial {
+                return decode_observed::<PU, PV, N, _>(capture, &model, opts, observer);
+            }
+            // The trial's other model: the DCT the ensemble screens with, on its schedules.
+            let dictionary = Dictionary::<5, 5, PU, PV, 13>::dct();
+            match model.schedules().copied() {
+                Some(schedules) => {
+                    let dct = slf_firmware::ScheduledDictionary { dictionary, schedules };
+                    decode_picked::<PU, PV, N, _, _>(capture, &dct, &model, true, opts, observer)
+                }
+                None => decode_picked::<PU, PV, N, _, _>(capture, &dictionary, &model, true, opts, observer),
+            }
         }
     }
 }
@@ -367,6 +380,10 @@ pub struct DecodeOptions {
     /// Whether half-pixel disparities are checked against the whole ones by the held-out
     /// error estimate ([`TileDecoder::with_shear_check`]). Off by default.
     pub shear_check: bool,
+    /// Whether an ensemble decode picks, per region, the ensemble or the DCT it screens
+    /// with by their held-out errors on pilot patches ([`crate::decode::trial`]). On by
+    /// default; the DCT's decode and the hand-set schedule's ignore it.
+    pub model_trial: bool,
 }
 
 /// Which schedule the solves take.
@@ -401,6 +418,7 @@ impl Default for DecodeOptions {
             plausibility: Plausibility::DEFAULT,
             error_estimate: false,
             shear_check: false,
+            model_trial: true,
         }
     }
 }
@@ -597,6 +615,21 @@ pub struct DecodeReport {
     /// Each estimated patch's error estimate (RMS per value, the output's units), by
     /// origin ([`DecodeOptions::error_estimate`]; empty without it).
     pub error_map: Vec<(PatchOrigin, f32)>,
+    /// What the model trial picked ([`DecodeOptions::model_trial`]; `None` without it).
+    pub trial: Option<TrialReport>,
+}
+
+/// The model trial's picks in a decode ([`crate::decode::trial`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TrialReport {
+    /// Pilot patches that estimated both models.
+    pub pilots: u32,
+    /// Whether the DCT decoded the frame (else the ensemble).
+    pub dct: bool,
+    /// The DCT's held-out error estimate over the pilots (RMS, the output's units).
+    pub dct_error: f64,
+    /// The ensemble's.
+    pub ensemble_error: f64,
 }
 
 /// Weighted sums of the patch estimates over one tile's lenslets and the halo a sheared
@@ -715,6 +748,26 @@ pub fn decode_observed<const PU: usize, const PV: usize, const N: usize, M: Patc
     opts: &DecodeOptions,
     observer: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<(LightField, DecodeReport)> {
+    decode_picked(capture, model, model, false, opts, observer)
+}
+
+/// [`decode_observed`] with two models: with `trial`, decoded by the one the model trial
+/// picks for the frame ([`crate::decode::trial`]); without, by `second` alone.
+///
+/// # Errors
+/// As [`decode`].
+pub fn decode_picked<const PU: usize, const PV: usize, const N: usize, A, Z>(
+    capture: &Capture,
+    first: &A,
+    second: &Z,
+    trial: bool,
+    opts: &DecodeOptions,
+    observer: &(dyn Fn(usize, usize) + Sync),
+) -> Result<(LightField, DecodeReport)>
+where
+    A: PatchModel<5, 5, PU, PV, 13, N> + Sync,
+    Z: PatchModel<5, 5, PU, PV, 13, N> + Sync,
+{
     let start = Instant::now();
     let d = &capture.description;
     ensure!(d.bands_nm.len() == 13, "the decoder's patch has 13 bands, the capture {}", d.bands_nm.len());
@@ -749,6 +802,10 @@ pub fn decode_observed<const PU: usize, const PV: usize, const N: usize, M: Patc
     let views = (d.views[0], d.views[1]);
     let range = decoder.config().raw.range();
     let halo = decoder.disparities().halo(views.0.max(views.1));
+    let trialled = trial.then(|| frame_trial(&decoder, first, second, &raw, &base));
+    let pick = trialled.map_or(Pick::Second, |t| t.pick());
+    let model = Picked { first, second, pick };
+    let model = &model;
     let run = |tiles: &[Tile], prior: Option<&LightField>| -> Vec<(TileSums<PU, PV>, Result<TileReport, String>)> {
         let bar = ProgressBar::with_draw_target(Some(tiles.len() as u64), ProgressDrawTarget::hidden());
         bar.set_style(
@@ -819,6 +876,17 @@ pub fn decode_observed<const PU: usize, const PV: usize, const N: usize, M: Patc
     report.seconds = start.elapsed().as_secs_f64();
     report.gains = gains;
     report.patch_views = PatchViews::of_views(PU, PV);
+    if let Some(t) = trialled {
+        // A pilot: the DCT's solve and the ensemble's two.
+        report.solves += 3 * u64::from(t.pilots);
+        let rms = |sum: f32| (f64::from(sum) / f64::from(t.pilots.max(1))).sqrt();
+        report.trial = Some(TrialReport {
+            pilots: t.pilots,
+            dct: pick == Pick::First,
+            dct_error: rms(t.first),
+            ensemble_error: rms(t.second),
+        });
+    }
     Ok((lf, report))
 }
 

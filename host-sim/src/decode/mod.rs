@@ -10,6 +10,8 @@
 //!   the references for the equivalence, speed and memory claims;
 //! - [`device`]: the device binary's capture, and the check of its log against the host;
 //! - [`preset`]: the named decodes (`preview`, `default`, `best`) on the speed-error curve;
+//! - [`trial`]: the model trial, the DCT or the ensemble per region of the frame by
+//!   their held-out errors on pilot patches;
 //! - [`settings`]: what a user asks of a decode (`slf decode`'s flags, `slf.decode`'s
 //!   keywords), parsed once and resolved to a basis and options.
 //!
@@ -22,3 +24,4 @@ pub mod device;
 pub mod paper_1d;
 pub mod preset;
 pub mod settings;
+pub mod trial;

@@ -405,6 +405,12 @@ pub struct DecodeSettings {
     /// (three more solves a half-pixel block).
     #[arg(long)]
     pub shear_check: bool,
+    /// With an ensemble: pick, per region of 3 x 3 tiles, the ensemble or the DCT it
+    /// screens with by their held-out errors on one pilot patch a tile (each model
+    /// decodes the pilot from seven in eight of its measurements; the one that predicts
+    /// the eighth better decodes the region) [default: true].
+    #[arg(long, value_name = "BOOL")]
+    pub model_trial: Option<bool>,
 }
 
 /// Parses `--plausible`: `FACTOR:MARGIN` or `off`.
@@ -498,6 +504,7 @@ impl DecodeSettings {
             plausibility: self.plausible.unwrap_or(base.plausibility),
             error_estimate: self.estimate || base.error_estimate,
             shear_check: self.shear_check || base.shear_check,
+            model_trial: self.model_trial.unwrap_or(base.model_trial),
             patch_views: self.basis.patch_views.or(base.patch_views),
             schedule: self.schedule,
             ..base

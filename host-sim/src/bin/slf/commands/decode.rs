@@ -169,6 +169,15 @@ pub fn run(args: Args) -> Result<()> {
             r.patches.implausible, r.patches.clipped, p.factor, p.margin
         );
     }
+    if let Some(t) = r.trial {
+        println!(
+            "model trial: decoded by the {} (held-out error over {} pilot patches: DCT {:.5}, ensemble {:.5})",
+            if t.dct { "DCT" } else { "ensemble" },
+            t.pilots,
+            t.dct_error,
+            t.ensemble_error
+        );
+    }
     if let Some(map) = &errors {
         let peak = f64::from(lf.max());
         let psnr = estimated_psnr(map, peak).map_or("none".into(), |p| format!("{p:.2} dB"));

@@ -1,0 +1,133 @@
+//! The model trial: its errors are the held-out estimate's, it picks the model nearer the
+//! truth, and the picked model decodes as it does alone.
+
+mod common;
+
+use common::*;
+use slf_firmware::*;
+
+type Ws = Workspace<5, 5, 4, 4, 13, 5200>;
+type Decoder = TileDecoder<'static, 5, 5, 4, 4, 13, 5200>;
+
+const L5: LensletSize = LensletSize { rows: 5, cols: 5 };
+
+fn frames(l: &[f32], mask: &Mask) -> Vec<RawFrame<'static, f32>> {
+    capture_10x15(l, mask)
+        .into_iter()
+        .map(|f| RawFrame::new(Box::leak(f.into_boxed_slice()), 50, 75).unwrap())
+        .collect()
+}
+
+fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200>>(dec: &Decoder, raw: &[RawFrame<f32>], model: &M) -> Patches {
+    let mut sink = Patches::default();
+    let mut ws = Box::new(Ws::new());
+    let r = dec.decode_frame(model, (2, 3), &mut FrameSource::new(raw), &mut sink, &mut ws);
+    assert_eq!((r.failed_tiles, r.patches.decoded), (0, 24));
+    sink
+}
+
+/// The six blocks of the 10 x 15-lenslet frame.
+fn blocks() -> impl Iterator<Item = (u16, u16)> {
+    (0..2u16).flat_map(|r| (0..3u16).map(move |c| (5 * r, 5 * c)))
+}
+
+#[test]
+fn a_pilots_errors_are_the_held_out_estimates_of_each_model() {
+    let l = rough_light_field(3);
+    let mask = Mask::pixel(4, 3, 13, L5).unwrap();
+    let raw = frames(&l, &mask);
+    let dec = Decoder::new(decoder_config((10, 15), mask)).unwrap();
+    let dct = Dictionary::<5, 5, 4, 4, 13>::dct();
+    let other = random_dictionary::<5, 5, 4, 4, 13>(7);
+    let estimated = |model: &Dictionary<5, 5, 4, 4, 13>| {
+        let dec = dec.with_error_estimate(Some(HoldOut::DEFAULT)).unwrap();
+        decode(&dec, &raw, model).0
+    };
+    let (by_dct, by_other) = (estimated(&dct), estimated(&other));
+    let mut ws = Box::new(Ws::new());
+    for at in blocks() {
+        let t = dec.trial(&dct, &other, at, &mut FrameSource::new(&raw), &mut ws).unwrap();
+        // The block's first window's patch, as the decode with the estimate reports it.
+        let reported = |patches: &[(PatchOrigin, Vec<f32>, PatchReport)]| {
+            let (_, _, r) = patches
+                .iter()
+                .find(|(o, _, _)| (o.lenslet_row, o.lenslet_col, o.view_row, o.view_col) == (at.0, at.1, 0, 0))
+                .unwrap();
+            r.error.unwrap()
+        };
+        let (a, z) = (reported(&by_dct), reported(&by_other));
+        assert_eq!(t.pilots, 1);
+        assert!((t.first.sqrt() - a).abs() <= 1e-6 * a, "{at:?}: {} against {a}", t.first.sqrt());
+        assert!((t.second.sqrt() - z).abs() <= 1e-6 * z, "{at:?}: {} against {z}", t.second.sqrt());
+    }
+}
+
+/// The true RMS error of a frame's patches against the light field.
+fn true_rms(patches: &Patches, l: &[f32]) -> f64 {
+    let (mut e2, mut n) = (0.0f64, 0.0f64);
+    for (o, p, _) in &patches.0 {
+        for (i, &x) in p.iter().enumerate() {
+            let [s, t, u, v, b] = PaperShape::coordinates(i);
+            let (s, t) = (o.lenslet_row as usize + s, o.lenslet_col as usize + t);
+            let (u, v) = (o.view_row as usize + u, o.view_col as usize + v);
+            e2 += (f64::from(x) - f64::from(l[((((s * 15) + t) * 5 + u) * 5 + v) * 13 + b])).powi(2);
+            n += 1.0;
+        }
+    }
+    (e2 / n).sqrt()
+}
+
+#[test]
+fn the_trial_picks_the_model_nearer_the_truth_in_either_order() {
+    for (seed, mask) in [(3, Mask::pixel(4, 3, 13, L5).unwrap()), (4, Mask::pixel(4, 1, 13, L5).unwrap())] {
+        let l = rough_light_field(seed);
+        let raw = frames(&l, &mask);
+        let dec = Decoder::new(decoder_config((10, 15), mask)).unwrap();
+        let dct = Dictionary::<5, 5, 4, 4, 13>::dct();
+        // A member the scene is not sparse in: the DCT's neighbour in a random rotation.
+        let other = random_dictionary::<5, 5, 4, 4, 13>(seed + 10);
+        let truth = [true_rms(&decode(&dec, &raw, &dct), &l), true_rms(&decode(&dec, &raw, &other), &l)];
+        let nearer = if truth[0] < truth[1] { Pick::First } else { Pick::Second };
+        let mut ws = Box::new(Ws::new());
+        let (mut forward, mut backward) = (TrialErrors::default(), TrialErrors::default());
+        for at in blocks() {
+            forward.add(&dec.trial(&dct, &other, at, &mut FrameSource::new(&raw), &mut ws).unwrap());
+            backward.add(&dec.trial(&other, &dct, at, &mut FrameSource::new(&raw), &mut ws).unwrap());
+        }
+        assert_eq!(forward.pilots, 6);
+        // Both orders: a trial that always said "first" (or "second") fails one of them.
+        assert_eq!(forward.pick(), nearer, "seed {seed}: true RMS {truth:?}, trial {forward:?}");
+        let flipped = if nearer == Pick::First { Pick::Second } else { Pick::First };
+        assert_eq!(backward.pick(), flipped, "seed {seed}: true RMS {truth:?}, trial {backward:?}");
+    }
+}
+
+#[test]
+fn the_picked_model_decodes_as_it_does_alone() {
+    let l = rough_light_field(5);
+    let mask = Mask::pixel(4, 3, 13, L5).unwrap();
+    let raw = frames(&l, &mask);
+    let dec = Decoder::new(decoder_config((10, 15), mask)).unwrap();
+    let dct = Dictionary::<5, 5, 4, 4, 13>::dct();
+    let other = random_dictionary::<5, 5, 4, 4, 13>(9);
+    let (by_dct, by_other) = (decode(&dec, &raw, &dct), decode(&dec, &raw, &other));
+    let first = decode(&dec, &raw, &Picked { first: &dct, second: &other, pick: Pick::First });
+    let second = decode(&dec, &raw, &Picked { first: &dct, second: &other, pick: Pick::Second });
+    let values = |p: &Patches| p.0.iter().map(|(o, v, _)| (*o, v.clone())).collect::<Vec<_>>();
+    assert_eq!(values(&first), values(&by_dct));
+    assert_eq!(values(&second), values(&by_other));
+    assert_ne!(values(&by_dct), values(&by_other));
+}
+
+#[test]
+fn the_pick_is_the_smaller_sum_and_the_second_without_pilots_or_on_a_tie() {
+    assert_eq!(TrialErrors::default().pick(), Pick::Second);
+    let mut t = TrialErrors { first: 1.0, second: 2.0, pilots: 1 };
+    assert_eq!(t.pick(), Pick::First);
+    t.add(&TrialErrors { first: 3.0, second: 1.0, pilots: 1 });
+    assert_eq!(t, TrialErrors { first: 4.0, second: 3.0, pilots: 2 });
+    assert_eq!(t.pick(), Pick::Second);
+    assert_eq!(TrialErrors { first: 2.0, second: 2.0, pilots: 3 }.pick(), Pick::Second);
+    // No pilot: the sums say nothing.
+    assert_eq!(TrialErrors { first: 0.0, second: 5.0, pilots: 0 }.pick(), Pick::Second);
+}

@@ -1,0 +1,51 @@
+//! The model trial on the workstation: the DCT or the screened ensemble for the frame,
+//! picked by their held-out errors on pilot patches ([`slf_firmware::trial`]).
+//!
+//! The pilots are the first blocks of the disjoint grid's tiles, at most [`MAX_PILOTS`]
+//! spread evenly over the frame. A pilot costs both models' decodes (the DCT's one solve and
+//! the ensemble's two): 3 solves a tile of 36 patches at stride 2 on a small frame, a fixed
+//! 192 on a large one.
+//!
+//! Why one pick for the frame, not per region: a pilot's held-out error is a noisy
+//! sample (about 78 held-out measurements, or 9 held-out (lenslet, band) groups on a lenslet
+//! mask). Picked per region of 3 x 3 tiles, the smooth scene at lenslet k = 3 went to the
+//! DCT in 16 of 25 regions, where the frame's pilots together favour the ensemble by 1.7
+//! times (0.0086 against 0.0111 RMS) and the ensemble decodes it 0.5 dB better
+//! (`docs/results-model-trial.md`).
+
+use rayon::prelude::*;
+use slf_firmware::{FrameSource, PatchModel, RawFrame, Tile, TileDecoder, TrialErrors, Workspace};
+
+/// The most pilots a frame's trial takes.
+pub const MAX_PILOTS: usize = 64;
+
+/// The model trial over `tiles` (the disjoint grid's): one pilot on each of at most
+/// [`MAX_PILOTS`] of them, evenly spaced, in parallel; their errors summed.
+pub fn frame_trial<const PU: usize, const PV: usize, const N: usize, A, Z>(
+    decoder: &TileDecoder<'_, 5, 5, PU, PV, 13, N>,
+    first: &A,
+    second: &Z,
+    raw: &[RawFrame<'_, u16>],
+    tiles: &[Tile],
+) -> TrialErrors
+where
+    A: PatchModel<5, 5, PU, PV, 13, N> + Sync,
+    Z: PatchModel<5, 5, PU, PV, 13, N> + Sync,
+{
+    let step = tiles.len().div_ceil(MAX_PILOTS).max(1);
+    tiles
+        .par_iter()
+        .step_by(step)
+        .map_init(
+            || Box::new(Workspace::<5, 5, PU, PV, 13, N>::new()),
+            |ws, t| {
+                let mut source = FrameSource::new(raw);
+                let at = (t.lenslet_row, t.lenslet_col);
+                decoder.trial(first, second, at, &mut source, ws).unwrap_or_default()
+            },
+        )
+        .reduce(TrialErrors::default, |mut a, b| {
+            a.add(&b);
+            a
+        })
+}
