@@ -5,10 +5,12 @@
 //! lenslets x all 5 x 5 views x 13 bands) with the shipped 8-member full-view ensemble and
 //! screened member choice, and prints over semihosting every decoded patch
 //! (f32 bit patterns) for `slf device-check` to compare with the host's decode. Then it
-//! decodes the same tiles with the 5D DCT, and last the whole frame with overlapping
-//! patches (stride 3, tapered window) through a strip of lenslet rows, printing each
-//! finished row. `bench_begin` / `bench_end` bracket one synthesis, then each ensemble
-//! tile, then each DCT tile, then the overlapped frame, then one block's disparity
+//! decodes the same tiles with the 5D DCT, runs the model trial (a pilot on each tile's
+//! block: the DCT against the ensemble by their held-out errors, printed with its pick), and
+//! last decodes the whole frame with the picked model in overlapping patches (stride 3,
+//! tapered window) through a strip of lenslet rows, printing each finished row.
+//! `bench_begin` / `bench_end` bracket one synthesis, then each ensemble tile, then each
+//! DCT tile, then each pilot, then the overlapped frame, then one block's disparity
 //! choice, then the DCT tiles sheared to whole and to half-pixel disparities, then a real
 //! sensor's tiles uncalibrated, calibrated, and with the error estimate, so the qemu plugin
 //! `scripts/wincount/wincount.c` counts instructions per transform and per patch. The
@@ -46,8 +48,9 @@ mod device {
     use slf_firmware::{
         ChoiceRule, DEFAULT_FULL_VIEW_ENSEMBLE, DecoderConfig, DefectList, Dictionary, Disparity, DisparityRange,
         Ensemble, EnsembleModel, FrameSource, FullViewShape, FullViewWorkspace, HoldOut, LeU16Frame, LensletSize, Mask,
-        MemberChoice, Overlap, OverlapDecoder, PatchModel, PatchOrigin, PatchReport, PatchSink, Pixel, RawFormat,
-        Response, ResponseModel, RowSink, SensorGeometry, Sl0Config, TileDecoder,
+        MemberChoice, Overlap, OverlapDecoder, PatchModel, PatchOrigin, PatchReport, PatchSink, Pick, Picked, Pixel,
+        RawFormat, Response, ResponseModel, RowSink, ScheduledDictionary, SensorGeometry, Sl0Config, TileDecoder,
+        TrialErrors,
     };
 
     use super::{bench_begin, bench_end};
@@ -329,6 +332,41 @@ mod device {
         let _ = dct.decode(&Sl0Config::DEFAULT, ws);
         let disjoint_stack = crate::stack::peak();
 
+        // Window 11: the model trial, a pilot on every tile's block: the DCT on the
+        // ensemble's schedules against the ensemble, by their held-out errors. The picked
+        // model decodes the overlapped frame; `slf device-check` runs the same trial.
+        let Some(scheduled) = model.schedules().copied().and_then(|schedules| {
+            cortex_m::singleton!(: ScheduledDictionary<5, 5, 5, 5, 13> = ScheduledDictionary { dictionary: Dictionary::dct(), schedules })
+        }) else {
+            hprintln!("error: the shipped ensemble has no trained schedules");
+            return debug::EXIT_FAILURE;
+        };
+        let mut trial = TrialErrors::default();
+        for tile in decoder.tiles((1, 1)) {
+            bench_begin(11);
+            let r = decoder.trial(
+                &*scheduled,
+                &model,
+                (tile.lenslet_row, tile.lenslet_col),
+                &mut FrameSource::new(&frames),
+                ws,
+            );
+            bench_end(11);
+            match r {
+                Ok(t) => trial.add(&t),
+                Err(_) => failed += 1,
+            }
+        }
+        let pick = trial.pick();
+        hprintln!(
+            "trial pilots {} dct {:08x} ensemble {:08x} pick {}",
+            trial.pilots,
+            trial.first.to_bits(),
+            trial.second.to_bits(),
+            if pick == Pick::First { "dct" } else { "ensemble" }
+        );
+        let picked = Picked { first: &*scheduled, second: &model, pick };
+
         // Window 3: the whole frame with overlapping patches (the host's default stride 3,
         // tapered window) through the strip, printed row by row for `slf device-check`.
         let Some(strip) = cortex_m::singleton!(: [f32; STRIP_LEN] = [0.0; STRIP_LEN]) else {
@@ -347,7 +385,7 @@ mod device {
         let mut rows = PrintRows { checksum: 0, rows: 0 };
         hprintln!("overlap stride 3 tapered disparities -1..1 strip columns {}", STRIP_COLUMNS);
         bench_begin(3);
-        let r = overlapped.decode_frame(&model, &mut FrameSource::new(&frames), strip, &mut rows, ws);
+        let r = overlapped.decode_frame(&picked, &mut FrameSource::new(&frames), strip, &mut rows, ws);
         bench_end(3);
         match r {
             Ok(r) => {

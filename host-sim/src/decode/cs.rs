@@ -230,9 +230,9 @@ fn decode_basis<const PU: usize, const PV: usize, const N: usize>(
             match model.schedules().copied() {
                 Some(schedules) => {
                     let dct = slf_firmware::ScheduledDictionary { dictionary, schedules };
-                    decode_picked::<PU, PV, N, _, _>(capture, &dct, &model, true, opts, observer)
+                    decode_picked::<PU, PV, N, _, _>(capture, &dct, &model, None, opts, observer)
                 }
-                None => decode_picked::<PU, PV, N, _, _>(capture, &dictionary, &model, true, opts, observer),
+                None => decode_picked::<PU, PV, N, _, _>(capture, &dictionary, &model, None, opts, observer),
             }
         }
     }
@@ -748,11 +748,11 @@ pub fn decode_observed<const PU: usize, const PV: usize, const N: usize, M: Patc
     opts: &DecodeOptions,
     observer: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<(LightField, DecodeReport)> {
-    decode_picked(capture, model, model, false, opts, observer)
+    decode_picked(capture, model, model, Some(Pick::Second), opts, observer)
 }
 
-/// [`decode_observed`] with two models: with `trial`, decoded by the one the model trial
-/// picks for the frame ([`crate::decode::trial`]); without, by `second` alone.
+/// [`decode_observed`] with two models: decoded by the one `pick` names, or (`None`) by the
+/// one the model trial picks for the frame ([`crate::decode::trial`]).
 ///
 /// # Errors
 /// As [`decode`].
@@ -760,7 +760,7 @@ pub fn decode_picked<const PU: usize, const PV: usize, const N: usize, A, Z>(
     capture: &Capture,
     first: &A,
     second: &Z,
-    trial: bool,
+    pick: Option<Pick>,
     opts: &DecodeOptions,
     observer: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<(LightField, DecodeReport)>
@@ -802,8 +802,8 @@ where
     let views = (d.views[0], d.views[1]);
     let range = decoder.config().raw.range();
     let halo = decoder.disparities().halo(views.0.max(views.1));
-    let trialled = trial.then(|| frame_trial(&decoder, first, second, &raw, &base));
-    let pick = trialled.map_or(Pick::Second, |t| t.pick());
+    let trialled = pick.is_none().then(|| frame_trial(&decoder, first, second, &raw, &base));
+    let pick = pick.or(trialled.map(|t| t.pick())).unwrap_or_default();
     let model = Picked { first, second, pick };
     let model = &model;
     let run = |tiles: &[Tile], prior: Option<&LightField>| -> Vec<(TileSums<PU, PV>, Result<TileReport, String>)> {

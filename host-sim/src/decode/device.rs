@@ -9,7 +9,9 @@
 //! than 1e-5 relative (to the patch's largest magnitude). The rows of the device's
 //! overlapped decode (its strip) are checked the same way against the host's default decode
 //! (stride 3, tapered window) with every patch decoded from nothing (not seeded, as the
-//! device's strip decodes), relative to the light field's largest magnitude.
+//! device's strip decodes), relative to the light field's largest magnitude. The device's
+//! model trial (one pilot a tile, [`slf_firmware::trial`]) must print the host's sums to
+//! 1e-5 relative and its pick; its overlapped frame is decoded by the picked model.
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -17,7 +19,7 @@ use std::path::Path;
 use anyhow::{Context, Result, bail, ensure};
 use slf_firmware::{
     ChoiceRule, DEFAULT_FULL_VIEW_ENSEMBLE, Ensemble, EnsembleModel, FrameSource, MemberChoice, PatchOrigin,
-    PatchReport, PatchSink, Pixel,
+    PatchReport, PatchSink, Pick, Pixel, ScheduledDictionary, TrialErrors,
 };
 
 use crate::decode::calibrate::calibrate;
@@ -234,6 +236,8 @@ struct DeviceLog {
     /// The real sensor's calibrated decode: its patches and white balance.
     calibrated: HashMap<PatchOrigin, DevicePatch>,
     calibrated_gains: Vec<f32>,
+    /// The model trial's pilots, sums of squared errors (DCT, ensemble) and pick.
+    trial: Option<(u32, f32, f32, String)>,
 }
 
 /// Which printed block the `data` lines belong to.
@@ -249,6 +253,7 @@ fn parse(log: &str) -> Result<DeviceLog> {
     let mut done = None;
     let mut gains = Vec::new();
     let (mut calibrated, mut calibrated_gains) = (HashMap::new(), Vec::new());
+    let mut trial = None;
     // After the `calibrated gains` line, patches are the real sensor's calibrated decode.
     let mut in_calibrated = false;
     for (i, line) in log.lines().enumerate() {
@@ -296,6 +301,17 @@ fn parse(log: &str) -> Result<DeviceLog> {
                     values.push(f32::from_bits(bits));
                 }
             }
+            Some("trial") => {
+                // trial pilots N dct BITS ensemble BITS pick NAME
+                ensure!(w.len() == 9, "line {}: a trial line has 9 words", i + 1);
+                let bits = |h: &str| {
+                    u32::from_str_radix(h, 16)
+                        .map(f32::from_bits)
+                        .with_context(|| format!("line {}: bad hex {h:?}", i + 1))
+                };
+                let pilots = w[2].parse::<u32>().with_context(|| format!("line {}: bad pilots {:?}", i + 1, w[2]))?;
+                trial = Some((pilots, bits(w[4])?, bits(w[6])?, w[8].to_string()));
+            }
             Some("done") => {
                 done = Some(w.get(1).and_then(|x| x.strip_prefix("patches=")).and_then(|x| x.parse().ok()).unwrap_or(0))
             }
@@ -303,7 +319,7 @@ fn parse(log: &str) -> Result<DeviceLog> {
         }
     }
     let count = done.context("the device log has no `done` line: the run did not finish")?;
-    Ok(DeviceLog { patches, rows, count, gains, calibrated, calibrated_gains })
+    Ok(DeviceLog { patches, rows, count, gains, calibrated, calibrated_gains, trial })
 }
 
 struct Collect(HashMap<PatchOrigin, (u16, Vec<f32>)>);
@@ -338,7 +354,7 @@ pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
     // A log is read whole only if it is a regular file of a log's size: a FIFO would block,
     // /dev/zero never end.
     let text = crate::io::capture::read_small_file(log, MAX_LOG)?;
-    let DeviceLog { patches: device, rows, count, gains, calibrated, calibrated_gains } = parse(&text)?;
+    let DeviceLog { patches: device, rows, count, gains, calibrated, calibrated_gains, trial } = parse(&text)?;
     let capture = Capture::load(capture_dir)?;
     // The device decodes full-view patches with the shipped full-view ensemble.
     let ensemble = Ensemble::<5, 5, 5, 5, 13>::new(DEFAULT_FULL_VIEW_ENSEMBLE).map_err(|e| anyhow::anyhow!("{e}"))?;
@@ -382,7 +398,35 @@ pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
     if !within(worst) {
         bail!("the device's patches differ from the host's by {worst:.2e} relative");
     }
-    check_rows(&rows, &capture, &model)?;
+    // The model trial: the same pilots (every tile's block, unsheared), the same sums.
+    let schedules = model.schedules().copied().context("the shipped ensemble has no trained schedules")?;
+    let dct = ScheduledDictionary { dictionary: slf_firmware::Dictionary::dct(), schedules };
+    let mut host_trial = TrialErrors::default();
+    for tile in decoder.tiles((1, 1)) {
+        let at = (tile.lenslet_row, tile.lenslet_col);
+        let t = decoder
+            .trial(&dct, &model, at, &mut FrameSource::new(&raw), &mut ws)
+            .map_err(|e| anyhow::anyhow!("{e}"))?;
+        host_trial.add(&t);
+    }
+    let pick = host_trial.pick();
+    let name = if pick == Pick::First { "dct" } else { "ensemble" };
+    let (pilots, first, second, device_pick) = trial.context("the device log has no `trial` line")?;
+    let rel = |a: f32, b: f32| f64::from((a - b).abs() / b.abs().max(f32::MIN_POSITIVE));
+    let worst_trial = worse(rel(first, host_trial.first), rel(second, host_trial.second));
+    println!(
+        "device vs host: model trial over {pilots} pilots picks the {device_pick} on both, errors differ by {worst_trial:.2e} \
+         relative (limit 1e-5)"
+    );
+    ensure!(
+        pilots == host_trial.pilots && device_pick == name && within(worst_trial),
+        "the device's model trial ({pilots} pilots, {first}, {second}, {device_pick}) differs from the host's ({}, {}, \
+         {}, {name})",
+        host_trial.pilots,
+        host_trial.first,
+        host_trial.second
+    );
+    check_rows(&rows, &capture, &dct, &model, pick)?;
     let dir = capture_dir.parent().unwrap_or(Path::new("."));
     check_calibrated(&calibrated, &calibrated_gains, &dir.join(SENSOR_CAPTURE), &dir.join(CALIBRATION), &model)
 }
@@ -460,7 +504,9 @@ fn check_calibrated(
 fn check_rows(
     rows: &HashMap<(usize, usize), Vec<f32>>,
     capture: &Capture,
+    dct: &ScheduledDictionary<5, 5, 5, 5, 13>,
     model: &EnsembleModel<'_, 5, 5, 5, 5, 13>,
+    pick: Pick,
 ) -> Result<()> {
     // The device's strip decodes every patch from nothing: the seeded decode needs the
     // disjoint grid's sums kept apart from the rest, rows ahead of the walk and columns
@@ -473,7 +519,9 @@ fn check_rows(
         patch_views: Some(crate::decode::cs::PatchViews::Five),
         ..Default::default()
     };
-    let (lf, _) = crate::decode::cs::decode::<5, 5, 8125, _>(capture, model, &opts)?;
+    // With the model the trial picked (the device's, checked above).
+    let (lf, _) =
+        crate::decode::cs::decode_picked::<5, 5, 8125, _, _>(capture, dct, model, Some(pick), &opts, &|_, _| {})?;
     let per_col = lf.views.0 * lf.views.1 * lf.bands;
     let mut covered = vec![false; lf.rows * lf.cols];
     let scale = lf.data.iter().fold(0.0f32, |m, x| m.max(x.abs())).max(f32::MIN_POSITIVE);
