@@ -36,6 +36,9 @@ run() {
   reg=$(echo "$log" | sed -n 's/^model trial: decoded by the \([A-Za-z]*\) (held-out error over [0-9]* pilot patches: DCT \([0-9.]*\), ensemble \([0-9.]*\)).*/\1 \2 \3/p')
   p=$("$slf" eval "$lf" "$out/rec.npy" | awk '/^PSNR/ { print $2 }')
 }
+# Per setting: cases, cases within 0.1 dB of the better of before and dct, the worst
+# trial - best, and the same two for before (the default without the trial) and for dct.
+declare -A cases near worst bnear bworst dnear dworst secs_b secs_t
 for token in $scenes; do
   scene_light_field "$token"
   for s in ${SLF_SETTINGS:-pixel:1 pixel:3 lenslet:3}; do
@@ -44,7 +47,28 @@ for token in $scenes; do
     run --dictionary dct; pd=$p; td=$t
     run; pt=$p; tt=$t; st=$sp; read -r who ed ee <<< "$reg"; rt="$who ($ed, $ee)"
     best=$(echo "if ($pb > $pd) $pb else $pd" | bc -l)
+    key="$mask k=$k"
+    cases[$key]=$(( ${cases[$key]:-0} + 1 ))
+    secs_b[$key]=$(echo "${secs_b[$key]:-0} + $tb" | bc -l)
+    secs_t[$key]=$(echo "${secs_t[$key]:-0} + $tt" | bc -l)
+    for v in t:$pt b:$pb d:$pd; do
+      who=${v%%:*}; x=${v#*:}; gap=$(echo "$x - $best" | bc -l)
+      case $who in t) n=near; w=worst ;; b) n=bnear; w=bworst ;; d) n=dnear; w=dworst ;; esac
+      if [ "$(echo "$gap >= -0.1" | bc -l)" = 1 ]; then eval "$n[\$key]=\$(( \${$n[\$key]:-0} + 1 ))"; fi
+      eval "old=\${$w[\$key]:-0}"
+      if [ "$(echo "$gap < $old" | bc -l)" = 1 ]; then eval "$w[\$key]=\$gap"; fi
+    done
     printf '| %s | %s k=%s | %.2f | %.2f | %.2f | %+.2f | %s | %s / %s / %s | %s / %s |\n' "$scene" "$mask" "$k" \
       "$pb" "$pd" "$pt" "$(echo "$pt - $best" | bc -l)" "$rt" "$tb" "$td" "$tt" "$sb" "$st"
   done
 done
+echo
+echo "Within 0.1 dB of the better of the two models, of the scenes (the worst gap in brackets):"
+echo
+echo "| setting | scenes | trial | before (ensemble everywhere) | dct everywhere | seconds, trial / before (sum over the scenes) |"
+echo "| --- | --- | --- | --- | --- | --- |"
+for key in "${!cases[@]}"; do
+  printf '| %s | %s | %s (%+.2f) | %s (%+.2f) | %s (%+.2f) | %.1f / %.1f = %.2f |\n' "$key" "${cases[$key]}" "${near[$key]:-0}" \
+    "${worst[$key]:-0}" "${bnear[$key]:-0}" "${bworst[$key]:-0}" "${dnear[$key]:-0}" "${dworst[$key]:-0}" \
+    "${secs_t[$key]}" "${secs_b[$key]}" "$(echo "${secs_t[$key]} / ${secs_b[$key]}" | bc -l)"
+done | sort
