@@ -29,7 +29,7 @@
 //!   synthesis and analysis transforms.
 //! - **solver** ([`solver`]: [`error`](solver::error), [`workspace`], [`sl0`], [`ascent`],
 //!   [`ball`], [`projection`], [`mixing`], [`fractional`], [`pinv`], [`fill`](solver::fill), [`choice`],
-//!   [`interpolate`], [`plausible`], [`holdout`]): the caller-owned workspace every path works in, nD SL0 (its hand-set
+//!   [`picked`], [`interpolate`], [`plausible`], [`holdout`]): the caller-owned workspace every path works in, nD SL0 (its hand-set
 //!   schedule, or the trained ones a blob carries) with the
 //!   orthonormal fast path and its cold start from the band-gain fill, the
 //!   noise ball a projection moves onto, the projection for filters whose response mixes
@@ -38,13 +38,14 @@
 //!   masks, the choice of an ensemble member per patch (exhaustive or screened, or seeded:
 //!   one solve from an estimate of the patch), and per-pixel spectral interpolation for
 //!   patches that measure too few distinct bands; the plausibility check of a decoded
-//!   patch against what its measurements allow; and a patch's estimate of its own error
-//!   from measurements held out of a solve.
-//! - **decode** ([`decode`]: [`tile`], [`overlap`]): a rectangle of the raw frame, patch by
+//!   patch against what its measurements allow; a patch's estimate of its own error
+//!   from measurements held out of a solve; and two models, one of which decodes.
+//! - **decode** ([`decode`]: [`tile`], [`overlap`], [`trial`]): a rectangle of the raw frame, patch by
 //!   patch, from a [`TileSource`] to a [`PatchSink`], into a caller-owned [`Workspace`]
 //!   (each patch from nothing, or from a [`PatchSeed`]'s estimate); and
 //!   patches at a stride below the patch size, averaged with a [`Window`] into a
-//!   caller-owned strip of lenslet rows, finished rows to a [`RowSink`].
+//!   caller-owned strip of lenslet rows, finished rows to a [`RowSink`]; and the model
+//!   trial, which of two models decodes a frame by their held-out errors on pilot patches.
 //!
 //! Each module is also at the crate root under its name of before the folders
 //! (`slf_firmware::transform`, `slf_firmware::tile`, ...), so integrators' paths still hold.

@@ -380,9 +380,12 @@ pub struct DecodeOptions {
     /// Whether half-pixel disparities are checked against the whole ones by the held-out
     /// error estimate ([`TileDecoder::with_shear_check`]). Off by default.
     pub shear_check: bool,
-    /// Whether an ensemble decode picks, per region, the ensemble or the DCT it screens
-    /// with by their held-out errors on pilot patches ([`crate::decode::trial`]). On by
-    /// default; the DCT's decode and the hand-set schedule's ignore it.
+    /// Whether an ensemble decode picks, for the frame, the ensemble or the DCT it screens
+    /// with by their held-out errors on pilot patches ([`crate::decode::trial`]). Off here,
+    /// where a decode measures the ensemble itself (`slf compare`, `slf evaluate`'s
+    /// ensemble rows, the bench's choice points); on in the default and best presets
+    /// ([`crate::decode::preset::Preset::options`]), which `slf decode` and `slf.decode`
+    /// run. A DCT decode ignores it.
     pub model_trial: bool,
 }
 
@@ -418,7 +421,7 @@ impl Default for DecodeOptions {
             plausibility: Plausibility::DEFAULT,
             error_estimate: false,
             shear_check: false,
-            model_trial: true,
+            model_trial: false,
         }
     }
 }

@@ -12,7 +12,9 @@
 //! - [`Preset::Default`]: the screened ensemble on full-view patches at stride 2 with the
 //!   tapered window, the capture's disparities (half pixels at one snapshot), seeded, with
 //!   the blob's trained schedules (24 steps the DCT's cold solve, 16 a member's or a seeded
-//!   solve): what `slf decode` does unless told.
+//!   solve), the frame given to the DCT instead where the model trial's pilots say it
+//!   predicts held-out measurements better ([`crate::decode::trial`]): what `slf decode`
+//!   does unless told.
 //! - [`Preset::Best`]: the default at stride 1, where every lenslet is covered by every
 //!   patch that holds it: 25 instead of 9 times the disjoint grid's patches.
 //!
@@ -35,7 +37,8 @@ pub enum Preset {
     /// whole-pixel shears without the edge fallback, one trained solve a patch from the
     /// band-gain fill (sigma floored at 3e-3).
     Preview,
-    /// The screened ensemble at stride 2 with the capture's disparities.
+    /// The screened ensemble at stride 2 with the capture's disparities (or the DCT, where
+    /// the model trial's pilots favour it).
     Default,
     /// The default at stride 1: slower, measured to gain.
     Best,
@@ -65,8 +68,8 @@ impl Preset {
                 edge_fallback: false,
                 ..DecodeOptions::default()
             },
-            Self::Default => DecodeOptions::default(),
-            Self::Best => DecodeOptions { stride: (1, 1), ..DecodeOptions::default() },
+            Self::Default => DecodeOptions { model_trial: true, ..DecodeOptions::default() },
+            Self::Best => DecodeOptions { stride: (1, 1), model_trial: true, ..DecodeOptions::default() },
         }
     }
 
