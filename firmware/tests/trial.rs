@@ -131,3 +131,46 @@ fn the_pick_is_the_smaller_sum_and_the_second_without_pilots_or_on_a_tie() {
     // No pilot: the sums say nothing.
     assert_eq!(TrialErrors { first: 0.0, second: 5.0, pilots: 0 }.pick(), Pick::Second);
 }
+
+/// A scene at half a pixel of disparity (each view of lenslet `(s, t)` sees the point
+/// `(s + d (u - 2), t + d (v - 2))` of a smooth texture), in the layout of
+/// [`rough_light_field`].
+fn sheared_light_field(d: f32) -> Vec<f32> {
+    let f = |y: f32, x: f32, b: usize| {
+        let b = b as f32;
+        0.45 + 0.2 * (0.9 * y + 0.3 * b).sin() * (0.7 * x - 0.2 * b).cos() + 0.1 * (0.4 * x + 0.5 * y).sin()
+    };
+    let mut l = vec![0.0; 10 * 15 * 25 * 13];
+    for (i, x) in l.iter_mut().enumerate() {
+        let (b, v, u, t, s) = (i % 13, (i / 13) % 5, (i / 65) % 5, (i / 325) % 15, i / (325 * 15));
+        *x = f(s as f32 + d * (u as f32 - 2.0), t as f32 + d * (v as f32 - 2.0), b);
+    }
+    l
+}
+
+#[test]
+fn the_shear_trial_pilots_half_pixel_blocks_and_finds_a_true_half_disparity_better() {
+    let mask = Mask::pixel(4, 1, 13, L5).unwrap();
+    let dct = Dictionary::<5, 5, 4, 4, 13>::dct();
+    let mut ws = Box::new(Ws::new());
+    let halves = DisparityRange::DEFAULT.with_halves(true);
+    // At a whole disparity (0: every view alike) no block is a pilot.
+    let raw = frames(&rough_light_field(3), &mask);
+    let dec = Decoder::new(decoder_config((10, 15), mask)).unwrap().with_disparities(halves);
+    for at in blocks() {
+        let t = dec.shear_trial(&dct, at, &mut FrameSource::new(&raw), &mut ws).unwrap();
+        assert_eq!(t, TrialErrors::default(), "{at:?}");
+    }
+    // At half a pixel, the inner blocks are pilots, and the half disparity predicts their
+    // held-out measurements better than the whole ones beside it.
+    let raw = frames(&sheared_light_field(0.5), &mask);
+    let mut sum = TrialErrors::default();
+    for at in blocks() {
+        let d = dec.choose_disparity(at.0 as usize, at.1 as usize, &mut FrameSource::new(&raw)).unwrap();
+        let t = dec.shear_trial(&dct, at, &mut FrameSource::new(&raw), &mut ws).unwrap();
+        assert_eq!(t.pilots, u32::from(!d.is_whole()), "{at:?} at {d:?}");
+        sum.add(&t);
+    }
+    assert!(sum.pilots >= 2, "{sum:?}");
+    assert!(sum.first < sum.second, "half {} against whole {}", sum.first.sqrt(), sum.second.sqrt());
+}

@@ -1075,17 +1075,19 @@ fn a_dark_canopy_decodes_without_a_blow_up_even_unchecked() {
 
 /// Issue 49, item 4: fine print at 0.7 pixels per view, whose half-pixel shears alias. The
 /// shear check (the held-out estimate of a half-pixel block against its whole neighbours)
-/// moves most blocks to whole shears and decodes far better; without the check, the decode
-/// is the one of before.
+/// moves most blocks to whole shears and decodes far better, and so does the shear trial
+/// (the default: the frame's pilots together), which says so; without either
+/// (`--shear-trial false`), the decode is the one of before.
 #[test]
-fn the_shear_check_takes_whole_shears_where_half_ones_alias() {
+fn the_shear_check_and_trial_take_whole_shears_where_half_ones_alias() {
     let dir = tempfile::tempdir().unwrap();
     let p = |name: &str| dir.path().join(name);
     stdout(slf().args(["scene", "print", "--size", "40", "-o"]).arg(p("truth.npy")));
     stdout(slf().arg("simulate").arg(p("truth.npy")).arg("-o").arg(p("cap")).args(["--seed", "2"]));
     let mut psnr = Vec::new();
-    for flags in [&[][..], &["--shear-check"]] {
+    for flags in [&["--shear-trial", "false"][..], &["--shear-trial", "false", "--shear-check"], &[]] {
         let out = stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("r.npy")).arg("-q").args(flags));
+        assert_eq!(out.contains("shear trial: whole disparities only: the half ones alias"), flags.is_empty(), "{out}");
         let halves: usize = out
             .lines()
             .find_map(|l| l.strip_prefix("disparity: blocks per disparity "))
@@ -1100,9 +1102,11 @@ fn the_shear_check_takes_whole_shears_where_half_ones_alias() {
         let eval = stdout(slf().arg("eval").arg(p("truth.npy")).arg(p("r.npy")));
         psnr.push((eval.split_whitespace().nth(1).unwrap().parse::<f64>().unwrap(), halves));
     }
-    let ((plain, plain_halves), (checked, checked_halves)) = (psnr[0], psnr[1]);
+    let ((plain, plain_halves), (checked, checked_halves), (trial, trial_halves)) = (psnr[0], psnr[1], psnr[2]);
     assert!(checked_halves * 2 < plain_halves, "{plain_halves} -> {checked_halves} half-pixel blocks");
     assert!(checked > plain + 5.0, "{plain:.2} -> {checked:.2} dB");
+    assert_eq!(trial_halves, 0, "the trial's decode has whole disparities only");
+    assert!(trial > plain + 5.0, "{plain:.2} -> {trial:.2} dB");
 }
 
 /// Issue 49, item 2: the model trial. The default decodes the frame with the model whose

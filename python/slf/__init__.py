@@ -330,6 +330,7 @@ def decode(
     plausible: Union[None, str, Tuple[float, float]] = None,
     shear_check: bool = False,
     model_trial: Optional[bool] = None,
+    shear_trial: Optional[bool] = None,
     error_map: bool = False,
     threads: Optional[int] = None,
     progress: Any = None,
@@ -362,7 +363,9 @@ def decode(
     ``adaptive`` and the solver's ``sigma_f`` ... ``min_bands``, ``plausible``,
     ``shear_check``, ``model_trial`` (the ensemble or the DCT for the frame by their
     held-out errors on pilot patches; default True: ``report["trial"]`` says which and the
-    errors), ``error_map``.
+    errors), ``shear_trial`` (whole disparities only for the frame where pilot patches
+    estimate them clearly better than the half-pixel ones; default True:
+    ``report["shear_trial"]``), ``error_map``.
 
     ``threads``: threads of this decode (None: one per core; 1 inside a Dask task).
     ``progress``: True for a bar (tqdm if installed), or a callable ``f(done, total)``
@@ -377,6 +380,8 @@ def decode(
         seeded = "true" if seeded else "false"  # type: ignore[assignment]
     if model_trial is not None:
         model_trial = "true" if model_trial else "false"  # type: ignore[assignment]
+    if shear_trial is not None:
+        shear_trial = "true" if shear_trial else "false"  # type: ignore[assignment]
     if isinstance(plausible, (list, tuple)):
         plausible = ":".join(f"{p:g}" for p in plausible)
     if blob is not None:
@@ -420,6 +425,7 @@ def decode(
         plausible=plausible,
         shear_check=shear_check,
         model_trial=model_trial,
+        shear_trial=shear_trial,
         estimate=True if error_map else None,
     )
     frames = _raw_frames(cap.frames)

@@ -108,6 +108,14 @@ pub fn decode<'py>(
                 let map = disparity_per_lenslet(&r.disparity_map, rows, cols);
                 report.set_item("disparity", plane(py, map, rows, cols)?)?;
             }
+            if let Some(t) = &r.shear_trial {
+                let trial = PyDict::new(py);
+                trial.set_item("halves", t.halves)?;
+                trial.set_item("pilots", t.pilots)?;
+                trial.set_item("half_error", t.half_error)?;
+                trial.set_item("whole_error", t.whole_error)?;
+                report.set_item("shear_trial", trial)?;
+            }
             if let Some(t) = &r.trial {
                 let trial = PyDict::new(py);
                 trial.set_item("model", if t.dct { "dct" } else { "ensemble" })?;

@@ -92,6 +92,7 @@ def test_a_calibrated_decode_equals_cli(tmp_path, slf_bin, depth):
         (["--plausible", "2:0.1"], {"plausible": (2, 0.1)}),
         (["--shear-check"], {"shear_check": True}),
         (["--model-trial", "false"], {"model_trial": False}),
+        (["--shear-trial", "false"], {"shear_trial": False}),
         (["--method", "demosaic"], {"method": "demosaic"}),
         (["--method", "ppid"], {"method": "ppid"}),
     ],
@@ -129,6 +130,10 @@ def test_model_trial_report_equals_cli(tmp_path, slf_bin, capture):
     assert np.array_equal(lf, alone), np.abs(lf - alone).max()
     _, off = slf.decode(capture, model_trial=False, report=True)
     assert "trial" not in off
+    # The shear trial (one snapshot: half-pixel disparities searched) reports as the command.
+    s = report["shear_trial"]
+    kept = "half-pixel disparities kept" if s["halves"] else "whole disparities only"
+    assert f"shear trial: {kept}" in out and f"over {s['pilots']} pilot patches at half-pixel" in out, out
 
 
 def test_error_map_equals_cli(tmp_path, slf_bin, depth, capture):

@@ -661,13 +661,8 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         source: &mut S,
         ws: &mut Workspace<PS, PT, PU, PV, B, N>,
     ) -> Result<Disparity, S::Error> {
-        let Some((view_row, view_col)) = self.windows().next() else { return Ok(half) };
-        let h = half.in_halves();
         let mut best = (f32::INFINITY, half);
-        for d in [half, Disparity::halves(h.saturating_sub(1)), Disparity::halves(h.saturating_add(1))] {
-            let origin = PatchOrigin { lenslet_row: row, lenslet_col: col, view_row, view_col, disparity: d };
-            self.read_patch(origin, source, ws)?;
-            let (error, _) = self.estimate_error(model, &HoldOut::DEFAULT, origin, source, ws, false)?;
+        for (d, error) in self.shear_errors(model, (row, col), half, source, ws)? {
             // A whole disparity must estimate clearly better than the half one.
             let error = if d == half { error } else { error.map(|e| e / SHEAR_MARGIN) };
             if let Some(e) = error.filter(|e| *e < best.0) {
@@ -675,6 +670,32 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             }
         }
         Ok(best.1)
+    }
+
+    /// The held-out error estimates of the first window's patch of the block at lenslet
+    /// `(row, col)` sheared to `half` and to the whole disparities beside it (`None` where
+    /// no estimate: no window, too few measurements).
+    ///
+    /// # Errors
+    /// The source's error.
+    pub(super) fn shear_errors<M: PatchModel<PS, PT, PU, PV, B, N>, S: TileSource>(
+        &self,
+        model: &M,
+        (row, col): (u16, u16),
+        half: Disparity,
+        source: &mut S,
+        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ) -> Result<[(Disparity, Option<f32>); 3], S::Error> {
+        let h = half.in_halves();
+        let mut out =
+            [half, Disparity::halves(h.saturating_sub(1)), Disparity::halves(h.saturating_add(1))].map(|d| (d, None));
+        let Some((view_row, view_col)) = self.windows().next() else { return Ok(out) };
+        for (d, error) in &mut out {
+            let origin = PatchOrigin { lenslet_row: row, lenslet_col: col, view_row, view_col, disparity: *d };
+            self.read_patch(origin, source, ws)?;
+            *error = self.estimate_error(model, &HoldOut::DEFAULT, origin, source, ws, false)?.0;
+        }
+        Ok(out)
     }
 
     /// The held-out measurements the error estimate takes, if the decoder estimates.

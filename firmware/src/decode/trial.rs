@@ -86,4 +86,35 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
             _ => none,
         })
     }
+
+    /// The shear trial on the block at lenslet `(row, col)`: where its views agree best at a
+    /// half-pixel disparity ([`Self::choose_disparity`]), the held-out error estimates of its
+    /// first window's patch at that disparity (`first`) and at the better of the whole ones
+    /// beside it (`second`), as one pilot, by the model's estimating solve as the shear
+    /// check's ([`TileDecoder::with_shear_check`]); no pilot at a whole disparity. Summed
+    /// over a frame's pilots, they say whether its half-pixel shears alias. `ws` is clobbered.
+    ///
+    /// # Errors
+    /// The source's error.
+    pub fn shear_trial<M: PatchModel<PS, PT, PU, PV, B, N>, S: TileSource>(
+        &self,
+        model: &M,
+        (row, col): (u16, u16),
+        source: &mut S,
+        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ) -> Result<TrialErrors, S::Error> {
+        let half = self.choose_disparity(row as usize, col as usize, source)?;
+        if half.is_whole() {
+            return Ok(TrialErrors::default());
+        }
+        let [(_, at_half), (_, below), (_, above)] = self.shear_errors(model, (row, col), half, source, ws)?;
+        let whole = match (below, above) {
+            (Some(b), Some(a)) => Some(b.min(a)),
+            (b, a) => b.or(a),
+        };
+        Ok(match (at_half, whole) {
+            (Some(h), Some(w)) => TrialErrors { first: h * h, second: w * w, pilots: 1 },
+            _ => TrialErrors::default(),
+        })
+    }
 }

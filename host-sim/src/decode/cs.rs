@@ -25,7 +25,7 @@ use slf_firmware::{
     TileReport, Workspace,
 };
 
-use crate::decode::trial::frame_trial;
+use crate::decode::trial::{frame_shear_trial, frame_trial, halves_alias};
 use crate::io::capture::Capture;
 use crate::io::lightfield::LightField;
 
@@ -387,6 +387,12 @@ pub struct DecodeOptions {
     /// ([`crate::decode::preset::Preset::options`]), which `slf decode` and `slf.decode`
     /// run. A DCT decode ignores it.
     pub model_trial: bool,
+    /// Whether a decode with half-pixel disparities first checks them on pilot patches
+    /// against the whole ones beside them by the held-out error estimate, and decodes the
+    /// frame with whole disparities only where the whole ones estimate clearly better
+    /// ([`crate::decode::trial::halves_alias`]). Off here, on in the default and best
+    /// presets.
+    pub shear_trial: bool,
 }
 
 /// Which schedule the solves take.
@@ -422,6 +428,7 @@ impl Default for DecodeOptions {
             error_estimate: false,
             shear_check: false,
             model_trial: false,
+            shear_trial: false,
         }
     }
 }
@@ -620,6 +627,22 @@ pub struct DecodeReport {
     pub error_map: Vec<(PatchOrigin, f32)>,
     /// What the model trial picked ([`DecodeOptions::model_trial`]; `None` without it).
     pub trial: Option<TrialReport>,
+    /// What the shear trial found ([`DecodeOptions::shear_trial`]; `None` without it or
+    /// without half-pixel disparities).
+    pub shear_trial: Option<ShearTrialReport>,
+}
+
+/// The shear trial's finding in a decode ([`crate::decode::trial::frame_shear_trial`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ShearTrialReport {
+    /// Pilot patches at a half-pixel disparity that estimated both.
+    pub pilots: u32,
+    /// Whether the decode kept its half-pixel disparities (else whole ones only).
+    pub halves: bool,
+    /// The held-out error estimate at the half-pixel disparities (RMS over the pilots).
+    pub half_error: f64,
+    /// At the better whole disparity beside each.
+    pub whole_error: f64,
 }
 
 /// The model trial's picks in a decode ([`crate::decode::trial`]).
@@ -809,6 +832,12 @@ where
     let pick = pick.or(trialled.map(|t| t.pick())).unwrap_or_default();
     let model = Picked { first, second, pick };
     let model = &model;
+    // The shear trial, with the model that decodes: half-pixel shears off for the frame
+    // where its pilots estimate the whole ones clearly better.
+    let sheared = (opts.shear_trial && decoder.disparities().has_halves())
+        .then(|| frame_shear_trial(&decoder, model, &raw, &base));
+    let alias = sheared.as_ref().is_some_and(halves_alias);
+    let decoder = if alias { decoder.with_disparities(decoder.disparities().with_halves(false)) } else { decoder };
     let run = |tiles: &[Tile], prior: Option<&LightField>| -> Vec<(TileSums<PU, PV>, Result<TileReport, String>)> {
         let bar = ProgressBar::with_draw_target(Some(tiles.len() as u64), ProgressDrawTarget::hidden());
         bar.set_style(
@@ -879,6 +908,17 @@ where
     report.seconds = start.elapsed().as_secs_f64();
     report.gains = gains;
     report.patch_views = PatchViews::of_views(PU, PV);
+    if let Some(t) = sheared {
+        // A pilot: three estimating solves.
+        report.solves += 3 * u64::from(t.pilots);
+        let rms = |sum: f32| (f64::from(sum) / f64::from(t.pilots.max(1))).sqrt();
+        report.shear_trial = Some(ShearTrialReport {
+            pilots: t.pilots,
+            halves: !alias,
+            half_error: rms(t.first),
+            whole_error: rms(t.second),
+        });
+    }
     if let Some(t) = trialled {
         // A pilot: the DCT's solve and the ensemble's two.
         report.solves += 3 * u64::from(t.pilots);

@@ -68,8 +68,10 @@ impl Preset {
                 edge_fallback: false,
                 ..DecodeOptions::default()
             },
-            Self::Default => DecodeOptions { model_trial: true, ..DecodeOptions::default() },
-            Self::Best => DecodeOptions { stride: (1, 1), model_trial: true, ..DecodeOptions::default() },
+            Self::Default => DecodeOptions { model_trial: true, shear_trial: true, ..DecodeOptions::default() },
+            Self::Best => {
+                DecodeOptions { stride: (1, 1), model_trial: true, shear_trial: true, ..DecodeOptions::default() }
+            }
         }
     }
 

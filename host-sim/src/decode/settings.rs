@@ -411,6 +411,13 @@ pub struct DecodeSettings {
     /// the eighth better decodes the region) [default: true].
     #[arg(long, value_name = "BOOL")]
     pub model_trial: Option<bool>,
+    /// With half-pixel disparities: check them first on one pilot patch a tile (up to 64)
+    /// against the whole disparities beside them by the held-out error estimate, and decode
+    /// the frame with whole disparities only where the whole ones estimate below 0.7 x the
+    /// half ones' RMS error (half-pixel measurements alias on detail at the pixel scale)
+    /// [default: true].
+    #[arg(long, value_name = "BOOL")]
+    pub shear_trial: Option<bool>,
 }
 
 /// Parses `--plausible`: `FACTOR:MARGIN` or `off`.
@@ -505,6 +512,7 @@ impl DecodeSettings {
             error_estimate: self.estimate || base.error_estimate,
             shear_check: self.shear_check || base.shear_check,
             model_trial: self.model_trial.unwrap_or(base.model_trial),
+            shear_trial: self.shear_trial.unwrap_or(base.shear_trial),
             patch_views: self.basis.patch_views.or(base.patch_views),
             schedule: self.schedule,
             ..base

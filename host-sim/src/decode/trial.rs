@@ -49,3 +49,41 @@ where
             a
         })
 }
+
+/// The shear trial over `tiles` (the disjoint grid's): on each of at most [`MAX_PILOTS`]
+/// of them whose first block's views agree best at a half-pixel disparity, the held-out
+/// errors at it and at the better whole one beside it
+/// ([`TileDecoder::shear_trial`]), summed.
+pub fn frame_shear_trial<const PU: usize, const PV: usize, const N: usize, M>(
+    decoder: &TileDecoder<'_, 5, 5, PU, PV, 13, N>,
+    model: &M,
+    raw: &[RawFrame<'_, u16>],
+    tiles: &[Tile],
+) -> TrialErrors
+where
+    M: PatchModel<5, 5, PU, PV, 13, N> + Sync,
+{
+    let step = tiles.len().div_ceil(MAX_PILOTS).max(1);
+    tiles
+        .par_iter()
+        .step_by(step)
+        .map_init(
+            || Box::new(Workspace::<5, 5, PU, PV, 13, N>::new()),
+            |ws, t| {
+                let mut source = FrameSource::new(raw);
+                decoder.shear_trial(model, (t.lenslet_row, t.lenslet_col), &mut source, ws).unwrap_or_default()
+            },
+        )
+        .reduce(TrialErrors::default, |mut a, b| {
+            a.add(&b);
+            a
+        })
+}
+
+/// Whether a frame's half-pixel shears alias, by its shear trial: the whole disparities'
+/// summed squared errors below [`slf_firmware::tile::SHEAR_MARGIN`] squared times the half
+/// ones' (the shear check's margin, on the frame's pilots together).
+pub fn halves_alias(t: &TrialErrors) -> bool {
+    let m = slf_firmware::tile::SHEAR_MARGIN;
+    t.pilots > 0 && t.second < m * m * t.first
+}

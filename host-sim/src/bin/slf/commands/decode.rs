@@ -169,6 +169,15 @@ pub fn run(args: Args) -> Result<()> {
             r.patches.implausible, r.patches.clipped, p.factor, p.margin
         );
     }
+    if let Some(t) = r.shear_trial {
+        println!(
+            "shear trial: {} (held-out error over {} pilot patches at half-pixel disparities: half {:.5}, whole {:.5})",
+            if t.halves { "half-pixel disparities kept" } else { "whole disparities only: the half ones alias" },
+            t.pilots,
+            t.half_error,
+            t.whole_error
+        );
+    }
     if let Some(t) = r.trial {
         println!(
             "model trial: decoded by the {} (held-out error over {} pilot patches: DCT {:.5}, ensemble {:.5})",
