@@ -132,8 +132,11 @@ def test_model_trial_report_equals_cli(tmp_path, slf_bin, capture):
     assert "trial" not in off
     # The shear trial (one snapshot: half-pixel disparities searched) reports as the command.
     s = report["shear_trial"]
-    kept = "half-pixel disparities kept" if s["halves"] else "whole disparities only"
-    assert f"shear trial: {kept}" in out and f"over {s['pilots']} pilot patches at half-pixel" in out, out
+    if s["pilots"] == 0:
+        assert s["halves"] and "shear trial: no pilot patch at a half-pixel disparity" in out, out
+    else:
+        kept = "half-pixel disparities kept" if s["halves"] else "whole disparities only"
+        assert f"shear trial: {kept}" in out and f"over {s['pilots']} pilot patches at half-pixel" in out, out
 
 
 def test_error_map_equals_cli(tmp_path, slf_bin, depth, capture):

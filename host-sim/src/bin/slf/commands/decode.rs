@@ -169,7 +169,11 @@ pub fn run(args: Args) -> Result<()> {
             r.patches.implausible, r.patches.clipped, p.factor, p.margin
         );
     }
-    if let Some(t) = r.shear_trial {
+    if r.shear_trial.is_some_and(|t| t.pilots == 0) {
+        println!(
+            "shear trial: no pilot patch at a half-pixel disparity could be estimated; half-pixel disparities kept"
+        );
+    } else if let Some(t) = r.shear_trial {
         println!(
             "shear trial: {} (held-out error over {} pilot patches at half-pixel disparities: half {:.5}, whole {:.5})",
             if t.halves { "half-pixel disparities kept" } else { "whole disparities only: the half ones alias" },
@@ -178,7 +182,11 @@ pub fn run(args: Args) -> Result<()> {
             t.whole_error
         );
     }
-    if let Some(t) = r.trial {
+    if r.trial.is_some_and(|t| t.pilots == 0) {
+        println!(
+            "model trial: no pilot patch could be estimated (too few bands measured, or the response in the projection); decoded by the ensemble"
+        );
+    } else if let Some(t) = r.trial {
         println!(
             "model trial: decoded by the {} (held-out error over {} pilot patches: DCT {:.5}, ensemble {:.5})",
             if t.dct { "DCT" } else { "ensemble" },
