@@ -12,11 +12,7 @@ set -euo pipefail
 out=${1:?usage: error-map-results.sh OUT_DIR}
 cd "$(dirname "$0")/.."
 . scripts/scene-tables.sh
-cargo build --release -q -p slf-host
-slf=${SLF_BIN:-./target/release/slf}
-size=${SLF_SIZE:-48}
-scenes=${SLF_SCENES:-$all_scenes}
-mkdir -p "$out"
+table_setup
 echo "# The error estimate"
 echo
 echo "Made by \`bash scripts/error-map-results.sh OUT_DIR\` (scenes of ${size} x ${size} lenslets, 5 x 5"

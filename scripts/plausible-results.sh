@@ -12,12 +12,8 @@ set -euo pipefail
 out=${1:?usage: plausible-results.sh OUT_DIR}
 cd "$(dirname "$0")/.."
 . scripts/scene-tables.sh
-cargo build --release -q -p slf-host
-slf=${SLF_BIN:-./target/release/slf}
-size=${SLF_SIZE:-48}
-scenes=${SLF_SCENES:-$all_scenes}
+table_setup
 methods="default=--preset,default dct=--dictionary,dct preview=--preset,preview"
-mkdir -p "$out"
 echo "# The plausibility check"
 echo
 echo "Made by \`bash scripts/plausible-results.sh OUT_DIR\` (scenes of ${size} x ${size} lenslets, 5 x 5"

@@ -1,11 +1,21 @@
 # Sourced by the scripts that tabulate decodes per scene (hard-cases.sh, sensor-results.sh,
 # plausible-results.sh, error-map-results.sh, shear-check-results.sh): the scene lists with the
 # real crops, a scene's light field and capture, and one decode measured.
-# They set `slf`, `out` and `size` first.
+# They set `out` and call `table_setup` first.
 
 # Every scene `slf scene` names but `random`: the test scenes, the realistic ones and the hard
 # cases (the issue-49 tables run over all of them).
 all_scenes="smooth texture depth saturated dark outdoor tungsten office led mosaic mosaic-2 field print speculars narrow dim canopy canopy-dim"
+
+# table_setup: builds the release binary and sets $slf, $size (SLF_SIZE, default 48) and
+# $scenes (SLF_SCENES, default every scene); makes $out.
+table_setup() {
+  cargo build --release -q -p slf-host
+  slf=${SLF_BIN:-./target/release/slf}
+  size=${SLF_SIZE:-48}
+  scenes=${SLF_SCENES:-$all_scenes}
+  mkdir -p "$out"
+}
 
 # Appends the real content the project evaluates to $scenes when present (scripts/real-eval.sh's
 # crops in $SLF_REAL, default /tmp/hci/real; their licence allows evaluation only).

@@ -14,11 +14,7 @@ set -euo pipefail
 out=${1:?usage: shear-check-results.sh OUT_DIR}
 cd "$(dirname "$0")/.."
 . scripts/scene-tables.sh
-cargo build --release -q -p slf-host
-slf=${SLF_BIN:-./target/release/slf}
-size=${SLF_SIZE:-48}
-scenes=${SLF_SCENES:-$all_scenes}
-mkdir -p "$out"
+table_setup
 echo "# The shear check and the shear trial"
 echo
 echo "Made by \`bash scripts/shear-check-results.sh OUT_DIR\` (scenes of ${size} x ${size} lenslets, the real"

@@ -827,16 +827,17 @@ where
     let lenslets = (d.lenslets[0], d.lenslets[1]);
     let views = (d.views[0], d.views[1]);
     let range = decoder.config().raw.range();
+    // The shear trial first: half-pixel shears off for the frame where its pilots estimate
+    // the whole ones clearly better (by the estimating solve, `second`'s), so the model
+    // trial's pilots are sheared as the decode will be.
+    let sheared = (opts.shear_trial && decoder.disparities().has_halves())
+        .then(|| frame_shear_trial(&decoder, second, &raw, &base));
+    let alias = sheared.as_ref().is_some_and(halves_alias);
+    let decoder = if alias { decoder.with_disparities(decoder.disparities().with_halves(false)) } else { decoder };
     let trialled = pick.is_none().then(|| frame_trial(&decoder, first, second, &raw, &base));
     let pick = pick.or(trialled.map(|t| t.pick())).unwrap_or_default();
     let model = Picked { first, second, pick };
     let model = &model;
-    // The shear trial, with the model that decodes: half-pixel shears off for the frame
-    // where its pilots estimate the whole ones clearly better.
-    let sheared = (opts.shear_trial && decoder.disparities().has_halves())
-        .then(|| frame_shear_trial(&decoder, model, &raw, &base));
-    let alias = sheared.as_ref().is_some_and(halves_alias);
-    let decoder = if alias { decoder.with_disparities(decoder.disparities().with_halves(false)) } else { decoder };
     let halo = decoder.disparities().halo(views.0.max(views.1));
     let run = |tiles: &[Tile], prior: Option<&LightField>| -> Vec<(TileSums<PU, PV>, Result<TileReport, String>)> {
         let bar = ProgressBar::with_draw_target(Some(tiles.len() as u64), ProgressDrawTarget::hidden());

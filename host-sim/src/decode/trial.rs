@@ -32,22 +32,7 @@ where
     A: PatchModel<5, 5, PU, PV, 13, N> + Sync,
     Z: PatchModel<5, 5, PU, PV, 13, N> + Sync,
 {
-    let step = tiles.len().div_ceil(MAX_PILOTS).max(1);
-    tiles
-        .par_iter()
-        .step_by(step)
-        .map_init(
-            || Box::new(Workspace::<5, 5, PU, PV, 13, N>::new()),
-            |ws, t| {
-                let mut source = FrameSource::new(raw);
-                let at = (t.lenslet_row, t.lenslet_col);
-                decoder.trial(first, second, at, &mut source, ws).unwrap_or_default()
-            },
-        )
-        .reduce(TrialErrors::default, |mut a, b| {
-            a.add(&b);
-            a
-        })
+    pilots::<PU, PV, N>(raw, tiles, |source, at, ws| decoder.trial(first, second, at, source, ws))
 }
 
 /// The shear trial over `tiles` (the disjoint grid's): on each of at most [`MAX_PILOTS`]
@@ -63,16 +48,29 @@ pub fn frame_shear_trial<const PU: usize, const PV: usize, const N: usize, M>(
 where
     M: PatchModel<5, 5, PU, PV, 13, N> + Sync,
 {
+    pilots::<PU, PV, N>(raw, tiles, |source, at, ws| decoder.shear_trial(model, at, source, ws))
+}
+
+/// `pilot` on the first block of each of at most [`MAX_PILOTS`] of `tiles`, evenly
+/// spaced, in parallel (a workspace a thread); their errors summed (a pilot whose source
+/// failed counts as none).
+fn pilots<const PU: usize, const PV: usize, const N: usize>(
+    raw: &[RawFrame<'_, u16>],
+    tiles: &[Tile],
+    pilot: impl Fn(
+        &mut FrameSource<'_, RawFrame<'_, u16>>,
+        (u16, u16),
+        &mut Workspace<5, 5, PU, PV, 13, N>,
+    ) -> Result<TrialErrors, slf_firmware::raw::ReadError>
+    + Sync,
+) -> TrialErrors {
     let step = tiles.len().div_ceil(MAX_PILOTS).max(1);
     tiles
         .par_iter()
         .step_by(step)
         .map_init(
             || Box::new(Workspace::<5, 5, PU, PV, 13, N>::new()),
-            |ws, t| {
-                let mut source = FrameSource::new(raw);
-                decoder.shear_trial(model, (t.lenslet_row, t.lenslet_col), &mut source, ws).unwrap_or_default()
-            },
+            |ws, t| pilot(&mut FrameSource::new(raw), (t.lenslet_row, t.lenslet_col), ws).unwrap_or_default(),
         )
         .reduce(TrialErrors::default, |mut a, b| {
             a.add(&b);
