@@ -17,7 +17,8 @@ echo "# The model trial"
 echo
 echo "Made by \`bash scripts/model-trial-results.sh OUT_DIR\` (scenes of ${size} x ${size} lenslets, the real crops"
 echo "at their own size, 5 x 5 views, \`slf simulate --seed 1\`; \`RAYON_NUM_THREADS=${RAYON_NUM_THREADS:-all}\`). \"before\": \`--model-trial false\`"
-echo "(the screened ensemble on every patch); \"dct\": \`--dictionary dct\`; \"trial\": the default. \"best\":"
+echo "(the screened ensemble on every patch; the shear trial on in all three, as in the default:"
+echo "docs/results-shear-check.md); \"dct\": \`--dictionary dct\`; \"trial\": the default. \"best\":"
 echo "the trial's PSNR minus the better of the other two. Times in seconds, one decode each; the"
 echo "held-out errors are the trial's, RMS over its pilot patches in the output's units."
 add_real_scenes
