@@ -411,7 +411,7 @@ pub struct DecodeSettings {
     /// the eighth better decodes the region) [default: true].
     #[arg(long, value_name = "BOOL")]
     pub model_trial: Option<bool>,
-    /// With half-pixel disparities: check them first on one pilot patch a tile (up to 64)
+    /// With half-pixel disparities: check them first on one pilot patch a tile (up to 256)
     /// against the whole disparities beside them by the held-out error estimate, and decode
     /// the frame with whole disparities only where the whole ones estimate below 0.7 x the
     /// half ones' RMS error (half-pixel measurements alias on detail at the pixel scale)
