@@ -335,6 +335,8 @@ mod device {
         // Window 11: the model trial, a pilot on every tile's block: the DCT on the
         // ensemble's schedules against the ensemble, by their held-out errors. The picked
         // model decodes the overlapped frame; `slf device-check` runs the same trial.
+        // Built in the singleton, not by `EnsembleModel::scheduled_screen`: its value, moved
+        // in, took 3.9 KB more peak stack (33,796 B against 29,900, `scripts/budgets.sh`).
         let Some(scheduled) = model.schedules().copied().and_then(|schedules| {
             cortex_m::singleton!(: ScheduledDictionary<5, 5, 5, 5, 13> = ScheduledDictionary { dictionary: Dictionary::dct(), schedules })
         }) else {

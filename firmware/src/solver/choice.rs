@@ -338,6 +338,12 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         self.schedules.as_ref()
     }
 
+    /// The DCT it screens with, on its trained schedules (`None` without them): the model
+    /// trial's other model ([`crate::decode::trial`]), which decodes as the DCT alone does.
+    pub fn scheduled_screen(&self) -> Option<ScheduledDictionary<PS, PT, PU, PV, B>> {
+        self.schedules.map(|schedules| ScheduledDictionary { dictionary: self.screen.clone(), schedules })
+    }
+
     /// A solve from the measurements alone: the cold trained schedule, or [`solve`].
     fn cold<const N: usize>(
         &self,

@@ -25,7 +25,7 @@ use slf_firmware::{
     TileReport, Workspace,
 };
 
-use crate::decode::trial::{frame_shear_trial, frame_trial, halves_alias};
+use crate::decode::trial::{frame_shear_trial, frame_trial, halves_alias, rms};
 use crate::io::capture::Capture;
 use crate::io::lightfield::LightField;
 
@@ -226,13 +226,12 @@ fn decode_basis<const PU: usize, const PV: usize, const N: usize>(
                 return decode_observed::<PU, PV, N, _>(capture, &model, opts, observer);
             }
             // The trial's other model: the DCT the ensemble screens with, on its schedules.
-            let dictionary = Dictionary::<5, 5, PU, PV, 13>::dct();
-            match model.schedules().copied() {
-                Some(schedules) => {
-                    let dct = slf_firmware::ScheduledDictionary { dictionary, schedules };
+            match model.scheduled_screen() {
+                Some(dct) => decode_picked::<PU, PV, N, _, _>(capture, &dct, &model, None, opts, observer),
+                None => {
+                    let dct = Dictionary::<5, 5, PU, PV, 13>::dct();
                     decode_picked::<PU, PV, N, _, _>(capture, &dct, &model, None, opts, observer)
                 }
-                None => decode_picked::<PU, PV, N, _, _>(capture, &dictionary, &model, None, opts, observer),
             }
         }
     }
@@ -909,28 +908,17 @@ where
     report.seconds = start.elapsed().as_secs_f64();
     report.gains = gains;
     report.patch_views = PatchViews::of_views(PU, PV);
-    if let Some(t) = sheared {
-        // A pilot: three estimating solves.
-        report.solves += 3 * u64::from(t.pilots);
-        let rms = |sum: f32| (f64::from(sum) / f64::from(t.pilots.max(1))).sqrt();
-        report.shear_trial = Some(ShearTrialReport {
-            pilots: t.pilots,
-            halves: !alias,
-            half_error: rms(t.first),
-            whole_error: rms(t.second),
-        });
-    }
-    if let Some(t) = trialled {
-        // A pilot: the DCT's solve and the ensemble's two.
-        report.solves += 3 * u64::from(t.pilots);
-        let rms = |sum: f32| (f64::from(sum) / f64::from(t.pilots.max(1))).sqrt();
-        report.trial = Some(TrialReport {
-            pilots: t.pilots,
-            dct: pick == Pick::First,
-            dct_error: rms(t.first),
-            ensemble_error: rms(t.second),
-        });
-    }
+    // A pilot of either trial costs three solves: three estimating ones for the shear
+    // trial, the DCT's one and the ensemble's two for the model trial.
+    report.solves += 3 * u64::from(sheared.map_or(0, |t| t.pilots) + trialled.map_or(0, |t| t.pilots));
+    report.shear_trial = sheared.map(|t| {
+        let (half_error, whole_error) = rms(&t);
+        ShearTrialReport { pilots: t.pilots, halves: !alias, half_error, whole_error }
+    });
+    report.trial = trialled.map(|t| {
+        let (dct_error, ensemble_error) = rms(&t);
+        TrialReport { pilots: t.pilots, dct: pick == Pick::First, dct_error, ensemble_error }
+    });
     Ok((lf, report))
 }
 

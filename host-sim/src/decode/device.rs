@@ -399,8 +399,7 @@ pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
         bail!("the device's patches differ from the host's by {worst:.2e} relative");
     }
     // The model trial: the same pilots (every tile's block, unsheared), the same sums.
-    let schedules = model.schedules().copied().context("the shipped ensemble has no trained schedules")?;
-    let dct = ScheduledDictionary { dictionary: slf_firmware::Dictionary::dct(), schedules };
+    let dct = model.scheduled_screen().context("the shipped ensemble has no trained schedules")?;
     let mut host_trial = TrialErrors::default();
     for tile in decoder.tiles((1, 1)) {
         let at = (tile.lenslet_row, tile.lenslet_col);

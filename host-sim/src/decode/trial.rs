@@ -89,3 +89,9 @@ pub fn halves_alias(t: &TrialErrors) -> bool {
     let m = slf_firmware::tile::SHEAR_MARGIN;
     t.pilots > 0 && t.second < m * m * t.first
 }
+
+/// A trial's errors as RMS over its pilots (first, second; 0 without pilots).
+pub fn rms(t: &TrialErrors) -> (f64, f64) {
+    let per = |sum: f32| (f64::from(sum) / f64::from(t.pilots.max(1))).sqrt();
+    (per(t.first), per(t.second))
+}
