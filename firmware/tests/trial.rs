@@ -132,6 +132,40 @@ fn the_pick_is_the_smaller_sum_and_the_second_without_pilots_or_on_a_tie() {
     assert_eq!(TrialErrors { first: 0.0, second: 5.0, pilots: 0 }.pick(), Pick::Second);
 }
 
+#[test]
+fn a_leaning_pick_leaves_its_model_only_below_the_margin() {
+    // Written from the definition: the other model where its summed squares are below
+    // margin^2 times the kept one's, the kept one on a tie, above it or without pilots.
+    let reference = |t: &TrialErrors, towards: Pick, margin: f32| {
+        let (kept, other) = if towards == Pick::First { (t.first, t.second) } else { (t.second, t.first) };
+        let flip = |p: Pick| if p == Pick::First { Pick::Second } else { Pick::First };
+        if t.pilots > 0 && f64::from(other) < f64::from(margin).powi(2) * f64::from(kept) {
+            flip(towards)
+        } else {
+            towards
+        }
+    };
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut next = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 40) as f32 / (1u64 << 24) as f32
+    };
+    for i in 0..2000 {
+        let t = TrialErrors { first: next(), second: next(), pilots: (i % 3) as u32 };
+        for (towards, margin) in [(Pick::First, 0.8), (Pick::Second, 0.8), (Pick::Second, 1.0), (Pick::First, 1.0)] {
+            assert_eq!(t.pick_leaning(towards, margin), reference(&t, towards, margin), "{t:?} {towards:?} {margin}");
+        }
+        assert_eq!(t.pick_leaning(Pick::Second, 1.0), t.pick(), "{t:?}");
+    }
+    // At the margin's edges: 0.64 x is not below 0.8^2 x, just under it is.
+    let t = |second: f32| TrialErrors { first: 1.0, second, pilots: 4 };
+    assert_eq!(t(0.7).pick_leaning(Pick::First, 0.8), Pick::First);
+    assert_eq!(t(0.6).pick_leaning(Pick::First, 0.8), Pick::Second);
+    assert_eq!(TrialErrors { first: 1.0, second: 0.0, pilots: 0 }.pick_leaning(Pick::First, 0.8), Pick::First);
+}
+
 /// A scene at half a pixel of disparity (each view of lenslet `(s, t)` sees the point
 /// `(s + d (u - 2), t + d (v - 2))` of a smooth texture), in the layout of
 /// [`rough_light_field`].

@@ -551,7 +551,8 @@ fn evaluate_compares_every_method_per_scene_and_on_average() {
 
 /// `--preset` names a basis, stride, window, disparities, edge fallback, sigma_min and
 /// cold start: the preview decodes
-/// the same bits as those flags spelled out, a flag given with a preset overrides the
+/// the same bits as those flags spelled out (a dictionary named decodes without the model
+/// trial unless asked), a flag given with a preset overrides the
 /// preset's value, and `best` decodes more patches than the default.
 #[test]
 fn presets_are_their_flags_and_flags_override_them() {
@@ -577,6 +578,8 @@ fn presets_are_their_flags_and_flags_override_them() {
         "false",
         "--sigma-min",
         "3e-3",
+        "--model-trial",
+        "true",
     ];
     let (flags, n_flags) = decode("flags.npy", &spelled);
     assert_eq!(n_preview, n_flags);
@@ -1112,6 +1115,57 @@ fn the_shear_check_and_trial_take_whole_shears_where_half_ones_alias() {
 /// Issue 49, item 2: the model trial. The default decodes the frame with the model whose
 /// held-out error over the pilots it prints is the smaller, and that decode is the model's
 /// own without the trial, bit for bit; `--model-trial false` is the screened ensemble.
+#[test]
+fn the_previews_model_trial_leans_to_the_dct_and_moves_only_where_the_ensemble_is_clearly_better() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    let mut picks = Vec::new();
+    for scene in ["speculars", "saturated"] {
+        let truth = p(&format!("{scene}.npy"));
+        stdout(slf().args(["scene", scene, "--size", "30", "-o"]).arg(&truth));
+        let cap = p(&format!("cap-{scene}"));
+        stdout(
+            slf().arg("simulate").arg(&truth).arg("-o").arg(&cap).args(["--mask", "lenslet", "-s", "3", "--seed", "1"]),
+        );
+        let decode = |name: &str, flags: &[&str]| {
+            let out = stdout(
+                slf().arg("decode").arg(&cap).arg("-o").arg(p(name)).args(["-q", "--preset", "preview"]).args(flags),
+            );
+            (out, std::fs::read(p(name)).unwrap())
+        };
+        let (out, trial) = decode("trial.npy", &[]);
+        let line = out.lines().find_map(|l| l.strip_prefix("model trial: decoded by the ")).unwrap().to_string();
+        let number = |after: &str| -> f64 {
+            let rest = &line[line.find(after).unwrap() + after.len()..];
+            rest.split([',', ')']).next().unwrap().trim().parse().unwrap()
+        };
+        let (dct, ensemble) = (number("patches: DCT "), number(", ensemble "));
+        let picked = if line.starts_with("DCT") { "dct" } else { "ensemble" };
+        // The lean: the ensemble only below 0.8 x the DCT's error (printed to 5 decimals).
+        assert!((ensemble - 0.8 * dct).abs() > 1e-4, "too near the margin to check: {line}");
+        assert_eq!(picked == "ensemble", ensemble < 0.8 * dct, "{scene}: {line}");
+        let (_, alone) = decode("alone.npy", &["--model-trial", "false", "--dictionary", picked]);
+        assert_eq!(trial, alone, "{scene}: {line}");
+        // Without the trial the preview is the DCT's, as before it.
+        let (off, by_dct) = decode("off.npy", &["--model-trial", "false"]);
+        assert!(!off.contains("model trial"), "{off}");
+        let (_, named) = decode("named.npy", &["--model-trial", "false", "--dictionary", "dct"]);
+        assert_eq!(by_dct, named);
+        if picked == "ensemble" {
+            // Where the pilots favour the ensemble that clearly, it decodes nearer the truth.
+            let psnr = |name: &str| -> f64 {
+                let out = stdout(slf().arg("eval").arg(&truth).arg(p(name)));
+                out.lines().find_map(|l| l.strip_prefix("PSNR ")).unwrap().split(' ').next().unwrap().parse().unwrap()
+            };
+            assert!(psnr("trial.npy") > psnr("off.npy"), "{scene}: {line}");
+        }
+        picks.push(picked);
+    }
+    // Both branches ran: the specular scene's pilots favour the ensemble by 2 x, the
+    // saturated one's are within 10 %.
+    assert_eq!(picks, ["ensemble", "dct"]);
+}
+
 #[test]
 fn the_model_trial_decodes_with_the_model_its_pilots_favour() {
     let dir = tempfile::tempdir().unwrap();

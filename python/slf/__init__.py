@@ -362,7 +362,8 @@ def decode(
     ``balance`` grey or off, ``gains`` (13),
     ``adaptive`` and the solver's ``sigma_f`` ... ``min_bands``, ``plausible``,
     ``shear_check``, ``model_trial`` (the ensemble or the DCT for the frame by their
-    held-out errors on pilot patches; default True: ``report["trial"]`` says which and the
+    held-out errors on pilot patches; default True in every preset, leaning to the DCT in
+    the preview, False where ``dictionary`` is named: ``report["trial"]`` says which and the
     errors), ``shear_trial`` (whole disparities only for the frame where pilot patches
     estimate them clearly better than the half-pixel ones; default True:
     ``report["shear_trial"]``), ``error_map``.

@@ -44,6 +44,22 @@ impl TrialErrors {
     pub fn pick(&self) -> Pick {
         if self.pilots > 0 && self.first < self.second { Pick::First } else { Pick::Second }
     }
+
+    /// The model `towards` unless the other's pilots erred below `margin` times its
+    /// (RMS over the pilots); `towards` without pilots. `pick_leaning(Pick::Second, 1.0)`
+    /// is [`Self::pick`]. A decode that must stay cheap leans to its cheap model and pays
+    /// for the other only where the pilots say it clearly predicts better.
+    pub fn pick_leaning(&self, towards: Pick, margin: f32) -> Pick {
+        let (kept, other) = match towards {
+            Pick::First => (self.first, self.second),
+            Pick::Second => (self.second, self.first),
+        };
+        let leave = self.pilots > 0 && other < margin * margin * kept;
+        match (towards, leave) {
+            (Pick::First, true) | (Pick::Second, false) => Pick::Second,
+            (Pick::First, false) | (Pick::Second, true) => Pick::First,
+        }
+    }
 }
 
 impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>

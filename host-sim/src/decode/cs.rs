@@ -25,7 +25,7 @@ use slf_firmware::{
     TileReport, Workspace,
 };
 
-use crate::decode::trial::{frame_shear_trial, frame_trial, halves_alias, rms};
+use crate::decode::trial::{DCT_LEAN, frame_shear_trial, frame_trial, halves_alias, pilot_budget, rms};
 use crate::io::capture::Capture;
 use crate::io::lightfield::LightField;
 
@@ -206,6 +206,19 @@ fn decode_basis<const PU: usize, const PV: usize, const N: usize>(
 ) -> Result<(LightField, DecodeReport)> {
     let trained = opts.schedule == SolveSchedule::Trained;
     match basis {
+        // With the model trial, a DCT decode screens the shipped ensemble on pilots and
+        // leans to the DCT: the ensemble only where its pilots clearly predict better.
+        Basis::Dct if opts.model_trial => {
+            let lean = ModelPick::Trial { towards: Pick::First, margin: DCT_LEAN };
+            trial_decode::<PU, PV, N>(
+                capture,
+                None,
+                slf_firmware::MemberChoice::Screened(slf_firmware::ChoiceRule::DEFAULT),
+                lean,
+                opts,
+                observer,
+            )
+        }
         Basis::Dct => {
             let dictionary = Dictionary::<5, 5, PU, PV, 13>::dct();
             // The DCT takes the schedules of the shipped blob, whose cold one is trained on
@@ -218,23 +231,54 @@ fn decode_basis<const PU: usize, const PV: usize, const N: usize>(
                 None => decode_observed::<PU, PV, N, _>(capture, &dictionary, opts, observer),
             }
         }
+        Basis::Ensemble { blob, choice } if opts.model_trial => {
+            let even = ModelPick::Trial { towards: Pick::Second, margin: 1.0 };
+            trial_decode::<PU, PV, N>(capture, blob.as_deref(), *choice, even, opts, observer)
+        }
         Basis::Ensemble { blob, choice } => {
             let ensemble = ensemble::<PU, PV>(blob.as_deref())?;
             let model = slf_firmware::EnsembleModel::new(ensemble, *choice);
             let model = if trained { model } else { model.with_schedules(None) };
-            if !opts.model_trial {
-                return decode_observed::<PU, PV, N, _>(capture, &model, opts, observer);
-            }
-            // The trial's other model: the DCT the ensemble screens with, on its schedules.
-            match model.scheduled_screen() {
-                Some(dct) => decode_picked::<PU, PV, N, _, _>(capture, &dct, &model, None, opts, observer),
-                None => {
-                    let dct = Dictionary::<5, 5, PU, PV, 13>::dct();
-                    decode_picked::<PU, PV, N, _, _>(capture, &dct, &model, None, opts, observer)
-                }
-            }
+            decode_observed::<PU, PV, N, _>(capture, &model, opts, observer)
         }
     }
+}
+
+/// The decode of the DCT or the ensemble of `blob` (the shipped one for `None`) with
+/// `choice`, whichever the model trial picks by `pick`.
+fn trial_decode<const PU: usize, const PV: usize, const N: usize>(
+    capture: &Capture,
+    blob: Option<&[u8]>,
+    choice: slf_firmware::MemberChoice,
+    pick: ModelPick,
+    opts: &DecodeOptions,
+    observer: &(dyn Fn(usize, usize) + Sync),
+) -> Result<(LightField, DecodeReport)> {
+    let model = slf_firmware::EnsembleModel::new(ensemble::<PU, PV>(blob)?, choice);
+    let model = if opts.schedule == SolveSchedule::Trained { model } else { model.with_schedules(None) };
+    // The trial's other model: the DCT the ensemble screens with, on its schedules.
+    match model.scheduled_screen() {
+        Some(dct) => decode_picked::<PU, PV, N, _, _>(capture, &dct, &model, pick, opts, observer),
+        None => {
+            let dct = Dictionary::<5, 5, PU, PV, 13>::dct();
+            decode_picked::<PU, PV, N, _, _>(capture, &dct, &model, pick, opts, observer)
+        }
+    }
+}
+
+/// Which of [`decode_picked`]'s two models decodes the frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ModelPick {
+    /// The one named.
+    Given(Pick),
+    /// The one the model trial picks ([`slf_firmware::TrialErrors::pick_leaning`]): `towards` unless the
+    /// other's pilots err below `margin` times its.
+    Trial {
+        /// The model kept on a tie or without pilots.
+        towards: Pick,
+        /// How far below (RMS) the other's error must be.
+        margin: f32,
+    },
 }
 
 /// The ensemble of `blob` (the shipped one of the patch for `None`) for `5 x 5 x PU x PV x
@@ -384,7 +428,8 @@ pub struct DecodeOptions {
     /// where a decode measures the ensemble itself (`slf compare`, `slf evaluate`'s
     /// ensemble rows, the bench's choice points); on in the default and best presets
     /// ([`crate::decode::preset::Preset::options`]), which `slf decode` and `slf.decode`
-    /// run. A DCT decode ignores it.
+    /// run. A DCT decode with it (the preview's) screens the shipped ensemble on the pilots
+    /// and leans to the DCT ([`crate::decode::trial::DCT_LEAN`]).
     pub model_trial: bool,
     /// Whether a decode with half-pixel disparities first checks them on pilot patches
     /// against the whole ones beside them by the held-out error estimate, and decodes the
@@ -773,11 +818,11 @@ pub fn decode_observed<const PU: usize, const PV: usize, const N: usize, M: Patc
     opts: &DecodeOptions,
     observer: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<(LightField, DecodeReport)> {
-    decode_picked(capture, model, model, Some(Pick::Second), opts, observer)
+    decode_picked(capture, model, model, ModelPick::Given(Pick::Second), opts, observer)
 }
 
-/// [`decode_observed`] with two models: decoded by the one `pick` names, or (`None`) by the
-/// one the model trial picks for the frame ([`crate::decode::trial`]).
+/// [`decode_observed`] with two models: decoded by the one `pick` names, or by the one the
+/// model trial picks for the frame ([`crate::decode::trial`]).
 ///
 /// # Errors
 /// As [`decode`].
@@ -785,7 +830,7 @@ pub fn decode_picked<const PU: usize, const PV: usize, const N: usize, A, Z>(
     capture: &Capture,
     first: &A,
     second: &Z,
-    pick: Option<Pick>,
+    pick: ModelPick,
     opts: &DecodeOptions,
     observer: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<(LightField, DecodeReport)>
@@ -829,12 +874,21 @@ where
     // The shear trial first: half-pixel shears off for the frame where its pilots estimate
     // the whole ones clearly better (by the estimating solve, `second`'s), so the model
     // trial's pilots are sheared as the decode will be.
+    // The decode's patches: the disjoint grid's blocks times the stride's shifts.
+    let shifts = |s: u8| 5usize.div_ceil(usize::from(s));
+    let blocks: usize = base.iter().map(|t| usize::from(t.lenslet_rows / 5) * usize::from(t.lenslet_cols / 5)).sum();
+    let budget = pilot_budget(blocks * shifts(opts.stride.0) * shifts(opts.stride.1));
     let sheared = (opts.shear_trial && decoder.disparities().has_halves())
-        .then(|| frame_shear_trial(&decoder, second, &raw, &base));
+        .then(|| frame_shear_trial(&decoder, second, &raw, &base, budget));
     let alias = sheared.as_ref().is_some_and(halves_alias);
     let decoder = if alias { decoder.with_disparities(decoder.disparities().with_halves(false)) } else { decoder };
-    let trialled = pick.is_none().then(|| frame_trial(&decoder, first, second, &raw, &base));
-    let pick = pick.or(trialled.map(|t| t.pick())).unwrap_or_default();
+    let (pick, trialled) = match pick {
+        ModelPick::Given(p) => (p, None),
+        ModelPick::Trial { towards, margin } => {
+            let t = frame_trial(&decoder, first, second, &raw, &base, budget);
+            (t.pick_leaning(towards, margin), Some(t))
+        }
+    };
     let model = Picked { first, second, pick };
     let model = &model;
     let halo = decoder.disparities().halo(views.0.max(views.1));

@@ -519,8 +519,14 @@ fn check_rows(
         ..Default::default()
     };
     // With the model the trial picked (the device's, checked above).
-    let (lf, _) =
-        crate::decode::cs::decode_picked::<5, 5, 8125, _, _>(capture, dct, model, Some(pick), &opts, &|_, _| {})?;
+    let (lf, _) = crate::decode::cs::decode_picked::<5, 5, 8125, _, _>(
+        capture,
+        dct,
+        model,
+        crate::decode::cs::ModelPick::Given(pick),
+        &opts,
+        &|_, _| {},
+    )?;
     let per_col = lf.views.0 * lf.views.1 * lf.bands;
     let mut covered = vec![false; lf.rows * lf.cols];
     let scale = lf.data.iter().fold(0.0f32, |m, x| m.max(x.abs())).max(f32::MIN_POSITIVE);

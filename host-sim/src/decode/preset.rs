@@ -8,7 +8,10 @@
 //!   `sigma_min = 3e-3`): a quarter of the default's patches, no half-pixel shears (their
 //!   projection costs about 1.5 times a whole one's). With `--schedule annealed` it is the
 //!   preview before the trained schedule: SL0 from the fill at 0.03 of its largest
-//!   coefficient, about 50 steps.
+//!   coefficient, about 50 steps. The model trial ([`crate::decode::trial`]) gives the
+//!   frame to the screened ensemble where its pilots' held-out error is below
+//!   [`crate::decode::trial::DCT_LEAN`] times the DCT's (leaning to the DCT, which costs
+//!   about 0.6 of the ensemble's time on these patches).
 //! - [`Preset::Default`]: the screened ensemble on full-view patches at stride 2 with the
 //!   tapered window, the capture's disparities (half pixels at one snapshot), seeded, with
 //!   the blob's trained schedules (24 steps the DCT's cold solve, 16 a member's or a seeded
@@ -35,7 +38,8 @@ use slf_firmware::{DisparityRange, Sl0Config};
 pub enum Preset {
     /// Fast, for the camera's screen and batch triage: the DCT on disjoint patches,
     /// whole-pixel shears without the edge fallback, one trained solve a patch from the
-    /// band-gain fill (sigma floored at 3e-3).
+    /// band-gain fill (sigma floored at 3e-3); by the screened ensemble where pilot patches
+    /// say it predicts clearly better.
     Preview,
     /// The screened ensemble at stride 2 with the capture's disparities (or the DCT, where
     /// the model trial's pilots favour it).
@@ -66,6 +70,7 @@ impl Preset {
                 window: Window::Uniform,
                 disparities: Some(DisparityRange::DEFAULT),
                 edge_fallback: false,
+                model_trial: true,
                 ..DecodeOptions::default()
             },
             Self::Default => DecodeOptions { model_trial: true, shear_trial: true, ..DecodeOptions::default() },

@@ -511,7 +511,8 @@ impl DecodeSettings {
             plausibility: self.plausible.unwrap_or(base.plausibility),
             error_estimate: self.estimate || base.error_estimate,
             shear_check: self.shear_check || base.shear_check,
-            model_trial: self.model_trial.unwrap_or(base.model_trial),
+            // A dictionary named is the model asked for: no trial unless asked too.
+            model_trial: self.model_trial.unwrap_or(base.model_trial && self.basis.dictionary.is_none()),
             shear_trial: self.shear_trial.unwrap_or(base.shear_trial),
             patch_views: self.basis.patch_views.or(base.patch_views),
             schedule: self.schedule,

@@ -23,23 +23,46 @@ use slf_firmware::{FrameSource, PatchModel, RawFrame, Tile, TileDecoder, TrialEr
 /// against 0.00277): a few pilots with large errors decide the sums, and 49 missed them.
 pub const MAX_PILOTS: usize = 256;
 
+/// The fewest pilots a frame's trial takes, where it has as many tiles.
+pub const MIN_PILOTS: usize = 16;
+
+/// Patches a pilot: a frame's trial takes at most one pilot for this many of the decode's
+/// patches (and [`MIN_PILOTS`] at least). The default's stride-2 grid has 36 patches a
+/// tile, so it keeps its pilot a tile; the preview's disjoint grid has 4, where a pilot a
+/// tile (3 solves) cost the preview 0.75 solves a patch on top of its one.
+pub const PATCHES_A_PILOT: usize = 16;
+
+/// How many pilots a trial over a decode of `patches` patches takes.
+pub fn pilot_budget(patches: usize) -> usize {
+    (patches / PATCHES_A_PILOT).clamp(MIN_PILOTS, MAX_PILOTS)
+}
+
+/// How far below the DCT's (RMS over the pilots) the ensemble's held-out error must be
+/// for a DCT decode with the model trial (the preview's) to give the frame to the ensemble,
+/// which costs it about 1.7 times the DCT's time. Chosen on the preview's table
+/// (`docs/results-preview.md`, every scene and setting; no set held out): the frames whose
+/// pilots favoured the ensemble by 1.25 times or more decoded 0.8 to 3.9 dB better with it,
+/// and those within 1.2 times from -0.7 to +1.8 dB, most within 0.5.
+pub const DCT_LEAN: f32 = 0.8;
+
 /// The model trial over `tiles` (the disjoint grid's): one pilot on each of at most
-/// [`MAX_PILOTS`] of them, evenly spaced, in parallel; their errors summed.
+/// `budget` ([`pilot_budget`]) of them, evenly spaced, in parallel; their errors summed.
 pub fn frame_trial<const PU: usize, const PV: usize, const N: usize, A, Z>(
     decoder: &TileDecoder<'_, 5, 5, PU, PV, 13, N>,
     first: &A,
     second: &Z,
     raw: &[RawFrame<'_, u16>],
     tiles: &[Tile],
+    budget: usize,
 ) -> TrialErrors
 where
     A: PatchModel<5, 5, PU, PV, 13, N> + Sync,
     Z: PatchModel<5, 5, PU, PV, 13, N> + Sync,
 {
-    pilots::<PU, PV, N>(raw, tiles, |source, at, ws| decoder.trial(first, second, at, source, ws))
+    pilots::<PU, PV, N>(raw, tiles, budget, |source, at, ws| decoder.trial(first, second, at, source, ws))
 }
 
-/// The shear trial over `tiles` (the disjoint grid's): on each of at most [`MAX_PILOTS`]
+/// The shear trial over `tiles` (the disjoint grid's): on each of at most `budget`
 /// of them whose first block's views agree best at a half-pixel disparity, the held-out
 /// errors at it and at the better whole one beside it
 /// ([`TileDecoder::shear_trial`]), summed.
@@ -48,19 +71,21 @@ pub fn frame_shear_trial<const PU: usize, const PV: usize, const N: usize, M>(
     model: &M,
     raw: &[RawFrame<'_, u16>],
     tiles: &[Tile],
+    budget: usize,
 ) -> TrialErrors
 where
     M: PatchModel<5, 5, PU, PV, 13, N> + Sync,
 {
-    pilots::<PU, PV, N>(raw, tiles, |source, at, ws| decoder.shear_trial(model, at, source, ws))
+    pilots::<PU, PV, N>(raw, tiles, budget, |source, at, ws| decoder.shear_trial(model, at, source, ws))
 }
 
-/// `pilot` on the first block of each of at most [`MAX_PILOTS`] of `tiles`, evenly
+/// `pilot` on the first block of each of at most `budget` of `tiles`, evenly
 /// spaced, in parallel (a workspace a thread); their errors summed (a pilot whose source
 /// failed counts as none).
 fn pilots<const PU: usize, const PV: usize, const N: usize>(
     raw: &[RawFrame<'_, u16>],
     tiles: &[Tile],
+    budget: usize,
     pilot: impl Fn(
         &mut FrameSource<'_, RawFrame<'_, u16>>,
         (u16, u16),
@@ -68,7 +93,7 @@ fn pilots<const PU: usize, const PV: usize, const N: usize>(
     ) -> Result<TrialErrors, slf_firmware::raw::ReadError>
     + Sync,
 ) -> TrialErrors {
-    let step = tiles.len().div_ceil(MAX_PILOTS).max(1);
+    let step = tiles.len().div_ceil(budget.max(1)).max(1);
     tiles
         .par_iter()
         .step_by(step)

@@ -182,9 +182,11 @@ pub fn run(args: Args) -> Result<()> {
             t.whole_error
         );
     }
-    if r.trial.is_some_and(|t| t.pilots == 0) {
+    if let Some(t) = r.trial.filter(|t| t.pilots == 0) {
         println!(
-            "model trial: no pilot patch could be estimated (too few bands measured, or the response in the projection); decoded by the ensemble"
+            "model trial: no pilot patch could be estimated (too few bands measured, or the response in the \
+             projection); decoded by the {}",
+            if t.dct { "DCT" } else { "ensemble" }
         );
     } else if let Some(t) = r.trial {
         println!(
