@@ -426,7 +426,7 @@ pub struct DecodeOptions {
     /// Whether an ensemble decode picks, for the frame, the ensemble or the DCT it screens
     /// with by their held-out errors on pilot patches ([`crate::decode::trial`]). Off here,
     /// where a decode measures the ensemble itself (`slf compare`, `slf evaluate`'s
-    /// ensemble rows, the bench's choice points); on in the default and best presets
+    /// ensemble rows, the bench's choice points); on in every preset
     /// ([`crate::decode::preset::Preset::options`]), which `slf decode` and `slf.decode`
     /// run. A DCT decode with it (the preview's) screens the shipped ensemble on the pilots
     /// and leans to the DCT ([`crate::decode::trial::DCT_LEAN`]).
@@ -871,13 +871,14 @@ where
     let lenslets = (d.lenslets[0], d.lenslets[1]);
     let views = (d.views[0], d.views[1]);
     let range = decoder.config().raw.range();
-    // The shear trial first: half-pixel shears off for the frame where its pilots estimate
-    // the whole ones clearly better (by the estimating solve, `second`'s), so the model
-    // trial's pilots are sheared as the decode will be.
-    // The decode's patches: the disjoint grid's blocks times the stride's shifts.
+    // The trials' pilots by the decode's patches: the disjoint grid's blocks times the
+    // stride's shifts.
     let shifts = |s: u8| 5usize.div_ceil(usize::from(s));
     let blocks: usize = base.iter().map(|t| usize::from(t.lenslet_rows / 5) * usize::from(t.lenslet_cols / 5)).sum();
     let budget = pilot_budget(blocks * shifts(opts.stride.0) * shifts(opts.stride.1));
+    // The shear trial first: half-pixel shears off for the frame where its pilots estimate
+    // the whole ones clearly better (by the estimating solve, `second`'s), so the model
+    // trial's pilots are sheared as the decode will be.
     let sheared = (opts.shear_trial && decoder.disparities().has_halves())
         .then(|| frame_shear_trial(&decoder, second, &raw, &base, budget));
     let alias = sheared.as_ref().is_some_and(halves_alias);
