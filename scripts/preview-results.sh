@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # The preview's table (docs/results-preview.md, issue 49): every test, realistic and
 # hard-case scene and the real crops at pixel k = 1 and 3, lenslet k = 3 and kronecker k = 3,
-# decoded by the two baselines (demosaic, PPID), by the preview without the model trial
-# (--model-trial false: the DCT on every patch, the preview before the trial), by the screened
-# ensemble on the preview's patches (--dictionary ensemble --model-trial false) and by the
-# preview (the trial leaning to the DCT). Per decode: PSNR and seconds; for the preview, the
-# model its trial picked and the pilots' held-out RMS errors. Then, per setting: cases below
-# the strongest baseline, the preview's gain, and its time over the one before.
+# decoded by the two baselines (demosaic, PPID), by the preview before issue 49's choices
+# (--model-trial false --sheared-fallback false: the DCT on every patch, the values between
+# blocks sheared otherwise filled from other views), with the sheared fallback alone
+# (--model-trial false) and by the preview (the fallback and the model trial leaning to the
+# DCT). Per decode: PSNR and seconds; for the preview, the model its trial picked and the
+# pilots' held-out RMS errors. Then, per setting: cases below the strongest baseline, the
+# preview's gain, and its time over the one before.
 #
 #   bash scripts/preview-results.sh OUT_DIR > docs/results-preview.md
 #   SLF_SIZE=40 SLF_SCENES="smooth canopy" bash scripts/preview-results.sh OUT_DIR
@@ -20,13 +21,15 @@ echo "# The preview and its model trial"
 echo
 echo "Made by \`bash scripts/preview-results.sh OUT_DIR\` (scenes of ${size} x ${size} lenslets, the real crops"
 echo "at their own size, 5 x 5 views, \`slf simulate --seed 3\`; \`RAYON_NUM_THREADS=${RAYON_NUM_THREADS:-all}\`)."
-echo "\"before\": \`--preset preview --model-trial false\` (the DCT on every patch); \"ensemble\": the screened"
-echo "ensemble on the same patches; \"preview\": \`--preset preview\`, whose model trial gives the frame to the"
-echo "ensemble only where the pilots' held-out RMS error is below 0.8 x the DCT's. Margins: PSNR less"
-echo "the strongest baseline's (demosaic or PPID). Times in seconds, one decode each."
+echo "\"before\": \`--preset preview --model-trial false --sheared-fallback false\` (the DCT on every patch,"
+echo "the values between blocks sheared otherwise from their lenslet's other views); \"fallback\":"
+echo "\`--model-trial false\` (every sheared block decoded unsheared as well, for those values);"
+echo "\"preview\": \`--preset preview\`, whose model trial also gives the frame to the screened ensemble"
+echo "where the pilots' held-out RMS error is below 0.8 x the DCT's. Margins: PSNR less the strongest"
+echo "baseline's (demosaic or PPID). Times in seconds, one decode each."
 add_real_scenes
 echo
-echo "| scene | setting | strongest baseline | before | ensemble | preview | picked (pilots: RMS DCT, ensemble) | s demosaic / before / preview |"
+echo "| scene | setting | strongest baseline | before | fallback | preview | picked (pilots: RMS DCT, ensemble) | s demosaic / before / preview |"
 echo "| --- | --- | --- | --- | --- | --- | --- | --- |"
 summary=$(mktemp)
 for token in $scenes; do
@@ -35,8 +38,8 @@ for token in $scenes; do
     scene_capture "$s" 3
     decode_eval "$cap" --method demosaic; dem=$p; tdem=$t
     decode_eval "$cap" --method ppid; base=$(echo "if ($p > $dem) $p else $dem" | bc -l)
-    decode_eval "$cap" --preset preview --model-trial false; before=$p; tbefore=$t
-    decode_eval "$cap" --preset preview --dictionary ensemble --model-trial false; ens=$p
+    decode_eval "$cap" --preset preview --model-trial false --sheared-fallback false; before=$p; tbefore=$t
+    decode_eval "$cap" --preset preview --model-trial false; ens=$p
     decode_eval "$cap" --preset preview; preview=$p; tpreview=$t
     pick=$("$slf" decode "$cap" -o "$out/rec.npy" --preset preview 2>/dev/null \
       | sed -n 's/^model trial: decoded by the \([A-Za-z]*\) (held-out error over \([0-9]*\) pilot patches: DCT \([0-9.]*\), ensemble \([0-9.]*\)).*/\1 (\2: \3, \4)/p')

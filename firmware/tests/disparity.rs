@@ -258,6 +258,42 @@ fn the_known_disparity_of_a_plane_is_chosen_off_the_edges() {
 }
 
 #[test]
+fn the_sheared_fallback_adds_each_sheared_blocks_unsheared_patches_and_nothing_else() {
+    let (rows, cols) = SENSOR.frame_size();
+    let mask = Mask::pixel(6, 1, 13, L5).unwrap();
+    let frames = plane(&mask, 1, 6);
+    let raw: Vec<RawFrame<f32>> = frames.iter().map(|f| RawFrame::new(f, rows, cols).unwrap()).collect();
+    let plain = paper_decoder(mask);
+    let sheared = plain.with_disparities(DisparityRange::new(-1, 1).unwrap());
+    let dct = Dictionary::dct();
+    let mut ws = Box::new(PaperWorkspace::new());
+    let run = |dec: &Decoder<'static>, ws: &mut PaperWorkspace| {
+        let mut sink = Collect::default();
+        dec.decode_frame(&dct, (2, 2), &mut FrameSource::new(&raw), &mut sink, ws);
+        sink.0
+    };
+    let (edges, all, unsheared) =
+        (run(&sheared, &mut ws), run(&sheared.with_sheared_fallback(true), &mut ws), run(&plain, &mut ws));
+    let key = |o: &PatchOrigin| (o.lenslet_row, o.lenslet_col, o.view_row, o.view_col);
+    // The sheared patches are the same with or without it.
+    let main = |v: &[(PatchOrigin, Vec<f32>, bool)]| v.iter().filter(|p| !p.2).cloned().collect::<Vec<_>>();
+    assert_eq!(main(&all), main(&edges));
+    // One fallback for each window of each sheared block, equal to the unsheared decode's
+    // patch there; the edge fallback alone covers fewer.
+    let sheared_windows: Vec<_> =
+        main(&all).iter().filter(|p| p.0.disparity != Disparity::ZERO).map(|p| key(&p.0)).collect();
+    assert!(sheared_windows.len() >= 8, "{} sheared windows", sheared_windows.len());
+    let fallbacks: Vec<_> = all.iter().filter(|p| p.2).collect();
+    assert_eq!(fallbacks.iter().map(|p| key(&p.0)).collect::<Vec<_>>(), sheared_windows);
+    for (o, values, _) in fallbacks {
+        assert_eq!(o.disparity, Disparity::ZERO);
+        let (_, twin, _) = unsheared.iter().find(|p| key(&p.0) == key(o)).unwrap();
+        assert_eq!(values, twin, "{o:?}");
+    }
+    assert!(edges.iter().filter(|p| p.2).count() < all.iter().filter(|p| p.2).count());
+}
+
+#[test]
 fn a_range_that_chooses_zero_everywhere_is_the_unsheared_decode_bit_for_bit() {
     let (rows, cols) = SENSOR.frame_size();
     let mask = Mask::pixel(5, 1, 13, L5).unwrap();

@@ -576,6 +576,8 @@ fn presets_are_their_flags_and_flags_override_them() {
         "--disparities=-1:1",
         "--edge-fallback",
         "false",
+        "--sheared-fallback",
+        "true",
         "--sigma-min",
         "3e-3",
         "--model-trial",
@@ -594,9 +596,13 @@ fn presets_are_their_flags_and_flags_override_them() {
     // is the default's stride with the preview's other choices.
     let (_, n_stride3) = decode("s3.npy", &["--preset", "preview", "--stride", "3"]);
     assert!(n_stride3 > n_preview, "{n_stride3} <= {n_preview}");
-    // The edge fallback: on, the sheared blocks at the frame's edge add patches.
-    let (_, n_fallback) = decode("fb.npy", &["--preset", "preview", "--edge-fallback", "true"]);
-    assert!(n_fallback > n_preview, "{n_fallback} <= {n_preview}");
+    // The sheared fallback: off, the sheared blocks' unsheared patches are gone; the edge
+    // fallback then adds those of the blocks at the frame's edge back.
+    let (_, n_unfilled) = decode("uf.npy", &["--preset", "preview", "--sheared-fallback", "false"]);
+    assert!(n_unfilled < n_preview, "{n_unfilled} >= {n_preview}");
+    let (_, n_edges) =
+        decode("fb.npy", &["--preset", "preview", "--sheared-fallback", "false", "--edge-fallback", "true"]);
+    assert!(n_unfilled < n_edges && n_edges <= n_preview, "{n_unfilled} / {n_edges} / {n_preview}");
     let (default, n_default) = decode("default.npy", &[]);
     let (named, n_named) = decode("named.npy", &["--preset", "default"]);
     assert!(default == named && n_default == n_named, "--preset default is not the default");

@@ -300,6 +300,7 @@ def decode(
     window: Optional[str] = None,
     disparities: Union[None, str, Sequence[float]] = None,
     edge_fallback: Optional[bool] = None,
+    sheared_fallback: Optional[bool] = None,
     seeded: Optional[bool] = None,
     schedule: Optional[str] = None,
     patch_views: Optional[int] = None,
@@ -351,7 +352,8 @@ def decode(
     ``preset``: preview (fast), default or best; any keyword below overrides the preset's
     value. The keywords are ``slf decode``'s flags (see ``slf decode --help``):
     ``stride`` 1..=5, ``window`` uniform or tapered, ``disparities`` ``"MIN:MAX[:STEP]"``
-    or ``(min, max[, step])``, ``edge_fallback``, ``seeded`` (shifted patches started from
+    or ``(min, max[, step])``, ``edge_fallback``, ``sheared_fallback`` (every sheared block decoded unsheared as
+    well, for the values no sheared patch reached; True in the preview), ``seeded`` (shifted patches started from
     the disjoint grid's decode), ``schedule`` trained (the blob's trained schedules, the
     default) or annealed (the hand-set one the solver keywords set), ``patch_views`` 4 or 5 (the paper's 4 x 4-view patch or the
     full-view patch; default 5 for lenslets of 5 x 5 views), ``dictionary`` dct or ensemble,
@@ -377,6 +379,8 @@ def decode(
         disparities = ":".join(f"{d:g}" for d in disparities)
     if edge_fallback is not None:
         edge_fallback = "true" if edge_fallback else "false"  # type: ignore[assignment]
+    if sheared_fallback is not None:
+        sheared_fallback = "true" if sheared_fallback else "false"  # type: ignore[assignment]
     if seeded is not None:
         seeded = "true" if seeded else "false"  # type: ignore[assignment]
     if model_trial is not None:
@@ -396,6 +400,7 @@ def decode(
         window=window,
         disparities=disparities,
         edge_fallback=edge_fallback,
+        sheared_fallback=sheared_fallback,
         seeded=seeded,
         schedule=schedule,
         patch_views=patch_views,

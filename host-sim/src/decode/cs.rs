@@ -396,6 +396,10 @@ pub struct DecodeOptions {
     /// ([`TileDecoder::with_edge_fallback`]); off, the views no sheared patch reached are
     /// filled from their lenslet's other views. On by default.
     pub edge_fallback: bool,
+    /// Whether every sheared block is decoded unsheared as well
+    /// ([`TileDecoder::with_sheared_fallback`]): off by default, on in the preview, whose
+    /// disjoint grid leaves the values between blocks sheared otherwise to no patch.
+    pub sheared_fallback: bool,
     /// With a stride below 5: decode the disjoint grid first, then start every shifted
     /// patch (those the adaptive rule asks for) from that decode ([`slf_firmware::tile::PatchSeed`],
     /// [`slf_firmware::PatchModel::decode_seeded`]): one seeded solve a shifted patch
@@ -464,6 +468,7 @@ impl Default for DecodeOptions {
             balance: Balance::default(),
             disparities: None,
             edge_fallback: true,
+            sheared_fallback: false,
             seeded: true,
             schedule: SolveSchedule::Trained,
             patch_views: None,
@@ -571,6 +576,7 @@ pub fn tile_decoder<'a, const PU: usize, const PV: usize, const N: usize>(
     Ok(decoder
         .with_disparities(opts.disparities_for(capture))
         .with_edge_fallback(opts.edge_fallback)
+        .with_sheared_fallback(opts.sheared_fallback)
         .with_shear_check(opts.shear_check))
 }
 

@@ -2,8 +2,9 @@
 //! what it is for instead of by a dozen solver flags.
 //!
 //! - [`Preset::Preview`]: the camera's screen and batch triage. The 5D DCT on the grid of
-//!   disjoint patches, sheared to whole-pixel disparities (-1..=1) per block without the
-//!   edge fallback, one solve a patch with the shipped blob's trained `alone` schedule (24
+//!   disjoint patches, sheared to whole-pixel disparities (-1..=1) per block, every sheared
+//!   block decoded unsheared as well for the values between blocks no sheared patch reached
+//!   (the sheared fallback, which covers the edge fallback's), one solve a patch with the shipped blob's trained `alone` schedule (24
 //!   steps from the band-gain fill, [`slf_firmware::solver::fill`], sigma floored at
 //!   `sigma_min = 3e-3`): a quarter of the default's patches, no half-pixel shears (their
 //!   projection costs about 1.5 times a whole one's). With `--schedule annealed` it is the
@@ -37,7 +38,7 @@ use slf_firmware::{DisparityRange, Sl0Config};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Preset {
     /// Fast, for the camera's screen and batch triage: the DCT on disjoint patches,
-    /// whole-pixel shears without the edge fallback, one trained solve a patch from the
+    /// whole-pixel shears with every sheared block decoded unsheared as well, one trained solve a patch from the
     /// band-gain fill (sigma floored at 3e-3); by the screened ensemble where pilot patches
     /// say it predicts clearly better.
     Preview,
@@ -70,6 +71,7 @@ impl Preset {
                 window: Window::Uniform,
                 disparities: Some(DisparityRange::DEFAULT),
                 edge_fallback: false,
+                sheared_fallback: true,
                 model_trial: true,
                 ..DecodeOptions::default()
             },

@@ -376,6 +376,11 @@ pub struct DecodeSettings {
     /// [default: true; false with --preset preview].
     #[arg(long, value_name = "BOOL")]
     pub edge_fallback: Option<bool>,
+    /// Decode every sheared block unsheared as well, for the values between blocks sheared
+    /// otherwise that no sheared patch reached (false: those come from their lenslet's
+    /// other views) [default: false; true with --preset preview].
+    #[arg(long, value_name = "BOOL")]
+    pub sheared_fallback: Option<bool>,
     /// With a stride below 5: decode the disjoint grid first and start each shifted patch
     /// from its decode, one solve a patch instead of two (false: every patch from
     /// nothing, the decode before 2026-11-25) [default: true].
@@ -507,6 +512,7 @@ impl DecodeSettings {
             balance,
             disparities: self.disparities.or(base.disparities),
             edge_fallback: self.edge_fallback.unwrap_or(base.edge_fallback),
+            sheared_fallback: self.sheared_fallback.unwrap_or(base.sheared_fallback),
             seeded: self.seeded.unwrap_or(base.seeded),
             plausibility: self.plausible.unwrap_or(base.plausibility),
             error_estimate: self.estimate || base.error_estimate,
@@ -601,6 +607,7 @@ impl DecodeSettings {
             (self.gains.is_none(), "--gains"),
             (self.disparities == d.disparities, "--disparities"),
             (self.edge_fallback == d.edge_fallback, "--edge-fallback"),
+            (self.sheared_fallback == d.sheared_fallback, "--sheared-fallback"),
             (self.seeded == d.seeded, "--seeded"),
             (self.schedule == d.schedule, "--schedule"),
             (self.plausible == d.plausible, "--plausible"),
@@ -773,8 +780,8 @@ mod tests {
         let d = Preset::Default.options();
         assert_eq!(basis.name(), Preset::Default.basis().name());
         assert_eq!(
-            (o.stride, o.window, o.disparities, o.edge_fallback),
-            (d.stride, d.window, d.disparities, d.edge_fallback)
+            (o.stride, o.window, o.disparities, o.edge_fallback, o.sheared_fallback),
+            (d.stride, d.window, d.disparities, d.edge_fallback, d.sheared_fallback)
         );
         assert_eq!(o.sl0, Sl0Config::DEFAULT);
         assert_eq!((o.noise, o.balance), (NoiseSource::Capture, Balance::GreyWorld));
@@ -786,8 +793,8 @@ mod tests {
         let (basis, o) = resolved(&["--preset", "preview"]);
         assert!(matches!(basis, Basis::Dct));
         assert_eq!(
-            (o.stride, o.window, o.disparities, o.edge_fallback),
-            (p.stride, p.window, p.disparities, p.edge_fallback)
+            (o.stride, o.window, o.disparities, o.edge_fallback, o.sheared_fallback),
+            (p.stride, p.window, p.disparities, p.edge_fallback, p.sheared_fallback)
         );
         assert_eq!((o.sl0.sigma_min, o.sl0.cold_start), (p.sl0.sigma_min, p.sl0.cold_start));
         let (basis, o) = resolved(&[
