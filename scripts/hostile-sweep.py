@@ -162,11 +162,12 @@ def main():
     for v in ["0.5:0", "2:-1", "nan:0.1", "inf:0", "1e39:0", "2", "2:0.1:3", "", "x", "on"]:
         s.run(["decode", "cap", "-o", "x.npy", "-q", f"--plausible={v}"], f"decode --plausible={v}",
               keep=capture_files)
-    for v in ["yes", "", "1", "x"]:
-        s.run(["decode", "cap", "-o", "x.npy", "-q", f"--model-trial={v}"], f"decode --model-trial={v}",
-              keep=capture_files)
+    for flag in ["--model-trial", "--sheared-fallback"]:
+        for v in ["yes", "", "1", "x"]:
+            s.run(["decode", "cap", "-o", "x.npy", "-q", f"{flag}={v}"], f"decode {flag}={v}", keep=capture_files)
     for extra in [["--error-map", "cap/capture.json"], ["--error-map", "x.npy"], ["--method", "ppid", "--estimate"],
-                  ["--model-trial", "true", "--dictionary", "dct"], ["--model-trial", "true", "--preset", "preview"]]:
+                  ["--model-trial", "true", "--dictionary", "dct"], ["--model-trial", "true", "--preset", "preview"],
+                  ["--sheared-fallback", "true", "--disparities", "0:0"], ["--sheared-fallback", "true", "--stride", "1"]]:
         s.run(["decode", "cap", "-o", "x.npy", "-q", *extra], f"decode {' '.join(extra)}", keep=capture_files)
 
     # Outputs over inputs, and over each other.
