@@ -1,10 +1,12 @@
 //! The model trial on the workstation: the DCT or the screened ensemble for the frame,
 //! picked by their held-out errors on pilot patches ([`slf_firmware::trial`]).
 //!
-//! The pilots are the first blocks of the disjoint grid's tiles, at most [`MAX_PILOTS`]
-//! spread evenly over the frame. A pilot costs both models' decodes (the DCT's one solve and
-//! the ensemble's two): 3 solves a tile of 36 patches at stride 2 (0.08 a patch) up to 160 x
-//! 160 lenslets, a fixed 768 on a larger frame.
+//! The pilots are the first blocks of the disjoint grid's tiles, at most [`pilot_budget`]
+//! of them (one for 16 of the decode's patches, 16 to [`MAX_PILOTS`]) spread evenly over the
+//! frame. A pilot costs both models' decodes (the DCT's one solve and the ensemble's two): in
+//! the default, 3 solves a tile of 36 patches at stride 2 (0.08 a patch) up to 160 x 160
+//! lenslets, a fixed 768 on a larger frame; in the preview (4 patches a tile) about 0.19 a
+//! patch, and 48 solves at least.
 //!
 //! Why one pick for the frame, not per region: a pilot's held-out error is a noisy
 //! sample (about 78 held-out measurements, or 9 held-out (lenslet, band) groups on a lenslet
