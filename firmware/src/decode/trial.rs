@@ -42,12 +42,12 @@ impl TrialErrors {
     /// The model whose pilots erred less; the second (the decode's default) without pilots
     /// or on a tie.
     pub fn pick(&self) -> Pick {
-        if self.pilots > 0 && self.first < self.second { Pick::First } else { Pick::Second }
+        self.pick_leaning(Pick::Second, 1.0)
     }
 
     /// The model `towards` unless the other's pilots erred below `margin` times its
-    /// (RMS over the pilots); `towards` without pilots. `pick_leaning(Pick::Second, 1.0)`
-    /// is [`Self::pick`]. A decode that must stay cheap leans to its cheap model and pays
+    /// (RMS over the pilots); `towards` without pilots ([`Self::pick`] is
+    /// `pick_leaning(Pick::Second, 1.0)`). A decode that must stay cheap leans to its cheap model and pays
     /// for the other only where the pilots say it clearly predicts better.
     pub fn pick_leaning(&self, towards: Pick, margin: f32) -> Pick {
         let (kept, other) = match towards {

@@ -4,12 +4,12 @@
 //! - [`Preset::Preview`]: the camera's screen and batch triage. The 5D DCT on the grid of
 //!   disjoint patches, sheared to whole-pixel disparities (-1..=1) per block, every sheared
 //!   block decoded unsheared as well for the values between blocks no sheared patch reached
-//!   (the sheared fallback, which covers the edge fallback's), one solve a patch with the shipped blob's trained `alone` schedule (24
-//!   steps from the band-gain fill, [`slf_firmware::solver::fill`], sigma floored at
-//!   `sigma_min = 3e-3`): a quarter of the default's patches, no half-pixel shears (their
-//!   projection costs about 1.5 times a whole one's). With `--schedule annealed` it is the
-//!   preview before the trained schedule: SL0 from the fill at 0.03 of its largest
-//!   coefficient, about 50 steps. The model trial ([`crate::decode::trial`]) gives the
+//!   (the sheared fallback, which covers the edge fallback's), one solve a patch with the
+//!   shipped blob's trained `alone` schedule (24 steps from the band-gain fill,
+//!   [`slf_firmware::solver::fill`], sigma floored at `sigma_min = 3e-3`): a quarter of
+//!   the default's patches, no half-pixel shears (their projection costs about 1.5 times a
+//!   whole one's). With `--schedule annealed` it is the preview before the trained schedule:
+//!   SL0 from the fill at 0.03 of its largest coefficient, about 50 steps. The model trial ([`crate::decode::trial`]) gives the
 //!   frame to the screened ensemble where its pilots' held-out error is below
 //!   [`crate::decode::trial::DCT_LEAN`] times the DCT's (leaning to the DCT, which costs
 //!   about 0.6 of the ensemble's time on these patches).
@@ -38,9 +38,9 @@ use slf_firmware::{DisparityRange, Sl0Config};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Preset {
     /// Fast, for the camera's screen and batch triage: the DCT on disjoint patches,
-    /// whole-pixel shears with every sheared block decoded unsheared as well, one trained solve a patch from the
-    /// band-gain fill (sigma floored at 3e-3); by the screened ensemble where pilot patches
-    /// say it predicts clearly better.
+    /// whole-pixel shears with every sheared block decoded unsheared as well, one trained
+    /// solve a patch from the band-gain fill (sigma floored at 3e-3); by the screened
+    /// ensemble where pilot patches say it predicts clearly better.
     Preview,
     /// The screened ensemble at stride 2 with the capture's disparities (or the DCT, where
     /// the model trial's pilots favour it).

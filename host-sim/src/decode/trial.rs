@@ -16,7 +16,7 @@
 //! (`docs/results-model-trial.md`).
 
 use rayon::prelude::*;
-use slf_firmware::{FrameSource, PatchModel, RawFrame, Tile, TileDecoder, TrialErrors, Workspace};
+use slf_firmware::{FrameSource, PatchModel, Pick, RawFrame, Tile, TileDecoder, TrialErrors, Workspace};
 
 /// The most pilots a frame's trial takes. With 64, the HCI crops' 196 tiles gave 49 pilots,
 /// and cotton and antinous at lenslet k = 3 went to the DCT (held-out RMS 0.00164 against
@@ -112,10 +112,10 @@ fn pilots<const PU: usize, const PV: usize, const N: usize>(
 
 /// Whether a frame's half-pixel shears alias, by its shear trial: the whole disparities'
 /// summed squared errors below [`slf_firmware::tile::SHEAR_MARGIN`] squared times the half
-/// ones' (the shear check's margin, on the frame's pilots together).
+/// ones' (the shear check's margin, on the frame's pilots together): the trial leaning to
+/// the half disparities (`first`) by that margin picks the whole ones.
 pub fn halves_alias(t: &TrialErrors) -> bool {
-    let m = slf_firmware::tile::SHEAR_MARGIN;
-    t.pilots > 0 && t.second < m * m * t.first
+    t.pick_leaning(Pick::First, slf_firmware::tile::SHEAR_MARGIN) == Pick::Second
 }
 
 /// A trial's errors as RMS over its pilots (first, second; 0 without pilots).
