@@ -1121,6 +1121,19 @@ fn the_shear_check_and_trial_take_whole_shears_where_half_ones_alias() {
 /// Issue 49, item 2: the model trial. The default decodes the frame with the model whose
 /// held-out error over the pilots it prints is the smaller, and that decode is the model's
 /// own without the trial, bit for bit; `--model-trial false` is the screened ensemble.
+/// The summary's `model trial:` line of a decode: the line after its prefix, the model
+/// it names as `--dictionary` spells it, and the printed held-out errors (DCT, ensemble).
+fn model_trial_line(out: &str) -> (String, &'static str, f64, f64) {
+    let line = out.lines().find_map(|l| l.strip_prefix("model trial: decoded by the ")).unwrap().to_string();
+    let number = |after: &str| -> f64 {
+        let rest = &line[line.find(after).unwrap() + after.len()..];
+        rest.split([',', ')']).next().unwrap().trim().parse().unwrap()
+    };
+    let (dct, ensemble) = (number("patches: DCT "), number(", ensemble "));
+    let picked = if line.starts_with("DCT") { "dct" } else { "ensemble" };
+    (line, picked, dct, ensemble)
+}
+
 #[test]
 fn the_previews_model_trial_leans_to_the_dct_and_moves_only_where_the_ensemble_is_clearly_better() {
     let dir = tempfile::tempdir().unwrap();
@@ -1140,13 +1153,7 @@ fn the_previews_model_trial_leans_to_the_dct_and_moves_only_where_the_ensemble_i
             (out, std::fs::read(p(name)).unwrap())
         };
         let (out, trial) = decode("trial.npy", &[]);
-        let line = out.lines().find_map(|l| l.strip_prefix("model trial: decoded by the ")).unwrap().to_string();
-        let number = |after: &str| -> f64 {
-            let rest = &line[line.find(after).unwrap() + after.len()..];
-            rest.split([',', ')']).next().unwrap().trim().parse().unwrap()
-        };
-        let (dct, ensemble) = (number("patches: DCT "), number(", ensemble "));
-        let picked = if line.starts_with("DCT") { "dct" } else { "ensemble" };
+        let (line, picked, dct, ensemble) = model_trial_line(&out);
         // The lean: the ensemble only below 0.8 x the DCT's error (printed to 5 decimals).
         assert!((ensemble - 0.8 * dct).abs() > 1e-4, "too near the margin to check: {line}");
         assert_eq!(picked == "ensemble", ensemble < 0.8 * dct, "{scene}: {line}");
@@ -1181,13 +1188,7 @@ fn the_model_trial_decodes_with_the_model_its_pilots_favour() {
         let cap = p(&format!("cap{k}"));
         stdout(slf().arg("simulate").arg(p("truth.npy")).arg("-o").arg(&cap).args(["-s", k, "--seed", seed]));
         let out = stdout(slf().arg("decode").arg(&cap).arg("-o").arg(p("trial.npy")).arg("-q"));
-        let line = out.lines().find_map(|l| l.strip_prefix("model trial: decoded by the ")).unwrap();
-        let number = |after: &str| -> f64 {
-            let rest = &line[line.find(after).unwrap() + after.len()..];
-            rest.split([',', ')']).next().unwrap().trim().parse().unwrap()
-        };
-        let (dct, ensemble) = (number("patches: DCT "), number(", ensemble "));
-        let picked = if line.starts_with("DCT") { "dct" } else { "ensemble" };
+        let (line, picked, dct, ensemble) = model_trial_line(&out);
         assert_eq!(picked == "dct", dct < ensemble, "{line}");
         stdout(slf().arg("decode").arg(&cap).arg("-o").arg(p("alone.npy")).arg("-q").args([
             "--model-trial",
