@@ -41,7 +41,7 @@ for token in $scenes; do
     decode_eval "$cap" --preset preview --model-trial false --sheared-fallback false; before=$p; tbefore=$t
     decode_eval "$cap" --preset preview --model-trial false; ens=$p
     decode_eval "$cap" --preset preview; preview=$p; tpreview=$t
-    pick=$("$slf" decode "$cap" -o "$out/rec.npy" --preset preview 2>/dev/null \
+    pick=$(echo "$log" \
       | sed -n 's/^model trial: decoded by the \([A-Za-z]*\) (held-out error over \([0-9]*\) pilot patches: DCT \([0-9.]*\), ensemble \([0-9.]*\)).*/\1 (\2: \3, \4)/p')
     printf '| %s | %s k=%s | %.2f | %+.2f | %+.2f | %+.2f | %s | %.3f / %.3f / %.3f |\n' "$scene" "$mask" "$k" "$base" \
       "$(echo "$before - $base" | bc -l)" "$(echo "$ens - $base" | bc -l)" "$(echo "$preview - $base" | bc -l)" \

@@ -41,9 +41,9 @@ scene_light_field() {
 }
 
 # decode_eval CAPTURE ARGS...: decodes CAPTURE with ARGS against $lf; sets $p $q $a (PSNR,
-# SSIM, SA) and $t (the decode's seconds).
+# SSIM, SA), $t (the decode's seconds) and $log (the decode's summary).
 decode_eval() {
-  local cap=$1 rec="$out/rec.npy" log; shift
+  local cap=$1 rec="$out/rec.npy"; shift
   log=$("$slf" decode "$cap" -o "$rec" --quiet "$@")
   t=$(echo "$log" | awk '/ in [0-9.]+ s/ { for (i = 1; i < NF; i++) if ($i == "in") print $(i + 1) }')
   read -r p q a < <("$slf" eval "$lf" "$rec" | awk '/^PSNR/ { p = $2 } /^SSIM/ { q = $2 } /^SA/ { a = $2 } END { print p, q, a }')
