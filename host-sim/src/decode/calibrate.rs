@@ -320,12 +320,12 @@ pub fn unmixing(cal: &Calibration) -> Result<Vec<f32>> {
     Ok((0..b).flat_map(|i| (0..b).map(move |j| (i, j))).map(|(i, j)| inv[(i, j)] as f32).collect())
 }
 
-/// Every spectrum of `lf` (what the one-hot decode recovered: each band as its filter saw
-/// it) unmixed by `inverse` ([`unmixing`]): the light the scene sent.
-pub fn unmix(lf: &mut crate::io::lightfield::LightField, inverse: &[f32]) {
-    let b = lf.bands;
+/// Every spectrum of `values` (`bands` values each: what the one-hot decode recovered, each
+/// band as its filter saw it) unmixed by `inverse` ([`unmixing`]): the light the scene sent.
+pub fn unmix(values: &mut [f32], bands: usize, inverse: &[f32]) {
+    let b = bands;
     let mut out = vec![0.0f32; b];
-    for z in lf.data.chunks_exact_mut(b) {
+    for z in values.chunks_exact_mut(b) {
         for (i, o) in out.iter_mut().enumerate() {
             *o = inverse[i * b..(i + 1) * b].iter().zip(z.iter()).map(|(a, x)| a * x).sum();
         }

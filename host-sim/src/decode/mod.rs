@@ -3,7 +3,10 @@
 //!
 //! - [`calibrate`]: a sensor's calibration from its calibration captures (`slf calibrate`);
 //! - [`cs`]: the firmware's tile decoder over a capture in parallel (rayon), with
-//!   overlapping patches, white balance, the noise model and the depth search;
+//!   overlapping patches, white balance, the noise model and the depth search, as asked by
+//!   its [`options`]: a frame's [`plan`] made once, then its rows decoded down the frame by
+//!   the [`strip`] (each tile's patches into `tile_sums`, the adaptive rule's [`seams`])
+//!   and put to a sink as they are finished; what it did in its [`report`];
 //! - [`baselines`]: decode methods without compressed sensing (per-pixel interpolation, a
 //!   neighbourhood demosaic, PPID);
 //! - [`paper_1d`]: the paper's 1D method (explicit Kronecker matrices) and a 5D SL0 in f64,
@@ -21,7 +24,13 @@ pub mod baselines;
 pub mod calibrate;
 pub mod cs;
 pub mod device;
+pub mod options;
 pub mod paper_1d;
+pub mod plan;
 pub mod preset;
+pub mod report;
+pub mod seams;
 pub mod settings;
+pub mod strip;
+pub(crate) mod tile_sums;
 pub mod trial;

@@ -21,14 +21,14 @@ use slf_firmware::{
 use crate::decode::baselines::{Baseline, BaselineReport};
 use crate::decode::calibrate::{corrected, unmix, unmixing};
 use crate::decode::cs::{
-    Balance, Basis, DecodeOptions, DecodeReport, NoiseSource, PatchViews, SolveSchedule, Window, decode_with_observer,
-    read_blob,
+    Balance, Basis, DecodeOptions, DecodeReport, NoiseSource, PatchViews, SolveSchedule, Window, decode_into, read_blob,
 };
 use crate::decode::preset::Preset;
 use crate::io::calibration::Calibration;
 use crate::io::capture::Capture;
 use crate::io::lightfield::LightField;
 use crate::io::message::number as show;
+use crate::io::rows::{MapRows, RowShape, RowSink, put_light_field};
 use crate::sim::flags::parse;
 
 /// Decode method: compressed sensing, or a baseline without it.
@@ -618,12 +618,33 @@ impl DecodeSettings {
     }
 
     /// Decodes `capture`. `progress` shows a bar on stderr once the decode has taken a
-    /// second; `observer` is called after each tile with (tiles done, tiles in the pass).
+    /// second; `observer` is called after each tile with (tiles done, tiles in all).
     ///
     /// # Errors
     /// What [`Self::resolve`] refuses; a capture the method cannot take; a decode where no
     /// patch decoded (every patch saturated, defective or unreadable).
     pub fn run(&self, capture: &Capture, progress: bool, observer: &(dyn Fn(usize, usize) + Sync)) -> Result<Decoded> {
+        let shape = output_shape(capture);
+        LightField::check_size(shape.views, shape.rows, shape.cols, shape.bands)?;
+        let mut light_field = LightField::zeros(shape.views, shape.rows, shape.cols, shape.bands);
+        let outcome = self.run_into(capture, progress, observer, &mut light_field)?;
+        Ok(Decoded { light_field, outcome })
+    }
+
+    /// [`Self::run`], each finished lenslet row of the light field ([`output_shape`]) put
+    /// into `sink` in order: a compressed-sensing decode holds a band of rows, not the
+    /// frame (a baseline decodes the frame, then puts its rows).
+    ///
+    /// # Errors
+    /// As [`Self::run`], or what the sink returns. On an error the sink may hold some rows
+    /// (a file sink is then dropped unfinished: nothing is written).
+    pub fn run_into(
+        &self,
+        capture: &Capture,
+        progress: bool,
+        observer: &(dyn Fn(usize, usize) + Sync),
+        sink: &mut dyn RowSink,
+    ) -> Result<Outcome> {
         // A frame with no pixel above the black level recorded no light (a lens cap, an
         // exposure of zero): every method would decode zeros.
         let black = capture.description.black_level;
@@ -652,21 +673,26 @@ impl DecodeSettings {
             )),
             _ => None,
         };
-        let mut decoded = self.run_corrected(capture, modelled, progress, observer)?;
-        if let (Some(inverse), None) = (&inverse, modelled) {
-            unmix(&mut decoded.light_field, inverse);
+        match (&inverse, modelled) {
+            (Some(inverse), None) => {
+                let bands = output_shape(capture).bands;
+                let mut unmixed = MapRows::new(sink, |row: &mut [f32]| unmix(row, bands, inverse));
+                self.run_corrected(capture, modelled, progress, observer, &mut unmixed)
+            }
+            _ => self.run_corrected(capture, modelled, progress, observer, sink),
         }
-        Ok(decoded)
     }
 
-    /// [`Self::run`] on a capture as it is (corrected already, or needing no correction).
+    /// [`Self::run_into`] on a capture as it is (corrected already, or needing no
+    /// correction).
     fn run_corrected(
         &self,
         capture: &Capture,
         response: Option<(Response<PATCH_BANDS>, ResponseModel)>,
         progress: bool,
         observer: &(dyn Fn(usize, usize) + Sync),
-    ) -> Result<Decoded> {
+        sink: &mut dyn RowSink,
+    ) -> Result<Outcome> {
         if let Some(baseline) = self.method.baseline() {
             let given = self.compressed_sensing_flags();
             ensure!(
@@ -677,11 +703,12 @@ impl DecodeSettings {
                 self.method.to_possible_value().map_or_else(String::new, |v| v.get_name().to_string())
             );
             let (light_field, report) = baseline.run(capture)?;
-            return Ok(Decoded { light_field, outcome: Outcome::Baseline { method: self.method, report } });
+            put_light_field(&light_field, sink)?;
+            return Ok(Outcome::Baseline { method: self.method, report });
         }
         let (basis, options) = self.resolve()?;
         let options = DecodeOptions { progress, response, ..options };
-        let (light_field, report) = decode_with_observer(capture, &basis, &options, observer)?;
+        let report = decode_into(capture, &basis, &options, observer, sink)?;
         let p = &report.patches;
         if p.decoded == 0 {
             bail!(
@@ -692,15 +719,30 @@ impl DecodeSettings {
                 report.tiles
             );
         }
-        Ok(Decoded { light_field, outcome: Outcome::Cs { options: Box::new(options), report: Box::new(report) } })
+        Ok(Outcome::Cs { options: Box::new(options), report: Box::new(report) })
     }
+}
+
+/// The shape of the light field a decode of `capture` makes: its views and lenslets, a band
+/// per filter type.
+pub fn output_shape(capture: &Capture) -> RowShape {
+    let d = &capture.description;
+    RowShape { views: (d.views[0], d.views[1]), rows: d.lenslets[0], cols: d.lenslets[1], bands: d.bands_nm.len() }
 }
 
 impl Decoded {
     /// A warning when more than [`WARN_FRACTION`] of the patches failed or were flagged, or
+    /// a tile failed ([`Outcome::warning`]).
+    pub fn warning(&self) -> Option<String> {
+        self.outcome.warning()
+    }
+}
+
+impl Outcome {
+    /// A warning when more than [`WARN_FRACTION`] of the patches failed or were flagged, or
     /// a tile failed.
     pub fn warning(&self) -> Option<String> {
-        let Outcome::Cs { report: r, .. } = &self.outcome else { return None };
+        let Outcome::Cs { report: r, .. } = self else { return None };
         let p = &r.patches;
         let all = p.decoded + p.failed;
         ((p.failed + p.flagged) as f64 > WARN_FRACTION * f64::from(all) || r.failed_tiles > 0).then(|| {

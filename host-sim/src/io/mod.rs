@@ -4,12 +4,14 @@
 //! - [`npy`]: `.npy` files of float32, float64 or uint16 in either byte order and either
 //!   memory order, every size checked before anything is allocated;
 //! - [`lightfield`]: the `(U, V, H, W, B)` light field and its `.npy` files;
+//! - [`npy_rows`]: a light field's `.npy` file written as its rows come;
 //! - [`calibration`]: the calibration folder `slf calibrate` writes and a calibrated
 //!   decode reads;
 //! - [`capture`]: the capture folder (frames and `capture.json`), loaded and saved;
 //! - [`import`]: views, hyperspectral cubes, HDF5 light fields and band resampling;
 //! - [`message`]: an error as the one line a user reads;
 //! - [`output`]: results written whole, never over an input of the same run;
+//! - [`rows`]: a light field put a lenslet row at a time (a streamed decode's sink);
 //! - [`sensor`]: a simulated sensor's imperfections as its captures record them.
 //!
 //! May use: nothing of this crate (the firmware crate's checked types). Used by every
@@ -21,5 +23,7 @@ pub mod import;
 pub mod lightfield;
 pub mod message;
 pub mod npy;
+pub mod npy_rows;
 pub mod output;
+pub mod rows;
 pub mod sensor;

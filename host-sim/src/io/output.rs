@@ -24,26 +24,66 @@ use anyhow::{Context, Result, bail, ensure};
 /// # Errors
 /// What `write` returns, or the I/O error, with the path.
 pub fn write_whole(path: &Path, write: impl FnOnce(&mut dyn Write) -> Result<()>) -> Result<()> {
+    let mut whole = WholeFile::create(path)?;
     let failed = || format!("cannot write {}", path.display());
-    let name = path.file_name().with_context(|| format!("cannot write {}: not a file name", path.display()))?;
-    ensure!(!path.is_dir(), "cannot write {}: a folder", path.display());
-    let mut prefix = std::ffi::OsString::from(".");
-    prefix.push(name);
-    prefix.push(".");
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(&prefix).suffix(".part");
-    // A temporary file is made 0600; the result is an ordinary file, 0666 less the umask
-    // as `File::create` makes it (as uv's `tempfile_in` does).
-    #[cfg(unix)]
-    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
-    let tmp = builder.tempfile_in(parent(path)).with_context(failed)?;
-    let mut out = BufWriter::new(tmp.as_file());
+    let mut out = BufWriter::new(whole.file());
     write(&mut out).with_context(failed)?;
     out.flush().with_context(failed)?;
     drop(out);
-    tmp.as_file().sync_all().with_context(failed)?;
-    tmp.persist(path).map_err(|e| e.error).with_context(failed)?;
-    Ok(())
+    whole.persist()
+}
+
+/// A file written whole in any order (a streamed decode's rows at their offsets): a
+/// temporary file in the destination's folder until [`Self::persist`] renames it over the
+/// destination. Dropped without it (an error, a panic, an interrupt the run turned into
+/// an error), the temporary file is removed and the destination is as it was.
+pub struct WholeFile {
+    tmp: tempfile::NamedTempFile,
+    path: PathBuf,
+}
+
+impl WholeFile {
+    /// The temporary file for `path`, empty.
+    ///
+    /// # Errors
+    /// `path` is a folder or not a file name, or its folder takes no new file.
+    pub fn create(path: &Path) -> Result<Self> {
+        let failed = || format!("cannot write {}", path.display());
+        let name = path.file_name().with_context(|| format!("cannot write {}: not a file name", path.display()))?;
+        ensure!(!path.is_dir(), "cannot write {}: a folder", path.display());
+        let mut prefix = std::ffi::OsString::from(".");
+        prefix.push(name);
+        prefix.push(".");
+        let mut builder = tempfile::Builder::new();
+        builder.prefix(&prefix).suffix(".part");
+        // A temporary file is made 0600; the result is an ordinary file, 0666 less the
+        // umask as `File::create` makes it (as uv's `tempfile_in` does).
+        #[cfg(unix)]
+        builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+        let tmp = builder.tempfile_in(parent(path)).with_context(failed)?;
+        Ok(Self { tmp, path: path.to_path_buf() })
+    }
+
+    /// The temporary file, to write (and seek) in.
+    pub fn file(&mut self) -> &mut fs::File {
+        self.tmp.as_file_mut()
+    }
+
+    /// The destination.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Syncs the temporary file and renames it over the destination.
+    ///
+    /// # Errors
+    /// The I/O error, with the path (the temporary file is removed).
+    pub fn persist(self) -> Result<()> {
+        let failed = || format!("cannot write {}", self.path.display());
+        self.tmp.as_file().sync_all().with_context(failed)?;
+        self.tmp.persist(&self.path).map_err(|e| e.error).with_context(failed)?;
+        Ok(())
+    }
 }
 
 /// Writes `bytes` to `path` whole ([`write_whole`]).

@@ -3,17 +3,20 @@
 //! flags are [`DecodeSettings`], shared with the Python package.
 
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::{Context, Result};
 use slf_host::decode::cs::{
     Balance, NoiseSource, PatchDecoder, disparity_per_lenslet, error_per_lenslet, estimated_psnr,
 };
-use slf_host::decode::settings::{DecodeSettings, Outcome};
+use slf_host::decode::settings::{DecodeSettings, Outcome, output_shape};
 use slf_host::firmware::disparity::Disparity;
 use slf_host::io::calibration::Calibration;
 use slf_host::io::capture::Capture;
-use slf_host::io::lightfield::{Dtype, write_npy, write_npy_f32_2d};
+use slf_host::io::lightfield::{Dtype, write_npy_f32_2d};
+use slf_host::io::npy_rows::NpyRows;
 use slf_host::io::output::{Outputs, write_bytes};
+use slf_host::io::rows::RowSink;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -49,6 +52,21 @@ pub struct Args {
     pub quiet: bool,
 }
 
+/// Set by the first interrupt of a decode.
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+/// A sink that refuses the next row once the run is interrupted.
+struct Interruptible<'a> {
+    inner: &'a mut dyn RowSink,
+}
+
+impl RowSink for Interruptible<'_> {
+    fn put_row(&mut self, y: usize, row: &[f32]) -> Result<()> {
+        anyhow::ensure!(!INTERRUPTED.load(Ordering::Relaxed), "interrupted at lenslet row {y}: nothing written");
+        self.inner.put_row(y, row)
+    }
+}
+
 pub fn run(args: Args) -> Result<()> {
     let Args { capture, output, mut settings, member_map, disparity_map, error_map, dtype, quiet } = args;
     settings.estimate |= error_map.is_some();
@@ -82,14 +100,25 @@ pub fn run(args: Args) -> Result<()> {
             "--disparity-map needs disparities to search: with --disparities 0:0 every block is at 0"
         );
     }
-    let decoded = settings.run(&cap, !quiet, &|_, _| {}).with_context(|| capture.display().to_string())?;
-    if let Some(w) = decoded.warning() {
+    // The light field goes to the file as its rows are decoded; the file takes its place
+    // only once the decode and the maps are done. An interrupt (Ctrl-C, SIGTERM) ends the
+    // decode at its next row as an error, so the file is dropped unfinished and nothing is
+    // left in its place (a second interrupt exits at once).
+    let mut file = NpyRows::create(&output, output_shape(&cap), dtype)?;
+    let _ = ctrlc::set_handler(|| {
+        if INTERRUPTED.swap(true, Ordering::Relaxed) {
+            std::process::exit(130);
+        }
+    });
+    let outcome = settings
+        .run_into(&cap, !quiet, &|_, _| {}, &mut Interruptible { inner: &mut file })
+        .with_context(|| capture.display().to_string())?;
+    if let Some(w) = outcome.warning() {
         eprintln!("warning: {}: {w}", capture.display());
     }
-    let lf = &decoded.light_field;
-    let (opts, r) = match &decoded.outcome {
+    let (opts, r) = match &outcome {
         Outcome::Baseline { method, report: r } => {
-            write_npy(&output, lf, dtype)?;
+            file.finish()?;
             println!(
                 "{:?}: {} sensor positions measured, {} filled from their neighbours, in {:.3} s; wrote {}",
                 method,
@@ -127,7 +156,8 @@ pub fn run(args: Args) -> Result<()> {
     if let (Some(path), Some(map)) = (&error_map, &errors) {
         write_npy_f32_2d(path, map, rows, cols).with_context(|| format!("cannot write {}", path.display()))?;
     }
-    write_npy(&output, lf, dtype)?;
+    let peak = f64::from(file.max());
+    file.finish()?;
     let used = opts.solver_config(&cap);
     let ball = match (opts.noise, used.noise > 0.0 || used.shot > 0.0) {
         (_, false) => "exact projection".to_string(),
@@ -198,7 +228,6 @@ pub fn run(args: Args) -> Result<()> {
         );
     }
     if let Some(map) = &errors {
-        let peak = f64::from(lf.max());
         let psnr = estimated_psnr(map, peak).map_or("none".into(), |p| format!("{p:.2} dB"));
         println!(
             "error estimate: {} of {} patches from held-out measurements; estimated PSNR {psnr} (data range {peak:.4} = the \

@@ -1,0 +1,242 @@
+//! A frame's plan ([`FramePlan`]), made once before its rows are decoded: the firmware's
+//! tile decoder with the capture's mask, noise model, white balance and disparities, the
+//! trials' picks (half-pixel shears, DCT or ensemble), and the tiles of the disjoint grid
+//! and of the grids shifted by the stride, in the order the strip decodes them
+//! ([`crate::decode::strip`]).
+
+use anyhow::{Result, anyhow, ensure};
+use slf_firmware::{FrameSource, HoldOut, PatchModel, Pick, RawFrame, Tile, TileDecoder, TrialErrors};
+
+use crate::decode::options::{Balance, DecodeOptions};
+use crate::decode::trial::{frame_shear_trial, frame_trial, halves_alias, pilot_budget};
+use crate::io::capture::Capture;
+use crate::io::rows::RowShape;
+
+/// A tile and its place in the decode's canonical order (the disjoint grid row by row,
+/// then each shifted grid in turn): the order its patches are listed in the report's maps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Planned {
+    pub tile: Tile,
+    pub order: usize,
+}
+
+/// What a decode of one frame does, decided before its first row.
+pub struct FramePlan<'a, const PU: usize, const PV: usize, const N: usize> {
+    /// The tile decoder, with the shear trial's disparities.
+    pub decoder: TileDecoder<'a, 5, 5, PU, PV, 13, N>,
+    /// Which of the two models decodes the frame.
+    pub pick: Pick,
+    /// The disjoint grid's tiles, row by row (their first rows never decrease).
+    pub disjoint: Vec<Planned>,
+    /// The shifted grids' tiles (with the adaptive rule: their single patches, the
+    /// candidates), ordered by first row; empty at stride 5.
+    pub shifted: Vec<Planned>,
+    /// Start the shifted patches from the disjoint grid's decode.
+    pub seeded: bool,
+    /// Decode a shifted candidate only where its seam score is above this.
+    pub adaptive: Option<f32>,
+    /// Lenslets a sheared patch reaches beyond its tile on every side.
+    pub halo: usize,
+    /// The light field's rows.
+    pub shape: RowShape,
+    /// The sensor's range of decoded values.
+    pub range: (f32, f32),
+    /// How overlapping estimates are weighed.
+    pub window: slf_firmware::overlap::Window,
+    /// The shear trial's errors, where it ran.
+    pub shear_trial: Option<TrialErrors>,
+    /// Whether the shear trial turned the half-pixel disparities off.
+    pub alias: bool,
+    /// The model trial's errors, where it ran.
+    pub model_trial: Option<TrialErrors>,
+}
+
+impl<'a, const PU: usize, const PV: usize, const N: usize> FramePlan<'a, PU, PV, N> {
+    /// The plan of `capture`'s decode by `first` or `second` as `pick` says, with `opts`:
+    /// the checks, the decoder and the trials (which decode pilot patches of `raw`).
+    ///
+    /// # Errors
+    /// A capture or options the decoder does not take, in one line.
+    pub fn new<A, Z>(
+        capture: &'a Capture,
+        first: &A,
+        second: &Z,
+        pick: ModelPick,
+        opts: &'a DecodeOptions,
+        raw: &[RawFrame<'_, u16>],
+    ) -> Result<Self>
+    where
+        A: PatchModel<5, 5, PU, PV, 13, N> + Sync,
+        Z: PatchModel<5, 5, PU, PV, 13, N> + Sync,
+    {
+        let d = &capture.description;
+        ensure!(d.bands_nm.len() == 13, "the decoder's patch has 13 bands, the capture {}", d.bands_nm.len());
+        if let Some(asked) = opts.patch_views {
+            ensure!(
+                asked.count() == PU && asked.count() == PV,
+                "--patch-views {asked}: this decoder's patch has {PU} x {PV} views"
+            );
+        }
+        ensure!(
+            PU <= d.views[0] && PV <= d.views[1],
+            "--patch-views {PU}: the capture's lenslets have {} x {} views, fewer than the patch's {PU} x {PV}",
+            d.views[0],
+            d.views[1]
+        );
+        let decoder = tile_decoder::<PU, PV, N>(capture, opts)?;
+        ensure!(
+            (1..=5).contains(&opts.stride.0) && (1..=5).contains(&opts.stride.1),
+            "stride {:?}: each axis must be in 1..=5 lenslets",
+            opts.stride
+        );
+        let base: Vec<Tile> = decoder.tiles(opts.tile_patches).collect();
+        ensure!(
+            !base.is_empty(),
+            "the sensor ({} x {} lenslets) is smaller than one 5 x 5 patch",
+            d.lenslets[0],
+            d.lenslets[1]
+        );
+        let lenslets = (d.lenslets[0], d.lenslets[1]);
+        let views = (d.views[0], d.views[1]);
+        // The trials' pilots by the decode's patches: the disjoint grid's blocks times the
+        // stride's shifts.
+        let shifts = |s: u8| 5usize.div_ceil(usize::from(s));
+        let blocks: usize =
+            base.iter().map(|t| usize::from(t.lenslet_rows / 5) * usize::from(t.lenslet_cols / 5)).sum();
+        let budget = pilot_budget(blocks * shifts(opts.stride.0) * shifts(opts.stride.1));
+        // The shear trial first: half-pixel shears off for the frame where its pilots
+        // estimate the whole ones clearly better (by the estimating solve, `second`'s), so
+        // the model trial's pilots are sheared as the decode will be.
+        let shear_trial = (opts.shear_trial && decoder.disparities().has_halves())
+            .then(|| frame_shear_trial(&decoder, second, raw, &base, budget));
+        let alias = shear_trial.as_ref().is_some_and(halves_alias);
+        let decoder = if alias { decoder.with_disparities(decoder.disparities().with_halves(false)) } else { decoder };
+        let (pick, model_trial) = match pick {
+            ModelPick::Given(p) => (p, None),
+            ModelPick::Trial { towards, margin } => {
+                let t = frame_trial(&decoder, first, second, raw, &base, budget);
+                (t.pick_leaning(towards, margin), Some(t))
+            }
+        };
+        let halo = decoder.disparities().halo(views.0.max(views.1));
+        // The shifted grids: every tile, or with the adaptive rule every single patch (the
+        // candidates its seams choose from). Their canonical order is grid by grid; the
+        // strip takes them by first row, the order their sums join the rows in.
+        let per = if opts.adaptive.is_some() { (1, 1) } else { opts.tile_patches };
+        let shifted = if opts.stride == (5, 5) { Vec::new() } else { shifted_tiles(lenslets, opts.stride, per) };
+        let disjoint: Vec<Planned> =
+            base.into_iter().enumerate().map(|(order, tile)| Planned { tile, order }).collect();
+        let mut shifted: Vec<Planned> =
+            shifted.into_iter().enumerate().map(|(i, tile)| Planned { tile, order: disjoint.len() + i }).collect();
+        shifted.sort_by_key(|p| p.tile.lenslet_row);
+        let range = decoder.config().raw.range();
+        Ok(Self {
+            decoder,
+            pick,
+            disjoint,
+            shifted,
+            seeded: opts.seeds(),
+            adaptive: opts.adaptive,
+            halo,
+            shape: RowShape { views, rows: lenslets.0, cols: lenslets.1, bands: 13 },
+            range,
+            window: opts.window,
+            shear_trial,
+            alias,
+            model_trial,
+        })
+    }
+
+    /// Lenslet rows a tile's sums reach: its own and the halo beside them, on the sensor.
+    pub fn reach(&self, tile: &Tile) -> core::ops::Range<usize> {
+        let row = usize::from(tile.lenslet_row);
+        row.saturating_sub(self.halo)..(row + usize::from(tile.lenslet_rows) + self.halo).min(self.shape.rows)
+    }
+}
+
+/// Which of a decode's two models decodes the frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ModelPick {
+    /// The one named.
+    Given(Pick),
+    /// The one the model trial picks ([`slf_firmware::TrialErrors::pick_leaning`]): `towards` unless the
+    /// other's pilots err below `margin` times its.
+    Trial {
+        /// The model kept on a tie or without pilots.
+        towards: Pick,
+        /// How far below (RMS) the other's error must be.
+        margin: f32,
+    },
+}
+
+/// The firmware's tile decoder for `capture` as a decode runs it: the solver config of
+/// [`DecodeOptions::solver_config`] and the band gains of [`DecodeOptions::balance`]
+/// (estimated from the frame for [`Balance::GreyWorld`], as the device does).
+///
+/// # Errors
+/// A capture the decoder cannot take, or gains outside `[1/64, 64]`.
+pub fn tile_decoder<'a, const PU: usize, const PV: usize, const N: usize>(
+    capture: &'a Capture,
+    opts: &'a DecodeOptions,
+) -> Result<TileDecoder<'a, 5, 5, PU, PV, 13, N>> {
+    let decoder = capture.decoder::<PU, PV, N>(opts.solver_config(capture))?;
+    // The response first: the white balance's gains are of the unmixed spectrum.
+    let decoder = match &opts.response {
+        Some((response, model)) => {
+            decoder.with_response(response, *model).map_err(|e| anyhow!("{}: {e}", capture.source()))?
+        }
+        None => decoder,
+    };
+    let gains = match opts.balance {
+        Balance::Off => [1.0; 13],
+        Balance::GreyWorld => {
+            let raw = capture.raw_frames()?;
+            decoder
+                .estimate_gains(&mut FrameSource::new(&raw))
+                .map_err(|e| anyhow!("{}: cannot read the frame for its white balance: {e:?}", capture.source()))?
+        }
+        Balance::Gains(g) => g,
+    };
+    let decoder = decoder.with_gains(&gains).map_err(|e| anyhow!("gains {gains:?}: {e}"))?;
+    let decoder = decoder
+        .with_error_estimate(opts.error_estimate.then_some(HoldOut::DEFAULT))
+        .map_err(|e| anyhow!("{e}"))?
+        .with_plausibility(opts.plausibility)
+        .map_err(|e| anyhow!("--plausible {}:{}: {e}", opts.plausibility.factor, opts.plausibility.margin))?;
+    Ok(decoder
+        .with_disparities(opts.disparities_for(capture))
+        .with_edge_fallback(opts.edge_fallback)
+        .with_sheared_fallback(opts.sheared_fallback)
+        .with_shear_check(opts.shear_check))
+}
+
+/// The tiles of the patch grids shifted by `(dy, dx)` lenslets for every multiple of the
+/// stride below 5 other than (0, 0), each of at most `per` patches, whole patches only
+/// (the unshifted grid, with its edge strips, already covers every lenslet).
+pub fn shifted_tiles(lenslets: (usize, usize), stride: (u8, u8), per: (u16, u16)) -> Vec<Tile> {
+    let offsets = |s: u8| (0..5usize).step_by(usize::from(s.clamp(1, 5)));
+    let spans = |total: usize, off: usize, per: usize| -> Vec<(usize, usize)> {
+        let whole = total.saturating_sub(off) / 5;
+        let per = per.max(1);
+        (0..whole.div_ceil(per)).map(|i| (off + i * per * 5, per.min(whole - i * per) * 5)).collect()
+    };
+    let mut tiles = Vec::new();
+    for dy in offsets(stride.0) {
+        for dx in offsets(stride.1) {
+            if (dy, dx) == (0, 0) {
+                continue;
+            }
+            for &(r0, nr) in &spans(lenslets.0, dy, usize::from(per.0)) {
+                for &(c0, nc) in &spans(lenslets.1, dx, usize::from(per.1)) {
+                    tiles.push(Tile {
+                        lenslet_row: r0 as u16,
+                        lenslet_col: c0 as u16,
+                        lenslet_rows: nr as u16,
+                        lenslet_cols: nc as u16,
+                    });
+                }
+            }
+        }
+    }
+    tiles
+}

@@ -1,0 +1,155 @@
+//! What a decode did ([`DecodeReport`]): its counts, which decoder made each patch, the
+//! disparities and error estimates by patch and per lenslet, and the trials' findings.
+
+use slf_firmware::disparity::Disparity;
+use slf_firmware::{Ended, PatchOrigin, PatchReport, TileReport};
+
+use crate::decode::options::PatchViews;
+
+/// Which decoder made a patch: a row of [`DecodeReport::member_map`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PatchDecoder {
+    /// SL0 with this ensemble member (the last solve's).
+    Member(u16),
+    /// SL0 with the single dictionary (the DCT, or a one-member basis).
+    Dictionary,
+    /// Per-pixel spectral interpolation: the patch measured fewer than `min_bands` bands.
+    Interpolated,
+    /// The flat short path: each band its mean, no solve.
+    Flat,
+}
+
+impl PatchDecoder {
+    /// The decoder of a patch from its report.
+    pub fn of(report: &PatchReport) -> Self {
+        match (report.outcome.ended, report.member) {
+            (Ended::Interpolated, _) => Self::Interpolated,
+            (Ended::Flat, _) => Self::Flat,
+            (_, Some(m)) => Self::Member(m),
+            (_, None) => Self::Dictionary,
+        }
+    }
+
+    /// Its name in the member map's `decoder` column.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Member(_) => "member",
+            Self::Dictionary => "dictionary",
+            Self::Interpolated => "interpolated",
+            Self::Flat => "flat",
+        }
+    }
+}
+
+/// What a decode did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct DecodeReport {
+    pub patches: TileReport,
+    pub tiles: usize,
+    pub failed_tiles: usize,
+    /// SL0 steps over all patches (the last solve of each).
+    pub steps: u64,
+    /// Solves over all patches (more than one per patch with an ensemble).
+    pub solves: u64,
+    /// Which decoder made each decoded patch, by patch origin: the ensemble member, the
+    /// single dictionary, interpolation or the flat short path.
+    pub member_map: Vec<(PatchOrigin, PatchDecoder)>,
+    /// Light-field values no decoded patch covered (left at 0).
+    pub uncovered: usize,
+    /// Values of a view no (sheared) patch covered, taken from the lenslet's other views.
+    pub filled: usize,
+    /// The disparity each spatial block was sheared to, by its first patch's origin
+    /// (empty when the decode searched no disparity).
+    pub disparity_map: Vec<(PatchOrigin, Disparity)>,
+    /// The most lenslet rows of sums the streamed decode held at once (each row's sums and
+    /// weights: 8 bytes a value of the row), besides a batch's tiles: what its memory grows
+    /// with, bounded by the tiles' height, not the frame's ([`crate::decode::strip`]).
+    pub rows_held: usize,
+    /// Wall time, seconds.
+    pub seconds: f64,
+    /// The band gains the decode used (1 without white balance).
+    pub gains: [f32; 13],
+    /// The patch it decoded with (`None` only in a report made by hand).
+    pub patch_views: Option<PatchViews>,
+    /// Each estimated patch's error estimate (RMS per value, the output's units), by
+    /// origin ([`crate::decode::options::DecodeOptions::error_estimate`]; empty without it).
+    pub error_map: Vec<(PatchOrigin, f32)>,
+    /// What the model trial picked ([`crate::decode::options::DecodeOptions::model_trial`]; `None` without it).
+    pub trial: Option<TrialReport>,
+    /// What the shear trial found ([`crate::decode::options::DecodeOptions::shear_trial`]; `None` without it or
+    /// without half-pixel disparities).
+    pub shear_trial: Option<ShearTrialReport>,
+}
+
+/// The shear trial's finding in a decode ([`crate::decode::trial::frame_shear_trial`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ShearTrialReport {
+    /// Pilot patches at a half-pixel disparity that estimated both.
+    pub pilots: u32,
+    /// Whether the decode kept its half-pixel disparities (else whole ones only).
+    pub halves: bool,
+    /// The held-out error estimate at the half-pixel disparities (RMS over the pilots).
+    pub half_error: f64,
+    /// At the better whole disparity beside each.
+    pub whole_error: f64,
+}
+
+/// The model trial's picks in a decode ([`crate::decode::trial`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TrialReport {
+    /// Pilot patches that estimated both models.
+    pub pilots: u32,
+    /// Whether the DCT decoded the frame (else the ensemble).
+    pub dct: bool,
+    /// The DCT's held-out error estimate over the pilots (RMS, the output's units).
+    pub dct_error: f64,
+    /// The ensemble's.
+    pub ensemble_error: f64,
+}
+
+/// The disparity per lenslet (row-major, `rows x cols`) from a decode's
+/// [`DecodeReport::disparity_map`]: the mean of the chosen disparities of the 5 x 5 blocks
+/// that cover the lenslet (overlapping blocks at a stride below 5), NaN where none does.
+pub fn disparity_per_lenslet(blocks: &[(PatchOrigin, Disparity)], rows: usize, cols: usize) -> Vec<f32> {
+    per_lenslet(blocks.iter().map(|(o, d)| (o, f64::from(d.as_f32()))), rows, cols, |mean| mean)
+}
+
+/// `finish` of the mean of the values of the 5 x 5-lenslet blocks (by their origins) that
+/// cover each lenslet (row-major, `rows x cols`), NaN where none does.
+fn per_lenslet<'a>(
+    blocks: impl Iterator<Item = (&'a PatchOrigin, f64)>,
+    rows: usize,
+    cols: usize,
+    finish: impl Fn(f64) -> f64,
+) -> Vec<f32> {
+    let mut sum = vec![0.0f64; rows * cols];
+    let mut count = vec![0u32; rows * cols];
+    for (o, x) in blocks {
+        for r in o.lenslet_row as usize..(o.lenslet_row as usize + 5).min(rows) {
+            for c in o.lenslet_col as usize..(o.lenslet_col as usize + 5).min(cols) {
+                sum[r * cols + c] += x;
+                count[r * cols + c] += 1;
+            }
+        }
+    }
+    sum.iter().zip(&count).map(|(&s, &n)| if n > 0 { finish(s / f64::from(n)) as f32 } else { f32::NAN }).collect()
+}
+
+/// The error estimate per lenslet (row-major, `rows x cols`) from a decode's
+/// [`DecodeReport::error_map`]: the RMS of the estimates of the patches whose 5 x 5
+/// lenslets cover it (every angular window, every overlapping patch), NaN where none does.
+pub fn error_per_lenslet(patches: &[(PatchOrigin, f32)], rows: usize, cols: usize) -> Vec<f32> {
+    per_lenslet(patches.iter().map(|(o, e)| (o, f64::from(*e) * f64::from(*e))), rows, cols, f64::sqrt)
+}
+
+/// The PSNR an error map estimates for a light field whose values span `data_range`: the
+/// mean squared error is the mean of the lenslets' squared estimates (NaN ones left out);
+/// `None` if none is finite.
+pub fn estimated_psnr(map: &[f32], data_range: f64) -> Option<f64> {
+    let (mut sum, mut n) = (0.0f64, 0usize);
+    for e in map.iter().filter(|e| e.is_finite()) {
+        sum += f64::from(*e) * f64::from(*e);
+        n += 1;
+    }
+    (n > 0).then(|| 10.0 * (data_range * data_range / (sum / n as f64).max(1e-20)).log10())
+}

@@ -1,0 +1,143 @@
+//! A light field written a lenslet row at a time: where a streamed decode puts its finished
+//! rows ([`RowSink`]), in memory ([`LightField`]) or in a file ([`crate::io::npy_rows`]).
+//!
+//! A row is every value of one spatial row `y` of the `(U, V, H, W, B)` light field: `U x V
+//! x W x B` values, views outermost, so each view's part of the row is one contiguous run of
+//! the light field's memory (and of its `.npy` file's data).
+
+use anyhow::{Result, ensure};
+
+use crate::io::lightfield::LightField;
+
+/// The shape of the rows a sink takes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RowShape {
+    /// Views: rows `U`, columns `V`.
+    pub views: (usize, usize),
+    /// Spatial rows `H`: rows `0..rows` are put once each, in order.
+    pub rows: usize,
+    /// Spatial columns `W`.
+    pub cols: usize,
+    /// Bands `B`.
+    pub bands: usize,
+}
+
+impl RowShape {
+    /// Values in one row: `U x V x W x B`.
+    pub fn row_len(&self) -> usize {
+        self.views.0 * self.views.1 * self.cols * self.bands
+    }
+
+    /// Values of one view in one row: `W x B`.
+    pub fn run_len(&self) -> usize {
+        self.cols * self.bands
+    }
+
+    /// Index in a row of `(u, v, x, b)`.
+    #[inline]
+    pub fn at(&self, u: usize, v: usize, x: usize, b: usize) -> usize {
+        ((u * self.views.1 + v) * self.cols + x) * self.bands + b
+    }
+
+    /// The shape as `[U, V, H, W, B]`.
+    pub fn shape(&self) -> [usize; 5] {
+        [self.views.0, self.views.1, self.rows, self.cols, self.bands]
+    }
+}
+
+/// Where finished lenslet rows go, each once, in order from row 0.
+pub trait RowSink {
+    /// Row `y` of the light field ([`RowShape::row_len`] values, views outermost).
+    ///
+    /// # Errors
+    /// A write that failed, or a row out of order or of the wrong length.
+    fn put_row(&mut self, y: usize, row: &[f32]) -> Result<()>;
+}
+
+/// A light field in memory, filled a row at a time (a decode into memory: the Python
+/// package's return value, the evaluations').
+impl RowSink for LightField {
+    fn put_row(&mut self, y: usize, row: &[f32]) -> Result<()> {
+        let shape = RowShape { views: self.views, rows: self.rows, cols: self.cols, bands: self.bands };
+        ensure!(y < self.rows && row.len() == shape.row_len(), "row {y} of {} values does not fit", row.len());
+        let run = shape.run_len();
+        for (p, values) in row.chunks_exact(run).enumerate() {
+            let at = (p * self.rows + y) * run;
+            self.data[at..at + run].copy_from_slice(values);
+        }
+        Ok(())
+    }
+}
+
+/// Puts every row of `lf` into `sink`, in order (a decode made whole, a baseline's).
+///
+/// # Errors
+/// What the sink returns.
+pub fn put_light_field(lf: &LightField, sink: &mut dyn RowSink) -> Result<()> {
+    let shape = RowShape { views: lf.views, rows: lf.rows, cols: lf.cols, bands: lf.bands };
+    let run = shape.run_len();
+    let mut row = vec![0.0; shape.row_len()];
+    for y in 0..lf.rows {
+        for (p, values) in row.chunks_exact_mut(run).enumerate() {
+            let at = (p * lf.rows + y) * run;
+            values.copy_from_slice(&lf.data[at..at + run]);
+        }
+        sink.put_row(y, &row)?;
+    }
+    Ok(())
+}
+
+/// A sink that passes each row on after `f` has changed it in place (a calibrated decode's
+/// unmixing of every spectrum).
+pub struct MapRows<'a, F> {
+    inner: &'a mut dyn RowSink,
+    f: F,
+    row: Vec<f32>,
+}
+
+impl<'a, F: FnMut(&mut [f32])> MapRows<'a, F> {
+    /// Rows through `f` into `inner`.
+    pub fn new(inner: &'a mut dyn RowSink, f: F) -> Self {
+        Self { inner, f, row: Vec::new() }
+    }
+}
+
+impl<F: FnMut(&mut [f32])> RowSink for MapRows<'_, F> {
+    fn put_row(&mut self, y: usize, row: &[f32]) -> Result<()> {
+        self.row.clear();
+        self.row.extend_from_slice(row);
+        (self.f)(&mut self.row);
+        self.inner.put_row(y, &self.row)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rows_put_into_a_light_field_land_where_its_index_says() {
+        let (views, rows, cols, bands) = ((2, 3), 4, 5, 3);
+        let want = LightField::from_fn(views, rows, cols, bands, |u, v, y, x, b| {
+            (u * 10_000 + v * 1000 + y * 100 + x * 10 + b) as f32
+        });
+        let shape = RowShape { views, rows, cols, bands };
+        let mut got = LightField::zeros(views, rows, cols, bands);
+        for y in 0..rows {
+            let mut row = vec![0.0; shape.row_len()];
+            for u in 0..views.0 {
+                for v in 0..views.1 {
+                    for x in 0..cols {
+                        for b in 0..bands {
+                            row[shape.at(u, v, x, b)] = want.get(u, v, y, x, b);
+                        }
+                    }
+                }
+            }
+            got.put_row(y, &row).unwrap();
+        }
+        assert_eq!(got, want);
+        assert!(got.put_row(rows, &vec![0.0; shape.row_len()]).is_err());
+        assert!(got.put_row(0, &[0.0; 3]).is_err());
+    }
+}

@@ -1,0 +1,153 @@
+//! The streamed decode (issue 50): a frame decoded down its rows in batches is the same bit
+//! for bit whatever the batches (one tile at a time, or the whole frame at once), and the
+//! rows it holds are bounded by the tiles' height, not the frame's.
+
+use slf_host::decode::cs::{Basis, DecodeOptions, DecodeReport, Window, decode_with};
+use slf_host::firmware::DisparityRange;
+use slf_host::io::capture::Capture;
+use slf_host::io::lightfield::LightField;
+use slf_host::sim::camera::{CameraConfig, simulate};
+use slf_host::sim::scene::{SceneSize, named};
+
+/// The depth scene (its blocks sheared, so tiles reach past their rows) at `rows x 16`
+/// lenslets, pixel mask, one snapshot.
+fn capture(rows: usize) -> Capture {
+    let truth = named("depth").unwrap().render(SceneSize { views: (5, 5), rows, cols: 16 });
+    simulate(&truth, &CameraConfig::pixel(5, 1)).unwrap()
+}
+
+/// The decode with `batch_tiles`, its report without the wall time.
+fn decode(capture: &Capture, opts: &DecodeOptions, batch_tiles: usize) -> (LightField, DecodeReport) {
+    let (lf, mut report) = decode_with(capture, &Basis::Dct, &DecodeOptions { batch_tiles, ..*opts }).unwrap();
+    report.seconds = 0.0;
+    report.rows_held = 0;
+    (lf, report)
+}
+
+/// Every way the strip decodes: seeded shifted grids at stride 2 (the default's), with
+/// whole and half-pixel shears; unseeded at stride 3; the adaptive rule; the disjoint grid with the
+/// sheared fallback (the preview's); an unsheared frame.
+fn settings() -> Vec<(&'static str, DecodeOptions)> {
+    let base = DecodeOptions {
+        disparities: Some(DisparityRange::new(-1, 1).unwrap().with_halves(true)),
+        ..DecodeOptions::default()
+    };
+    vec![
+        ("stride 2 seeded", base),
+        ("stride 3 unseeded", DecodeOptions { stride: (3, 3), seeded: false, ..base }),
+        ("adaptive 1.1", DecodeOptions { adaptive: Some(1.1), ..base }),
+        (
+            "disjoint, sheared fallback",
+            DecodeOptions { stride: (5, 5), window: Window::Uniform, sheared_fallback: true, ..base },
+        ),
+        ("unsheared", DecodeOptions { disparities: Some(DisparityRange::OFF), ..base }),
+    ]
+}
+
+#[test]
+fn a_streamed_decode_is_the_same_bit_for_bit_whatever_its_batches() {
+    // 23 rows: four rows of tiles and the end-aligned edge strip.
+    let capture = capture(23);
+    for (name, opts) in settings() {
+        let (whole, whole_report) = decode(&capture, &opts, usize::MAX);
+        assert!(whole_report.patches.decoded > 0, "{name}: nothing decoded");
+        for batch in [1, 3] {
+            let (streamed, report) = decode(&capture, &opts, batch);
+            assert!(whole.data == streamed.data, "{name}: batches of {batch} differ from the whole frame's");
+            assert_eq!(report, whole_report, "{name}: batches of {batch}");
+        }
+    }
+}
+
+#[test]
+fn the_rows_a_streamed_decode_holds_do_not_grow_with_the_frame() {
+    let held = |rows: usize, opts: &DecodeOptions| {
+        let (_, report) = decode_with(&capture(rows), &Basis::Dct, &DecodeOptions { batch_tiles: 1, ..*opts }).unwrap();
+        report.rows_held
+    };
+    for (name, opts) in settings() {
+        let (short, tall) = (held(60, &opts), held(120, &opts));
+        // A tile is 10 lenslet rows; a shifted one waits for the disjoint tiles below it,
+        // and a sheared patch reaches a halo of rows beyond its tile.
+        assert!(short == tall && tall <= 30, "{name}: {short} rows held at 60 rows, {tall} at 120");
+    }
+    // The whole frame at once holds every row.
+    let (_, report) =
+        decode_with(&capture(60), &Basis::Dct, &DecodeOptions { batch_tiles: usize::MAX, ..settings()[0].1 }).unwrap();
+    assert_eq!(report.rows_held, 60);
+}
+
+/// `slf decode -o OUT.npy` writes its rows as they are decoded: the file is the light field
+/// the library decodes into memory with the same flags, value for value: compressed sensing
+/// streamed by the strip, and a baseline decoded whole and put row by row.
+#[test]
+fn the_decode_written_as_it_goes_is_the_decode_in_memory() {
+    use slf_host::decode::settings::DecodeSettings;
+    use slf_host::io::lightfield::read_npy;
+    let dir = tempfile::tempdir().unwrap();
+    let cap = dir.path().join("cap");
+    let capture = capture(23);
+    capture.save(&cap).unwrap();
+    for flags in [&["--preset", "default"][..], &["--preset", "preview"], &["--method", "ppid"]] {
+        let out = dir.path().join("out.npy");
+        let run = assert_cmd::Command::cargo_bin("slf")
+            .unwrap()
+            .arg("decode")
+            .arg(&cap)
+            .arg("-o")
+            .arg(&out)
+            .arg("-q")
+            .args(flags)
+            .output()
+            .unwrap();
+        assert!(run.status.success(), "{flags:?}: {}", String::from_utf8_lossy(&run.stderr));
+        let settings = DecodeSettings::from_flags(flags.iter().copied()).unwrap();
+        let want = settings.run(&Capture::load(&cap).unwrap(), false, &|_, _| {}).unwrap().light_field;
+        let got = read_npy(&out).unwrap();
+        assert!(got == want, "{flags:?}: the file differs from the decode in memory");
+    }
+}
+
+/// An interrupted decode (Ctrl-C) stops at its next row with an error and leaves nothing:
+/// no output file, no temporary file beside it, an old output as it was.
+#[cfg(unix)]
+#[test]
+fn an_interrupted_decode_leaves_no_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let cap = dir.path().join("cap");
+    capture(60).save(&cap).unwrap();
+    let out = dir.path().join("out.npy");
+    std::fs::write(&out, b"the old output").unwrap();
+    let entries = || -> Vec<String> {
+        let mut names: Vec<String> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        names
+    };
+    let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("slf"))
+        .arg("decode")
+        .arg(&cap)
+        .arg("-o")
+        .arg(&out)
+        .args(["-q", "--preset", "best"])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // The temporary file appears before the decode starts; interrupt then.
+    let start = std::time::Instant::now();
+    while !entries().iter().any(|n| n.ends_with(".part")) {
+        assert!(start.elapsed().as_secs() < 60, "no temporary file: {:?}", entries());
+        std::thread::sleep(std::time::Duration::from_millis(1));
+    }
+    let killed = std::process::Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
+    assert!(killed.success());
+    let mut err = String::new();
+    std::io::Read::read_to_string(child.stderr.as_mut().unwrap(), &mut err).unwrap();
+    let status = child.wait().unwrap();
+    assert!(!status.success() && err.contains("interrupted"), "{status:?}: {err}");
+    assert_eq!(entries(), ["cap", "out.npy"]);
+    assert_eq!(std::fs::read(&out).unwrap(), b"the old output");
+}
