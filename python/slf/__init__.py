@@ -336,6 +336,7 @@ def decode(
     threads: Optional[int] = None,
     progress: Any = None,
     report: bool = False,
+    output: Optional[PathLike] = None,
 ) -> Union[np.ndarray, Tuple[np.ndarray, Dict[str, Any]]]:
     """Decodes a capture (or a capture folder's path) as ``slf decode`` does, bit for bit.
 
@@ -373,6 +374,13 @@ def decode(
     ``threads``: threads of this decode (None: one per core; 1 inside a Dask task).
     ``progress``: True for a bar (tqdm if installed), or a callable ``f(done, total)``
     called after each tile, from the decode's threads. The GIL is released while decoding.
+
+    ``output``: a ``.npy`` path the light field is written to as its rows are decoded, as
+    ``slf decode -o`` writes it: the decode then holds a band of rows, not the frame (a
+    frame of any size fits), the file is in place only once the decode is done (a failed
+    decode leaves none), and the light field returned is a read-only memory map of it
+    (``np.load(output, mmap_mode="r")``). ``report["rows_held"]``: the most lenslet rows
+    of sums the decode held at once.
     """
     cap = capture if isinstance(capture, Capture) else load_capture(capture)
     if isinstance(disparities, (list, tuple)):
@@ -435,10 +443,28 @@ def decode(
         estimate=True if error_map else None,
     )
     frames = _raw_frames(cap.frames)
-    lf, rep = _slf.decode(frames, json.dumps(cap.description), args, threads, _progress_callback(progress))
+    path = None if output is None else os.fspath(output)
+    if path is not None and not isinstance(capture, Capture):
+        _check_output(os.fspath(capture), path)
+    lf, rep = _slf.decode(frames, json.dumps(cap.description), args, threads, _progress_callback(progress), path)
+    if path is not None:
+        lf = np.load(path, mmap_mode="r")
     if "warning" in rep:
         warnings.warn(f"slf: {rep['warning']}", stacklevel=2)
     return (lf, rep) if report or error_map else lf
+
+
+def _check_output(folder: str, output: str) -> None:
+    """Refuses an ``output`` that is a file of the capture folder it decodes (its
+    ``capture.json`` or a frame), as ``slf decode`` does; paths compared resolved."""
+    inputs = {os.path.realpath(os.path.join(folder, "capture.json"))}
+    try:
+        with open(os.path.join(folder, "capture.json"), encoding="utf-8") as f:
+            inputs |= {os.path.realpath(os.path.join(folder, n)) for n in json.load(f).get("frames", []) if isinstance(n, str)}
+    except (OSError, ValueError, AttributeError):
+        pass  # the load above read it; nothing more to find
+    if os.path.realpath(output) in inputs:
+        raise ValueError(f"output {output}: a file of the capture {folder}, which the decode reads")
 
 
 def evaluate(truth: np.ndarray, recon: np.ndarray) -> Dict[str, float]:

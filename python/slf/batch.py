@@ -12,8 +12,9 @@ Dask cluster, each capture a task.
         print(r.name, r.ok, r.seconds if r.ok else r.error)
 
 Each task loads one capture, decodes it with one thread (``threads=1``: Dask's worker
-threads are the parallelism) and writes ``OUT/<name>.npy`` itself, on the worker, as soon as
-it is done (written to a temporary name and renamed, so a file that exists is whole). A
+threads are the parallelism) and writes ``OUT/<name>.npy`` itself, on the worker, as its
+rows are decoded (``slf.decode(..., output=)``: a worker holds a band of rows, not the frame;
+the file goes to a temporary name and is renamed when done, so a file that exists is whole). A
 capture that fails is reported in its result with the one-line error; the others go on.
 On a real cluster the same call runs with a ``Client`` of Dask's own deployments
 (``dask-scheduler`` / ``dask-worker``, dask-jobqueue for SLURM and PBS, dask-kubernetes):
@@ -27,7 +28,6 @@ import time
 from dataclasses import dataclass
 from typing import Any, Callable, Iterable, List, Optional, Union
 
-import numpy as np
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -104,13 +104,11 @@ def decode_one(capture: str, out_dir: str, options: dict) -> Result:
     start = time.perf_counter()
     name = os.path.basename(os.path.normpath(capture))
     try:
-        lf = slf.decode(capture, **{"threads": 1, **options})
         os.makedirs(out_dir, exist_ok=True)
         path = os.path.join(out_dir, name + ".npy")
-        tmp = path + ".part"
-        with open(tmp, "wb") as f:
-            np.save(f, lf)
-        os.replace(tmp, path)
+        # Written as it is decoded: the worker holds a band of rows, not the frame, and the
+        # file is in place only once the decode is done.
+        slf.decode(capture, **{"threads": 1, **options, "output": path})
         return Result(name, capture, path, time.perf_counter() - start)
     except (ValueError, OSError) as e:
         return Result(name, capture, None, time.perf_counter() - start, f"{type(e).__name__}: {e}")

@@ -8,7 +8,9 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use slf_host::decode::cs::{PatchViews, disparity_per_lenslet, error_per_lenslet, estimated_psnr};
-use slf_host::decode::settings::{DecodeSettings, Outcome};
+use slf_host::decode::settings::{DecodeSettings, Outcome, output_shape};
+use slf_host::io::lightfield::Dtype;
+use slf_host::io::npy_rows::NpyRows;
 
 use crate::arrays::{plane, to_array};
 use crate::capture::from_parts;
@@ -16,9 +18,12 @@ use crate::errors::{OrPy, flags};
 
 /// Decodes the capture `(frames, description JSON)` with `slf decode`'s flags `args`:
 /// `(light field, report)`. `threads`: the decode's threads (`None`: one per core);
-/// `progress(done, total)` is called from the worker threads after each tile.
+/// `progress(done, total)` is called from the worker threads after each tile. With
+/// `output`, the light field is written to that `.npy` file as its rows are decoded (the
+/// memory of a band of rows, not the frame; the file is in place only once the decode is
+/// done) and `None` is returned in its stead.
 #[pyfunction]
-#[pyo3(signature = (frames, description, args, threads=None, progress=None))]
+#[pyo3(signature = (frames, description, args, threads=None, progress=None, output=None))]
 pub fn decode<'py>(
     py: Python<'py>,
     frames: PyReadonlyArrayDyn<'py, u16>,
@@ -26,7 +31,8 @@ pub fn decode<'py>(
     args: Vec<String>,
     threads: Option<usize>,
     progress: Option<Py<PyAny>>,
-) -> PyResult<(Bound<'py, PyArrayDyn<f32>>, Bound<'py, PyDict>)> {
+    output: Option<std::path::PathBuf>,
+) -> PyResult<(Option<Bound<'py, PyArrayDyn<f32>>>, Bound<'py, PyDict>)> {
     let settings = DecodeSettings::from_flags(&args).map_err(flags)?;
     let capture = from_parts(&frames, description)?;
     // The decode is compute-bound: threads past a few per core buy nothing, and 10**9 of
@@ -52,9 +58,23 @@ pub fn decode<'py>(
             });
         }
     };
-    let decoded = py
+    // The light field in memory, or its file as it goes; the largest value either way
+    // (the estimated PSNR's data range).
+    let (outcome, light_field, peak) = py
         .detach(|| {
-            let run = || settings.run(&capture, false, &observer);
+            let run = || match &output {
+                None => settings.run(&capture, false, &observer).map(|d| {
+                    let peak = d.light_field.max();
+                    (d.outcome, Some(d.light_field), peak)
+                }),
+                Some(path) => {
+                    let mut file = NpyRows::create(path, output_shape(&capture), Dtype::F32)?;
+                    let outcome = settings.run_into(&capture, false, &observer, &mut file)?;
+                    let peak = file.max();
+                    file.finish()?;
+                    Ok((outcome, None, peak))
+                }
+            };
             match threads {
                 None => run(),
                 Some(n) => rayon::ThreadPoolBuilder::new()
@@ -69,11 +89,11 @@ pub fn decode<'py>(
         return Err(e);
     }
     let report = PyDict::new(py);
-    if let Some(w) = decoded.warning() {
+    if let Some(w) = outcome.warning() {
         report.set_item("warning", w)?;
     }
     let d = &capture.description;
-    match &decoded.outcome {
+    match &outcome {
         Outcome::Baseline { method, report: r } => {
             report.set_item("method", format!("{method:?}").to_lowercase())?;
             report.set_item("measured", r.measured)?;
@@ -98,6 +118,7 @@ pub fn decode<'py>(
             report.set_item("filled", r.filled)?;
             report.set_item("gains", r.gains.to_vec())?;
             report.set_item("seconds", r.seconds)?;
+            report.set_item("rows_held", r.rows_held)?;
             report.set_item("stride", options.stride.0)?;
             report.set_item("seeded", options.seeds())?;
             report.set_item("patch_views", r.patch_views.map(PatchViews::count))?;
@@ -127,11 +148,10 @@ pub fn decode<'py>(
             if !r.error_map.is_empty() {
                 let (rows, cols) = (d.lenslets[0], d.lenslets[1]);
                 let map = error_per_lenslet(&r.error_map, rows, cols);
-                let peak = f64::from(decoded.light_field.max());
-                report.set_item("estimated_psnr", estimated_psnr(&map, peak))?;
+                report.set_item("estimated_psnr", estimated_psnr(&map, f64::from(peak)))?;
                 report.set_item("error_map", plane(py, map, rows, cols)?)?;
             }
         }
     }
-    Ok((to_array(py, decoded.light_field)?, report))
+    Ok((light_field.map(|lf| to_array(py, lf)).transpose()?, report))
 }

@@ -150,3 +150,36 @@ def test_random_array_layouts_are_read_by_value(capture, depth):
         assert np.array_equal(got, want)
         t, r = relaid(depth), relaid(recon)
         assert dict(_slf.evaluate(t, r)) == score
+
+
+def test_output_streams_to_a_file_and_returns_its_memory_map(capture, tmp_path):
+    # The file is the decode in memory, value for value, written as the rows are decoded;
+    # what comes back is a read-only memory map of it.
+    out = tmp_path / "lf.npy"
+    mapped, report = slf.decode(capture, output=out, report=True)
+    assert isinstance(mapped, np.memmap) and not mapped.flags.writeable
+    assert np.array_equal(mapped, slf.decode(capture))
+    assert np.array_equal(np.load(out), mapped)
+    assert 0 < report["rows_held"] <= 20
+    # A baseline too (decoded whole, then written by rows).
+    base = slf.decode(capture, method="demosaic", output=tmp_path / "d.npy")
+    assert np.array_equal(base, slf.decode(capture, method="demosaic"))
+
+
+def test_a_failed_decode_to_a_file_leaves_none(capture, tmp_path):
+    out = tmp_path / "lf.npy"
+    dark = slf.Capture(np.zeros_like(np.asarray(capture.frames)), capture.description)
+    with pytest.raises(ValueError, match="no light"):
+        slf.decode(dark, output=out)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_an_output_is_never_a_file_of_the_capture(capture, tmp_path):
+    folder = tmp_path / "cap"
+    capture.save(folder)
+    frames = json.loads((folder / "capture.json").read_text())["frames"]
+    for name in ["capture.json", *frames]:
+        before = (folder / name).read_bytes()
+        with pytest.raises(ValueError, match="a file of the capture"):
+            slf.decode(folder, output=folder / name)
+        assert (folder / name).read_bytes() == before

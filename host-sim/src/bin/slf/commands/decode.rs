@@ -244,6 +244,14 @@ pub fn run(args: Args) -> Result<()> {
         per(r.solves),
         per(r.steps)
     );
+    let row_mb = (2 * output_shape(&cap).row_len() * 4) as f64 / 1e6;
+    println!(
+        "memory: the decode held at most {} of the frame's {rows} lenslet rows of sums at once ({:.1} MB; the \
+         light field is written to {} as its rows are finished)",
+        r.rows_held,
+        r.rows_held as f64 * row_mb,
+        output.display()
+    );
     println!(
         "decoded {} patches ({} solved, {} interpolated from fewer than {} bands, {} flat; {} flagged, {} failed, {} \
          tiles failed) in {:.3} s; wrote {}",

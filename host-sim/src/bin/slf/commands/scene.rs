@@ -28,6 +28,11 @@ pub struct Args {
     /// (SSIM's 11 x 11 window).
     #[arg(long, default_value_t = 100, value_parser = ranged::<11, 4096>)]
     pub size: usize,
+    /// Spatial rows (lenslets), 11..=4096, where they differ from --size (which then gives
+    /// the columns): a frame wider than tall, e.g. for a strip's memory against the
+    /// frame's height at equal width.
+    #[arg(long, value_parser = ranged::<11, 4096>)]
+    pub rows: Option<usize>,
     /// Views per side, 4..=16: the decoder's patch takes 4 x 4.
     #[arg(long, default_value_t = 5, value_parser = ranged::<4, 16>)]
     pub views: usize,
@@ -37,10 +42,11 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let Args { name, output, seed, size, views, dtype } = args;
+    let Args { name, output, seed, size, rows, views, dtype } = args;
     let s = hard::by_name(&name, seed)?;
-    let size = SceneSize { views: (views, views), rows: size, cols: size };
-    size.check().map_err(|e| anyhow::anyhow!("--size {} with --views {views}: {e}", size.rows))?;
+    let size = SceneSize { views: (views, views), rows: rows.unwrap_or(size), cols: size };
+    size.check()
+        .map_err(|e| anyhow::anyhow!("--size {} (--rows {}) with --views {views}: {e}", size.cols, size.rows))?;
     let lf = s.render(size);
     write_npy(&output, &lf, dtype)?;
     println!("wrote {} ({:?})", output.display(), lf.shape());
