@@ -16,6 +16,9 @@ use crate::arrays::{plane, to_array};
 use crate::capture::from_parts;
 use crate::errors::{OrPy, flags};
 
+/// A decode's light field (`None` when it went to a file) and its report.
+type Decoded<'py> = (Option<Bound<'py, PyArrayDyn<f32>>>, Bound<'py, PyDict>);
+
 /// Decodes the capture `(frames, description JSON)` with `slf decode`'s flags `args`:
 /// `(light field, report)`. `threads`: the decode's threads (`None`: one per core);
 /// `progress(done, total)` is called from the worker threads after each tile. With
@@ -32,7 +35,7 @@ pub fn decode<'py>(
     threads: Option<usize>,
     progress: Option<Py<PyAny>>,
     output: Option<std::path::PathBuf>,
-) -> PyResult<(Option<Bound<'py, PyArrayDyn<f32>>>, Bound<'py, PyDict>)> {
+) -> PyResult<Decoded<'py>> {
     let settings = DecodeSettings::from_flags(&args).map_err(flags)?;
     let capture = from_parts(&frames, description)?;
     // The decode is compute-bound: threads past a few per core buy nothing, and 10**9 of
