@@ -151,3 +151,46 @@ fn an_interrupted_decode_leaves_no_output() {
     assert_eq!(entries(), ["cap", "out.npy"]);
     assert_eq!(std::fs::read(&out).unwrap(), b"the old output");
 }
+
+/// `slf decode -o OUT.h5`: the same light field as the `.npy`, read back by `slf import
+/// hdf5`'s reader bit for bit, compressed or not; the flags of one format refused with the
+/// other.
+#[test]
+fn the_decode_written_to_hdf5_is_the_decode_written_to_npy() {
+    use slf_host::io::hdf5_rows::{AXES, DATASET};
+    use slf_host::io::import::hdf5::{Hdf5Layout, read_hdf5};
+    use slf_host::io::lightfield::read_npy;
+    let dir = tempfile::tempdir().unwrap();
+    let cap = dir.path().join("cap");
+    capture(23).save(&cap).unwrap();
+    let decode = |out: &std::path::Path, flags: &[&str]| {
+        assert_cmd::Command::cargo_bin("slf")
+            .unwrap()
+            .arg("decode")
+            .arg(&cap)
+            .arg("-o")
+            .arg(out)
+            .arg("-q")
+            .args(flags)
+            .output()
+            .unwrap()
+    };
+    let npy = dir.path().join("lf.npy");
+    assert!(decode(&npy, &["--preset", "preview"]).status.success());
+    let want = read_npy(&npy).unwrap();
+    let layout = Hdf5Layout { dataset: DATASET.into(), axes: AXES.into() };
+    for (name, flags) in [("lf.h5", &[][..]), ("lf.hdf5", &["--deflate", "6"]), ("lf.data", &["--format", "hdf5"])] {
+        let out = dir.path().join(name);
+        let run = decode(&out, &[&["--preset", "preview"][..], flags].concat());
+        assert!(run.status.success(), "{name}: {}", String::from_utf8_lossy(&run.stderr));
+        assert!(read_hdf5(&out, &layout, 1.0).unwrap() == want, "{name} {flags:?}: differs from the .npy");
+    }
+    for (name, flags, says) in
+        [("x.npy", &["--deflate", "4"][..], "--deflate"), ("x.h5", &["--dtype", "u16"], "--dtype u16")]
+    {
+        let run = decode(&dir.path().join(name), flags);
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert!(!run.status.success() && err.contains(says), "{name} {flags:?}: {err}");
+        assert!(!dir.path().join(name).exists());
+    }
+}

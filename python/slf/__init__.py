@@ -446,6 +446,8 @@ def decode(
     path = None if output is None else os.fspath(output)
     if path is not None and not isinstance(capture, Capture):
         _check_output(os.fspath(capture), path)
+    if path is not None and not path.lower().endswith(".npy"):
+        raise ValueError(f"output {path}: a .npy path (an HDF5 file: slf decode -o OUT.h5)")
     lf, rep = _slf.decode(frames, json.dumps(cap.description), args, threads, _progress_callback(progress), path)
     if path is not None:
         lf = np.load(path, mmap_mode="r")

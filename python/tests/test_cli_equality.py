@@ -168,3 +168,19 @@ def test_evaluate_equals_cli(tmp_path, slf_bin, depth, capture):
     assert f"SSIM {m['ssim']:.4f}" in out
     assert re.search(rf"SA +{m['sa']:.3f} deg", out)
     assert 15 < m["psnr"] < 60 and 0 < m["ssim"] <= 1 and m["sa"] >= 0
+
+
+def test_an_hdf5_decode_reads_in_h5py(tmp_path, slf_bin, capture):
+    # `slf decode -o OUT.h5`: h5py reads the light field (the package's decode, bit for
+    # bit), its axes, its 13 band centres and the capture's description.
+    import h5py
+
+    capture.save(tmp_path / "cap")
+    run([slf_bin, "decode", tmp_path / "cap", "-o", tmp_path / "lf.h5", "--deflate", "4", "-q"])
+    with h5py.File(tmp_path / "lf.h5", "r") as f:
+        d = f["lightfield"]
+        assert np.array_equal(d[()], slf.decode(capture))
+        assert [a.decode() for a in d.attrs["axes"]] == list("uvhwb")
+        assert np.array_equal(d.attrs["bands_nm"], np.asarray(capture.description["bands_nm"], dtype=np.float32))
+        assert json.loads(d.attrs["description"]) == capture.description
+        assert d.compression == "gzip" and d.chunks is not None

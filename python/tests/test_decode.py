@@ -183,3 +183,5 @@ def test_an_output_is_never_a_file_of_the_capture(capture, tmp_path):
         with pytest.raises(ValueError, match="a file of the capture"):
             slf.decode(folder, output=folder / name)
         assert (folder / name).read_bytes() == before
+    with pytest.raises(ValueError, match="a .npy path"):
+        slf.decode(capture, output=tmp_path / "lf.h5")

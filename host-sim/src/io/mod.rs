@@ -8,6 +8,7 @@
 //! - [`calibration`]: the calibration folder `slf calibrate` writes and a calibrated
 //!   decode reads;
 //! - [`capture`]: the capture folder (frames and `capture.json`), loaded and saved;
+//! - [`hdf5_rows`]: a light field's HDF5 file, from its rows;
 //! - [`import`]: views, hyperspectral cubes, HDF5 light fields and band resampling;
 //! - [`message`]: an error as the one line a user reads;
 //! - [`output`]: results written whole, never over an input of the same run;
@@ -19,6 +20,7 @@
 
 pub mod calibration;
 pub mod capture;
+pub mod hdf5_rows;
 pub mod import;
 pub mod lightfield;
 pub mod message;

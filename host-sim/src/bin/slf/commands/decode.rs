@@ -13,6 +13,7 @@ use slf_host::decode::settings::{DecodeSettings, Outcome, output_shape};
 use slf_host::firmware::disparity::Disparity;
 use slf_host::io::calibration::Calibration;
 use slf_host::io::capture::Capture;
+use slf_host::io::hdf5_rows::Hdf5Rows;
 use slf_host::io::lightfield::{Dtype, write_npy_f32_2d};
 use slf_host::io::npy_rows::NpyRows;
 use slf_host::io::output::{Outputs, write_bytes};
@@ -22,11 +23,19 @@ use slf_host::io::rows::RowSink;
 pub struct Args {
     /// Capture folder (capture.json and frames).
     pub capture: PathBuf,
-    /// Output .npy file: normalised units (white = 1), every method's values clamped to the
+    /// Output file, .npy (written as its rows are decoded) or HDF5 (.h5, .hdf5; or
+    /// --format): normalised units (white = 1), every method's values clamped to the
     /// sensor's physical range, 0 to (max_valid - black) / (white - black) (1.111 for the
     /// simulator's default sensor).
     #[arg(short, long)]
     pub output: PathBuf,
+    /// The output's format [default: hdf5 for a name ending in .h5 or .hdf5, else npy].
+    #[arg(long, value_enum)]
+    pub format: Option<Format>,
+    /// HDF5: compress the dataset's chunks by deflate at this level (1..=9, with the
+    /// shuffle filter); none by default.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=9))]
+    pub deflate: Option<u32>,
     #[command(flatten)]
     pub settings: DecodeSettings,
     /// Also write which decoder made each patch (CSV: the patch's origin, the disparity it
@@ -67,8 +76,63 @@ impl RowSink for Interruptible<'_> {
     }
 }
 
+/// `slf decode --format`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Format {
+    /// A 5-axis `.npy` (U, V, H, W, 13), written as its rows are decoded.
+    Npy,
+    /// An HDF5 file: the chunked dataset `lightfield` (U, V, H, W, 13) with its axes, the
+    /// band centres in nm, the capture's description and the decode's command as
+    /// attributes (`slf import hdf5 OUT --dataset lightfield --axes uvhwb` reads it back).
+    Hdf5,
+}
+
+/// The file a decode writes, by format.
+enum OutputFile {
+    Npy(NpyRows),
+    Hdf5(Hdf5Rows),
+}
+
+impl OutputFile {
+    fn sink(&mut self) -> &mut dyn RowSink {
+        match self {
+            Self::Npy(f) => f,
+            Self::Hdf5(f) => f,
+        }
+    }
+
+    fn max(&self) -> f32 {
+        match self {
+            Self::Npy(f) => f.max(),
+            Self::Hdf5(f) => f.max(),
+        }
+    }
+
+    /// Puts the file in place, an HDF5 file with `settings` (the decode's, resolved).
+    fn finish(self, settings: &str) -> Result<()> {
+        match self {
+            Self::Npy(f) => f.finish(),
+            Self::Hdf5(mut f) => {
+                f.attr("settings", settings);
+                f.finish()
+            }
+        }
+    }
+}
+
 pub fn run(args: Args) -> Result<()> {
-    let Args { capture, output, mut settings, member_map, disparity_map, error_map, dtype, quiet } = args;
+    let Args { capture, output, format, deflate, mut settings, member_map, disparity_map, error_map, dtype, quiet } =
+        args;
+    let hdf5_name = output.extension().is_some_and(|e| e.eq_ignore_ascii_case("h5") || e.eq_ignore_ascii_case("hdf5"));
+    let format = format.unwrap_or(if hdf5_name { Format::Hdf5 } else { Format::Npy });
+    anyhow::ensure!(
+        format == Format::Hdf5 || deflate.is_none(),
+        "--deflate compresses an HDF5 output: give -o OUT.h5 or --format hdf5"
+    );
+    anyhow::ensure!(
+        format == Format::Npy || dtype == Dtype::F32,
+        "--dtype u16 is for a .npy output; the HDF5 output is float32"
+    );
     settings.estimate |= error_map.is_some();
     let cap = Capture::load(&capture)?;
     // Where the results go is checked before the decode, not found unwritable after it, and
@@ -104,21 +168,29 @@ pub fn run(args: Args) -> Result<()> {
     // only once the decode and the maps are done. An interrupt (Ctrl-C, SIGTERM) ends the
     // decode at its next row as an error, so the file is dropped unfinished and nothing is
     // left in its place (a second interrupt exits at once).
-    let mut file = NpyRows::create(&output, output_shape(&cap), dtype)?;
+    let mut file = match format {
+        Format::Npy => OutputFile::Npy(NpyRows::create(&output, output_shape(&cap), dtype)?),
+        Format::Hdf5 => {
+            let mut f = Hdf5Rows::create(&output, output_shape(&cap), &cap.description.bands_nm, deflate)?;
+            f.attr("description", &serde_json::to_string(&cap.description)?);
+            f.attr("command", &std::env::args().collect::<Vec<_>>().join(" "));
+            OutputFile::Hdf5(f)
+        }
+    };
     let _ = ctrlc::set_handler(|| {
         if INTERRUPTED.swap(true, Ordering::Relaxed) {
             std::process::exit(130);
         }
     });
     let outcome = settings
-        .run_into(&cap, !quiet, &|_, _| {}, &mut Interruptible { inner: &mut file })
+        .run_into(&cap, !quiet, &|_, _| {}, &mut Interruptible { inner: file.sink() })
         .with_context(|| capture.display().to_string())?;
     if let Some(w) = outcome.warning() {
         eprintln!("warning: {}: {w}", capture.display());
     }
     let (opts, r) = match &outcome {
         Outcome::Baseline { method, report: r } => {
-            file.finish()?;
+            file.finish(&format!("--method {method:?}"))?;
             println!(
                 "{:?}: {} sensor positions measured, {} filled from their neighbours, in {:.3} s; wrote {}",
                 method,
@@ -157,7 +229,7 @@ pub fn run(args: Args) -> Result<()> {
         write_npy_f32_2d(path, map, rows, cols).with_context(|| format!("cannot write {}", path.display()))?;
     }
     let peak = f64::from(file.max());
-    file.finish()?;
+    file.finish(&format!("{opts:?}"))?;
     let used = opts.solver_config(&cap);
     let ball = match (opts.noise, used.noise > 0.0 || used.shot > 0.0) {
         (_, false) => "exact projection".to_string(),
