@@ -167,7 +167,10 @@ def main():
             s.run(["decode", "cap", "-o", "x.npy", "-q", f"{flag}={v}"], f"decode {flag}={v}", keep=capture_files)
     for extra in [["--error-map", "cap/capture.json"], ["--error-map", "x.npy"], ["--method", "ppid", "--estimate"],
                   ["--model-trial", "true", "--dictionary", "dct"], ["--model-trial", "true", "--preset", "preview"],
-                  ["--sheared-fallback", "true", "--disparities", "0:0"], ["--sheared-fallback", "true", "--stride", "1"]]:
+                  ["--sheared-fallback", "true", "--disparities", "0:0"], ["--sheared-fallback", "true", "--stride", "1"],
+                  ["--format", "hdf5"], ["--format", "x"], ["--deflate", "4"], ["--format", "hdf5", "--deflate", "0"],
+                  ["--format", "hdf5", "--deflate", "10"], ["--format", "hdf5", "--dtype", "u16"],
+                  ["--format", "hdf5", "--deflate", "9", "--method", "ppid"]]:
         s.run(["decode", "cap", "-o", "x.npy", "-q", *extra], f"decode {' '.join(extra)}", keep=capture_files)
 
     # Outputs over inputs, and over each other.
