@@ -242,6 +242,11 @@ fn out_of_range_arguments_name_the_argument_and_its_range() {
         (&["scene", "depth", "--views", "0"], "'--views <VIEWS>': 0 is out of range 4..=16"),
         (&["scene", "depth", "--views", "3"], "'--views <VIEWS>': 3 is out of range 4..=16"),
         (&["scene", "depth", "--views", "16", "--size", "4096"], "--size 4096 with --views 16"),
+        (
+            &["scene", "depth", "--views", "16", "--size", "4096", "--rows", "2048"],
+            "--size 4096 --rows 2048 with --views 16",
+        ),
+        (&["scene", "depth", "--rows", "10"], "'--rows <ROWS>': 10 is out of range 11..=4096"),
         (&["demo", "--size", "0"], "0 is out of range 11..=2048"),
         (&["compare", "--size", "0"], "0 is out of range 11..=1024"),
         (&["sweep", "--size", "3"], "3 is out of range 11..=1024"),

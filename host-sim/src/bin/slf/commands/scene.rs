@@ -45,8 +45,8 @@ pub fn run(args: Args) -> Result<()> {
     let Args { name, output, seed, size, rows, views, dtype } = args;
     let s = hard::by_name(&name, seed)?;
     let size = SceneSize { views: (views, views), rows: rows.unwrap_or(size), cols: size };
-    size.check()
-        .map_err(|e| anyhow::anyhow!("--size {} (--rows {}) with --views {views}: {e}", size.cols, size.rows))?;
+    let given = rows.map_or(String::new(), |r| format!(" --rows {r}"));
+    size.check().map_err(|e| anyhow::anyhow!("--size {}{given} with --views {views}: {e}", size.cols))?;
     let lf = s.render(size);
     write_npy(&output, &lf, dtype)?;
     println!("wrote {} ({:?})", output.display(), lf.shape());
