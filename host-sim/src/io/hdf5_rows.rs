@@ -16,7 +16,7 @@ use hdf5_pure::{AttrValue, FileBuilder};
 
 use crate::io::lightfield::LightField;
 use crate::io::output::WholeFile;
-use crate::io::rows::{RowShape, RowSink};
+use crate::io::rows::{RowShape, RowSink, check_row};
 
 /// The dataset's name.
 pub const DATASET: &str = "lightfield";
@@ -102,19 +102,7 @@ impl Hdf5Rows {
 
 impl RowSink for Hdf5Rows {
     fn put_row(&mut self, y: usize, row: &[f32]) -> Result<()> {
-        ensure!(
-            y == self.next && y < self.shape.rows && row.len() == self.shape.row_len(),
-            "row {y} of {} values put out of order (row {} next, {} values a row)",
-            row.len(),
-            self.next,
-            self.shape.row_len()
-        );
-        if let Some(i) = row.iter().position(|x| !x.is_finite()) {
-            anyhow::bail!(
-                "cannot write {}: a value that is not finite in row {y} (at {i})",
-                self.file.path().display()
-            );
-        }
+        check_row(self.shape, self.next, y, row, self.file.path())?;
         let run = self.shape.run_len();
         for (p, values) in row.chunks_exact(run).enumerate() {
             let at = (p * self.shape.rows + y) * run * 4;

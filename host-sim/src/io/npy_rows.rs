@@ -12,7 +12,7 @@ use npyz::WriterBuilder;
 
 use crate::io::lightfield::Dtype;
 use crate::io::output::WholeFile;
-use crate::io::rows::{RowShape, RowSink};
+use crate::io::rows::{RowShape, RowSink, check_row};
 
 /// Bytes of rows gathered before they are written: each write is then one run per view
 /// of many rows, not of one.
@@ -115,20 +115,7 @@ impl NpyRows {
 
 impl RowSink for NpyRows {
     fn put_row(&mut self, y: usize, row: &[f32]) -> Result<()> {
-        ensure!(
-            y == self.next && y < self.shape.rows && row.len() == self.shape.row_len(),
-            "row {y} of {} values put out of order (row {} next, {} values a row)",
-            row.len(),
-            self.next,
-            self.shape.row_len()
-        );
-        // slf writes no light field it would refuse to read (as `write_npy`).
-        if let Some(i) = row.iter().position(|x| !x.is_finite()) {
-            anyhow::bail!(
-                "cannot write {}: a value that is not finite in row {y} (at {i})",
-                self.file.path().display()
-            );
-        }
+        check_row(self.shape, self.next, y, row, self.file.path())?;
         for &x in row {
             self.max = self.max.max(x);
             match self.dtype {

@@ -45,6 +45,25 @@ impl RowShape {
     }
 }
 
+/// Checks that `row` is row `y` of `shape` and the one a file sink of `path` takes next
+/// (`next`), and that every value is finite: slf writes no light field it would refuse to
+/// read (as [`crate::io::lightfield::write_npy`]).
+///
+/// # Errors
+/// A row out of order, of the wrong length, or holding a NaN or an infinity.
+pub fn check_row(shape: RowShape, next: usize, y: usize, row: &[f32], path: &std::path::Path) -> Result<()> {
+    ensure!(
+        y == next && y < shape.rows && row.len() == shape.row_len(),
+        "row {y} of {} values put out of order (row {next} next, {} values a row)",
+        row.len(),
+        shape.row_len()
+    );
+    if let Some(i) = row.iter().position(|x| !x.is_finite()) {
+        anyhow::bail!("cannot write {}: a value that is not finite in row {y} (at {i})", path.display());
+    }
+    Ok(())
+}
+
 /// Where finished lenslet rows go, each once, in order from row 0.
 pub trait RowSink {
     /// Row `y` of the light field ([`RowShape::row_len`] values, views outermost).
