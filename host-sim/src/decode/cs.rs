@@ -33,7 +33,7 @@ use crate::decode::strip::decode_rows;
 use crate::decode::trial::{DCT_LEAN, rms};
 use crate::io::capture::Capture;
 use crate::io::lightfield::LightField;
-use crate::io::rows::RowSink;
+use crate::io::rows::{RowShape, RowSink};
 
 /// A dictionary of the paper's patch: 5 x 5 lenslets x 4 x 4 views x 13 bands.
 pub type PaperDictionary = Dictionary<5, 5, 4, 4, 13>;
@@ -267,9 +267,7 @@ where
 /// A light field too large to hold ([`LightField::check_size`]).
 pub fn empty_light_field(capture: &Capture) -> Result<LightField> {
     let d = &capture.description;
-    let views = (d.views[0], d.views[1]);
-    LightField::check_size(views, d.lenslets[0], d.lenslets[1], 13)?;
-    Ok(LightField::zeros(views, d.lenslets[0], d.lenslets[1], 13))
+    RowShape { views: (d.views[0], d.views[1]), rows: d.lenslets[0], cols: d.lenslets[1], bands: 13 }.zeros()
 }
 
 /// [`decode_picked`], each finished lenslet row put into `sink` in order as the decode goes

@@ -624,9 +624,7 @@ impl DecodeSettings {
     /// What [`Self::resolve`] refuses; a capture the method cannot take; a decode where no
     /// patch decoded (every patch saturated, defective or unreadable).
     pub fn run(&self, capture: &Capture, progress: bool, observer: &(dyn Fn(usize, usize) + Sync)) -> Result<Decoded> {
-        let shape = output_shape(capture);
-        LightField::check_size(shape.views, shape.rows, shape.cols, shape.bands)?;
-        let mut light_field = LightField::zeros(shape.views, shape.rows, shape.cols, shape.bands);
+        let mut light_field = output_shape(capture).zeros()?;
         let outcome = self.run_into(capture, progress, observer, &mut light_field)?;
         Ok(Decoded { light_field, outcome })
     }

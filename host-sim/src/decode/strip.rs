@@ -84,6 +84,13 @@ struct SumRow {
     weight: Vec<f32>,
 }
 
+impl SumRow {
+    /// A row of `shape` no estimate has reached.
+    fn zeros(shape: RowShape) -> Self {
+        Self { sum: vec![0.0; shape.row_len()], weight: vec![0.0; shape.row_len()] }
+    }
+}
+
 /// The finished rows of the disjoint grid's decode: the shifted patches' seeds, and what
 /// the adaptive rule scores.
 struct SeedRows<'r> {
@@ -128,7 +135,7 @@ impl<const PU: usize, const PV: usize, const N: usize> PatchSeed<N> for FrameSee
 
 /// Adds a tile's sums into the rows it reaches (made where not held yet).
 fn add_tile<const PU: usize, const PV: usize>(rows: &mut Rows<SumRow>, sums: &TileSums<PU, PV>, shape: RowShape) {
-    let zero = || SumRow { sum: vec![0.0; shape.row_len()], weight: vec![0.0; shape.row_len()] };
+    let zero = || SumRow::zeros(shape);
     let tile = sums.tile;
     let (extent_rows, extent_cols) = sums.extent();
     for s in 0..extent_rows {
@@ -285,7 +292,7 @@ where
     let mut disjoint = Rows::<SumRow>::new();
     let mut sums = Rows::<SumRow>::new();
     let mut seeds = Rows::<Vec<f32>>::new();
-    let zero = || SumRow { sum: vec![0.0; shape.row_len()], weight: vec![0.0; shape.row_len()] };
+    let zero = || SumRow::zeros(shape);
     let (mut next_disjoint, mut next_shifted) = (0, 0);
     // Rows below these are final in `disjoint` (moved on), and put to the sink.
     let (mut disjoint_done, mut put) = (0, 0);

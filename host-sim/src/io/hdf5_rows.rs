@@ -14,7 +14,6 @@ use std::path::Path;
 use anyhow::{Context, Result, ensure};
 use hdf5_pure::{AttrValue, FileBuilder};
 
-use crate::io::lightfield::LightField;
 use crate::io::output::WholeFile;
 use crate::io::rows::{RowShape, RowSink, check_row};
 
@@ -41,10 +40,10 @@ impl Hdf5Rows {
     /// compressed by deflate at `deflate` (1..=9) or not at all.
     ///
     /// # Errors
-    /// A light field too large to hold ([`LightField::check_size`]), a band count other
+    /// A light field too large to hold ([`RowShape::check`]), a band count other
     /// than the shape's, a level outside 1..=9, or a folder that takes no new file.
     pub fn create(path: &Path, shape: RowShape, bands_nm: &[f32], deflate: Option<u32>) -> Result<Self> {
-        LightField::check_size(shape.views, shape.rows, shape.cols, shape.bands)?;
+        shape.check()?;
         ensure!(bands_nm.len() == shape.bands, "{} band centres for {} bands", bands_nm.len(), shape.bands);
         ensure!(deflate.is_none_or(|l| (1..=9).contains(&l)), "deflate level {deflate:?}: want 1..=9");
         let file = WholeFile::create(path)?;
@@ -120,6 +119,7 @@ impl RowSink for Hdf5Rows {
 mod tests {
     use super::*;
     use crate::io::import::hdf5::{Hdf5Layout, read_hdf5};
+    use crate::io::lightfield::LightField;
     use crate::io::rows::put_light_field;
 
     /// The file reads back through `slf import hdf5`'s reader bit for bit, compressed or

@@ -43,6 +43,23 @@ impl RowShape {
     pub fn shape(&self) -> [usize; 5] {
         [self.views.0, self.views.1, self.rows, self.cols, self.bands]
     }
+
+    /// Checks that a light field of this shape may be held ([`LightField::check_size`]).
+    ///
+    /// # Errors
+    /// An empty axis, or more values than [`LightField::MAX_VALUES`].
+    pub fn check(&self) -> Result<()> {
+        LightField::check_size(self.views, self.rows, self.cols, self.bands)
+    }
+
+    /// A light field of this shape, zeros, its size checked before it is allocated.
+    ///
+    /// # Errors
+    /// As [`Self::check`].
+    pub fn zeros(&self) -> Result<LightField> {
+        self.check()?;
+        Ok(LightField::zeros(self.views, self.rows, self.cols, self.bands))
+    }
 }
 
 /// Checks that `row` is row `y` of `shape` and the one a file sink of `path` takes next
