@@ -34,7 +34,7 @@ use crate::eval::metrics::evaluate;
 use crate::io::capture::MaskDescription;
 use crate::io::capture::regular_file;
 use crate::io::lightfield::LightField;
-use crate::io::output::{write_bytes, write_png_rgb};
+use crate::io::output::write_bytes;
 use crate::sim::camera::{CameraConfig, simulate};
 use crate::sim::scene::{self, SceneSize};
 
@@ -449,13 +449,46 @@ pub fn mark_pareto(points: &mut [Point]) {
 }
 
 /// Writes `bench.csv`, `bench.md` and `bench.png` into `dir`; `bench.md` ends with the
-/// device's frame figure when `device` holds any rows.
+/// device's frame figure when `device` holds any rows. All three are made in memory first,
+/// so a point the plot refuses writes no file.
 ///
 /// # Errors
 /// I/O and drawing errors.
 pub fn write(points: &[Point], device: &[DeviceFrame], dir: &Path) -> Result<()> {
     anyhow::ensure!(!points.is_empty(), "no points to write");
+    let csv = csv_of(points)?;
+    let (md, png) = (markdown(points, device), plot(points)?);
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    write_bytes(&dir.join("bench.csv"), &csv)?;
+    write_bytes(&dir.join("bench.md"), md.as_bytes())?;
+    write_bytes(&dir.join("bench.png"), &png)
+}
+
+/// Draws `bench.md` and `bench.png` into `dir` again from the `bench.csv` at `from` (with
+/// the device's figure, say) without sweeping again, and returns the points. `dir`'s
+/// `bench.csv` becomes a copy of `from`, byte for byte: when it is `from` itself it is
+/// left as it is (before, it was written again at the table's rounding).
+///
+/// # Errors
+/// As [`read_points`] and [`write()`].
+pub fn redraw(from: &Path, device: &[DeviceFrame], dir: &Path) -> Result<usize> {
+    regular_file(from, 16 << 20, "a bench table holds")?;
+    let bytes = std::fs::read(from).with_context(|| format!("cannot read {}", from.display()))?;
+    let points = points_of(csv::Reader::from_reader(&bytes[..])).with_context(|| from.display().to_string())?;
+    let (md, png) = (markdown(&points, device), plot(&points)?);
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let target = dir.join("bench.csv");
+    let same = matches!((std::fs::canonicalize(from), std::fs::canonicalize(&target)), (Ok(a), Ok(b)) if a == b);
+    if !same {
+        write_bytes(&target, &bytes)?;
+    }
+    write_bytes(&dir.join("bench.md"), md.as_bytes())?;
+    write_bytes(&dir.join("bench.png"), &png)?;
+    Ok(points.len())
+}
+
+/// The points as `bench.csv`'s bytes.
+fn csv_of(points: &[Point]) -> Result<Vec<u8>> {
     // Setting names hold commas ("ensemble screened, tolerance 1e-3, ..."): the csv crate
     // quotes them.
     let mut csv = csv::Writer::from_writer(Vec::new());
@@ -472,9 +505,6 @@ pub fn write(points: &[Point], device: &[DeviceFrame], dir: &Path) -> Result<()>
         "frame_512_s_1_thread",
         "pareto",
     ])?;
-    let mut md = String::from(
-        "| mask | k | setting | PSNR dB | SSIM | SA deg | ms / patch (1 thread) | ms / patch (all) | solves | 512 x 512 frame, s (1 thread) | Pareto |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n",
-    );
     for p in points {
         csv.write_record([
             p.mask.clone(),
@@ -489,6 +519,16 @@ pub fn write(points: &[Point], device: &[DeviceFrame], dir: &Path) -> Result<()>
             format!("{:.2}", p.frame_s),
             p.pareto.to_string(),
         ])?;
+    }
+    csv.into_inner().context("csv buffer")
+}
+
+/// The points as `bench.md`, with the device's figure after the table when there is one.
+fn markdown(points: &[Point], device: &[DeviceFrame]) -> String {
+    let mut md = String::from(
+        "| mask | k | setting | PSNR dB | SSIM | SA deg | ms / patch (1 thread) | ms / patch (all) | solves | 512 x 512 frame, s (1 thread) | Pareto |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n",
+    );
+    for p in points {
         md += &format!(
             "| {} | {} | {} | {:.2} | {:.4} | {:.2} | {:.2} | {:.2} | {:.1} | {:.1} | {} |\n",
             p.mask,
@@ -507,9 +547,7 @@ pub fn write(points: &[Point], device: &[DeviceFrame], dir: &Path) -> Result<()>
     if !device.is_empty() {
         md += &device_frame::markdown(device);
     }
-    write_bytes(&dir.join("bench.csv"), &csv.into_inner().context("csv buffer")?)?;
-    write_bytes(&dir.join("bench.md"), md.as_bytes())?;
-    plot(points, &dir.join("bench.png"))
+    md
 }
 
 /// The points of a `bench.csv` that [`write()`] wrote, to draw its table and plot again
@@ -536,28 +574,39 @@ fn points_of<R: std::io::Read>(mut r: csv::Reader<R>) -> Result<Vec<Point>> {
             let x = at(j)?;
             x.parse().with_context(|| format!("line {line}: field {} {x:?} is not a number", j + 1))
         };
-        // What the plot and the Pareto front need: finite values, a time above zero.
-        let finite = |j: usize| -> Result<f64> {
+        // What the plot and the Pareto front need: finite values in the range a decode can
+        // give (a PSNR of 1.7e308 or a time of 1e-200 ms once held the plot's axes for
+        // minutes), a time above zero.
+        let within = |j: usize, what: &str, (lo, hi): (f64, f64)| -> Result<f64> {
             let x = number(j)?;
             anyhow::ensure!(x.is_finite(), "line {line}: field {} is {x}, not a finite number", j + 1);
+            anyhow::ensure!(
+                (lo..=hi).contains(&x),
+                "line {line}: field {} is {what} of {x}, outside [{lo:e}, {hi:e}]",
+                j + 1
+            );
             Ok(x)
         };
         let time = |j: usize| -> Result<f64> {
-            let x = finite(j)?;
-            anyhow::ensure!(x > 0.0, "line {line}: field {} is a time of {x} ms, not above 0", j + 1);
-            Ok(x)
+            let x = number(j)?;
+            anyhow::ensure!(
+                x.is_finite() && x > 0.0,
+                "line {line}: field {} is a time of {x} ms, not above 0",
+                j + 1
+            );
+            within(j, "a time in ms", TIME_MS)
         };
         points.push(Point {
             mask: at(0)?.to_owned(),
             k: at(1)?.parse().with_context(|| format!("line {line}: k"))?,
             setting: at(2)?.to_owned(),
-            psnr: finite(3)?,
-            ssim: finite(4)?,
-            sa: finite(5)?,
+            psnr: within(3, "a PSNR in dB", PSNR_DB)?,
+            ssim: within(4, "an SSIM", (-1.0, 1.0))?,
+            sa: within(5, "a spectral angle in degrees", (0.0, 180.0))?,
             ms_one: time(6)?,
             ms_all: time(7)?,
-            solves: finite(8)?,
-            frame_s: finite(9)?,
+            solves: within(8, "a count of solves", (0.0, 1e9))?,
+            frame_s: within(9, "a time in s", (0.0, 1e15))?,
             pareto: at(10)? == "true",
         });
     }
@@ -565,18 +614,30 @@ fn points_of<R: std::io::Read>(mut r: csv::Reader<R>) -> Result<Vec<Point>> {
     Ok(points)
 }
 
-fn plot(points: &[Point], path: &Path) -> Result<()> {
+/// The PSNRs a bench table may hold, in dB: a plot's axis spans them in bounded time.
+const PSNR_DB: (f64, f64) = (-1000.0, 1000.0);
+/// The times per patch a bench table may hold, in ms: 1 ps to 11 days, 21 decades on the
+/// plot's log axis.
+const TIME_MS: (f64, f64) = (1e-9, 1e12);
+
+/// The plot as PNG bytes.
+fn plot(points: &[Point]) -> Result<Vec<u8>> {
+    use image::ImageEncoder;
     let (width, height) = (1000u32, 700u32);
     let mut raw = vec![0u8; 3 * (width * height) as usize];
     draw(points, BitMapBackend::with_buffer(&mut raw, (width, height)))?;
-    write_png_rgb(path, width, height, &raw)
+    let mut png = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut png).write_image(&raw, width, height, image::ExtendedColorType::Rgb8)?;
+    Ok(png)
 }
 
 fn draw(points: &[Point], backend: BitMapBackend<'_>) -> Result<()> {
     // A point that cannot be placed (a time of 0 on the log axis, a PSNR of NaN from a
-    // decode that failed) is in the table, not on the plot; the axes span the others.
+    // decode that failed, values no decode gives) is in the table, not on the plot; the
+    // axes span the others.
+    let inside = |x: f64, (lo, hi): (f64, f64)| (lo..=hi).contains(&x);
     let points: Vec<Point> =
-        points.iter().filter(|p| p.ms_one > 0.0 && p.ms_one.is_finite() && p.psnr.is_finite()).cloned().collect();
+        points.iter().filter(|p| inside(p.ms_one, TIME_MS) && inside(p.psnr, PSNR_DB)).cloned().collect();
     anyhow::ensure!(!points.is_empty(), "no point with a time above 0 and a finite PSNR to plot");
     let points = &points[..];
     let root = backend.into_drawing_area();
@@ -739,6 +800,17 @@ mod tests {
         let md2 = std::fs::read_to_string(other.path().join("bench.md")).unwrap();
         assert_eq!(md2, md.clone() + &device_frame::markdown(&device));
         assert!(md2.contains("| DCT | 1600 | 50.0 M | 480 | 167 |"), "{md2}");
+        // Issue 51, item 12: drawn again from its own folder's bench.csv, the file keeps
+        // its bytes (before: 30.123456789 became 30.1235); into another folder, a copy.
+        let own = dir.path().join("bench.csv");
+        let text = std::fs::read_to_string(&own).unwrap().replace("31.5000", "30.123456789");
+        std::fs::write(&own, &text).unwrap();
+        assert_eq!(redraw(&own, &device, dir.path()).unwrap(), 2);
+        assert_eq!(std::fs::read_to_string(&own).unwrap(), text);
+        assert!(std::fs::read_to_string(dir.path().join("bench.md")).unwrap().contains("| 30.12 |"));
+        let third = tempfile::tempdir().unwrap();
+        redraw(&own, &[], third.path()).unwrap();
+        assert_eq!(std::fs::read_to_string(third.path().join("bench.csv")).unwrap(), text);
         // A row that is not a point is refused with its line.
         let bad = dir.path().join("bad.csv");
         std::fs::write(&bad, "mask,k,setting\npixel,three,x\n").unwrap();
@@ -783,6 +855,30 @@ mod tests {
             frame_s: 1.0,
             pareto: false,
         };
+        // Issue 51, item 1: values no decode gives are refused with their line and field,
+        // at once (before: +-1.7e308 dB or times of 1e-200 and 1e200 ms ran the plot's axes
+        // past 150 s, with bench.csv and bench.md already written).
+        for (rows, says) in [
+            ("pixel,3,x,1.7e308,0.9,4,1,0.5,1,2,true\npixel,3,y,-1.7e308,0.9,4,1,0.5,1,2,true", "line 2: field 4"),
+            ("pixel,3,x,30,0.9,4,1e-200,0.5,1,2,true\npixel,3,y,30,0.9,4,1e200,0.5,1,2,true", "line 2: field 7"),
+            ("pixel,3,x,30,0.9,4,1,0.5,1,2,true\npixel,3,y,30,0.9,4,1e200,0.5,1,2,true", "line 3: field 7"),
+            ("pixel,3,x,30,1.5,4,1,0.5,1,2,true", "line 2: field 5 is an SSIM of 1.5"),
+            ("pixel,3,x,30,0.9,-4,1,0.5,1,2,true", "line 2: field 6 is a spectral angle"),
+        ] {
+            let out = tempfile::tempdir().unwrap();
+            std::fs::write(&csv, format!("{header}{rows}\n")).unwrap();
+            let start = std::time::Instant::now();
+            let e = format!("{:#}", redraw(&csv, &[], out.path()).unwrap_err());
+            assert!(e.contains(says), "{e}");
+            assert!(start.elapsed().as_secs() < 10, "refusing took {:?}", start.elapsed());
+            assert_eq!(std::fs::read_dir(out.path()).unwrap().count(), 0, "a refused table wrote files");
+        }
+        // The widest table allowed draws at once.
+        let wide = "pixel,3,x,-1000,0.9,4,1e-9,0.5,1,2,true\npixel,3,y,1000,0.9,4,1e12,0.5,1,2,true";
+        std::fs::write(&csv, format!("{header}{wide}\n")).unwrap();
+        let start = std::time::Instant::now();
+        assert_eq!(redraw(&csv, &[], dir.path()).unwrap(), 2);
+        assert!(start.elapsed().as_secs() < 30, "drawing took {:?}", start.elapsed());
         let start = std::time::Instant::now();
         write(&[point(f64::NAN, 1.0), point(30.0, 0.0), point(31.0, 2.0)], &[], dir.path()).unwrap();
         assert!(start.elapsed().as_secs() < 30, "drawing took {:?}", start.elapsed());

@@ -32,8 +32,8 @@ pub struct Args {
     #[arg(long, value_name = "CSV")]
     pub device: Option<PathBuf>,
     /// Instead of sweeping: draw bench.md and bench.png again from a bench.csv this command
-    /// wrote (e.g. with `--device`). It may be the bench.csv of --out: it is read whole
-    /// before anything is written, and written again with the same rows.
+    /// wrote (e.g. with `--device`). Its bench.csv is copied to --out byte for byte; it may
+    /// be the bench.csv of --out, which is then left as it is.
     #[arg(long, value_name = "CSV")]
     pub from: Option<PathBuf>,
 }
@@ -45,14 +45,15 @@ pub fn run(args: Args) -> Result<()> {
     }
     // The device's file is read before the sweep, so a bad one costs no sweep.
     let device = args.device.as_deref().map(device_frame::read).transpose()?.unwrap_or_default();
-    let points = if let Some(csv) = &args.from {
-        bench::read_points(csv)?
+    let n = if let Some(csv) = &args.from {
+        bench::redraw(csv, &device, &args.out)?
     } else {
         let masks = args.masks.iter().map(|m| m.family()).collect();
         let opts = BenchOptions { quick: args.quick, progress: true, only: args.only, masks };
-        bench::run(&opts)?
+        let points = bench::run(&opts)?;
+        bench::write(&points, &device, &args.out)?;
+        points.len()
     };
-    bench::write(&points, &device, &args.out)?;
-    println!("{} points; wrote {}/bench.csv, bench.md, bench.png", points.len(), args.out.display());
+    println!("{n} points; wrote {}/bench.csv, bench.md, bench.png", args.out.display());
     Ok(())
 }
