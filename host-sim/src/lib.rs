@@ -36,8 +36,11 @@
 
 pub use slf_firmware as firmware;
 
+// First: its `outln!` is for every layer above.
+#[macro_use]
+pub mod io;
+
 pub mod decode;
 pub mod eval;
-pub mod io;
 pub mod sim;
 pub mod train;

@@ -67,7 +67,7 @@ pub fn write_capture(dir: &Path) -> Result<()> {
     );
     let consts = consts + &write_sensor_capture(&truth, dir)?;
     crate::io::output::write_bytes(&dir.join("capture.rs"), consts.as_bytes())?;
-    println!("wrote {} ({} frames)", dir.display(), capture.frames.len());
+    outln!("wrote {} ({} frames)", dir.display(), capture.frames.len())?;
     Ok(())
 }
 
@@ -369,7 +369,7 @@ pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
     let host_gains = *decoder.gains();
     ensure!(gains.len() == 13, "the device printed {} gains, not 13", gains.len());
     let worst_gain = gains.iter().zip(&host_gains).map(|(a, b)| f64::from((a - b).abs() / b)).fold(0.0, worse);
-    println!("device vs host: white balance gains differ by {worst_gain:.2e} relative (limit 1e-5)");
+    outln!("device vs host: white balance gains differ by {worst_gain:.2e} relative (limit 1e-5)")?;
     ensure!(within(worst_gain), "the device's gains {gains:?} differ from the host's {host_gains:?}");
     let mut host = Collect(HashMap::new());
     let mut ws = Box::new(slf_firmware::FullViewWorkspace::new());
@@ -394,7 +394,7 @@ pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
         let rel = d.values.iter().zip(h).map(|(a, b)| f64::from((a - b).abs() / scale)).fold(0.0, worse);
         worst = worse(worst, rel);
     }
-    println!("device vs host: {} patches, largest relative difference {worst:.2e} (limit 1e-5)", host.0.len());
+    outln!("device vs host: {} patches, largest relative difference {worst:.2e} (limit 1e-5)", host.0.len())?;
     if !within(worst) {
         bail!("the device's patches differ from the host's by {worst:.2e} relative");
     }
@@ -413,10 +413,10 @@ pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
     let (pilots, first, second, device_pick) = trial.context("the device log has no `trial` line")?;
     let rel = |a: f32, b: f32| f64::from((a - b).abs() / b.abs().max(f32::MIN_POSITIVE));
     let worst_trial = worse(rel(first, host_trial.first), rel(second, host_trial.second));
-    println!(
+    outln!(
         "device vs host: model trial over {pilots} pilots picks the {device_pick} on both, errors differ by {worst_trial:.2e} \
          relative (limit 1e-5)"
-    );
+    )?;
     ensure!(
         pilots == host_trial.pilots && device_pick == name && within(worst_trial),
         "the device's model trial ({pilots} pilots, {first}, {second}, {device_pick}) differs from the host's ({}, {}, \
@@ -489,12 +489,12 @@ fn check_calibrated(
         let scale = h.iter().fold(0.0f32, |m, x| m.max(x.abs())).max(f32::MIN_POSITIVE);
         worst = worse(worst, d.values.iter().zip(h).map(|(a, b)| f64::from((a - b).abs() / scale)).fold(0.0, worse));
     }
-    println!(
+    outln!(
         "device vs host, calibrated real sensor ({} hot pixels, a flat per view and region, the response unmixed): {} patches, \
          largest relative difference {worst:.2e} (limit 1e-5); gains {worst_gain:.2e}",
         c.defects.len(),
         host.0.len()
-    );
+    )?;
     ensure!(within(worst), "the device's calibrated patches differ from the host's by {worst:.2e} relative");
     Ok(())
 }
@@ -550,12 +550,12 @@ fn check_rows(
     let missing = covered.iter().filter(|&&c| !c).count();
     ensure!(!rows.is_empty(), "the device printed no rows of its overlapped decode");
     ensure!(missing == 0, "the device's overlapped decode left {missing} lenslets out");
-    println!(
+    outln!(
         "device strip vs host (stride {:?}, {:?}): {} rows, largest relative difference {worst:.2e} (limit 1e-5)",
         opts.stride,
         opts.window,
         rows.len()
-    );
+    )?;
     if !within(worst) {
         bail!("the device's overlapped rows differ from the host's by {worst:.2e} relative");
     }

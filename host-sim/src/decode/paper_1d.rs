@@ -327,21 +327,21 @@ pub fn compare_1d(patches: usize, family: MaskFamily, k: u8) -> anyhow::Result<(
         mem1 = mem1.max(one.memory_bytes());
         worst = worst.max(x1.iter().zip(ws.patch()).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max));
         if p == 0 {
-            println!("1D set-up (D, A, A^+ for one mask): {setup:.2} s");
+            outln!("1D set-up (D, A, A^+ for one mask): {setup:.2} s")?;
         }
     }
     // 5D: the five matrices (as stored in a blob) and the workspace; 1D: D, A and A^+.
     let dict5 = blob::member_len(PaperShape::DIMS);
     let ws5 = std::mem::size_of::<PaperWorkspace>();
-    println!("{patches} patches, {family:?} mask, k = {k}, default SL0; 1D vs 5D max abs difference {worst:.2e}");
-    println!("| method | time per patch | memory |\n| --- | --- | --- |");
-    println!("| 5D (firmware, f32) | {:.2} ms | {dict5} B dictionary + {ws5} B workspace |", 1e3 * t5 / patches as f64);
-    println!("| 1D (dense f32, f64 sums) | {:.2} ms | {mem1} B (D, A, A^+) |", 1e3 * t1 / patches as f64);
-    println!("time ratio 1D/5D {:.1}x (paper: 106x)", t1 / t5);
-    println!(
+    outln!("{patches} patches, {family:?} mask, k = {k}, default SL0; 1D vs 5D max abs difference {worst:.2e}")?;
+    outln!("| method | time per patch | memory |\n| --- | --- | --- |")?;
+    outln!("| 5D (firmware, f32) | {:.2} ms | {dict5} B dictionary + {ws5} B workspace |", 1e3 * t5 / patches as f64)?;
+    outln!("| 1D (dense f32, f64 sums) | {:.2} ms | {mem1} B (D, A, A^+) |", 1e3 * t1 / patches as f64)?;
+    outln!("time ratio 1D/5D {:.1}x (paper: 106x)", t1 / t5)?;
+    outln!(
         "memory ratio 1D/5D: dictionaries {:.0} (paper: 107,729), everything {:.0}",
         (5200.0f64 * 5200.0 * 4.0) / dict5 as f64,
         mem1 as f64 / (dict5 + ws5) as f64
-    );
+    )?;
     Ok(())
 }

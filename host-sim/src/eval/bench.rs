@@ -589,11 +589,7 @@ fn points_of<R: std::io::Read>(mut r: csv::Reader<R>) -> Result<Vec<Point>> {
         };
         let time = |j: usize| -> Result<f64> {
             let x = number(j)?;
-            anyhow::ensure!(
-                x.is_finite() && x > 0.0,
-                "line {line}: field {} is a time of {x} ms, not above 0",
-                j + 1
-            );
+            anyhow::ensure!(x.is_finite() && x > 0.0, "line {line}: field {} is a time of {x} ms, not above 0", j + 1);
             within(j, "a time in ms", TIME_MS)
         };
         points.push(Point {

@@ -133,10 +133,13 @@ pub fn evaluate_set(
                     _ => unreachable!("a method is a baseline or a basis"),
                 };
                 let metrics = evaluate(truth, &recon)?;
-                println!(
+                outln!(
                     "{name} {family:?} k={k} {method}: {:.2} dB, SSIM {:.4}, SA {:.2} deg, {:.3} ms/patch",
-                    metrics.psnr, metrics.ssim, metrics.sa, ms
-                );
+                    metrics.psnr,
+                    metrics.ssim,
+                    metrics.sa,
+                    ms
+                )?;
                 if si == 0 {
                     let p = out.join(format!("{}_{}.png", slug(name), slug(&method)));
                     let label = format!("{method}, {} k = {k}", format!("{family:?}").to_lowercase());

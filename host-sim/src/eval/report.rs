@@ -52,26 +52,26 @@ pub fn demo(out: &Path, name: &str, size: usize, basis: &Basis, views: Option<Pa
     let s = scene::named(name).with_context(|| format!("unknown scene {name:?}: one of {:?}", scene::NAMES))?;
     let truth = s.render(SceneSize { views: (5, 5), rows: size, cols: size });
     write_npy(&out.join("truth.npy"), &truth, Dtype::F32)?;
-    println!(
+    outln!(
         "scene {name}: {size} x {size} lenslets, 5 x 5 views, 13 bands; pixel mask; {}; {} threads",
         basis.name(),
         rayon::current_num_threads()
-    );
-    println!("{HEADER}");
+    )?;
+    outln!("{HEADER}")?;
     for k in [1u8, 3] {
         let cam = CameraConfig::pixel(7, k);
         let (recon, m, r) = run_one(&truth, &cam, basis, views, true)?;
-        println!("{}", row(name, "pixel", k, &m, r.seconds));
+        outln!("{}", row(name, "pixel", k, &m, r.seconds))?;
         write_npy(&out.join(format!("recon_k{k}.npy")), &recon, Dtype::F32)?;
         let label = format!("{}, pixel k = {k}", basis.name());
         write_comparison(&out.join(format!("preview_k{k}.png")), &truth, &recon, &label)?;
     }
-    println!("PSNR data range = max of ground truth ({:.4}).", truth.max());
-    println!(
+    outln!("PSNR data range = max of ground truth ({:.4}).", truth.max())?;
+    outln!(
         "previews (truth | reconstruction | error) in {}; total {:.1} s",
         out.display(),
         start.elapsed().as_secs_f64()
-    );
+    )?;
     Ok(())
 }
 
@@ -108,7 +108,7 @@ pub fn sweep(size: usize, ks: &[u8], output: Option<&Path>, basis: &Basis, views
         String::new(),
         HEADER.to_string(),
     ];
-    println!("{HEADER}");
+    outln!("{HEADER}")?;
     for name in scene::NAMES {
         let truth =
             scene::named(name).context("named scene")?.render(SceneSize { views: (5, 5), rows: size, cols: size });
@@ -118,7 +118,7 @@ pub fn sweep(size: usize, ks: &[u8], output: Option<&Path>, basis: &Basis, views
                 let (_, m, r) = run_one(&truth, &cam, basis, views, false)?;
                 let fam = format!("{family:?}").to_lowercase();
                 let line = row(name, &fam, k, &m, r.seconds);
-                println!("{line}");
+                outln!("{line}")?;
                 lines.push(line);
             }
         }
@@ -158,7 +158,9 @@ pub fn compare(
         format!("| basis | mask | k | PSNR dB | SSIM | SA deg | solves / patch | ms / patch (1 core) |"),
         "| --- | --- | --- | --- | --- | --- | --- | --- |".to_string(),
     ];
-    lines.iter().for_each(|l| println!("{l}"));
+    for l in &lines {
+        outln!("{l}")?;
+    }
     let threads = rayon::current_num_threads() as f64;
     let families = if masks.is_empty() {
         vec![MaskFamily::Pixel, MaskFamily::Lenslet, MaskFamily::Kronecker]
@@ -192,7 +194,7 @@ pub fn compare(
                     solves as f64 / patches as f64,
                     1e3 * secs * threads / patches as f64
                 );
-                println!("{line}");
+                outln!("{line}")?;
                 lines.push(line);
                 patches_per_field = patches as f64 / n;
             }
@@ -217,7 +219,7 @@ pub fn compare(
                     a / n,
                     1e3 * secs / n / patches_per_field.max(1.0)
                 );
-                println!("{line}");
+                outln!("{line}")?;
                 lines.push(line);
             }
         }

@@ -13,7 +13,8 @@
 //! - [`message`]: an error as the one line a user reads;
 //! - [`output`]: results written whole, never over an input of the same run;
 //! - [`rows`]: a light field put a lenslet row at a time (a streamed decode's sink);
-//! - [`sensor`]: a simulated sensor's imperfections as its captures record them.
+//! - [`sensor`]: a simulated sensor's imperfections as its captures record them;
+//! - [`stdout`]: lines to standard output that fail as errors ([`crate::outln!`]).
 //!
 //! May use: nothing of this crate (the firmware crate's checked types). Used by every
 //! layer above.
@@ -29,3 +30,5 @@ pub mod npy_rows;
 pub mod output;
 pub mod rows;
 pub mod sensor;
+#[macro_use]
+pub mod stdout;

@@ -494,20 +494,20 @@ fn train_blob_of<const PU: usize, const PV: usize, const N: usize>(
     anyhow::ensure!(cfg.tau <= N, "--tau {}: at most {N}, the values of a 5x5x{PU}x{PV}x13 patch", cfg.tau);
     let data = sample_patches::<PU, PV, N>(fields, patches, cfg.seed);
     let (dicts, reports) = train::<PU, PV, N>(&data, cfg);
-    println!("| iteration | members | ensemble coding error | DCT coding error |\n| --- | --- | --- | --- |");
+    outln!("| iteration | members | ensemble coding error | DCT coding error |\n| --- | --- | --- | --- |")?;
     for (i, r) in reports.iter().enumerate() {
-        println!("| {} | {} | {:.5} | {:.5} |", i + 1, r.members, r.ensemble_error, r.dct_error);
+        outln!("| {} | {} | {:.5} | {:.5} |", i + 1, r.members, r.ensemble_error, r.dct_error)?;
     }
     let tau = cfg.tau;
     let final_err = ensemble_error::<PU, PV, N>(&data, &dicts, tau);
-    println!(
+    outln!(
         "final: {} members, coding error {final_err:.5} vs DCT {:.5} (tau {tau}, relative energy)",
         dicts.len(),
         reports.first().map_or(0.0, |r| r.dct_error)
-    );
+    )?;
     let mut blob = vec![0u8; slf_firmware::blob::blob_len(dims::<PU, PV>(), dicts.len())];
     slf_firmware::blob::write_blob(&dicts, &mut blob).map_err(|e| anyhow::anyhow!("{e}"))?;
     crate::io::output::write_bytes(output, &blob)?;
-    println!("wrote {} ({} bytes) in {:.1} s", output.display(), blob.len(), start.elapsed().as_secs_f64());
+    outln!("wrote {} ({} bytes) in {:.1} s", output.display(), blob.len(), start.elapsed().as_secs_f64())?;
     Ok(())
 }

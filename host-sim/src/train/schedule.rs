@@ -609,18 +609,18 @@ fn train_schedule_blob_of<const PU: usize, const PV: usize, const N: usize>(
     }
     let patches = crate::train::ensemble::sample_patches::<PU, PV, N>(fields, cfg.patches, cfg.seed);
     let (schedules, report) = train::<PU, PV, N>(&members, dct, &patches, cfg)?;
-    println!("| schedule | steps | first batch mean PSNR | last batch mean PSNR |\n| --- | --- | --- | --- |");
+    outln!("| schedule | steps | first batch mean PSNR | last batch mean PSNR |\n| --- | --- | --- | --- |")?;
     let all = [
         ("cold", &schedules.cold, report.cold),
         ("warm", &schedules.warm, report.warm),
         ("alone", &schedules.alone, report.alone),
     ];
     for (name, s, f) in all {
-        println!("| {name} | {} | {:.2} dB | {:.2} dB |", s.len(), Fit::psnr(f.first), Fit::psnr(f.last));
+        outln!("| {name} | {} | {:.2} dB | {:.2} dB |", s.len(), Fit::psnr(f.first), Fit::psnr(f.last))?;
     }
     for (name, s, _) in all {
         let list = |v: &[f32]| v.iter().map(|x| format!("{x:.3e}")).collect::<Vec<_>>().join(" ");
-        println!("{name} sigma: {}\n{name} mu: {}", list(s.sigma()), list(s.mu()));
+        outln!("{name} sigma: {}\n{name} mu: {}", list(s.sigma()), list(s.mu()))?;
     }
     let dims = dims::<PU, PV>();
     let steps = [schedules.cold.len(), schedules.warm.len(), schedules.alone.len()];
@@ -629,6 +629,6 @@ fn train_schedule_blob_of<const PU: usize, const PV: usize, const N: usize>(
     slf_firmware::blob::write_blob_scheduled(&members, Some(&schedules), &mut out)
         .map_err(|e| anyhow::anyhow!("{e}"))?;
     crate::io::output::write_bytes(output, &out)?;
-    println!("wrote {} ({} bytes) in {:.1} s", output.display(), out.len(), start_time.elapsed().as_secs_f64());
+    outln!("wrote {} ({} bytes) in {:.1} s", output.display(), out.len(), start_time.elapsed().as_secs_f64())?;
     Ok(())
 }

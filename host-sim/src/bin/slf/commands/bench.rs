@@ -1,6 +1,7 @@
 //! `slf bench`: speed against error. Sweeps solver settings, bases, masks and k; writes CSV,
 //! markdown and a plot (or, with `--paper-scale`, the paper's scale end to end).
 
+use slf_host::outln;
 use std::path::PathBuf;
 
 use anyhow::Result;
@@ -40,7 +41,7 @@ pub struct Args {
 
 pub fn run(args: Args) -> Result<()> {
     if args.paper_scale {
-        println!("{}", bench::paper_scale()?);
+        outln!("{}", bench::paper_scale()?)?;
         return Ok(());
     }
     // The device's file is read before the sweep, so a bad one costs no sweep.
@@ -54,6 +55,6 @@ pub fn run(args: Args) -> Result<()> {
         bench::write(&points, &device, &args.out)?;
         points.len()
     };
-    println!("{n} points; wrote {}/bench.csv, bench.md, bench.png", args.out.display());
+    outln!("{n} points; wrote {}/bench.csv, bench.md, bench.png", args.out.display())?;
     Ok(())
 }

@@ -3,6 +3,7 @@
 //! `slf decode --calibration` reads (`docs/capture-format.md`, "Calibration"). The work is
 //! [`calibrate_folders`], shared with the Python package.
 
+use slf_host::outln;
 use std::path::PathBuf;
 
 use anyhow::Result;
@@ -30,6 +31,6 @@ pub fn run(args: Args) -> Result<()> {
     for line in &report.lines {
         eprintln!("{line}");
     }
-    println!("wrote {}", output.display());
+    outln!("wrote {}", output.display())?;
     Ok(())
 }

@@ -2,6 +2,7 @@
 //! firmware's decoder, in parallel over tiles) or by a baseline without it. The decode's
 //! flags are [`DecodeSettings`], shared with the Python package.
 
+use slf_host::outln;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -191,14 +192,14 @@ pub fn run(args: Args) -> Result<()> {
     let (opts, r) = match &outcome {
         Outcome::Baseline { method, report: r } => {
             file.finish(&format!("--method {method:?}"))?;
-            println!(
+            outln!(
                 "{:?}: {} sensor positions measured, {} filled from their neighbours, in {:.3} s; wrote {}",
                 method,
                 r.measured,
                 r.filled,
                 r.seconds,
                 output.display()
-            );
+            )?;
             return Ok(());
         }
         Outcome::Cs { options, report } => (options, report),
@@ -239,15 +240,15 @@ pub fn run(args: Args) -> Result<()> {
         (NoiseSource::Config, true) => format!("noise sd {:.2e} + shot {:.2e} per unit", used.noise, used.shot),
     };
     if let Some(v) = r.patch_views {
-        println!("patch: {} (--patch-views {v})", v.shape_name());
+        outln!("patch: {} (--patch-views {v})", v.shape_name())?;
     }
-    println!("projection: {ball}");
+    outln!("projection: {ball}")?;
     let gains: Vec<String> = r.gains.iter().map(|g| format!("{g:.3}")).collect();
     match opts.balance {
-        Balance::Off => println!("white balance: off"),
-        Balance::GreyWorld => println!("white balance: grey world, gains {}", gains.join(" ")),
-        Balance::Gains(_) => println!("white balance: given gains {}", gains.join(" ")),
-    }
+        Balance::Off => outln!("white balance: off"),
+        Balance::GreyWorld => outln!("white balance: grey world, gains {}", gains.join(" ")),
+        Balance::Gains(_) => outln!("white balance: given gains {}", gains.join(" ")),
+    }?;
     if !opts.disparities_for(&cap).is_off() {
         let mut counts = std::collections::BTreeMap::<Disparity, usize>::new();
         for (_, d) in &r.disparity_map {
@@ -255,76 +256,79 @@ pub fn run(args: Args) -> Result<()> {
         }
         let counts: Vec<String> =
             counts.iter().map(|(d, n)| format!("{}{d}: {n}", if d.in_halves() > 0 { "+" } else { "" })).collect();
-        println!(
+        outln!(
             "disparity: blocks per disparity {}; {} values of views no sheared patch reached, from their lenslet's other views",
             counts.join(", "),
             r.filled
-        );
+        )?;
     }
     let p = opts.plausibility;
     if p.is_off() {
-        println!("plausibility: off");
+        outln!("plausibility: off")?;
     } else {
-        println!(
+        outln!(
             "plausibility: {} implausible patches decoded again, {} of them clipped (a value above {} x its \
              neighbourhood's brightest measurement + {})",
-            r.patches.implausible, r.patches.clipped, p.factor, p.margin
-        );
+            r.patches.implausible,
+            r.patches.clipped,
+            p.factor,
+            p.margin
+        )?;
     }
     if r.shear_trial.is_some_and(|t| t.pilots == 0) {
-        println!(
+        outln!(
             "shear trial: no pilot patch at a half-pixel disparity could be estimated; half-pixel disparities kept"
-        );
+        )?;
     } else if let Some(t) = r.shear_trial {
-        println!(
+        outln!(
             "shear trial: {} (held-out error over {} pilot patches at half-pixel disparities: half {:.5}, whole {:.5})",
             if t.halves { "half-pixel disparities kept" } else { "whole disparities only: the half ones alias" },
             t.pilots,
             t.half_error,
             t.whole_error
-        );
+        )?;
     }
     if let Some(t) = r.trial.filter(|t| t.pilots == 0) {
-        println!(
+        outln!(
             "model trial: no pilot patch could be estimated (too few bands measured, or the response in the \
              projection); decoded by the {}",
             if t.dct { "DCT" } else { "ensemble" }
-        );
+        )?;
     } else if let Some(t) = r.trial {
-        println!(
+        outln!(
             "model trial: decoded by the {} (held-out error over {} pilot patches: DCT {:.5}, ensemble {:.5})",
             if t.dct { "DCT" } else { "ensemble" },
             t.pilots,
             t.dct_error,
             t.ensemble_error
-        );
+        )?;
     }
     if let Some(map) = &errors {
         let psnr = estimated_psnr(map, peak).map_or("none".into(), |p| format!("{p:.2} dB"));
-        println!(
+        outln!(
             "error estimate: {} of {} patches from held-out measurements; estimated PSNR {psnr} (data range {peak:.4} = the \
              decode's maximum)",
             r.error_map.len(),
             r.patches.decoded
-        );
+        )?;
     }
     let per = |n: u64| n as f64 / f64::from(r.patches.decoded.max(1));
-    println!(
+    outln!(
         "sl0: {} solves, {} steps ({:.2} solves and {:.1} steps a patch, the last solve's steps counted)",
         r.solves,
         r.steps,
         per(r.solves),
         per(r.steps)
-    );
+    )?;
     let row_mb = (2 * output_shape(&cap).row_len() * 4) as f64 / 1e6;
-    println!(
+    outln!(
         "memory: the decode held at most {} of the frame's {rows} lenslet rows of sums at once ({:.1} MB; the \
          light field is written to {} as its rows are finished)",
         r.rows_held,
         r.rows_held as f64 * row_mb,
         output.display()
-    );
-    println!(
+    )?;
+    outln!(
         "decoded {} patches ({} solved, {} interpolated from fewer than {} bands, {} flat; {} flagged, {} failed, {} \
          tiles failed) in {:.3} s; wrote {}",
         r.patches.decoded,
@@ -337,6 +341,6 @@ pub fn run(args: Args) -> Result<()> {
         r.failed_tiles,
         r.seconds,
         output.display()
-    );
+    )?;
     Ok(())
 }

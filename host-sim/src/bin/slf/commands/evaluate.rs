@@ -2,6 +2,7 @@
 //! pixel k = 1, 3 and lenslet k = 3: PSNR / SSIM / SA and ms per patch, per scene and mean
 //! (`table.md`), and previews of a zoomed crop at pixel k = 1.
 
+use slf_host::outln;
 use std::path::PathBuf;
 
 use anyhow::Result;
@@ -83,6 +84,6 @@ pub fn run(args: Args) -> Result<()> {
     let t = table(&rows, &SETTINGS);
     let path = out.join("table.md");
     slf_host::io::output::write_bytes(&path, t.as_bytes())?;
-    println!("{t}wrote {}", path.display());
+    outln!("{t}wrote {}", path.display())?;
     Ok(())
 }

@@ -2,6 +2,7 @@
 //! cubes and light fields of other band counts, HDF5 light fields; written as a
 //! `(U, V, H, W, 13)` light field `.npy`.
 
+use slf_host::outln;
 use std::path::{Path, PathBuf};
 
 use anyhow::Result;
@@ -34,14 +35,14 @@ pub fn run(args: Args) -> Result<()> {
         ImportSource::Bands { input, output, wavelengths } => {
             let lf = camera_bands(read_npy(&input)?, Some(&wavelengths), &input)?;
             write_npy(&output, &lf, Dtype::F32)?;
-            println!("wrote {} ({:?})", output.display(), lf.shape());
+            outln!("wrote {} ({:?})", output.display(), lf.shape())?;
             Ok(())
         }
         ImportSource::Hdf5 { input, output, dataset, axes, wavelengths, white } => {
             let lf = read_hdf5(&input, &Hdf5Layout { dataset, axes }, white)?;
             let lf = camera_bands(lf, wavelengths.as_deref(), &input)?;
             write_npy(&output, &lf, Dtype::F32)?;
-            println!("wrote {} ({:?})", output.display(), lf.shape());
+            outln!("wrote {} ({:?})", output.display(), lf.shape())?;
             Ok(())
         }
     }
@@ -131,11 +132,11 @@ fn write_imported(imported: &Imported, input: &Path, output: &Path, what: &str) 
         eprintln!("note: {}: {n}", input.display());
     }
     write_npy(output, &imported.lightfield, Dtype::F32)?;
-    println!("wrote {} ({:?})", output.display(), imported.lightfield.shape());
+    outln!("wrote {} ({:?})", output.display(), imported.lightfield.shape())?;
     if let Some(d) = &imported.disparity {
         let p = disparity_path(output);
         write_npy_f32_2d(&p, &d.data, d.rows, d.cols)?;
-        println!("wrote {}{what}", p.display());
+        outln!("wrote {}{what}", p.display())?;
     }
     Ok(())
 }

@@ -1,6 +1,7 @@
 //! `slf scene`: a named test scene, a realistic one or a random training scene, as a
 //! `(U, V, H, W, B)` `.npy`.
 
+use slf_host::outln;
 use std::path::PathBuf;
 
 use anyhow::Result;
@@ -49,6 +50,6 @@ pub fn run(args: Args) -> Result<()> {
     size.check().map_err(|e| anyhow::anyhow!("--size {}{given} with --views {views}: {e}", size.cols))?;
     let lf = s.render(size);
     write_npy(&output, &lf, dtype)?;
-    println!("wrote {} ({:?})", output.display(), lf.shape());
+    outln!("wrote {} ({:?})", output.display(), lf.shape())?;
     Ok(())
 }

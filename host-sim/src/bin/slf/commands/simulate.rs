@@ -2,6 +2,7 @@
 //! frames, defects) into a capture folder. The flags are [`SimulateSettings`], shared with
 //! the Python package.
 
+use slf_host::outln;
 use std::path::PathBuf;
 
 use anyhow::Result;
@@ -47,10 +48,10 @@ pub fn run(args: Args) -> Result<()> {
     }
     outputs.check_distinct()?;
     simulated.capture.save(&output)?;
-    println!("wrote {} ({} snapshots)", output.display(), simulated.capture.frames.len());
+    outln!("wrote {} ({} snapshots)", output.display(), simulated.capture.frames.len())?;
     if let Some(dir) = &calibration_captures {
         calibration::save(&calibration, dir)?;
-        println!("wrote {} calibration captures into {}", calibration.len(), dir.display());
+        outln!("wrote {} calibration captures into {}", calibration.len(), dir.display())?;
     }
     Ok(())
 }
