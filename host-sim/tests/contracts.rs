@@ -69,3 +69,21 @@ fn a_failed_stdout_is_an_error_line_not_a_panic() {
     }
 }
 
+/// Item 11: a write past `ulimit -f` fails as an error and leaves no temporary file
+/// (before: SIGXFSZ ended the process, exit 153, with `.s.npy.XXXXXX.part` left).
+#[cfg(unix)]
+#[test]
+fn a_file_size_limit_leaves_no_temporary() {
+    let dir = tempfile::tempdir().unwrap();
+    let script = format!(
+        "ulimit -f 40; exec '{}' scene smooth --size 40 -o '{}'",
+        bin().display(),
+        dir.path().join("s.npy").display()
+    );
+    let out = Std::new("sh").args(["-c", &script]).output().unwrap();
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.starts_with("error: ") && err.contains("File too large"), "{err}");
+    let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert!(left.is_empty(), "left {left:?}");
+}

@@ -68,6 +68,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    ignore_file_size_signal();
     use clap::{CommandFactory, FromArgMatches};
     let parsed = slf_host::sim::flags::negative_numbers(Cli::command())
         .try_get_matches()
@@ -122,3 +123,17 @@ fn run(cli: Cli) -> Result<()> {
         Command::Compare(args) => compare::run(args),
     }
 }
+
+/// A write past the file-size limit (`ulimit -f`) is an error the write returns (EFBIG), so
+/// the whole-write contract removes its temporary file; by default SIGXFSZ would end the
+/// process first and leave `.NAME.XXXXXX.part` behind.
+#[cfg(unix)]
+fn ignore_file_size_signal() {
+    use nix::sys::signal::{SigHandler, Signal, signal};
+    // SAFETY: SIG_IGN installs no handler, so no code runs in signal context; this runs
+    // first in main, before any thread that could race on the disposition exists.
+    let _ = unsafe { signal(Signal::SIGXFSZ, SigHandler::SigIgn) };
+}
+
+#[cfg(not(unix))]
+fn ignore_file_size_signal() {}
