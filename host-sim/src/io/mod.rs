@@ -5,6 +5,7 @@
 //!   memory order, every size checked before anything is allocated;
 //! - [`lightfield`]: the `(U, V, H, W, B)` light field and its `.npy` files;
 //! - [`npy_rows`]: a light field's `.npy` file written as its rows come;
+//! - [`budget`]: the memory a command may take, checked before the work starts;
 //! - [`calibration`]: the calibration folder `slf calibrate` writes and a calibrated
 //!   decode reads;
 //! - [`capture`]: the capture folder (frames and `capture.json`), loaded and saved;
@@ -19,6 +20,7 @@
 //! May use: nothing of this crate (the firmware crate's checked types). Used by every
 //! layer above.
 
+pub mod budget;
 pub mod calibration;
 pub mod capture;
 pub mod hdf5_rows;

@@ -446,8 +446,29 @@ pub enum Generator {
     Realistic,
 }
 
+/// Checks, before anything is rendered, that `scenes` training scenes of `size` x `size`
+/// pixels a view and `patches` patches fit the memory cap ([`crate::io::budget`]): the
+/// scenes twice (rendered, then white-balanced) and the patches twice (sampled, then the
+/// trainer's own copy) at the full-view patch's 8,125 values. Before, `slf train-schedule
+/// --scenes 3 --size 1024` ran out of memory after 90 s.
+///
+/// # Errors
+/// A scene too large to render, or the estimate above the cap, with the flags to change.
+pub fn check_training_memory(scenes: usize, size: usize, patches: usize) -> anyhow::Result<()> {
+    crate::sim::scene::SceneSize { views: (5, 5), rows: size, cols: size }.check()?;
+    let scene = 25 * (size as u64).pow(2) * 13 * 4;
+    let need = 2 * scenes as u64 * scene + 2 * patches as u64 * 8125 * 4;
+    crate::io::budget::check(
+        need,
+        &format!("training on {scenes} scenes of {size} x {size} pixels a view and {patches} patches"),
+        "fewer --scenes, a smaller --size or fewer --patches",
+    )
+}
+
 /// Random light fields for training (seeds `seed..seed + count`; the named scenes of
-/// either generator use seeds below 1000, and `slf train` starts at 1000 + its seed).
+/// either generator use seeds below 1000, and `slf train` starts at 1000 + its seed), of
+/// `size` x `size` pixels a view and 5 x 5 views (their memory checked first:
+/// [`check_training_memory`]).
 pub fn training_fields(count: usize, size: usize, seed: u64, generator: Generator) -> Vec<LightField> {
     let size = crate::sim::scene::SceneSize { views: (5, 5), rows: size, cols: size };
     (0..count as u64)

@@ -21,6 +21,18 @@ use commands::{
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Memory cap in GiB for what a command's inputs declare (an HDF5 dataset's shape, a
+    /// training's scenes x size and patches, a calibration's captures), 0.01..=4096: above
+    /// it the command is refused before it starts. Default 8, never above `ulimit -v`.
+    #[arg(long, global = true, value_name = "GIB", value_parser = gib)]
+    max_memory: Option<f64>,
+}
+
+fn gib(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(x) if (0.01..=4096.0).contains(&x) => Ok(x),
+        _ => Err(format!("{s:?} is not a size in GiB within 0.01..=4096")),
+    }
 }
 
 #[derive(Subcommand)]
@@ -104,6 +116,9 @@ fn main() -> ExitCode {
 }
 
 fn run(cli: Cli) -> Result<()> {
+    if let Some(cap) = cli.max_memory {
+        slf_host::io::budget::set_cap((cap * f64::from(1u32 << 30)) as u64);
+    }
     match cli.command {
         Command::Demo(args) => demo::run(args),
         Command::Scene(args) => scene::run(args),

@@ -87,6 +87,7 @@ pub fn run(args: Args) -> Result<()> {
             GeneratorArg::Realistic => train::Generator::Realistic,
             GeneratorArg::Toy => train::Generator::Toy,
         };
+        train::check_training_memory(scenes, size, patches)?;
         train::training_fields(scenes, size, 1000 + seed, generator)
     } else {
         input.iter().map(|p| read_npy(p)).collect::<Result<Vec<_>, _>>()?

@@ -63,6 +63,7 @@ pub fn run(args: Args) -> Result<()> {
         progress: true,
         ..Default::default()
     };
+    train::check_training_memory(scenes, size, patches)?;
     let fields: Vec<_> = train::training_fields(scenes, size, 1000 + seed, Generator::Realistic)
         .iter()
         .map(train::white_balanced)
