@@ -170,7 +170,26 @@ fn the_calibration_folder_reads_back_and_refuses_corruption() {
         e
     };
     assert!(spoil(&|v| v["version"] = 9.into()).contains("version 9"));
-    assert!(spoil(&|v| v["response"][3] = serde_json::json!([1.0])).contains("response is"));
+    // Issue 51, item 16: a ragged row is named with its length (before: "response is 13
+    // x 13, expected 13 x 13").
+    let e = spoil(&|v| v["response"][3] = serde_json::json!([1.0]));
+    assert!(e.contains("response[3] has 1 entries, expected 13"), "{e}");
+    // Item 9: rows of another scale than 1 would rescale the output, and a row summing to 0
+    // was accepted by the baselines; item 6: a matrix a decode cannot invert.
+    let scaled = |k: f64| {
+        move |v: &mut serde_json::Value| {
+            for row in v["response"].as_array_mut().unwrap() {
+                for x in row.as_array_mut().unwrap() {
+                    *x = (x.as_f64().unwrap() * k).into();
+                }
+            }
+        }
+    };
+    let e = spoil(&scaled(0.3));
+    assert!(e.contains("response[0] sums to 0.3") && e.contains("each row sums to 1"), "{e}");
+    assert!(spoil(&scaled(1.2)).contains("sums to 1.2"));
+    let e = spoil(&|v| v["response"] = serde_json::json!(vec![vec![1.0 / 13.0; 13]; 13]));
+    assert!(e.contains("condition number"), "{e}");
     assert!(spoil(&|v| v["response"][2][2] = 0.0.into()).contains("response[2][2]"));
     assert!(spoil(&|v| v["vignetting"][0][0] = (-1.0).into()).contains("vignetting"));
     assert!(spoil(&|v| v["hot_pixels"] = serde_json::json!([[5000, 1]])).contains("outside"));
@@ -185,7 +204,22 @@ fn the_calibration_folder_reads_back_and_refuses_corruption() {
     flat[7] = f32::NAN;
     slf_host::io::lightfield::write_npy_f32_2d(&at.join("flat.npy"), &flat, rows, cols).unwrap();
     let e = format!("{:#}", Calibration::load(&at).unwrap_err());
-    assert!(e.contains("flat[0, 7]"), "{e}");
+    assert!(e.contains("flat.npy: flat[0, 7]"), "{e}");
+    slf_host::io::lightfield::write_npy_f32_2d(&at.join("flat.npy"), &cal.flat, rows, cols).unwrap();
+    // Item 5: a working pixel's dark level above half the range (at the raw values' top, it
+    // made every output zero) or below 0 DN (-65535 made every value 18.05) is refused,
+    // naming its file.
+    let white = cal.description.white_level;
+    let hot = cal.description.hot_pixels.iter().map(|p| p[0] as usize * cols + p[1] as usize).collect::<Vec<_>>();
+    let working = (0..rows * cols).find(|p| !hot.contains(p)).unwrap();
+    for level in [white, -65535.0, f32::NAN] {
+        let mut dark = cal.dark.clone();
+        dark[working] = level;
+        slf_host::io::lightfield::write_npy_f32_2d(&at.join("dark.npy"), &dark, rows, cols).unwrap();
+        let e = format!("{:#}", Calibration::load(&at).unwrap_err());
+        let at_pixel = format!("dark.npy: dark[{}, {}] is", working / cols, working % cols);
+        assert!(e.contains(&at_pixel) && e.contains("list it in hot_pixels"), "{level}: {e}");
+    }
 }
 
 /// The loop closed: a real sensor's scene decoded with the calibration its calibration

@@ -153,7 +153,10 @@ fn a_training_too_large_for_memory_is_refused_at_once() {
         "--iterations",
         "1",
     ]));
-    assert!(e.contains("training on 1000 scenes of 1024 x 1024 pixels a view and 4 patches needs about 2539.1 GiB"), "{e}");
+    assert!(
+        e.contains("training on 1000 scenes of 1024 x 1024 pixels a view and 4 patches needs about 2539.1 GiB"),
+        "{e}"
+    );
     assert!(e.contains("fewer --scenes, a smaller --size or fewer --patches"), "{e}");
     let e = failure(slf().arg("train").arg("-o").arg(dir.path().join("e.slfd")).args([
         "--scenes",
@@ -166,4 +169,159 @@ fn a_training_too_large_for_memory_is_refused_at_once() {
     assert!(e.contains("training on 3 scenes of 1024 x 1024") && e.contains("more than the 4.0 GiB cap"), "{e}");
     assert!(start.elapsed().as_secs() < 30, "refusing took {:?}", start.elapsed());
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}
+
+/// The set-up: a 16 x 16-lenslet smooth scene, its capture with 10 % leakage, 2
+/// exposures of calibration captures, and their calibration.
+fn calibrated_setup(dir: &Path) {
+    let p = |n: &str| dir.join(n);
+    ok(slf().args(["scene", "smooth", "--size", "16", "-o"]).arg(p("lf.npy")));
+    ok(slf()
+        .arg("simulate")
+        .arg(p("lf.npy"))
+        .arg("-o")
+        .arg(p("cap"))
+        .args(["--leakage", "0.1", "--exposures", "2", "--calibration-captures"])
+        .arg(p("cc")));
+    ok(slf().arg("calibrate").arg(p("cc")).arg("-o").arg(p("cal")));
+}
+
+fn edit_capture(dir: &Path, f: impl FnOnce(&mut slf_host::io::capture::Capture)) {
+    let mut c = slf_host::io::capture::Capture::load(dir).unwrap();
+    f(&mut c);
+    c.save(dir).unwrap();
+}
+
+/// Items 5, 6, 8 and 9 through the command line: a calibration that cannot decode is
+/// refused when it is made and when it is read; a decode of no light above the dark
+/// levels is refused; baselines keep the output's range with a calibration.
+#[test]
+fn calibrations_are_checked_when_made_and_when_read() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let p = |n: &str| dir.join(n);
+    calibrated_setup(dir);
+    let calibration = slf_host::io::calibration::Calibration::load(&p("cal")).unwrap();
+    let decode = |cal: &Path, method: &str| {
+        let mut c = slf();
+        c.arg("decode")
+            .arg(p("cap"))
+            .arg("--calibration")
+            .arg(cal)
+            .args(["--method", method, "-q", "-o"])
+            .arg(p("out.npy"));
+        c
+    };
+
+    // Item 8: every method's values within [0, the sensor's top] with a calibration.
+    for method in ["ppid", "demosaic", "interpolate", "cs"] {
+        ok(&mut decode(&p("cal"), method));
+        let lf = slf_host::io::lightfield::read_npy(&p("out.npy")).unwrap();
+        let least = lf.data.iter().fold(f32::INFINITY, |m, &x| m.min(x));
+        assert!(least >= 0.0, "{method}: a value of {least}");
+    }
+
+    // Item 5: a capture that records nothing above the calibration's dark levels (before:
+    // "0 flagged", every value 0, exit 0).
+    let black = calibration.description.black_level;
+    edit_capture(&p("cap"), |c| c.frames.iter_mut().flatten().for_each(|x| *x = black as u16 + 4));
+    let mut dark = calibration.clone();
+    dark.dark.iter_mut().for_each(|d| *d = black + 8.0);
+    dark.save(&p("dark-cal")).unwrap();
+    let e = failure(&mut decode(&p("dark-cal"), "cs"));
+    assert!(e.contains("with its dark levels subtracted every pixel is at or below the black level"), "{e}");
+
+    // Item 6: calibrate refuses what a decode would: --response of a 13 x 13 matrix of ones
+    // (rows summing to 13), and rows summing to 1 that do not tell the bands apart.
+    let curves = |name: &str, r: &[f32]| {
+        let path = p(name);
+        slf_host::io::lightfield::write_npy_f32_2d(&path, r, 13, 13).unwrap();
+        path
+    };
+    let ones = curves("ones.npy", &[1.0; 169]);
+    let e = failure(slf().arg("calibrate").arg(p("cc")).arg("-o").arg(p("c1")).arg("--response").arg(&ones));
+    assert!(e.contains("ones.npy") && e.contains("response[0] sums to 13"), "{e}");
+    let mut near: Vec<f32> = (0..169).map(|i| if i % 14 == 0 { 1.0 } else { 0.0 }).collect();
+    // Filters 11 and 12 almost alike: condition number about 2e4.
+    near[11 * 13 + 11] = 0.50005;
+    near[11 * 13 + 12] = 0.49995;
+    near[12 * 13 + 11] = 0.49995;
+    near[12 * 13 + 12] = 0.50005;
+    let near = curves("near.npy", &near);
+    let e = failure(slf().arg("calibrate").arg(p("cc")).arg("-o").arg(p("c1")).arg("--response").arg(&near));
+    assert!(e.contains("near.npy") && e.contains("condition number"), "{e}");
+    assert!(!p("c1").exists());
+}
+
+/// Item 6, the band sweep: saturated band captures, labels rotated by one, and every band's
+/// frames copied from one band each give a calibration nobody can use; refused at
+/// calibrate time with the capture named. Item 7: captures of two sensors mixed are refused
+/// (before: rc 0 and 5.5 dB lost).
+#[test]
+fn calibrate_refuses_saturated_mislabelled_and_mixed_sweeps() {
+    use slf_host::io::capture::{Capture, Light};
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let p = |n: &str| dir.join(n);
+    calibrated_setup(dir);
+    let copy = |name: &str| {
+        let to = p(name);
+        for entry in std::fs::read_dir(p("cc")).unwrap() {
+            let from = entry.unwrap().path();
+            let into = to.join(from.file_name().unwrap());
+            std::fs::create_dir_all(&into).unwrap();
+            for f in std::fs::read_dir(&from).unwrap() {
+                let f = f.unwrap().path();
+                std::fs::copy(&f, into.join(f.file_name().unwrap())).unwrap();
+            }
+        }
+        to
+    };
+    let calibrate = |cc: &Path| {
+        let mut c = slf();
+        c.arg("calibrate").arg(cc).arg("-o").arg(p("c2"));
+        c
+    };
+    let saturated = copy("saturated");
+    let top = Capture::load(&saturated.join("band-03-00")).unwrap().description.saturation_level as u16;
+    for n in ["band-03-00", "band-03-01"] {
+        edit_capture(&saturated.join(n), |c| c.frames.iter_mut().flatten().for_each(|x| *x = top));
+    }
+    let e = failure(&mut calibrate(&saturated));
+    assert!(e.contains("band-03-00") && e.contains("under band 3's light") && e.contains("saturated"), "{e}");
+
+    let rotated = copy("rotated");
+    for b in 0..13u8 {
+        for x in 0..2 {
+            edit_capture(&rotated.join(format!("band-{b:02}-{x:02}")), |c| {
+                if let Light::Band { level, .. } = c.description.light {
+                    c.description.light = Light::Band { band: (b + 1) % 13, level };
+                }
+            });
+        }
+    }
+    let e = failure(&mut calibrate(&rotated));
+    assert!(e.contains("seen most by filter") && e.contains("mislabelled"), "{e}");
+
+    let copied = copy("copied");
+    let frames = Capture::load(&copied.join("band-00-00")).unwrap().frames;
+    for b in 1..13u8 {
+        for x in 0..2 {
+            edit_capture(&copied.join(format!("band-{b:02}-{x:02}")), |c| c.frames = frames.clone());
+        }
+    }
+    let e = failure(&mut calibrate(&copied));
+    assert!(e.contains("seen most by filter 0"), "{e}");
+
+    // Another sensor's captures beside these.
+    ok(slf()
+        .arg("simulate")
+        .arg(p("lf.npy"))
+        .arg("-o")
+        .arg(p("cap2"))
+        .args(["--leakage", "0.3", "--calibration-captures"])
+        .arg(p("other")));
+    let e = failure(slf().arg("calibrate").arg(p("cc")).arg(p("other/flat-00")).arg("-o").arg(p("c2")));
+    assert!(e.contains("other/flat-00: another sensor than"), "{e}");
+    assert!(!p("c2").exists());
 }

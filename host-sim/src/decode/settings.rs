@@ -650,11 +650,22 @@ impl DecodeSettings {
             capture.frames.iter().flatten().any(|&x| f32::from(x) > black),
             "every pixel of every frame is at or below the black level ({black} DN): no light was recorded"
         );
+        // The output contract, on the capture as recorded: a corrected capture's saturation
+        // is the top of 16 bits.
+        let (lo, hi) = capture.raw_format().range();
         let calibrated;
         let (capture, inverse, response) = match &self.calibration {
             Some(dir) => {
                 let cal = Calibration::load(dir)?;
                 calibrated = corrected(capture, &cal)?;
+                // The same check on the corrected frames: a dark level at or above the raw
+                // values once decoded to all zeros with "0 flagged".
+                ensure!(
+                    calibrated.frames.iter().flatten().any(|&x| f32::from(x) > black && x != u16::MAX),
+                    "{}: with its dark levels subtracted every pixel is at or below the black level ({black} DN): no \
+                     light above the dark was recorded (is it this sensor's calibration?)",
+                    dir.display()
+                );
                 let inverse = unmixing(&cal).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
                 (&calibrated, Some(inverse), Some(cal.description.response))
             }
@@ -674,7 +685,12 @@ impl DecodeSettings {
         match (&inverse, modelled) {
             (Some(inverse), None) => {
                 let bands = output_shape(capture).bands;
-                let mut unmixed = MapRows::new(sink, |row: &mut [f32]| unmix(row, bands, inverse));
+                // Unmixing can take a value below 0 or past the sensor's top (PPID's wrote
+                // 20,531 of 83,200 values below 0): clamped again, as every method's output.
+                let mut unmixed = MapRows::new(sink, |row: &mut [f32]| {
+                    unmix(row, bands, inverse);
+                    row.iter_mut().for_each(|v| *v = v.clamp(lo, hi));
+                });
                 self.run_corrected(capture, modelled, progress, observer, &mut unmixed)
             }
             _ => self.run_corrected(capture, modelled, progress, observer, sink),

@@ -7,7 +7,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Result, anyhow, ensure};
+use anyhow::{Result, anyhow, bail, ensure};
 use serde::{Deserialize, Serialize};
 
 use crate::io::capture::{MAX_DESCRIPTION, read_small_file};
@@ -124,18 +124,11 @@ impl CalibrationDescription {
                 && self.white_level > self.black_level,
             "levels: need 0 <= black_level < white_level, finite"
         );
-        ensure!(
-            self.response.len() == b && self.response.iter().all(|r| r.len() == b),
-            "response is {} x {}, expected {b} x {b} (filters x bands)",
-            self.response.len(),
-            self.response.first().map_or(0, Vec::len)
-        );
-        for (f, row) in self.response.iter().enumerate() {
-            if let Some(x) = row.iter().find(|x| !(x.is_finite() && (-0.1..=2.0).contains(*x))) {
-                return Err(anyhow!("response[{f}] holds {}: each entry must be in [-0.1, 2]", number(*x)));
-            }
-            ensure!(row[f] > 0.0, "response[{f}][{f}] is {}: a filter must see its own band", number(row[f]));
+        ensure!(self.response.len() == b, "response has {} rows, expected {b} (one a filter)", self.response.len());
+        if let Some((f, row)) = self.response.iter().enumerate().find(|(_, r)| r.len() != b) {
+            bail!("response[{f}] has {} entries, expected {b} (one a band)", row.len());
         }
+        check_response(&self.response)?;
         ensure!(
             self.vignetting.len() == self.views[0] && self.vignetting.iter().all(|r| r.len() == self.views[1]),
             "vignetting is not {} x {} (views)",
@@ -152,6 +145,76 @@ impl CalibrationDescription {
     }
 }
 
+/// The largest condition number of a response matrix a decode inverts: beyond it the
+/// unmixing would amplify noise more than the leakage it removes.
+pub const MAX_CONDITION: f64 = 1e3;
+
+/// How far a response row's sum may be from 1: a row is relative to the filter's response
+/// to light of equal energy in every band, so it sums to 1 up to the calibration's noise
+/// (within 1e-3 on the simulator's sensors). Rows of another scale would rescale the
+/// output by their inverse (0.3 x a valid matrix made every value 3.33 x).
+pub const ROW_SUM_TOLERANCE: f32 = 0.1;
+
+/// Checks a square response matrix `[filter][band]` as a decode needs it: entries finite in
+/// [-0.1, 2], every filter seeing its own band, rows summing to 1 within
+/// [`ROW_SUM_TOLERANCE`], and a condition number of at most [`MAX_CONDITION`].
+///
+/// # Errors
+/// The first entry, row or the matrix that is not, in one line.
+pub fn check_response(response: &[Vec<f32>]) -> Result<()> {
+    for (f, row) in response.iter().enumerate() {
+        if let Some(x) = row.iter().find(|x| !(x.is_finite() && (-0.1..=2.0).contains(*x))) {
+            return Err(anyhow!("response[{f}] holds {}: each entry must be in [-0.1, 2]", number(*x)));
+        }
+        ensure!(row[f] > 0.0, "response[{f}][{f}] is {}: a filter must see its own band", number(row[f]));
+        let sum: f32 = row.iter().sum();
+        ensure!(
+            (sum - 1.0).abs() <= ROW_SUM_TOLERANCE,
+            "response[{f}] sums to {}: a filter's row is relative to light of equal energy in every band and sums \
+             to 1 (within {ROW_SUM_TOLERANCE}); scale measured curves so that each row sums to 1",
+            number(sum)
+        );
+    }
+    let b = response.len();
+    let r = nalgebra::DMatrix::from_fn(b, b, |f, band| f64::from(response[f][band]));
+    let sv = r.singular_values();
+    let (hi, lo) = (sv.max(), sv.min());
+    ensure!(
+        lo > 0.0 && hi / lo <= MAX_CONDITION,
+        "the response matrix's condition number is {:.3e} (at most {MAX_CONDITION:e}): the filters do not tell the \
+         bands apart",
+        hi / lo
+    );
+    Ok(())
+}
+
+/// A working pixel's dark level lies between 0 and half-way up the range, `black + (white -
+/// black) / 2` DN: above, a pixel records less than half the light it should and is no
+/// working pixel (a calibration lists it in `hot_pixels`). A dark level at or above the raw
+/// values once made every output zero, and one of -65535 every value 18.05.
+fn check_dark(d: &CalibrationDescription, dark: &[f32], cols: usize) -> Result<()> {
+    let hot: std::collections::BTreeSet<usize> =
+        d.hot_pixels.iter().map(|p| p[0] as usize * cols + p[1] as usize).collect();
+    let top = d.black_level + (d.white_level - d.black_level) / 2.0;
+    for (i, &x) in dark.iter().enumerate() {
+        let (lo, hi) = if hot.contains(&i) { (0.0, 65535.0) } else { (0.0, top) };
+        if !(x.is_finite() && (lo..=hi).contains(&x)) {
+            let working =
+                if hot.contains(&i) { "a hot pixel's" } else { "a working pixel's (else list it in hot_pixels)" };
+            bail!("dark[{}, {}] is {} DN: {working} dark level is in [{lo}, {hi}]", i / cols, i % cols, number(x));
+        }
+    }
+    Ok(())
+}
+
+/// Every flat finite in [0, 16] (a flat of 0 is a dead pixel: list it as hot).
+fn check_flat(flat: &[f32], cols: usize) -> Result<()> {
+    if let Some(i) = flat.iter().position(|x| !(x.is_finite() && (0.0..=16.0).contains(x))) {
+        bail!("flat[{}, {}] is {}: must be in [0, 16]", i / cols, i % cols, number(flat[i]));
+    }
+    Ok(())
+}
+
 impl Calibration {
     /// Checks the description and the frames against each other.
     ///
@@ -166,12 +229,8 @@ impl Calibration {
             dark.len(),
             flat.len()
         );
-        if let Some(i) = dark.iter().position(|x| !(x.is_finite() && (-65535.0..=65535.0).contains(x))) {
-            return Err(anyhow!("dark[{}, {}] is {}: must be a finite DN", i / cols, i % cols, number(dark[i])));
-        }
-        if let Some(i) = flat.iter().position(|x| !(x.is_finite() && (0.0..=16.0).contains(x))) {
-            return Err(anyhow!("flat[{}, {}] is {}: must be in [0, 16]", i / cols, i % cols, number(flat[i])));
-        }
+        check_dark(&description, &dark, cols)?;
+        check_flat(&flat, cols)?;
         Ok(Self { description, dark, flat })
     }
 
@@ -213,7 +272,10 @@ impl Calibration {
                 Values::U16(_) => Err(anyhow!("{}: holds uint16, a calibration frame float32", p.display())),
             }
         };
+        // Each fault names its file.
         let (dark, flat) = (read(DARK)?, read(FLAT)?);
+        check_dark(&description, &dark, cols).map_err(|e| anyhow!("{}: {e}", dir.join(DARK).display()))?;
+        check_flat(&flat, cols).map_err(|e| anyhow!("{}: {e}", dir.join(FLAT).display()))?;
         Self::new(description, dark, flat).map_err(|e| anyhow!("{}: {e}", dir.display()))
     }
 
