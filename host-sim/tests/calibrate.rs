@@ -195,17 +195,33 @@ fn the_calibration_folder_reads_back_and_refuses_corruption() {
     assert!(spoil(&|v| v["hot_pixels"] = serde_json::json!([[5000, 1]])).contains("outside"));
     assert!(spoil(&|v| v["lenslets"] = serde_json::json!([25, 24])).contains("[125, 120]"));
     std::fs::write(&json, &good).unwrap();
-    // A flat of another size is refused from its header; a NaN in it by value.
-    slf_host::io::lightfield::write_npy_f32_2d(&at.join("flat.npy"), &[1.0; 6], 2, 3).unwrap();
-    let e = format!("{:#}", Calibration::load(&at).unwrap_err());
+    // A frame written in place of the calibration's own is refused by its recorded size and
+    // checksum (issue 51, item 2); one whose record is written too (a hand-made
+    // calibration) by its shape from the header or its values.
+    let put = |name: &str, values: &[f32], rows: usize, cols: usize, record: bool| {
+        slf_host::io::lightfield::write_npy_f32_2d(&at.join(name), values, rows, cols).unwrap();
+        let mut v: serde_json::Value = serde_json::from_str(&good).unwrap();
+        if record {
+            let r = slf_host::io::folder::record(&at, name).unwrap();
+            let files = v["files"].as_array_mut().unwrap();
+            let i = files.iter().position(|f| f["name"] == name).unwrap();
+            files[i] = serde_json::to_value(r).unwrap();
+        }
+        std::fs::write(&json, serde_json::to_string(&v).unwrap()).unwrap();
+        format!("{:#}", Calibration::load(&at).unwrap_err())
+    };
+    let e = put("flat.npy", &[1.0; 6], 2, 3, false);
+    assert!(e.contains("flat.npy: 152 bytes, but") && e.contains("calibration.json records"), "{e}");
+    let e = put("flat.npy", &[1.0; 6], 2, 3, true);
     assert!(e.contains("flat.npy") && e.contains("[2, 3]"), "{e}");
     let (rows, cols) = cal.frame_size();
     let mut flat = cal.flat.clone();
     flat[7] = f32::NAN;
-    slf_host::io::lightfield::write_npy_f32_2d(&at.join("flat.npy"), &flat, rows, cols).unwrap();
-    let e = format!("{:#}", Calibration::load(&at).unwrap_err());
+    let e = put("flat.npy", &flat, rows, cols, false);
+    assert!(e.contains("flat.npy: CRC-32"), "{e}");
+    let e = put("flat.npy", &flat, rows, cols, true);
     assert!(e.contains("flat.npy: flat[0, 7]"), "{e}");
-    slf_host::io::lightfield::write_npy_f32_2d(&at.join("flat.npy"), &cal.flat, rows, cols).unwrap();
+    cal.save(&at).unwrap();
     // Item 5: a working pixel's dark level above half the range (at the raw values' top, it
     // made every output zero) or below 0 DN (-65535 made every value 18.05) is refused,
     // naming its file.
@@ -215,8 +231,7 @@ fn the_calibration_folder_reads_back_and_refuses_corruption() {
     for level in [white, -65535.0, f32::NAN] {
         let mut dark = cal.dark.clone();
         dark[working] = level;
-        slf_host::io::lightfield::write_npy_f32_2d(&at.join("dark.npy"), &dark, rows, cols).unwrap();
-        let e = format!("{:#}", Calibration::load(&at).unwrap_err());
+        let e = put("dark.npy", &dark, rows, cols, true);
         let at_pixel = format!("dark.npy: dark[{}, {}] is", working / cols, working % cols);
         assert!(e.contains(&at_pixel) && e.contains("list it in hot_pixels"), "{level}: {e}");
     }

@@ -138,8 +138,11 @@ fn fuzz_capture_loader() {
     let mut cam = CameraConfig::pixel(3, 2);
     cam.frame_ext = "pgm".into();
     simulate(&lf, &cam).unwrap().save(base.path()).unwrap();
-    let json: serde_json::Value =
+    let mut json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(base.path().join("capture.json")).unwrap()).unwrap();
+    // Without its file records (a folder from another tool), so a corrupted frame reaches
+    // the frame readers; "files" is among the fields mutated below.
+    json.as_object_mut().unwrap().remove("files");
     let frame0 = std::fs::read(base.path().join("snapshot_0.pgm")).unwrap();
     let frame1 = std::fs::read(base.path().join("snapshot_1.pgm")).unwrap();
     let keys = vec![
@@ -156,6 +159,7 @@ fn fuzz_capture_loader() {
         "saturation_level",
         "noise",
         "defective_pixels",
+        "files",
         "extra",
     ];
     let edits = prop::collection::vec((prop::sample::select(keys), json_value()), 0..4);
@@ -208,6 +212,11 @@ fn flag_number() -> impl Strategy<Value = String> {
         1 => prop::sample::select(vec!["0", "-1", "1e30", "1e-30", "inf", "-inf", "NaN", "", "x", "1,2"])
             .prop_map(String::from),
     ]
+}
+
+/// A table field: one of `valid` nine times in ten, else one of `invalid`.
+fn field(valid: &[&'static str], invalid: &[&'static str]) -> impl Strategy<Value = &'static str> {
+    prop_oneof![9 => prop::sample::select(valid.to_vec()), 1 => prop::sample::select(invalid.to_vec())]
 }
 
 /// `A,B` or `A,B,C,D` of flag numbers (sizes, windows, crops).
@@ -470,8 +479,9 @@ fn h_of(h: &str) -> u32 {
 static DRAWN: AtomicU32 = AtomicU32::new(0);
 
 /// `slf bench --from` on tables of any rows (times of 0, NaN, negative, huge; no rows;
-/// short rows): a table is read only with finite values and times above 0, and what is read
-/// is drawn at once (issue 41: an empty table aborted, a time of 0 or a NaN ran past a
+/// short rows): a table is read only with values in the ranges a decode gives (PSNR within
+/// +-1000 dB, SSIM [-1, 1], SA [0, 180], times 1e-9..1e12 ms), and what is read is drawn at
+/// once (issue 41: an empty table aborted, a time of 0 or a NaN ran past a
 /// minute).
 #[test]
 fn fuzz_bench_inputs() {
@@ -482,11 +492,23 @@ fn fuzz_bench_inputs() {
                   solves_per_patch,frame_512_s_1_thread,pareto";
     let row = (
         prop::sample::select(vec!["pixel", "lenslet", "kronecker", ""]),
-        prop::sample::select(vec!["1", "3", "0", "x", "300"]),
-        prop::collection::vec(flag_number(), 7),
+        field(&["1", "3", "0"], &["x", "300"]),
+        // Each field from values in its range and out of it (issue 51: +-1.7e308 dB and
+        // times of 1e-200 and 1e200 ms once held the plot for minutes).
+        (
+            field(&["30", "0", "-1000", "1000"], &["-1.7e308", "1.7e308", "NaN", "x"]),
+            field(&["0.9", "-1", "1"], &["1.5", "inf"]),
+            field(&["4", "0", "180"], &["200", "-1"]),
+            field(&["1", "1e-9", "1e12"], &["0", "1e-200", "1e200", "-2"]),
+            field(&["0.5"], &["0", "NaN"]),
+            field(&["1", "0"], &["-1", "2e9"]),
+            field(&["2", "0"], &["1e300", "-1"]),
+        ),
         any::<bool>(),
     )
-        .prop_map(|(mask, k, numbers, pareto)| format!("{mask},{k},a setting,{},{pareto}", numbers.join(",")));
+        .prop_map(|(mask, k, (p, s, a, t1, t2, n, f), pareto)| {
+            format!("{mask},{k},a setting,{p},{s},{a},{t1},{t2},{n},{f},{pareto}")
+        });
     let table = prop::collection::vec(row, 0..6);
     let drawn_at_most = 25; // drawing is 50 ms a table: a few suffice
     runner()
@@ -497,7 +519,8 @@ fn fuzz_bench_inputs() {
                 Ok(points) => {
                     prop_assert!(!points.is_empty());
                     for p in &points {
-                        prop_assert!(p.ms_one > 0.0 && p.ms_one.is_finite() && p.psnr.is_finite());
+                        prop_assert!((1e-9..=1e12).contains(&p.ms_one) && (-1000.0..=1000.0).contains(&p.psnr));
+                        prop_assert!((-1.0..=1.0).contains(&p.ssim) && (0.0..=180.0).contains(&p.sa));
                     }
                     if DRAWN.fetch_add(1, Ordering::Relaxed) < drawn_at_most {
                         let out = dir.path().join("out");

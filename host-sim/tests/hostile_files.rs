@@ -278,6 +278,7 @@ fn a_capture_from_a_12_bit_tool_decodes_like_its_16_bit_copy() {
     let dir = tempfile::tempdir().unwrap();
     let cap = simulate(&lf, &CameraConfig::pixel(3, 1)).unwrap();
     cap.save(dir.path()).unwrap();
+    forget_records(dir.path()); // another tool's folder
     let (rows, cols) = cap.frame_size();
     pgm_4095(&dir.path().join("snapshot_0.pgm"), rows, cols, &cap.frames[0]);
     let back = Capture::load(dir.path()).unwrap();
@@ -292,12 +293,24 @@ fn a_capture_from_a_12_bit_tool_decodes_like_its_16_bit_copy() {
     assert_eq!(e.lines().count(), 1, "{e}");
 }
 
+/// A capture saved, then its description's file records dropped: a folder from another tool
+/// (or an older slf), so that every check of the frames themselves is reached when a test
+/// writes a frame in place.
 fn saved_capture() -> (tempfile::TempDir, serde_json::Value) {
     let lf = small_smooth(5);
     let dir = tempfile::tempdir().unwrap();
     simulate(&lf, &CameraConfig::pixel(3, 1)).unwrap().save(dir.path()).unwrap();
+    forget_records(dir.path());
     let json = std::fs::read_to_string(dir.path().join("capture.json")).unwrap();
     (dir, serde_json::from_str(&json).unwrap())
+}
+
+/// Drops `files` from the capture folder's description (see [`saved_capture`]).
+fn forget_records(dir: &Path) {
+    let path = dir.join("capture.json");
+    let mut v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    v.as_object_mut().unwrap().remove("files");
+    std::fs::write(&path, serde_json::to_string_pretty(&v).unwrap()).unwrap();
 }
 
 #[test]

@@ -62,6 +62,31 @@ def _flag(name: str, value: Any) -> Optional[str]:
     return f"{flag}={value}"
 
 
+def _bool(name: str, value: Any, default: Optional[bool] = None) -> Optional[bool]:
+    """A boolean keyword: True, False, or None for ``default`` (the command's). Anything
+    else is refused: ``"false"`` is a true string in Python and once acted as True."""
+    if value is None:
+        return default
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    raise TypeError(f"{name}: want True, False or None, got {value!r} ({type(value).__name__})")
+
+
+def _switch(name: str, value: Any) -> Optional[str]:
+    """A boolean keyword as a ``--name true|false`` flag's value, None left to the preset."""
+    b = _bool(name, value)
+    return None if b is None else ("true" if b else "false")
+
+
+def _path(name: str, value: Any) -> str:
+    """A path keyword as a string; an empty one (which would write into the working
+    folder) is refused."""
+    p = os.fspath(value)
+    if not p:
+        raise ValueError(f"{name}: an empty path names no file or folder")
+    return p
+
+
 def _raw_frames(frames: Any) -> np.ndarray:
     """A capture's frames as the extension takes them (uint16), or one line saying why not:
     ``capture.frames`` may have been replaced after the capture was made."""
@@ -129,7 +154,7 @@ class Capture:
     def save(self, path: PathLike) -> None:
         """Writes the capture folder ``path`` (``capture.json`` and one frame file per
         snapshot, in the format its names say), as ``slf simulate -o path`` does."""
-        _slf.save_capture(_raw_frames(self.frames), json.dumps(self.description), os.fspath(path))
+        _slf.save_capture(_raw_frames(self.frames), json.dumps(self.description), _path("path", path))
 
     def __repr__(self) -> str:
         mask = self.description.get("mask", {}).get("family", "?")
@@ -172,7 +197,7 @@ def simulate(
     mask: str = "pixel",
     k: int = 1,
     seed: int = 1,
-    noise: bool = True,
+    noise: Optional[bool] = True,
     *,
     read_noise: Optional[float] = None,
     full_well: Optional[float] = None,
@@ -195,7 +220,7 @@ def simulate(
     """Records the light field ``lf`` ``(U, V, H, W, B)`` with the camera, as ``slf simulate``.
 
     ``mask``: pixel, lenslet or kronecker; ``k``: snapshots (1..=13); ``seed``: the mask's,
-    the noise's and the defects'; ``noise=False`` is ``--no-noise``. ``read_noise`` (DN,
+    the noise's and the defects'; ``noise=False`` is ``--no-noise`` (None: the command's default, noise on). ``read_noise`` (DN,
     default 2), ``full_well`` (electrons at white, default 20000), ``defects`` (fraction of
     defective pixels, default 0), ``wavelengths`` (of ``lf``'s bands when it does not have
     the camera's 13: ``"START:STOP:STEP"`` or a comma list, nm) and ``format`` (of the frame
@@ -217,7 +242,7 @@ def simulate(
         mask=mask,
         snapshots=k,
         seed=seed,
-        no_noise=not noise,
+        no_noise=not _bool("noise", noise, True),
         read_noise=read_noise,
         full_well=full_well,
         defects=defects,
@@ -234,7 +259,7 @@ def simulate(
         vignetting=vignetting,
         sensor_seed=sensor_seed,
     )
-    cal = None if calibration_captures is None else os.fspath(calibration_captures)
+    cal = None if calibration_captures is None else _path("calibration_captures", calibration_captures)
     frames, text, notes = _slf.simulate(arr, args, cal, exposures)
     for n in notes:
         warnings.warn(f"slf: {n}", stacklevel=2)
@@ -256,7 +281,7 @@ def calibrate(captures: Union[PathLike, Sequence[PathLike]], output: PathLike) -
     ``output`` that ``decode(..., calibration=output)`` reads. Returns the command's report
     lines (captures used, hot pixels found, the darkest view's vignetting)."""
     given = [captures] if isinstance(captures, (str, os.PathLike)) else list(captures)
-    return list(_slf.calibrate([os.fspath(c) for c in given], os.fspath(output)))
+    return list(_slf.calibrate([_path("captures", c) for c in given], _path("output", output)))
 
 
 def _progress_callback(progress: Any) -> Optional[Callable[[int, int], None]]:
@@ -385,22 +410,23 @@ def decode(
     cap = capture if isinstance(capture, Capture) else load_capture(capture)
     if isinstance(disparities, (list, tuple)):
         disparities = ":".join(f"{d:g}" for d in disparities)
-    if edge_fallback is not None:
-        edge_fallback = "true" if edge_fallback else "false"  # type: ignore[assignment]
-    if sheared_fallback is not None:
-        sheared_fallback = "true" if sheared_fallback else "false"  # type: ignore[assignment]
-    if seeded is not None:
-        seeded = "true" if seeded else "false"  # type: ignore[assignment]
-    if model_trial is not None:
-        model_trial = "true" if model_trial else "false"  # type: ignore[assignment]
-    if shear_trial is not None:
-        shear_trial = "true" if shear_trial else "false"  # type: ignore[assignment]
+    edge_fallback = _switch("edge_fallback", edge_fallback)  # type: ignore[assignment]
+    sheared_fallback = _switch("sheared_fallback", sheared_fallback)  # type: ignore[assignment]
+    seeded = _switch("seeded", seeded)  # type: ignore[assignment]
+    model_trial = _switch("model_trial", model_trial)  # type: ignore[assignment]
+    shear_trial = _switch("shear_trial", shear_trial)  # type: ignore[assignment]
+    exact = bool(_bool("exact", exact, False))
+    shear_check = bool(_bool("shear_check", shear_check, False))
+    error_map = bool(_bool("error_map", error_map, False))
+    report = bool(_bool("report", report, False))
     if isinstance(plausible, (list, tuple)):
         plausible = ":".join(f"{p:g}" for p in plausible)
     if blob is not None:
-        blob = os.fspath(blob)
+        blob = _path("blob", blob)
     if calibration is not None:
-        calibration = os.fspath(calibration)
+        calibration = _path("calibration", calibration)
+    if output is not None:
+        output = _path("output", output)
     args = _flags(
         method=method,
         preset=preset,

@@ -3,6 +3,7 @@ decode bit for bit, the same metrics; captures round-trip between the two."""
 
 import json
 import re
+import subprocess
 
 import numpy as np
 import pytest
@@ -184,3 +185,18 @@ def test_an_hdf5_decode_reads_in_h5py(tmp_path, slf_bin, capture):
         assert np.array_equal(d.attrs["bands_nm"], np.asarray(capture.description["bands_nm"], dtype=np.float32))
         assert json.loads(d.attrs["description"]) == capture.description
         assert d.compression == "gzip" and d.chunks is not None
+
+
+def test_an_hdf5_soft_link_is_named_as_one(tmp_path, slf_bin):
+    # Issue 51, item 16: a soft link said "need 18446744073709551615 bytes"; the dataset
+    # itself imports.
+    import h5py
+
+    with h5py.File(tmp_path / "soft.h5", "w") as f:
+        f["real"] = np.zeros((2, 2, 3, 3, 13), "f4")
+        f["lf"] = h5py.SoftLink("/real")
+    base = [slf_bin, "import", "hdf5", tmp_path / "soft.h5", "--axes", "uvhwb", "-o", tmp_path / "x.npy"]
+    p = subprocess.run([str(c) for c in base + ["--dataset", "lf"]], capture_output=True, text=True)
+    assert p.returncode == 1
+    assert "is a soft link or another object" in p.stderr and "18446744073709551615" not in p.stderr
+    run(base + ["--dataset", "real"])

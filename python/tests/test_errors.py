@@ -157,3 +157,34 @@ def test_arrays_as_flags_and_float_frames(capture):
     with pytest.raises(ValueError, match="frames: dtype float32, want uint16") as e:
         slf.decode(c)
     assert "\n" not in str(e.value)
+
+
+def test_none_is_the_default_and_strings_are_no_booleans(depth, capture):
+    """Issue 51, item 13: ``noise=None`` is the command's default (noise on), not
+    noiseless; ``"false"`` for a boolean keyword is refused, not taken as True."""
+    noisy = slf.simulate(depth, seed=3, noise=None)
+    assert np.array_equal(noisy.frames, slf.simulate(depth, seed=3).frames)
+    assert not np.array_equal(noisy.frames, slf.simulate(depth, seed=3, noise=False).frames)
+    for key in ("edge_fallback", "seeded", "sheared_fallback", "model_trial", "shear_trial", "exact", "report"):
+        with pytest.raises(TypeError, match=f"{key}: want True, False or None, got 'false'"):
+            slf.decode(capture, **{key: "false"})
+    with pytest.raises(TypeError, match="noise: want True, False or None"):
+        slf.simulate(depth, noise="no")
+    # np.bool_ is a boolean.
+    a = slf.decode(capture, preset="preview", seeded=np.bool_(False))
+    b = slf.decode(capture, preset="preview", seeded=False)
+    assert np.array_equal(a, b)
+
+
+def test_an_empty_path_is_refused(depth, capture, tmp_path, monkeypatch):
+    """Issue 51, item 14: an empty path wrote into the working folder."""
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(ValueError, match="path: an empty path"):
+        capture.save("")
+    with pytest.raises(ValueError, match="calibration_captures: an empty path"):
+        slf.simulate(depth, leakage=0.1, calibration_captures="")
+    with pytest.raises(ValueError, match="output: an empty path"):
+        slf.calibrate(str(tmp_path), "")
+    with pytest.raises(ValueError, match="output: an empty path"):
+        slf.decode(capture, output="")
+    assert list(tmp_path.iterdir()) == []

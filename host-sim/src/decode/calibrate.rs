@@ -51,8 +51,12 @@ pub fn calibrate_folders(paths: &[PathBuf], output: &Path, response: Option<&Pat
             let mut inner: Vec<PathBuf> = std::fs::read_dir(dir)
                 .with_context(|| format!("{}: neither a capture folder nor a folder of them", dir.display()))?
                 .filter_map(|e| e.ok().map(|e| e.path()))
-                .filter(|p| p.join(DESCRIPTION).is_file())
+                .filter(|p| p.is_dir())
                 .collect();
+            // A subfolder that is no capture is named, not skipped without a word.
+            if let Some(p) = inner.iter().find(|p| !p.join(DESCRIPTION).is_file()) {
+                bail!("{}: no {DESCRIPTION}: a folder of calibration captures holds capture folders only", p.display());
+            }
             ensure!(!inner.is_empty(), "{}: holds no capture folder", dir.display());
             inner.sort();
             folders.extend(inner);
@@ -263,6 +267,7 @@ pub fn calibrate(captures: &[(String, Capture)], response: Option<Vec<Vec<f32>>>
         vignetting,
         hot_pixels,
         sources: Sources { dark: darks.len(), flat: flats.len(), band: band_count },
+        files: None,
     };
     let report = Report {
         lines: vec![
@@ -298,14 +303,20 @@ pub fn calibrate(captures: &[(String, Capture)], response: Option<Vec<Vec<f32>>>
 pub fn corrected(capture: &Capture, cal: &Calibration) -> Result<Capture> {
     let (d, c) = (&capture.description, &cal.description);
     ensure!(
-        d.lenslets == c.lenslets && d.views == c.views && d.bands_nm == c.bands_nm,
-        "the calibration is of {:?} lenslets, {:?} views, {} bands; the capture {:?}, {:?}, {}",
+        d.lenslets == c.lenslets && d.views == c.views,
+        "the calibration is of {:?} lenslets and {:?} views; the capture of {:?} and {:?}",
         c.lenslets,
         c.views,
-        c.bands_nm.len(),
         d.lenslets,
-        d.views,
-        d.bands_nm.len()
+        d.views
+    );
+    // The band centres themselves, not their count (a shift of 1 nm once read as "the same
+    // bands").
+    ensure!(
+        d.bands_nm == c.bands_nm,
+        "the calibration's band centres (bands_nm {:?} nm) are not the capture's ({:?} nm)",
+        c.bands_nm,
+        d.bands_nm
     );
     ensure!(
         d.black_level == c.black_level && d.white_level == c.white_level,

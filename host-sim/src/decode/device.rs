@@ -240,6 +240,11 @@ struct DeviceLog {
     trial: Option<(u32, f32, f32, String)>,
 }
 
+/// A patch as a message names it.
+fn patch_name(o: &PatchOrigin) -> String {
+    format!("the patch at lenslet ({}, {}), view ({}, {})", o.lenslet_row, o.lenslet_col, o.view_row, o.view_col)
+}
+
 /// Which printed block the `data` lines belong to.
 enum Block {
     Patch(PatchOrigin),
@@ -291,10 +296,21 @@ fn parse(log: &str) -> Result<DeviceLog> {
                 current = Some(Block::Row(at));
             }
             Some("data") => {
-                let values = match current.as_ref().with_context(|| format!("line {}: data before any patch", i + 1))? {
-                    Block::Patch(o) if in_calibrated => &mut calibrated.get_mut(o).context("patch")?.values,
-                    Block::Patch(o) => &mut patches.get_mut(o).context("patch")?.values,
-                    Block::Row(at) => rows.get_mut(at).context("row")?,
+                let line = i + 1;
+                // A data line belongs to the block printed just before it; a log whose lines
+                // are out of order once said only "error: patch".
+                let lost = |what: String| {
+                    anyhow::anyhow!(
+                        "line {line}: data for {what}, whose header line is not in this part of the log: are the \
+                         log's lines out of order?"
+                    )
+                };
+                let values = match current.as_ref().with_context(|| format!("line {line}: data before any patch"))? {
+                    Block::Patch(o) if in_calibrated => {
+                        &mut calibrated.get_mut(o).ok_or_else(|| lost(patch_name(o)))?.values
+                    }
+                    Block::Patch(o) => &mut patches.get_mut(o).ok_or_else(|| lost(patch_name(o)))?.values,
+                    Block::Row(at) => rows.get_mut(at).ok_or_else(|| lost(format!("row {at:?}")))?,
                 };
                 for h in &w[1..] {
                     let bits = u32::from_str_radix(h, 16).with_context(|| format!("line {}: bad hex {h:?}", i + 1))?;

@@ -643,6 +643,31 @@ impl DecodeSettings {
         observer: &(dyn Fn(usize, usize) + Sync),
         sink: &mut dyn RowSink,
     ) -> Result<Outcome> {
+        // Values that would be accepted and ignored: the projection needs a calibration's
+        // response, and turns half-pixel shears off (`-1:1:0.5` once gave `-1:1`'s bytes).
+        if self.response_model == ResponseChoice::Projection {
+            ensure!(
+                self.calibration.is_some(),
+                "--response-model projection given without --calibration: the response it projects is a \
+                 calibration's"
+            );
+            ensure!(
+                self.method.baseline().is_none(),
+                "--response-model projection given with a baseline method, which unmixes its spectra: drop it, or \
+                 use --method cs"
+            );
+            ensure!(
+                !self.disparities.is_some_and(|d| d.has_halves()),
+                "--disparities with half-pixel steps given with --response-model projection, which turns them off: \
+                 give whole steps (e.g. -1:1) or --response-model unmix"
+            );
+        }
+        // A calibration capture is no scene: decoding it once went without a word.
+        ensure!(
+            capture.description.light.is_scene(),
+            "{}: a calibration capture (its light is dark, flat or a band), not a scene's: slf calibrate reads it",
+            capture.source()
+        );
         // A frame with no pixel above the black level recorded no light (a lens cap, an
         // exposure of zero): every method would decode zeros.
         let black = capture.description.black_level;

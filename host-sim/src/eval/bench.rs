@@ -580,10 +580,15 @@ fn points_of<R: std::io::Read>(mut r: csv::Reader<R>) -> Result<Vec<Point>> {
         let within = |j: usize, what: &str, (lo, hi): (f64, f64)| -> Result<f64> {
             let x = number(j)?;
             anyhow::ensure!(x.is_finite(), "line {line}: field {} is {x}, not a finite number", j + 1);
+            let show =
+                |v: f64| if v != 0.0 && !(1e-3..1e6).contains(&v.abs()) { format!("{v:e}") } else { v.to_string() };
             anyhow::ensure!(
                 (lo..=hi).contains(&x),
-                "line {line}: field {} is {what} of {x}, outside [{lo:e}, {hi:e}]",
-                j + 1
+                "line {line}: field {} is {what} of {}, outside [{}, {}]",
+                j + 1,
+                show(x),
+                show(lo),
+                show(hi)
             );
             Ok(x)
         };

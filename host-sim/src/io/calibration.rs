@@ -8,6 +8,8 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Result, anyhow, bail, ensure};
+
+use crate::io::folder::{FileRecord, Kind, WholeFolder, record, verify};
 use serde::{Deserialize, Serialize};
 
 use crate::io::capture::{MAX_DESCRIPTION, read_small_file};
@@ -59,6 +61,11 @@ pub struct CalibrationDescription {
     /// `[row, col]` of pixels whose dark level or flat is no working pixel's.
     pub hot_pixels: Vec<[u32; 2]>,
     pub sources: Sources,
+    /// `dark.npy`'s and `flat.npy`'s sizes and CRC-32s as written ([`crate::io::folder`]),
+    /// checked on load; a loaded calibration's description holds none. Absent in folders
+    /// written before they were (loaded with a note).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub files: Option<Vec<FileRecord>>,
 }
 
 /// Measured filter curves: a float `.npy` of shape `(bands, bands)`, `[filter][band]` as
@@ -252,8 +259,18 @@ impl Calibration {
     pub fn load(dir: &Path) -> Result<Self> {
         let path = dir.join(DESCRIPTION);
         let text = read_small_file(&path, MAX_DESCRIPTION)?;
-        let description: CalibrationDescription =
+        let mut description: CalibrationDescription =
             serde_json::from_str(&text).map_err(|e| anyhow!("{}: invalid calibration: {e}", path.display()))?;
+        match description.files.take() {
+            // A flat from another calibration beside these dark levels once decoded with
+            // exit 0.
+            Some(records) => verify(dir, &path, &records, &[DARK, FLAT])?,
+            None => eprintln!(
+                "note: {} records no sizes and checksums of {DARK} and {FLAT} (written before slf checked them): \
+                 files from another calibration would not be noticed",
+                path.display()
+            ),
+        }
         let (rows, cols) = description.check().map_err(|e| anyhow!("{}: {e}", path.display()))?;
         let read = |name: &str| -> Result<Vec<f32>> {
             let p: PathBuf = dir.join(name);
@@ -288,12 +305,20 @@ impl Calibration {
     ///
     /// # Errors
     /// I/O errors, with the file.
+    ///
+    /// The folder is written whole ([`WholeFolder`]): a failure leaves the old folder as it
+    /// was (before, a failed write could leave new dark levels beside old flats). An
+    /// existing `dir` must be empty or a calibration folder.
     pub fn save(&self, dir: &Path) -> Result<()> {
-        std::fs::create_dir_all(dir).map_err(|e| anyhow!("cannot create {}: {e}", dir.display()))?;
+        let folder = WholeFolder::create(dir, Kind::Files(DESCRIPTION, &[DARK, FLAT]))?;
+        let at = folder.path();
         let (rows, cols) = self.frame_size();
-        write_npy_f32_2d(&dir.join(DARK), &self.dark, rows, cols)?;
-        write_npy_f32_2d(&dir.join(FLAT), &self.flat, rows, cols)?;
-        let text = serde_json::to_string_pretty(&self.description)?;
-        write_bytes(&dir.join(DESCRIPTION), (text + "\n").as_bytes())
+        write_npy_f32_2d(&at.join(DARK), &self.dark, rows, cols)?;
+        write_npy_f32_2d(&at.join(FLAT), &self.flat, rows, cols)?;
+        let files = Some(vec![record(at, DARK)?, record(at, FLAT)?]);
+        let description = CalibrationDescription { files, ..self.description.clone() };
+        let text = serde_json::to_string_pretty(&description)?;
+        write_bytes(&at.join(DESCRIPTION), (text + "\n").as_bytes())?;
+        folder.persist()
     }
 }

@@ -13,6 +13,7 @@ use slf_firmware::{
     Sl0Config, TileDecoder,
 };
 
+use crate::io::folder::{FileRecord, Kind, WholeFolder, record, verify};
 use crate::io::lightfield::{read_npy_u16_2d, write_npy_u16_2d};
 use crate::io::message::one_line;
 use crate::io::output::{write_bytes, write_whole};
@@ -117,6 +118,11 @@ pub struct CaptureDescription {
     /// or one of the calibration captures `slf calibrate` reads.
     #[serde(default, skip_serializing_if = "Light::is_scene")]
     pub light: Light,
+    /// Each frame's size and CRC-32 as written ([`crate::io::folder`]), checked on load; a
+    /// loaded capture's description holds none (they describe the files, not the capture).
+    /// Absent in folders written before they were (loaded with a note).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub files: Option<Vec<FileRecord>>,
 }
 
 /// What a capture looked at: a scene, or a calibration target.
@@ -372,8 +378,9 @@ impl Capture {
         let desc_path = dir.join(DESCRIPTION);
         let named = |e: anyhow::Error| anyhow!("{}: {}", desc_path.display(), one_line(&e));
         let text = read_small_file(&desc_path, MAX_DESCRIPTION)?;
-        let description: CaptureDescription = serde_json::from_str(&text)
+        let mut description: CaptureDescription = serde_json::from_str(&text)
             .map_err(|e| anyhow!("{}: invalid capture description: {e}", desc_path.display()))?;
+        let records = description.files.take();
         let (rows, cols) = description.frame_size().map_err(named)?;
         ensure!(
             (1..=MAX_BANDS).contains(&description.frames.len()),
@@ -381,11 +388,27 @@ impl Capture {
             desc_path.display(),
             description.frames.len()
         );
-        let mut frames = Vec::with_capacity(description.frames.len());
+        let mut paths = Vec::with_capacity(description.frames.len());
         for (i, name) in description.frames.iter().enumerate() {
             let path =
                 frame_path(dir, name).map_err(|e| anyhow!("{}: frames[{i}]: {}", desc_path.display(), one_line(&e)))?;
             inside(dir, &path).map_err(|e| anyhow!("{}: frames[{i}]: {}", desc_path.display(), one_line(&e)))?;
+            paths.push(path);
+        }
+        // The frames are the ones written with this description, before any is read.
+        match records {
+            Some(records) => {
+                let names: Vec<&str> = description.frames.iter().map(String::as_str).collect();
+                verify(dir, &desc_path, &records, &names)?;
+            }
+            None => eprintln!(
+                "note: {} records no sizes and checksums of its frames (written before slf checked them): a frame \
+                 from another capture would not be noticed",
+                desc_path.display()
+            ),
+        }
+        let mut frames = Vec::with_capacity(description.frames.len());
+        for path in paths {
             // Of the capture's size: read_frame refuses another from the file's header.
             let frame = read_frame(&path, Some((rows, cols)))?;
             ensure!(
@@ -430,15 +453,35 @@ impl Capture {
     ///
     /// # Errors
     /// I/O and encoding errors, with the file.
+    ///
+    /// The folder is written whole ([`WholeFolder`]): into a temporary folder beside `dir`,
+    /// renamed into place at the end, so a failure leaves the old folder as it was. An
+    /// existing `dir` must be empty or a capture folder.
     pub fn save(&self, dir: &Path) -> Result<()> {
-        fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        let folder = WholeFolder::create(dir, Kind::Files(DESCRIPTION, &[]))?;
+        self.write_into(folder.path())?;
+        folder.persist()
+    }
+
+    /// Writes the capture's files into the existing folder `dir` (one being written whole:
+    /// [`Self::save`]), the description last with each frame's size and CRC-32.
+    ///
+    /// # Errors
+    /// I/O and encoding errors, with the file.
+    pub fn write_into(&self, dir: &Path) -> Result<()> {
         let (rows, cols) = self.frame_size();
+        let mut records = Vec::with_capacity(self.frames.len());
         for (name, data) in self.description.frames.iter().zip(&self.frames) {
-            write_frame(&dir.join(name), data, rows, cols)?;
+            let path = dir.join(name);
+            if let Some(parent) = path.parent() {
+                fs::create_dir_all(parent).with_context(|| format!("cannot create {}", parent.display()))?;
+            }
+            write_frame(&path, data, rows, cols)?;
+            records.push(record(dir, name)?);
         }
-        let path = dir.join(DESCRIPTION);
-        let text = serde_json::to_string_pretty(&self.description)?;
-        write_bytes(&path, (text + "\n").as_bytes())
+        let description = CaptureDescription { files: Some(records), ..self.description.clone() };
+        let text = serde_json::to_string_pretty(&description)?;
+        write_bytes(&dir.join(DESCRIPTION), (text + "\n").as_bytes())
     }
 }
 

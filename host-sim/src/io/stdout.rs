@@ -38,7 +38,7 @@ pub fn closed_pipe(e: &anyhow::Error) -> bool {
 
 #[cfg(test)]
 mod tests {
-    use super::closed_pipe;
+    use crate::io::stdout::closed_pipe;
 
     #[test]
     fn a_closed_pipe_is_told_from_other_failures() {

@@ -15,7 +15,8 @@ use std::path::Path;
 
 use anyhow::{Result, ensure};
 
-use crate::io::capture::{Capture, Light};
+use crate::io::capture::{Capture, DESCRIPTION, Light};
+use crate::io::folder::{Kind, WholeFolder};
 use crate::io::lightfield::LightField;
 use crate::io::output::Outputs;
 use crate::sim::camera::{CameraConfig, simulate_under};
@@ -74,13 +75,18 @@ pub fn with_outputs(outputs: Outputs, captures: &[(String, Capture)], dir: &Path
 }
 
 /// Writes `captures` into `dir`, one capture folder each, by name (what `slf calibrate DIR`
-/// reads).
+/// reads). The set is written whole ([`WholeFolder`]): an existing `dir` must be empty or
+/// hold only capture folders, and is replaced, so no capture of an earlier set (another
+/// sensor's, say) is left beside the new ones.
 ///
 /// # Errors
-/// I/O errors.
+/// A `dir` holding anything else; I/O errors.
 pub fn save(captures: &[(String, Capture)], dir: &Path) -> Result<()> {
+    let folder = WholeFolder::create(dir, Kind::Folders(DESCRIPTION))?;
     for (name, c) in captures {
-        c.save(&dir.join(name))?;
+        let at = folder.path().join(name);
+        std::fs::create_dir(&at).map_err(|e| anyhow::anyhow!("cannot create {}: {e}", at.display()))?;
+        c.write_into(&at)?;
     }
-    Ok(())
+    folder.persist()
 }

@@ -162,6 +162,7 @@ pub fn simulate_under(lf: &LightField, cam: &CameraConfig, light: Light) -> Resu
         defective_pixels: defects.clone(),
         simulated_sensor: real.then_some(cam.sensor),
         light,
+        files: None,
     };
     // Build the mask through the capture so the description is checked the same way as a
     // loaded one.

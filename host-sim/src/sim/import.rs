@@ -69,7 +69,7 @@ pub struct ViewsSettings {
     #[arg(long)]
     pub pattern: Option<String>,
     /// The number of the first row and column in --pattern names (0 or 1, usually).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, requires = "pattern")]
     pub index_base: usize,
     /// The full view grid, ROWS,COLS.
     #[arg(long, value_parser = pair, default_value = "9,9")]

@@ -167,6 +167,33 @@ pub struct Simulated {
     pub notes: Vec<String>,
 }
 
+impl SensorSettings {
+    /// Refuses the filters' shape without leakage: it shapes only the leaked light, so
+    /// `--filter-width 200 --secondary 1` without `--leakage` once wrote an ideal capture.
+    ///
+    /// # Errors
+    /// The shape flags given, and the flag they need.
+    pub fn check(&self) -> Result<()> {
+        let ideal = FilterDescription::IDEAL;
+        let given: Vec<&str> = [
+            (self.filter_width != ideal.width_nm, "--filter-width"),
+            (self.secondary != ideal.secondary, "--secondary"),
+            (self.secondary_nm != ideal.secondary_nm, "--secondary-nm"),
+            (self.leak_floor != ideal.floor, "--leak-floor"),
+        ]
+        .into_iter()
+        .filter_map(|(g, name)| g.then_some(name))
+        .collect();
+        anyhow::ensure!(
+            self.leakage > 0.0 || given.is_empty(),
+            "{} given without --leakage above 0: the filters' shape only shapes the leaked light (give --leakage, \
+             e.g. 0.1)",
+            given.join(", ")
+        );
+        Ok(())
+    }
+}
+
 impl SimulateSettings {
     /// The settings from `slf simulate`'s flags (without the input and `-o`), e.g.
     /// `["--mask=lenslet", "--snapshots=3"]`.
@@ -199,6 +226,7 @@ impl SimulateSettings {
     /// Wavelengths that do not parse or fit the light field; a light field the camera
     /// cannot record (see [`simulate`]).
     pub fn run(&self, lf: LightField, source: &str) -> Result<Simulated> {
+        self.sensor.check()?;
         let (lf, note) = with_camera_bands(lf, self.wavelengths.as_deref(), source)?;
         // A capture the decoder could not take is refused here, not written for `decode`
         // to refuse.
@@ -216,12 +244,22 @@ impl SimulateSettings {
         }
         let (clipped, total) = capture.saturated_pixels();
         if clipped > 0 {
+            let top = 1.0 / cam.white_fraction;
+            // Who saturated them: the light field only when it exceeds white; else the
+            // sensor's dark levels (--dark-sd 1000 once blamed the light field).
+            let cause = if lf.max() > top {
+                format!("the light field exceeds white (max {:.3}, clips at {top:.3})", lf.max())
+            } else {
+                format!(
+                    "the light field stays below the clip ({:.3} of {top:.3}): the sensor's dark levels (--dark-sd, \
+                     --hot-pixels) push them there",
+                    lf.max()
+                )
+            };
             notes.push(format!(
-                "warning: {source}: {clipped} of {total} pixels ({:.2} %) saturated: the light field exceeds \
-                 white (max {:.3}, clips at {:.3}); saturated pixels are not measurements",
-                100.0 * clipped as f64 / total as f64,
-                lf.max(),
-                1.0 / cam.white_fraction
+                "warning: {source}: {clipped} of {total} pixels ({:.2} %) saturated: {cause}; saturated pixels are \
+                 not measurements",
+                100.0 * clipped as f64 / total as f64
             ));
         }
         Ok(Simulated { capture, notes })

@@ -51,9 +51,20 @@ pub fn read_hdf5(path: &Path, layout: &Hdf5Layout, white: f32) -> Result<LightFi
     ensure!(meta.len() <= MAX_FILE, "{}: {} bytes, more than the {MAX_FILE} read", path.display(), meta.len());
     let file = hdf5_pure::File::open(path)
         .map_err(|e| anyhow::anyhow!("{}: not an HDF5 file slf reads: {e}", path.display()))?;
-    let ds = file
-        .dataset(layout.dataset.trim_start_matches('/'))
-        .map_err(|e| anyhow::anyhow!("{}: no dataset {:?}: {e}", path.display(), layout.dataset))?;
+    let ds = file.dataset(layout.dataset.trim_start_matches('/')).map_err(|e| {
+        // HDF5's undefined address (all ones) is where the reader meets a link it does not
+        // follow: a soft link once said "need 18446744073709551615 bytes".
+        if e.to_string().contains(&u64::MAX.to_string()) {
+            anyhow::anyhow!(
+                "{}: {:?} is a soft link or another object slf's HDF5 reader does not follow (its address is \
+                 undefined): give the path of the dataset itself (h5py: f[name].name)",
+                path.display(),
+                layout.dataset
+            )
+        } else {
+            anyhow::anyhow!("{}: no dataset {:?}: {e}", path.display(), layout.dataset)
+        }
+    })?;
     let shape: Vec<usize> = ds
         .shape()
         .map_err(|e| anyhow::anyhow!("{}: {}: unreadable shape: {e}", path.display(), layout.dataset))?
