@@ -4,7 +4,10 @@ them: missing, empty, random, truncated and lying files, FIFOs and devices, spar
 claiming gigabytes, every numeric flag of `slf decode` with values out of range, outputs
 over inputs. Each run gets a memory limit and a time limit; the sweep fails on any abort,
 hang, panic, multi-line error or exit 0 that leaves a destroyed input or a light field slf
-itself refuses.
+itself refuses, or where slf must refuse (issue 51's classes: extreme bench tables, mixed
+folders, trainings larger than memory, unusable calibrations, a failed standard output, a
+file-size limit, values accepted and ignored, and, with a Python that imports slf, the
+package's None, string booleans and empty paths).
 
     python3 scripts/hostile-sweep.py [SLF]        # default: target/release/slf
 
@@ -23,6 +26,10 @@ import tempfile
 from pathlib import Path
 
 SLF = os.path.abspath(sys.argv[1] if len(sys.argv) > 1 else "target/release/slf")
+# The Python package's cases run with this interpreter when it imports slf (CI's venv);
+# skipped, and said, when it does not.
+PYTHON = os.environ.get("SLF_PYTHON", sys.executable)
+REPO = Path(__file__).resolve().parents[1]
 MEMORY = 3 << 30  # bytes of address space a run may take
 SECONDS = 120
 
@@ -49,24 +56,45 @@ class Sweep:
         self.cases = self.refused = self.accepted = 0
         self.failures = []
 
-    def run(self, args, name, outputs=(), keep=()):
-        """Runs `slf ARGS`; `outputs` are .npy light fields an exit 0 must leave readable,
-        `keep` files no run may change."""
+    def run(self, args, name, outputs=(), keep=(), refuse=False, stdout=None, file_limit=None, python=None):
+        """Runs `slf ARGS` (or, with `python`, that Python source with the package); `outputs`
+        are .npy light fields an exit 0 must leave readable, `keep` files no run may
+        change; `refuse`: the run must fail (an exit 0 is a failure of the sweep); `stdout`
+        a file to write standard output to; `file_limit` bytes of RLIMIT_FSIZE."""
         self.cases += 1
         before = {p: Path(p).read_bytes() for p in keep if Path(p).is_file()}
+
+        def preexec():
+            limits()
+            if file_limit is not None:
+                signal.signal(signal.SIGXFSZ, signal.SIG_DFL)
+                resource.setrlimit(resource.RLIMIT_FSIZE, (file_limit, file_limit))
+
+        cmd = [PYTHON, "-c", python] if python is not None else [SLF, *map(str, args)]
         try:
+            out = open(stdout, "w") if stdout else subprocess.PIPE
             p = subprocess.run(
-                [SLF, *map(str, args)],
+                cmd,
                 cwd=self.work,
-                capture_output=True,
+                stdout=out,
+                stderr=subprocess.PIPE,
                 text=True,
                 timeout=SECONDS,
-                preexec_fn=limits,
+                preexec_fn=preexec,
             )
+            if stdout:
+                out.close()
         except subprocess.TimeoutExpired:
             self.failures.append(f"{name}: hang (over {SECONDS} s)")
             return
         err = p.stderr.strip()
+        if python is not None:
+            # The package raises one exception: its last line is the message.
+            err = err.splitlines()[-1] if err else ""
+            if p.returncode != 0 and err:
+                err = "error: " + err
+        if p.returncode == 0 and refuse:
+            self.failures.append(f"{name}: exit 0, where slf must refuse")
         if p.returncode < 0:
             self.failures.append(f"{name}: killed by {signal.Signals(-p.returncode).name}: {err[-200:]}")
         elif "panicked" in err or "memory allocation" in err:
@@ -87,9 +115,125 @@ class Sweep:
                 self.failures.append(f"{name}: {path} changed or destroyed")
 
 
+def issue_51(s, work, ok):
+    """The classes of issue 51 (nothing lost, nothing silently wrong, round 4): each must be
+    refused with one line (or, where marked, run to a correct end)."""
+    header = (work / "header.csv").read_text()
+    # 1, 12: bench tables of values no decode gives; a table redrawn from its own folder.
+    for row in ["pixel,3,x,1.7e308,0.9,4,1,0.5,1,2,true\npixel,3,y,-1.7e308,0.9,4,1,0.5,1,2,true",
+                "pixel,3,x,30,0.9,4,1e-200,0.5,1,2,true\npixel,3,y,30,0.9,4,1e200,0.5,1,2,true"]:
+        (work / "extreme.csv").write_text(header + row + "\n")
+        s.run(["bench", "--from", "extreme.csv", "--out", "bench-x"], f"bench --from {row[:30]}...", refuse=True)
+    (work / "own").mkdir(exist_ok=True)
+    (work / "own" / "bench.csv").write_text(header + "pixel,3,x,30.123456789,0.9,4,1,0.5,1,2,true\n")
+    s.run(["bench", "--from", "own/bench.csv", "--out", "own"], "bench --from DIR/bench.csv --out DIR",
+          keep=[str(work / "own" / "bench.csv")])
+
+    # The calibrated set-up of the issue.
+    ok("scene", "smooth", "--size", "16", "-o", "lf16.npy")
+    ok("simulate", "lf16.npy", "-o", "cap16", "--leakage", "0.1", "--calibration-captures", "cc", "--exposures", "2")
+    ok("calibrate", "cc", "-o", "cal")
+    ok("simulate", "lf16.npy", "-o", "cap16b", "--leakage", "0.3", "--calibration-captures", "cc-b",
+       "--exposures", "1")
+    ok("calibrate", "cc-b", "-o", "cal-b")
+    cal_files = [str(work / "cal" / f) for f in os.listdir(work / "cal")]
+
+    # 2: folders mixed after they were written: a flat or a frame from elsewhere.
+    shutil.copytree(work / "cal", work / "cal-mixed")
+    shutil.copy(work / "cal-b" / "flat.npy", work / "cal-mixed" / "flat.npy")
+    s.run(["decode", "cap16", "--calibration", "cal-mixed", "-o", "m.npy", "-q"], "decode with a mixed calibration",
+          refuse=True)
+    shutil.copytree(work / "cap16", work / "cap-mixed")
+    shutil.copy(work / "cap16b" / "snapshot_0.pgm", work / "cap-mixed" / "snapshot_0.pgm")
+    s.run(["decode", "cap-mixed", "-o", "m.npy", "-q"], "decode a capture with another's frame", refuse=True)
+    # A folder holding a user's file is not an output to replace.
+    (work / "mine").mkdir(exist_ok=True)
+    (work / "mine" / "notes.txt").write_text("mine")
+    for args in [["simulate", "lf16.npy", "-o", "mine"], ["calibrate", "cc", "-o", "mine"]]:
+        s.run(args, f"{args[0]} -o a folder with a user's file", refuse=True, keep=[str(work / "mine" / "notes.txt")])
+
+    # 4: a training larger than memory, refused before it renders.
+    blob = REPO / "firmware" / "dictionaries" / "fullview8.slfd"
+    for scenes, size in [("3", "1024"), ("1000", "1024")]:
+        s.run(["train-schedule", blob, "-o", "t.slfd", "--scenes", scenes, "--size", size, "--patches", "4",
+               "--iterations", "1"], f"train-schedule --scenes {scenes} --size {size}", refuse=True)
+    s.run(["train", "-o", "t.slfd", "--scenes", "1000", "--size", "1024"], "train --scenes 1000 --size 1024",
+          refuse=True)
+
+    # 6, 9: response curves no decode can use, refused when calibrating.
+    eye = [[1.0 if i == j else 0.0 for j in range(13)] for i in range(13)]
+    for label, rows in [("ones", [[1.0] * 13] * 13), ("0.3 x I", [[0.3 * x for x in r] for r in eye]),
+                        ("a zero row", eye[:12] + [[0.0] * 12 + [1e-9]])]:
+        body = b"".join(struct.pack("<f", x) for r in rows for x in r)
+        (work / "curves.npy").write_bytes(npy("<f4", (13, 13), body))
+        s.run(["calibrate", "cc", "-o", "c1", "--response", "curves.npy"], f"calibrate --response {label}",
+              refuse=True)
+    # 7: captures of two sensors.
+    s.run(["calibrate", "cc", "cc-b/flat-00", "-o", "c1"], "calibrate two sensors' captures", refuse=True)
+    # A calibration capture decoded as a scene.
+    s.run(["decode", "cc/flat-00", "-o", "m.npy", "-q"], "decode a calibration capture", refuse=True)
+
+    # 8: baselines with a calibration: accepted, and their values in the sensor's range
+    # (checked by reading the .npy's float32 body).
+    for method in ["ppid", "demosaic"]:
+        out = work / f"b-{method}.npy"
+        s.run(["decode", "cap16", "--calibration", "cal", "--method", method, "-o", out.name, "-q"],
+              f"decode --method {method} --calibration", outputs=[out.name], keep=cal_files)
+        if out.exists():
+            data = out.read_bytes()
+            start = 10 + struct.unpack("<H", data[8:10])[0]
+            least = min(struct.unpack(f"<{(len(data) - start) // 4}f", data[start:]))
+            if least < 0:
+                s.failures.append(f"decode --method {method} --calibration: a value of {least} below 0")
+
+    # 10, 11: a standard output that cannot be written; a file-size limit.
+    s.run(["scene", "smooth", "--size", "11", "-o", "s11.npy"], "scene > /dev/full", stdout="/dev/full", refuse=True)
+    (work / "uf").mkdir(exist_ok=True)
+    s.run(["scene", "smooth", "--size", "40", "-o", "uf/s.npy"], "scene under ulimit -f", file_limit=40 << 10,
+          refuse=True)
+    left = [f for f in os.listdir(work / "uf")]
+    if left:
+        s.failures.append(f"scene under ulimit -f: left {left}")
+
+    # 15: values accepted and ignored.
+    for args in [["simulate", "lf16.npy", "-o", "x-cap", "--filter-width", "200", "--secondary", "1"],
+                 ["import", "views", "cap16", "--index-base", "7", "-o", "v.npy"],
+                 ["decode", "cap16", "--calibration", "cal", "--response-model", "projection",
+                  "--disparities=-1:1:0.5", "-o", "m.npy", "-q"],
+                 ["decode", "cap16", "--response-model", "projection", "-o", "m.npy", "-q"]]:
+        s.run(args, " ".join(args[:1] + args[2:]), refuse=True)
+
+    python_cases(s)
+
+
+def python_cases(s):
+    """Issue 51, 13 and 14: the Python package's None, string booleans and empty paths, when
+    PYTHON imports slf (SLF_SWEEP_ONLY=python runs these alone)."""
+    probe = subprocess.run([PYTHON, "-c", "import slf"], capture_output=True)
+    if probe.returncode != 0:
+        print(f"note: {PYTHON} does not import slf: the package's cases are skipped (set SLF_PYTHON)")
+        return
+    pre = "import slf, numpy as np; lf = slf.scene('smooth', size=12); cap = slf.simulate(lf)\n"
+    for label, code in [("noise='no'", "slf.simulate(lf, noise='no')"),
+                        ("edge_fallback='false'", "slf.decode(cap, edge_fallback='false')"),
+                        ("seeded='false'", "slf.decode(cap, seeded='false')"),
+                        ("Capture.save('')", "cap.save('')"),
+                        ("calibrate('cc', '')", "slf.calibrate('cc', '')"),
+                        ("simulate(calibration_captures='')", "slf.simulate(lf, leakage=0.1, calibration_captures='')"),
+                        ("decode(output='')", "slf.decode(cap, output='')")]:
+        s.run([], f"python: {label}", python=pre + code, refuse=True)
+    s.run([], "python: noise=None is noise on", python=pre + (
+        "a = slf.simulate(lf, seed=3, noise=None).frames; b = slf.simulate(lf, seed=3).frames\n"
+        "assert np.array_equal(a, b), 'noise=None is not the default'"))
+
+
 def main():
     work = Path(tempfile.mkdtemp(prefix="slf-sweep-"))
     s = Sweep(work)
+    if os.environ.get("SLF_SWEEP_ONLY") == "python":
+        (work / "cc").mkdir()
+        python_cases(s)
+        return report(s, work)
     ok = lambda *a: subprocess.run([SLF, *map(str, a)], cwd=work, check=True, capture_output=True)
     ok("scene", "smooth", "--size", "12", "-o", "truth.npy")
     ok("simulate", "truth.npy", "-o", "cap", "--format", "npy")
@@ -201,6 +345,12 @@ def main():
     for missing in [["decode"], ["decode", "cap"], ["simulate", "truth.npy"], ["import"], []]:
         s.run(missing, f"slf {' '.join(missing)} (missing arguments)")
 
+    issue_51(s, work, ok)
+
+    return report(s, work)
+
+
+def report(s, work):
     for f in s.failures:
         print("FAIL", f)
     print(f"hostile sweep: {s.cases} cases, {s.refused} refused with one line, {s.accepted} accepted, "

@@ -453,3 +453,85 @@ fn a_seeded_tile_decode_starts_each_patch_from_its_balanced_seed() {
         assert!(es < ec, "{origin:?}: seeded from the truth {es}, cold {ec}");
     }
 }
+
+/// `with_view_gains`: each sample of view `(u, v)` of a lenslet in region `(i, j)` is divided
+/// by that region's gain for the view, region `(i, j)` holding lenslet row `r` when
+/// `r * rows / S == i` (columns likewise). Written out here from that definition: with gains
+/// that are powers of two the division is exact, so the decode with the table equals, bit for
+/// bit, the decode without it of the frames divided by hand. (Issue 51: before, only the
+/// host's calibration test, with its fixture's region count written in, reached it.)
+#[test]
+fn view_gains_divide_each_view_of_each_region() {
+    let l = light_field();
+    let mask = Mask::pixel(3, 3, 13, L5).unwrap();
+    let frames = capture(&l, &mask);
+    let (rows, cols) = (2usize, 3usize);
+    // Gains of 1, 2 and 4 (values only fall: none reaches the saturation level).
+    let gain = |i: usize, j: usize, u: usize, v: usize| [1.0f32, 2.0, 4.0][(i + 2 * j + u + 3 * v) % 3];
+    let mut table = Vec::new();
+    for i in 0..rows {
+        for j in 0..cols {
+            for u in 0..5 {
+                for v in 0..5 {
+                    table.push(gain(i, j, u, v));
+                }
+            }
+        }
+    }
+    let divided: Vec<Vec<f32>> = frames
+        .iter()
+        .map(|f| {
+            f.iter()
+                .enumerate()
+                .map(|(p, &x)| {
+                    let (row, col) = (p / 75, p % 75);
+                    let (i, j) = ((row / 5) * rows / 10, (col / 5) * cols / 15);
+                    x / gain(i, j, row % 5, col % 5)
+                })
+                .collect()
+        })
+        .collect();
+    let dict = Dictionary::dct();
+    let regions = (rows as u16, cols as u16);
+    let gained = Decoder::new(config(mask)).unwrap().with_view_gains(Some((&table, regions))).unwrap();
+    assert_eq!(gained.view_gains(), Some((&table[..], regions)));
+    let (a, ra) = decode_all(&gained, &frames, &dict);
+    let (b, rb) = decode_all(&Decoder::new(config(mask)).unwrap(), &divided, &dict);
+    assert_eq!(ra, rb);
+    assert_eq!(a.accepted.len(), 24);
+    for ((oa, pa, _), (ob, pb, _)) in a.accepted.iter().zip(&b.accepted) {
+        assert_eq!(oa, ob);
+        assert_eq!(pa, pb, "{oa:?}");
+    }
+    // A table that is not one gain per view and region, in [1/64, 64], is refused.
+    let refuse = |g: &[f32], r: (u16, u16)| Decoder::new(config(mask)).unwrap().with_view_gains(Some((g, r))).err();
+    assert_eq!(refuse(&table, (0, 3)), Some(ConfigError::ViewGains));
+    assert_eq!(refuse(&table, (11, 3)), Some(ConfigError::ViewGains)); // more regions than lenslet rows
+    assert_eq!(refuse(&table[1..], regions), Some(ConfigError::ViewGains));
+    for bad in [0.0, 65.0, f32::NAN] {
+        let mut t = table.clone();
+        t[7] = bad;
+        assert_eq!(refuse(&t, regions), Some(ConfigError::ViewGains), "{bad}");
+    }
+    assert!(Decoder::new(config(mask)).unwrap().with_view_gains(None).unwrap().view_gains().is_none());
+}
+
+/// `with_response`: a response that mixes bands, placed in the projection, is refused on a
+/// kronecker mask (its patches measure whole blocks in one band); unmixing is not.
+#[test]
+fn a_mixing_projection_is_refused_on_kronecker_masks() {
+    let mut r = [[0.0f32; 13]; 13];
+    for (f, row) in r.iter_mut().enumerate() {
+        for (b, x) in row.iter_mut().enumerate() {
+            *x = if f == b { 0.88 } else { 0.01 };
+        }
+    }
+    let response = Response::new(&r).unwrap();
+    let kron = Mask::kronecker(3, 2, 13, L5, (5, 5)).unwrap();
+    let dec = |m| Decoder::new(config(m)).unwrap();
+    assert_eq!(dec(kron).with_response(&response, ResponseModel::Projection).err(), Some(ConfigError::Response));
+    assert!(dec(kron).with_response(&response, ResponseModel::Unmix).is_ok());
+    assert!(dec(kron).with_response(&Response::IDENTITY, ResponseModel::Projection).is_ok());
+    let pixel = Mask::pixel(3, 3, 13, L5).unwrap();
+    assert!(dec(pixel).with_response(&response, ResponseModel::Projection).is_ok());
+}
