@@ -29,6 +29,7 @@ SLF = os.path.abspath(sys.argv[1] if len(sys.argv) > 1 else "target/release/slf"
 # The Python package's cases run with this interpreter when it imports slf (CI's venv);
 # skipped, and said, when it does not.
 PYTHON = os.environ.get("SLF_PYTHON", sys.executable)
+PYTHON = os.path.abspath(PYTHON) if os.sep in PYTHON else PYTHON  # the runs' folder is another
 REPO = Path(__file__).resolve().parents[1]
 MEMORY = 3 << 30  # bytes of address space a run may take
 SECONDS = 120

@@ -4,6 +4,7 @@ decode bit for bit, the same metrics; captures round-trip between the two."""
 import json
 import re
 import subprocess
+import zlib
 
 import numpy as np
 import pytest
@@ -29,7 +30,15 @@ def test_simulate_equals_cli_and_round_trips(tmp_path, slf_bin, depth):
     ours.save(tmp_path / "py")
     again = slf.load_capture(tmp_path / "py")
     assert np.array_equal(again.frames, ours.frames) and again.description == ours.description
-    assert json.loads((tmp_path / "py" / "capture.json").read_text()) == ours.description
+    written = json.loads((tmp_path / "py" / "capture.json").read_text())
+    # Beside the description, each frame's size and CRC-32 as written (issue 51), checked
+    # here with zlib's CRC-32.
+    records = written.pop("files")
+    assert written == ours.description
+    assert [r["name"] for r in records] == ours.description["frames"]
+    for r in records:
+        data = (tmp_path / "py" / r["name"]).read_bytes()
+        assert r["bytes"] == len(data) and r["crc32"] == f"{zlib.crc32(data):08x}"
 
 
 def test_a_real_sensor_equals_cli(tmp_path, slf_bin, depth):
