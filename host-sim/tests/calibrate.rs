@@ -237,10 +237,13 @@ fn the_calibration_folder_reads_back_and_refuses_corruption() {
     }
 }
 
-/// The loop closed: a real sensor's scene decoded with the calibration its calibration
-/// captures gave is within 0.5 dB of the ideal sensor's decode (the issue's target at 10 %
-/// leakage and vignetting to 50 %), where the uncorrected decode is 10 dB and more below;
-/// the demosaic gets the same correction.
+/// The loop closed, on one case: the office scene at pixel k = 1, 30 x 30 lenslets, 10 %
+/// leakage, 50 % vignetting, one sensor (seed 21). Decoded with the calibration its
+/// calibration captures gave, it is within 0.5 dB of the ideal sensor's decode and (CS)
+/// within 10 % of its spectral angle, where the uncorrected decode is 5 dB and more below;
+/// the demosaic gets the same correction. This case only: across the realistic set and the
+/// leakages of `docs/results-sensor.md` the PSNR target holds more widely than the
+/// spectral angle's, which holds in 2 of its 14 cases.
 #[test]
 fn a_calibrated_decode_is_the_ideal_sensors() {
     use slf_host::decode::settings::DecodeSettings;
@@ -323,53 +326,78 @@ fn the_decode_unmixes_as_the_inverse_does() {
     assert!(p.psnr > u.psnr - 1.0 && p.psnr.is_finite(), "projection {} dB against unmixing {}", p.psnr, u.psnr);
 }
 
-/// What the device's compact calibration (`Compact::of`: one dark level, a flat per view,
-/// the hot pixels, the response) loses against the per-pixel one: the same real sensor's
-/// scene decoded with each, the compact one written as a calibration whose every pixel has
-/// the mean dark level and its view's flat (the device's model, through the host's decode).
+/// What the device's compact calibration (`Compact::of`: one dark level, a flat per view and
+/// region of 5 x 5 lenslets, the hot pixels, the response) must guarantee against the
+/// per-pixel one: the same real sensor's scene decoded with each (the compact one written as
+/// a calibration whose every pixel has the mean dark level and its view's flat in its region:
+/// the device's model through the host's decode), on two scenes and two sensors. What the
+/// compact model leaves in is each pixel's own gain (PRNU, 1 % here) and dark offset (3 DN):
+/// noise of that size, so it must recover most of what the per-pixel calibration gains over
+/// no correction (asserted: 90 %), and its regions must do better than one flat per view for
+/// the whole sensor (the vignetting drifts across it). Issue 51: before, one scene and one
+/// seed held it within 0.5 dB where 0.47 was measured.
 #[test]
 fn the_compact_calibration_is_close_to_the_per_pixel_one() {
     use slf_host::decode::device::Compact;
     use slf_host::decode::settings::DecodeSettings;
     use slf_host::eval::metrics::evaluate;
     use slf_host::sim::scene::SceneSize;
-    let lf = slf_host::sim::realistic::named("office").unwrap().render(SceneSize { views: (5, 5), rows: 30, cols: 30 });
-    let d = SensorDescription { hot_fraction: 0.001, ..sensor(0.1) };
-    let real = slf_host::sim::camera::simulate(&lf, &camera(d, 1)).unwrap();
-    let caps = calibration_captures(&camera(d, 1), [30, 30], VIEWS, BAND_NM.len(), 4).unwrap();
-    let (cal, _) = calibrate(&caps, None).unwrap();
-    // The device's regions (5 x 5 lenslets), and one region for the whole sensor.
-    let whole = Compact::of(&cal, (1, 1)).unwrap();
-    let c = Compact::of(&cal, slf_host::decode::device::regions_for([30, 30])).unwrap();
-    let (rows, cols) = cal.frame_size();
-    let (u, v) = (VIEWS[0], VIEWS[1]);
-    let per_pixel = |c: &Compact| -> Vec<f32> {
-        let (rr, rc) = (usize::from(c.regions.0), usize::from(c.regions.1));
-        (0..rows * cols)
-            .map(|p| {
-                let (row, col) = (p / cols, p % cols);
-                let (i, j) = ((row / u) * rr / 30, (col / v) * rc / 30);
-                c.view_gains[((i * rc + j) * u + row % u) * v + col % v]
-            })
-            .collect()
-    };
-    let flat = per_pixel(&c);
-    let one = Calibration::new(cal.description.clone(), vec![whole.black; rows * cols], per_pixel(&whole)).unwrap();
-    let compact = Calibration::new(cal.description.clone(), vec![c.black; rows * cols], flat).unwrap();
-    let dirs = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
-    cal.save(dirs.0.path()).unwrap();
-    compact.save(dirs.1.path()).unwrap();
-    one.save(dirs.2.path()).unwrap();
-    let decode = |dir: &std::path::Path| {
-        let at = dir.display().to_string();
-        // One model for all three (the model trial could pick another for each): the
-        // calibrations are compared, not the models.
-        let s = DecodeSettings::from_flags(["--calibration", at.as_str(), "--model-trial", "false"]).unwrap();
-        evaluate(&lf, &s.run(&real, false, &|_, _| {}).unwrap().light_field).unwrap()
-    };
-    let (full, small, whole) = (decode(dirs.0.path()), decode(dirs.1.path()), decode(dirs.2.path()));
-    eprintln!("per-pixel {full:?}\ncompact {small:?}\none flat per view {whole:?}");
-    assert!(small.psnr > full.psnr - 0.5, "compact {} dB against per-pixel {}", small.psnr, full.psnr);
-    // Without regions the drift of the vignetting is left in: the regions are needed.
-    assert!(whole.psnr < small.psnr - 1.0, "one flat per view {} dB against regions {}", whole.psnr, small.psnr);
+    for (scene, seed) in [("office", 21u64), ("outdoor", 5)] {
+        let lf =
+            slf_host::sim::realistic::named(scene).unwrap().render(SceneSize { views: (5, 5), rows: 30, cols: 30 });
+        let d = SensorDescription { hot_fraction: 0.001, seed, ..sensor(0.1) };
+        let real = slf_host::sim::camera::simulate(&lf, &camera(d, 1)).unwrap();
+        let caps = calibration_captures(&camera(d, 1), [30, 30], VIEWS, BAND_NM.len(), 4).unwrap();
+        let (cal, _) = calibrate(&caps, None).unwrap();
+        // The device's regions (5 x 5 lenslets), and one region for the whole sensor.
+        let whole = Compact::of(&cal, (1, 1)).unwrap();
+        let c = Compact::of(&cal, slf_host::decode::device::regions_for([30, 30])).unwrap();
+        let (rows, cols) = cal.frame_size();
+        let (u, v) = (VIEWS[0], VIEWS[1]);
+        let per_pixel = |c: &Compact| -> Vec<f32> {
+            let (rr, rc) = (usize::from(c.regions.0), usize::from(c.regions.1));
+            (0..rows * cols)
+                .map(|p| {
+                    let (row, col) = (p / cols, p % cols);
+                    let (i, j) = ((row / u) * rr / 30, (col / v) * rc / 30);
+                    c.view_gains[((i * rc + j) * u + row % u) * v + col % v]
+                })
+                .collect()
+        };
+        let flat = per_pixel(&c);
+        let one = Calibration::new(cal.description.clone(), vec![whole.black; rows * cols], per_pixel(&whole)).unwrap();
+        let compact = Calibration::new(cal.description.clone(), vec![c.black; rows * cols], flat).unwrap();
+        let dirs = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+        cal.save(dirs.0.path()).unwrap();
+        compact.save(dirs.1.path()).unwrap();
+        one.save(dirs.2.path()).unwrap();
+        // One model for all (the model trial could pick another for each): the calibrations
+        // are compared, not the models.
+        let decode = |flags: &[&str]| {
+            let s = DecodeSettings::from_flags([&["--model-trial", "false"], flags].concat()).unwrap();
+            evaluate(&lf, &s.run(&real, false, &|_, _| {}).unwrap().light_field).unwrap()
+        };
+        let with = |dir: &std::path::Path| decode(&["--calibration", dir.to_str().unwrap()]);
+        let (full, small, one) = (with(dirs.0.path()), with(dirs.1.path()), with(dirs.2.path()));
+        let none = decode(&[]);
+        eprintln!(
+            "{scene}, sensor seed {seed}: uncorrected {:.2} dB, per-pixel {:.2}, compact {:.2}, one flat per view {:.2}",
+            none.psnr, full.psnr, small.psnr, one.psnr
+        );
+        let gained = full.psnr - none.psnr;
+        assert!(gained > 3.0, "{scene}: the per-pixel calibration gains only {gained:.2} dB: nothing to test");
+        assert!(
+            small.psnr - none.psnr >= 0.9 * gained,
+            "{scene}: compact {:.2} dB recovers less than 90 % of the per-pixel {:.2} over uncorrected {:.2}",
+            small.psnr,
+            full.psnr,
+            none.psnr
+        );
+        assert!(
+            one.psnr < small.psnr,
+            "{scene}: one flat per view {:.2} dB against regions {:.2}",
+            one.psnr,
+            small.psnr
+        );
+    }
 }
