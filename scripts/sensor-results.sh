@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The real sensor's tables (docs/results-sensor.md, issue 43): for each scene at pixel k = 1
-# and 3, a sensor with 0, 10 and 30 % filter leakage, with and without vignetting to 50 %
-# (and always a 3 DN dark spread, 1 % PRNU, 0.1 % hot pixels when the sensor is real): the
+# and 3, the ideal sensor (no leakage, no vignetting, no dark spread) and a real one with 10
+# and 30 % filter leakage, each with and without vignetting to 50 % (and a 3 DN dark spread,
+# 1 % PRNU, 0.1 % hot pixels); vignetting without leakage is scripts/vignetting-noise.sh's. The
 # ideal sensor's decode, the real sensor's uncorrected decode, its calibrated decode
 # (`slf simulate --calibration-captures`, `slf calibrate`, `slf decode --calibration`), and
 # the calibrated baselines. PSNR / SSIM / SA and the decode's seconds. Nothing is kept but
