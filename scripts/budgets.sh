@@ -14,7 +14,15 @@
 # 128.5 KiB.
 # Also writes the device's frame figure for `slf bench --device` to target/device-frame.csv
 # (or $SLF_DEVICE_FRAME): patch solves, instructions a solve and clock per kind of decode.
+#
+#   bash scripts/budgets.sh            # measure and print the table
+#   bash scripts/budgets.sh --write    # and put it in the README, between its budgets.sh marks
+#   bash scripts/budgets.sh --check    # and fail when the README's table is not the one measured
+#                                      # (each number within 3 %: another compiler moves the
+#                                      # instruction counts a little; CI runs this)
 set -euo pipefail
+mode=${1:-}
+case "$mode" in ""|--write|--check) ;; *) echo "usage: budgets.sh [--write|--check]"; exit 2 ;; esac
 cd "$(dirname "$0")/.."
 source scripts/device-build.sh
 timeout 600 qemu-system-arm -M mps2-an500 -nographic -semihosting-config enable=on,target=native \
@@ -23,8 +31,14 @@ timeout 600 qemu-system-arm -M mps2-an500 -nographic -semihosting-config enable=
 sizes=$(llvm-size -A "$elf")
 sec() { echo "$sizes" | awk -v s="$1" '$1 == s { print $2 }'; }
 text=$(sec .text); rodata=$(sec .rodata); data=$(sec .data); bss=$(sec .bss)
-python3 - "$text" "$rodata" "$data" "$bss" "${SLF_DEVICE_FRAME:-target/device-frame.csv}" <<'PY'
-import re, sys
+SLF_BUDGETS_MODE="$mode" python3 - "$text" "$rodata" "$data" "$bss" "${SLF_DEVICE_FRAME:-target/device-frame.csv}" <<'PY'
+import os, re, sys
+table = []
+_print = print
+def print(line):
+    """A line of the table: printed, and kept for the README."""
+    table.append(line)
+    _print(line)
 text, rodata, data, bss = (int(x or 0) for x in sys.argv[1:5])
 log = open("target/budget-device.log").read()
 wins = [int(x) for x in re.findall(r"wincount: end window \d+ insns=(\d+)", open("target/wincount.log").read())]
@@ -106,6 +120,39 @@ with open(sys.argv[5], "w") as f:
     f.write(f'"default kind: screened ensemble, full-view patches, stride 3, sheared strip in bands",{solves_100:.0f},{ens:.0f},480\n')
     f.write(f'"preview kind: 5D DCT, full-view patches, disjoint grid, from the minimum-norm start",{20 * 20},{dct:.0f},480\n')
 ok = flash <= 256 * 1024 and ram <= 512 * 1024 and stack <= 128 * 1024
-print("within budget" if ok else "OVER BUDGET")
+_print("within budget" if ok else "OVER BUDGET")
+
+# The README's table is this one: written there with --write, compared with --check.
+BEGIN, END = "<!-- budgets.sh: made by `bash scripts/budgets.sh --write` -->", "<!-- /budgets.sh -->"
+readme = open("README.md").read()
+mode = os.environ.get("SLF_BUDGETS_MODE", "")
+block = "\n".join(t for line in table for t in line.split("\n"))
+if mode:
+    if BEGIN not in readme or END not in readme:
+        sys.exit(f"README.md has no {BEGIN} ... {END} block")
+    head, rest = readme.split(BEGIN, 1)
+    old, tail = rest.split(END, 1)
+if mode == "--write":
+    open("README.md", "w").write(head + BEGIN + "\n" + block + "\n" + END + tail)
+    _print("wrote the table into README.md")
+elif mode == "--check":
+    number = re.compile(r"\d[\d,]*(?:\.\d+)?")
+    def parts(text):
+        rows = [r for r in text.strip().splitlines() if r.strip()]
+        return [(number.sub("#", r), [float(x.replace(",", "")) for x in number.findall(r)]) for r in rows]
+    have, want = parts(old), parts(block)
+    stale = len(have) != len(want)
+    for (hs, hn), (ws_, wn) in zip(have, want):
+        if hs != ws_ or len(hn) != len(wn):
+            _print(f"README row differs: {hs!r}\n  measured:         {ws_!r}")
+            stale = True
+            continue
+        for h, w in zip(hn, wn):
+            if abs(h - w) > 0.03 * max(abs(w), 1.0):
+                _print(f"README says {h:g}, measured {w:g}: {ws_}")
+                stale = True
+    if stale:
+        sys.exit("README.md's budget table is not the one measured: run bash scripts/budgets.sh --write")
+    _print("README.md's budget table is the one measured (each number within 3 %)")
 sys.exit(0 if ok else 1)
 PY
