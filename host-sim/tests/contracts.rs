@@ -417,3 +417,35 @@ fn folders_are_written_whole_and_refused_when_mixed() {
     let err = String::from_utf8(out.stderr).unwrap();
     assert!(err.contains("records no sizes and checksums of its frames"), "{err}");
 }
+
+/// The memory a calibration's exposures take, checked before any capture is made or read
+/// (issue 51: `--exposures 256` at 100 x 100 lenslets peaked at 2.1 GB unannounced).
+#[test]
+fn calibration_captures_are_checked_against_the_memory_cap() {
+    let tmp = tempfile::tempdir().unwrap();
+    let p = |n: &str| tmp.path().join(n);
+    ok(slf().args(["scene", "smooth", "--size", "16", "-o"]).arg(p("lf.npy")));
+    let e = failure(
+        slf()
+            .arg("simulate")
+            .arg(p("lf.npy"))
+            .arg("-o")
+            .arg(p("cap"))
+            .args(["--leakage", "0.1", "--exposures", "256", "--max-memory", "0.05", "--calibration-captures"])
+            .arg(p("cc")),
+    );
+    assert!(e.contains("15 kinds of calibration capture x 256 exposures of 80 x 80 pixels needs about"), "{e}");
+    assert!(e.contains("fewer --exposures"), "{e}");
+    assert!(!p("cap").exists() && !p("cc").exists());
+    ok(slf()
+        .arg("simulate")
+        .arg(p("lf.npy"))
+        .arg("-o")
+        .arg(p("cap"))
+        .args(["--leakage", "0.1", "--exposures", "64", "--calibration-captures"])
+        .arg(p("cc")));
+    // 960 captures of 12.8 KB: 12.4 MB, over a cap of 0.01 GiB (10.7 MB).
+    let e = failure(slf().arg("calibrate").arg(p("cc")).arg("-o").arg(p("cal")).args(["--max-memory", "0.01"]));
+    assert!(e.contains("960 calibration captures of 1 frames of 80 x 80 pixels needs about"), "{e}");
+    ok(slf().arg("calibrate").arg(p("cc")).arg("-o").arg(p("cal")));
+}

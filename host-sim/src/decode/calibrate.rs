@@ -62,8 +62,28 @@ pub fn calibrate_folders(paths: &[PathBuf], output: &Path, response: Option<&Pat
             folders.extend(inner);
         }
     }
-    let loaded: Vec<(String, Capture)> =
-        folders.iter().map(|p| Capture::load(p).map(|c| (p.display().to_string(), c))).collect::<Result<_>>()?;
+    // Every capture is held while the calibration is made: the first's size times their
+    // count is checked against the memory cap before the rest are read.
+    let mut loaded: Vec<(String, Capture)> = Vec::with_capacity(folders.len());
+    for (i, p) in folders.iter().enumerate() {
+        let c = Capture::load(p)?;
+        if i == 0 {
+            let (rows, cols) = c.frame_size();
+            let each = (c.frames.len() * rows * cols * 2) as u64;
+            // The dark and flat sums and the hot pixels beside them, in f64: 17 bytes a pixel.
+            let need = each * folders.len() as u64 + (rows * cols) as u64 * 17;
+            crate::io::budget::check(
+                need,
+                &format!(
+                    "{} calibration captures of {} frames of {rows} x {cols} pixels",
+                    folders.len(),
+                    c.frames.len()
+                ),
+                "fewer exposures",
+            )?;
+        }
+        loaded.push((p.display().to_string(), c));
+    }
     let mut outputs = Outputs::new();
     for (_, c) in &loaded {
         outputs = outputs.inputs(c.files(), "a calibration capture's file");
