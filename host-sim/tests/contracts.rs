@@ -449,3 +449,54 @@ fn calibration_captures_are_checked_against_the_memory_cap() {
     assert!(e.contains("960 calibration captures of 1 frames of 80 x 80 pixels needs about"), "{e}");
     ok(slf().arg("calibrate").arg(p("cc")).arg("-o").arg(p("cal")));
 }
+
+/// Item 16 and the "also confusing" list: messages that name what is wrong, and refusals
+/// where a run went on without a word.
+#[test]
+fn messages_name_what_is_wrong() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let p = |n: &str| dir.join(n);
+    calibrated_setup(dir);
+
+    // A calibration whose band centres are 1 nm off: named as band centres (before: "the same
+    // lenslets, views and bands").
+    let mut cal = slf_host::io::calibration::Calibration::load(&p("cal")).unwrap();
+    cal.description.bands_nm.iter_mut().for_each(|b| *b += 1.0);
+    cal.save(&p("cal-shifted")).unwrap();
+    let e = failure(
+        slf().arg("decode").arg(p("cap")).arg("--calibration").arg(p("cal-shifted")).args(["-o"]).arg(p("o.npy")),
+    );
+    assert!(e.contains("band centres (bands_nm [401.0") && e.contains("are not the capture's ([400.0"), "{e}");
+
+    // A device log whose lines are out of order: the line and the patch named (before:
+    // "error: patch").
+    std::fs::write(p("device.log"), "patch 0 5 0 0 x 7\ncalibrated gains 3f800000\ndata 3f800000\n").unwrap();
+    let e = failure(slf().arg("device-check").arg(p("device.log")).arg("--capture").arg(p("cap")));
+    assert!(
+        e.contains("line 3: data for the patch at lenslet (0, 5), view (0, 0)") && e.contains("out of order"),
+        "{e}"
+    );
+
+    // A sensor's dark levels saturating pixels are not the light field's fault.
+    let out = slf()
+        .arg("simulate")
+        .arg(p("lf.npy"))
+        .arg("-o")
+        .arg(p("dark-sd"))
+        .args(["--dark-sd", "1000"])
+        .assert()
+        .success()
+        .get_output()
+        .clone();
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(err.contains("saturated: the light field stays below the clip") && err.contains("--dark-sd"), "{err}");
+
+    // A calibration capture is not decoded as a scene; a subfolder that is no capture is
+    // named, not skipped.
+    let e = failure(slf().arg("decode").arg(p("cc/flat-00")).arg("-o").arg(p("o.npy")));
+    assert!(e.contains("flat-00/capture.json: a calibration capture"), "{e}");
+    std::fs::create_dir(p("cc/notes")).unwrap();
+    let e = failure(slf().arg("calibrate").arg(p("cc")).arg("-o").arg(p("cal-2")));
+    assert!(e.contains("cc/notes: no capture.json"), "{e}");
+}
