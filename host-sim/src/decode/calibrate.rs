@@ -257,14 +257,14 @@ pub fn calibrate(captures: &[(String, Capture)], response: Option<Vec<Vec<f32>>>
                 .collect();
             // The sweep's labels against its frames: band b's light is seen most by filter
             // b (labels rotated by one once calibrated at 16.8 dB with rc 0).
-            for b in 0..bands {
+            for (b, band_nm) in d0.bands_nm.iter().enumerate() {
                 let most = (0..bands).max_by(|&f, &g| r[f][b].total_cmp(&r[g][b])).unwrap_or(b);
                 if most != b {
                     let name = clipped.get(&b).map_or("", |e| e.2);
                     bail!(
                         "{name}: the captures labelled band {b} ({} nm) are seen most by filter {most} ({} nm), not \
                          by filter {b}: is the sweep mislabelled?",
-                        d0.bands_nm[b],
+                        band_nm,
                         d0.bands_nm[most]
                     );
                 }
