@@ -176,14 +176,15 @@ fn a_training_too_large_for_memory_is_refused_at_once() {
 fn calibrated_setup(dir: &Path) {
     let p = |n: &str| dir.join(n);
     ok(slf().args(["scene", "smooth", "--size", "16", "-o"]).arg(p("lf.npy")));
-    ok(slf()
-        .arg("simulate")
-        .arg(p("lf.npy"))
-        .arg("-o")
-        .arg(p("cap"))
-        .args(["--leakage", "0.1", "--exposures", "2", "--calibration-captures"])
-        .arg(p("cc")));
+    ok(&mut simulate_with_captures(&p("lf.npy"), &p("cap"), &p("cc"), &["--leakage", "0.1", "--exposures", "2"]));
     ok(slf().arg("calibrate").arg(p("cc")).arg("-o").arg(p("cal")));
+}
+
+/// `slf simulate LF -o CAP FLAGS... --calibration-captures CC`.
+fn simulate_with_captures(lf: &Path, cap: &Path, cc: &Path, flags: &[&str]) -> Command {
+    let mut c = slf();
+    c.arg("simulate").arg(lf).arg("-o").arg(cap).args(flags).arg("--calibration-captures").arg(cc);
+    c
 }
 
 fn edit_capture(dir: &Path, f: impl FnOnce(&mut slf_host::io::capture::Capture)) {
@@ -314,13 +315,7 @@ fn calibrate_refuses_saturated_mislabelled_and_mixed_sweeps() {
     assert!(e.contains("seen most by filter 0"), "{e}");
 
     // Another sensor's captures beside these.
-    ok(slf()
-        .arg("simulate")
-        .arg(p("lf.npy"))
-        .arg("-o")
-        .arg(p("cap2"))
-        .args(["--leakage", "0.3", "--calibration-captures"])
-        .arg(p("other")));
+    ok(&mut simulate_with_captures(&p("lf.npy"), &p("cap2"), &p("other"), &["--leakage", "0.3"]));
     let e = failure(slf().arg("calibrate").arg(p("cc")).arg(p("other/flat-00")).arg("-o").arg(p("c2")));
     assert!(e.contains("other/flat-00: another sensor than"), "{e}");
     assert!(!p("c2").exists());
@@ -356,13 +351,12 @@ fn folders_are_written_whole_and_refused_when_mixed() {
     assert!(e.contains("two/snapshot_1.pgm: CRC-32") && e.contains("mixed or the file altered"), "{e}");
 
     // A flat from another calibration beside these dark levels.
-    ok(slf()
-        .arg("simulate")
-        .arg(p("lf.npy"))
-        .arg("-o")
-        .arg(p("cap-b"))
-        .args(["--leakage", "0.1", "--prnu", "0.05", "--exposures", "1", "--calibration-captures"])
-        .arg(p("cc-b")));
+    ok(&mut simulate_with_captures(
+        &p("lf.npy"),
+        &p("cap-b"),
+        &p("cc-b"),
+        &["--leakage", "0.1", "--prnu", "0.05", "--exposures", "1"],
+    ));
     ok(slf().arg("calibrate").arg(p("cc-b")).arg("-o").arg(p("cal-b")));
     std::fs::copy(p("cal-b/flat.npy"), p("cal/flat.npy")).unwrap();
     let e = failure(&mut decode(&p("cap"), Some(&p("cal"))));
@@ -397,13 +391,7 @@ fn folders_are_written_whole_and_refused_when_mixed() {
     // A set of calibration captures written over another sensor's set replaces it whole
     // (item 7: before, the old captures stayed beside the new ones and calibrate read all).
     let old_set = std::fs::read_dir(p("cc")).unwrap().count();
-    ok(slf()
-        .arg("simulate")
-        .arg(p("lf.npy"))
-        .arg("-o")
-        .arg(p("cap-c"))
-        .args(["--leakage", "0.3", "--exposures", "1", "--calibration-captures"])
-        .arg(p("cc")));
+    ok(&mut simulate_with_captures(&p("lf.npy"), &p("cap-c"), &p("cc"), &["--leakage", "0.3", "--exposures", "1"]));
     let new_set = std::fs::read_dir(p("cc")).unwrap().count();
     assert_eq!((old_set, new_set), (30, 15));
     ok(slf().arg("calibrate").arg(p("cc")).arg("-o").arg(p("cal-c")));
@@ -425,25 +413,16 @@ fn calibration_captures_are_checked_against_the_memory_cap() {
     let tmp = tempfile::tempdir().unwrap();
     let p = |n: &str| tmp.path().join(n);
     ok(slf().args(["scene", "smooth", "--size", "16", "-o"]).arg(p("lf.npy")));
-    let e = failure(
-        slf()
-            .arg("simulate")
-            .arg(p("lf.npy"))
-            .arg("-o")
-            .arg(p("cap"))
-            .args(["--leakage", "0.1", "--exposures", "256", "--max-memory", "0.05", "--calibration-captures"])
-            .arg(p("cc")),
-    );
+    let e = failure(&mut simulate_with_captures(
+        &p("lf.npy"),
+        &p("cap"),
+        &p("cc"),
+        &["--leakage", "0.1", "--exposures", "256", "--max-memory", "0.05"],
+    ));
     assert!(e.contains("15 kinds of calibration capture x 256 exposures of 80 x 80 pixels needs about"), "{e}");
     assert!(e.contains("fewer --exposures"), "{e}");
     assert!(!p("cap").exists() && !p("cc").exists());
-    ok(slf()
-        .arg("simulate")
-        .arg(p("lf.npy"))
-        .arg("-o")
-        .arg(p("cap"))
-        .args(["--leakage", "0.1", "--exposures", "64", "--calibration-captures"])
-        .arg(p("cc")));
+    ok(&mut simulate_with_captures(&p("lf.npy"), &p("cap"), &p("cc"), &["--leakage", "0.1", "--exposures", "64"]));
     // 960 captures of 12.8 KB: 12.4 MB, over a cap of 0.01 GiB (10.7 MB).
     let e = failure(slf().arg("calibrate").arg(p("cc")).arg("-o").arg(p("cal")).args(["--max-memory", "0.01"]));
     assert!(e.contains("960 calibration captures of 1 frames of 80 x 80 pixels needs about"), "{e}");
