@@ -7,6 +7,8 @@ use std::process::{Command as Std, Stdio};
 
 use assert_cmd::Command;
 
+mod common;
+
 fn slf() -> Command {
     Command::cargo_bin("slf").unwrap()
 }
@@ -397,10 +399,7 @@ fn folders_are_written_whole_and_refused_when_mixed() {
     ok(slf().arg("calibrate").arg(p("cc")).arg("-o").arg(p("cal-c")));
 
     // A capture written before the records existed loads, with a note.
-    let json = p("three/capture.json");
-    let mut v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-    v.as_object_mut().unwrap().remove("files");
-    std::fs::write(&json, serde_json::to_string_pretty(&v).unwrap()).unwrap();
+    common::forget_records(&p("three"));
     let out = decode(&p("three"), None).assert().success().get_output().clone();
     let err = String::from_utf8(out.stderr).unwrap();
     assert!(err.contains("records no sizes and checksums of its frames"), "{err}");

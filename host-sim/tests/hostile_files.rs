@@ -15,7 +15,7 @@ use slf_host::io::npy::{self, NpyErrorKind, Values};
 use slf_host::sim::camera::{CameraConfig, simulate};
 
 mod common;
-use common::{npy_bytes, png_claiming, small_smooth};
+use common::{forget_records, npy_bytes, png_claiming, small_smooth};
 
 fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
     let p = dir.join(name);
@@ -303,14 +303,6 @@ fn saved_capture() -> (tempfile::TempDir, serde_json::Value) {
     forget_records(dir.path());
     let json = std::fs::read_to_string(dir.path().join("capture.json")).unwrap();
     (dir, serde_json::from_str(&json).unwrap())
-}
-
-/// Drops `files` from the capture folder's description (see [`saved_capture`]).
-fn forget_records(dir: &Path) {
-    let path = dir.join("capture.json");
-    let mut v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
-    v.as_object_mut().unwrap().remove("files");
-    std::fs::write(&path, serde_json::to_string_pretty(&v).unwrap()).unwrap();
 }
 
 #[test]

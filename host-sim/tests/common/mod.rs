@@ -108,3 +108,12 @@ impl<const PU: usize, const PV: usize, const N: usize> slf_host::firmware::Patch
         }
     }
 }
+
+/// Drops `files` (each file's size and CRC-32) from the folder's `capture.json`: a folder
+/// from another tool or an older slf, whose frames are read without that check.
+pub fn forget_records(dir: &std::path::Path) {
+    let path = dir.join("capture.json");
+    let mut v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    v.as_object_mut().unwrap().remove("files");
+    std::fs::write(&path, serde_json::to_string_pretty(&v).unwrap()).unwrap();
+}
