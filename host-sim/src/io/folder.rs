@@ -34,7 +34,11 @@ pub enum Kind {
 /// description at `target` names in `frames` and `files`.
 fn named_files(target: &Path, description: &str, fixed: &[&str]) -> Vec<String> {
     let mut names: Vec<String> = std::iter::once(description).chain(fixed.iter().copied()).map(String::from).collect();
-    let text = fs::read_to_string(target.join(description)).unwrap_or_default();
+    // A description is small: one larger than 64 MiB (a capture's own cap) is not read,
+    // and names nothing.
+    let path = target.join(description);
+    let small = fs::metadata(&path).is_ok_and(|m| m.is_file() && m.len() <= 64 << 20);
+    let text = if small { fs::read_to_string(&path).unwrap_or_default() } else { String::new() };
     if let Ok(v) = serde_json::from_str::<serde_json::Value>(&text) {
         let frames = v["frames"].as_array().into_iter().flatten().filter_map(|f| f.as_str());
         let files = v["files"].as_array().into_iter().flatten().filter_map(|f| f["name"].as_str());
