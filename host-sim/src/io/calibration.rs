@@ -293,7 +293,9 @@ impl Calibration {
         let (dark, flat) = (read(DARK)?, read(FLAT)?);
         check_dark(&description, &dark, cols).map_err(|e| anyhow!("{}: {e}", dir.join(DARK).display()))?;
         check_flat(&flat, cols).map_err(|e| anyhow!("{}: {e}", dir.join(FLAT).display()))?;
-        Self::new(description, dark, flat).map_err(|e| anyhow!("{}: {e}", dir.display()))
+        // Every check of `new` is done: the description above, the frames' shapes from
+        // their headers, their values just now (each naming its file).
+        Ok(Self { description, dark, flat })
     }
 
     /// The files a calibration has in folder `dir`.
