@@ -46,7 +46,7 @@ fn the_calibration_recovers_the_simulated_sensor() {
         assert_eq!(report.lines.len(), 2);
         let desc = &caps[0].1.description;
         let range = desc.white_level - desc.black_level;
-        let truth = Sensor::new(&d, LENSLETS, VIEWS, &BAND_NM, range).unwrap();
+        let truth = Sensor::new(&d, LENSLETS, VIEWS, &BAND_NM, range, None).unwrap();
         let b = BAND_NM.len();
 
         // The response matrix, per entry above 1 % of its row's peak.

@@ -51,7 +51,7 @@ fn a_real_sensors_capture_is_its_model_pixel_by_pixel() {
         let desc = &cap.description;
         let (black, white, top) =
             (f64::from(desc.black_level), f64::from(desc.white_level), f64::from(desc.saturation_level));
-        let sensor = Sensor::new(&d, [LENSLETS, LENSLETS], [5, 5], &BAND_NM, (white - black) as f32).unwrap();
+        let sensor = Sensor::new(&d, [LENSLETS, LENSLETS], [5, 5], &BAND_NM, (white - black) as f32, None).unwrap();
         let r = response(&d.filters, &BAND_NM).unwrap();
         let mask = cap.mask().unwrap();
         let (rows, cols) = (LENSLETS * 5, LENSLETS * 5);

@@ -14,6 +14,7 @@ use slf_firmware::{
 };
 
 use crate::io::folder::{FileRecord, Kind, WholeFolder, record, verify};
+use crate::io::grid::LensletGrid;
 use crate::io::lightfield::{read_npy_u16_2d, write_npy_u16_2d};
 use crate::io::message::one_line;
 use crate::io::output::{write_bytes, write_whole};
@@ -56,6 +57,15 @@ impl MaskDescription {
             MaskFamily::Pixel => Self::Pixel(src),
             MaskFamily::Lenslet => Self::Lenslet(src),
             MaskFamily::Kronecker => Self::Kronecker { snapshots, seed, block: [5, 5] },
+        }
+    }
+
+    /// The family's name, as `capture.json` writes it.
+    pub fn family_name(&self) -> &'static str {
+        match self {
+            Self::Pixel(_) => "pixel",
+            Self::Lenslet(_) => "lenslet",
+            Self::Kronecker { .. } => "kronecker",
         }
     }
 }
@@ -118,6 +128,10 @@ pub struct CaptureDescription {
     /// or one of the calibration captures `slf calibrate` reads.
     #[serde(default, skip_serializing_if = "Light::is_scene")]
     pub light: Light,
+    /// Where the lenslet array sits on the sensor (version 2, [`crate::io::grid`]): the
+    /// frames are then its sensor's size, not `S*U x T*V`. Absent: the aligned grid.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lenslet_grid: Option<LensletGrid>,
     /// Each frame's size and CRC-32 as written ([`crate::io::folder`]), checked on load; a
     /// loaded capture's description holds none (they describe the files, not the capture).
     /// Absent in folders written before they were (loaded with a note).
@@ -277,7 +291,10 @@ impl Capture {
 
     /// Frame size `(rows, cols)`.
     pub fn frame_size(&self) -> (usize, usize) {
-        self.sensor().frame_size()
+        match &self.description.lenslet_grid {
+            Some(g) => (g.sensor[0], g.sensor[1]),
+            None => self.sensor().frame_size(),
+        }
     }
 
     /// The mask, built by the firmware's own code.
@@ -770,6 +787,24 @@ impl CaptureDescription {
             u16::MAX,
             u16::MAX
         );
+        let (rows, cols) = match &self.lenslet_grid {
+            None => (rows, cols),
+            Some(g) => {
+                ensure!(
+                    self.version == VERSION_SENSOR,
+                    "lenslet_grid needs version {VERSION_SENSOR}, this capture says {}",
+                    self.version
+                );
+                g.check(self.lenslets, self.views)?;
+                ensure!(
+                    matches!(self.mask, MaskDescription::Pixel(_)),
+                    "lenslet_grid with a {} mask: its filters sit on the lenslets, and only a pixel mask (a filter \
+                     per sensor pixel) is modelled behind a lenslet grid",
+                    self.mask.family_name()
+                );
+                (g.sensor[0], g.sensor[1])
+            }
+        };
         ensure!(
             (1..=32).contains(&self.bands_nm.len()),
             "bands_nm has {} entries, expected 1..=32",

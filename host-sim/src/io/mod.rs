@@ -11,6 +11,7 @@
 //! - [`capture`]: the capture folder (frames and `capture.json`), loaded and saved;
 //! - [`hdf5_rows`]: a light field's HDF5 file, from its rows;
 //! - [`folder`]: folders written whole, and the checksums their descriptions record;
+//! - [`grid`]: the lenslet grid, where a real lenslet array sits on the sensor;
 //! - [`import`]: views, hyperspectral cubes, HDF5 light fields and band resampling;
 //! - [`message`]: an error as the one line a user reads;
 //! - [`output`]: results written whole, never over an input of the same run;
@@ -25,6 +26,7 @@ pub mod budget;
 pub mod calibration;
 pub mod capture;
 pub mod folder;
+pub mod grid;
 pub mod hdf5_rows;
 pub mod import;
 pub mod lightfield;

@@ -8,6 +8,13 @@
 //! code is saturated). Defective pixels are stuck at 0 or the top code and listed in the
 //! capture description, as a calibrated camera would list them.
 //!
+//! Behind a lenslet grid ([`CameraConfig::grid`], [`crate::io::grid`]: rotated, a
+//! non-integer pitch, offset) a pixel records each view cell it covers, weighted by the
+//! share of its area the cell covers ([`crate::sim::footprint`]), across the micro-images'
+//! borders too; the frames are the grid's sensor's size, and the capture records the grid
+//! (`lenslet_grid`, version 2). Only the pixel mask (a filter per sensor pixel) is modelled
+//! there: a lenslet or kronecker mask's filters sit on the lenslets.
+//!
 //! With a real sensor ([`crate::sim::sensor`]) a pixel records its filter's response to
 //! every band, times its gain and its view's vignetting, above its own dark level; the
 //! capture then records the sensor (`simulated_sensor`, version 2). The ideal sensor's
@@ -22,9 +29,11 @@ use crate::io::capture::{
     Capture, CaptureDescription, FORMAT, Light, MaskDescription, MaskSource, NoiseDescription, VERSION, VERSION_SENSOR,
     frame_names,
 };
+use crate::io::grid::LensletGrid;
 use crate::io::lightfield::LightField;
 use crate::io::sensor::SensorDescription;
-use crate::sim::sensor::Sensor;
+use crate::sim::footprint::footprint;
+use crate::sim::sensor::{Sensor, vignette_on_grid};
 use crate::sim::spectra::BAND_NM;
 
 /// Everything about the simulated camera besides the light field.
@@ -50,6 +59,31 @@ pub struct CameraConfig {
     pub frame_ext: String,
     /// The sensor's imperfections ([`SensorDescription::IDEAL`]: none).
     pub sensor: SensorDescription,
+    /// Where the lenslet array sits on the sensor: rotation, pitch, offset
+    /// ([`crate::io::grid`]); `None` (or the aligned grid) for `U x V` pixels under every
+    /// lenslet, its rows the sensor's.
+    pub grid: Option<GridSettings>,
+}
+
+/// A lenslet grid as a user states it: the sensor's size and the offset follow from the
+/// light field's lenslets ([`LensletGrid::centred`]) unless given.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GridSettings {
+    /// Degrees (positive turns the lenslet rows down to the right).
+    pub rotation_deg: f64,
+    /// Pixels per lenslet, `[rows, cols]`.
+    pub pitch: [f64; 2],
+    /// Lenslet (0, 0)'s micro-image centre `[row, col]`, pixels; `None`: the array
+    /// centred on the sensor.
+    pub offset: Option<[f64; 2]>,
+}
+
+impl GridSettings {
+    /// The grid for a light field of `lenslets` lenslets.
+    pub fn grid(&self, lenslets: [usize; 2]) -> LensletGrid {
+        let centred = LensletGrid::centred(lenslets, self.rotation_deg, self.pitch);
+        LensletGrid { offset: self.offset.unwrap_or(centred.offset), ..centred }
+    }
 }
 
 impl CameraConfig {
@@ -67,6 +101,7 @@ impl CameraConfig {
             seed,
             frame_ext: "pgm".into(),
             sensor: SensorDescription::IDEAL,
+            grid: None,
         }
     }
 
@@ -137,7 +172,12 @@ pub fn simulate_under(lf: &LightField, cam: &CameraConfig, light: Light) -> Resu
     ensure!(black < top, "black level {black} at or above the top code {top}");
     let white = black + cam.white_fraction * (top - black);
     let (lu, lv) = lf.views;
-    let (rows, cols) = (lf.rows * lu, lf.cols * lv);
+    // The aligned grid is no grid: its captures are made and written as before grids.
+    let grid = cam.grid.map(|g| g.grid([lf.rows, lf.cols])).filter(|g| !g.is_aligned([lf.rows, lf.cols], [lu, lv]));
+    if let Some(g) = &grid {
+        g.check([lf.rows, lf.cols], [lu, lv])?;
+    }
+    let (rows, cols) = grid.map_or((lf.rows * lu, lf.cols * lv), |g| (g.sensor[0], g.sensor[1]));
     let k = cam.snapshots();
 
     let mut rng = ChaCha8Rng::seed_from_u64(cam.seed);
@@ -148,7 +188,7 @@ pub fn simulate_under(lf: &LightField, cam: &CameraConfig, light: Light) -> Resu
     let real = !cam.sensor.is_ideal();
     let description = CaptureDescription {
         format: FORMAT.into(),
-        version: if real || !light.is_scene() { VERSION_SENSOR } else { VERSION },
+        version: if real || !light.is_scene() || grid.is_some() { VERSION_SENSOR } else { VERSION },
         lenslets: [lf.rows, lf.cols],
         views: [lu, lv],
         bands_nm: BAND_NM.to_vec(),
@@ -162,6 +202,7 @@ pub fn simulate_under(lf: &LightField, cam: &CameraConfig, light: Light) -> Resu
         defective_pixels: defects.clone(),
         simulated_sensor: real.then_some(cam.sensor),
         light,
+        lenslet_grid: grid,
         files: None,
     };
     // Build the mask through the capture so the description is checked the same way as a
@@ -169,21 +210,44 @@ pub fn simulate_under(lf: &LightField, cam: &CameraConfig, light: Light) -> Resu
     let blank = Capture::new(description.clone(), vec![vec![0; rows * cols]; k])?;
     let mask = blank.mask()?;
     let sensor = if real {
-        Some(Sensor::new(&cam.sensor, [lf.rows, lf.cols], [lu, lv], &BAND_NM, white - black)?)
+        Some(Sensor::new(&cam.sensor, [lf.rows, lf.cols], [lu, lv], &BAND_NM, white - black, grid.as_ref())?)
     } else {
         None
     };
     let read = Normal::new(0.0f32, cam.read_noise.max(0.0)).map_err(|e| anyhow::anyhow!("read noise: {e}"))?;
     let mut frames = vec![vec![0u16; rows * cols]; k];
+    let vignetting = cam.sensor.vignetting;
+    let mut cells = Vec::new();
     for row in 0..rows {
         for col in 0..cols {
             let bands = mask.bands_at(row, col);
+            // The light field where the pixel lies: its view, or behind a grid each view
+            // cell it covers, weighted by its share and shaded by its view's vignetting
+            // (the lenslet's neighbours' cells too; no light outside the light field).
             let (s, u, t, v) = (row / lu, row % lu, col / lv, col % lv);
+            if let Some(g) = &grid {
+                footprint(g, [lu, lv], row, col, &mut cells);
+            }
+            let light = |b: usize| match &grid {
+                None => lf.get(u, v, s, t, b),
+                Some(_) => cells
+                    .iter()
+                    .filter_map(|&([i, j], share)| {
+                        let (s, u) = (i.div_euclid(lu as i64), i.rem_euclid(lu as i64) as usize);
+                        let (t, v) = (j.div_euclid(lv as i64), j.rem_euclid(lv as i64) as usize);
+                        let (s, t) = (usize::try_from(s).ok()?, usize::try_from(t).ok()?);
+                        (s < lf.rows && t < lf.cols).then(|| {
+                            let shade = if real { vignette_on_grid(vignetting, [lu, lv], u, v) } else { 1.0 };
+                            share * shade * f64::from(lf.get(u, v, s, t, b).max(0.0))
+                        })
+                    })
+                    .sum::<f64>() as f32,
+            };
             for (j, &band) in bands.iter().enumerate() {
                 let p = row * cols + col;
                 let l = match &sensor {
-                    None => lf.get(u, v, s, t, band as usize).max(0.0),
-                    Some(sensor) => sensor.signal(p, band as usize, |b| lf.get(u, v, s, t, b)),
+                    None => light(band as usize).max(0.0),
+                    Some(sensor) => sensor.signal(p, band as usize, light),
                 };
                 let dark = sensor.as_ref().map_or(0.0, |sensor| sensor.dark[p]);
                 let signal = match cam.full_well {

@@ -10,6 +10,7 @@
 //!   light, dim captures);
 //! - [`camera`]: a light field to raw frames with the firmware's masks, noise, black level,
 //!   quantisation, saturation and defects, as a capture;
+//! - [`footprint`]: the share of a pixel each view cell of a lenslet grid covers;
 //! - [`calibration`]: a simulated sensor's calibration captures (dark, flat, band sweep);
 //! - [`sensor`]: the sensor as it is: leaky filters, dark levels and gains per pixel, hot
 //!   pixels, vignetted views;
@@ -24,6 +25,7 @@
 pub mod calibration;
 pub mod camera;
 pub mod flags;
+pub mod footprint;
 pub mod hard;
 pub mod import;
 pub mod realistic;

@@ -36,6 +36,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 
+use crate::io::grid::LensletGrid;
 use crate::io::sensor::{FilterDescription, SensorDescription};
 
 /// How far the micro-image's centre moves at the sensor's edges, in views.
@@ -111,12 +112,30 @@ pub fn vignette(
     if vignetting == 0.0 || corner == 0.0 {
         return 1.0;
     }
-    let a = 1.0 / (1.0 - f64::from(vignetting)).sqrt() - 1.0;
     // The micro-image's centre, moved by the lenslet's place (-1 to 1 across the sensor).
     let place = |i: usize, n: usize| 2.0 * (i as f64 + 0.5) / n as f64 - 1.0;
     let cu = half(views[0]) + IMAGE_SHIFT * place(s, lenslets[0]);
     let cv = half(views[1]) + IMAGE_SHIFT * place(t, lenslets[1]);
-    let r2 = ((u as f64 - cu).powi(2) + (v as f64 - cv).powi(2)) / (corner * corner);
+    shade(vignetting, corner, [u as f64 - cu, v as f64 - cv])
+}
+
+/// [`vignette`] on a lenslet grid ([`crate::io::grid`]): view `(u, v)` of a micro-image
+/// centred on its middle view. The grid is the micro-images' grid, found from a flat as
+/// the toolboxes find it, so the chief ray's shift is in its pitch, not here.
+pub fn vignette_on_grid(vignetting: f32, views: [usize; 2], u: usize, v: usize) -> f64 {
+    let half = |n: usize| (n as f64 - 1.0) / 2.0;
+    let corner = half(views[0]).hypot(half(views[1]));
+    if vignetting == 0.0 || corner == 0.0 {
+        return 1.0;
+    }
+    shade(vignetting, corner, [u as f64 - half(views[0]), v as f64 - half(views[1])])
+}
+
+/// The cos^4 law's share at `d` views from the micro-image's centre, the corner view
+/// `corner` views away losing `vignetting`.
+fn shade(vignetting: f32, corner: f64, d: [f64; 2]) -> f64 {
+    let a = 1.0 / (1.0 - f64::from(vignetting)).sqrt() - 1.0;
+    let r2 = (d[0] * d[0] + d[1] * d[1]) / (corner * corner);
     1.0 / (1.0 + a * r2).powi(2)
 }
 
@@ -131,7 +150,8 @@ pub struct Sensor {
     pub response: Vec<f64>,
     /// Each pixel's dark level above the black level, DN, row-major.
     pub dark: Vec<f32>,
-    /// Each pixel's gain times its view's vignetting, row-major.
+    /// Each pixel's gain times its view's vignetting, row-major (on a lenslet grid the
+    /// gain alone: the camera shades each view cell a pixel covers, [`vignette_on_grid`]).
     pub gain: Vec<f32>,
     /// Hot pixels, `[row, col]`, in row-major order.
     pub hot: Vec<[u32; 2]>,
@@ -140,7 +160,7 @@ pub struct Sensor {
 impl Sensor {
     /// The sensor `d` describes, for frames of `lenslets` x `views` pixels over `bands_nm`,
     /// with `range_dn` DN between black and white (hot pixels sit 10-50 % of it above
-    /// black).
+    /// black); behind a lenslet grid, frames of `grid`'s sensor size.
     ///
     /// # Errors
     /// A description out of its ranges.
@@ -150,10 +170,14 @@ impl Sensor {
         views: [usize; 2],
         bands_nm: &[f32],
         range_dn: f32,
+        grid: Option<&LensletGrid>,
     ) -> Result<Self> {
         d.check()?;
         let response = response(&d.filters, bands_nm)?;
-        let (rows, cols) = (lenslets[0] * views[0], lenslets[1] * views[1]);
+        let (rows, cols) = match grid {
+            Some(g) => (g.sensor[0], g.sensor[1]),
+            None => (lenslets[0] * views[0], lenslets[1] * views[1]),
+        };
         // Its own stream: the same sensor whatever seeds the scene's noise.
         let mut rng = ChaCha8Rng::seed_from_u64(d.seed ^ 0x5e45_0a5e_45a0_5e45);
         let dark_sd = Normal::new(0.0f32, d.dark_sd_dn).map_err(|e| anyhow::anyhow!("dark_sd_dn: {e}"))?;
@@ -169,7 +193,8 @@ impl Sensor {
                 }
                 dark[p] = level;
                 let (s, u, t, v) = (row / views[0], row % views[0], col / views[1], col % views[1]);
-                let shade = vignette(d.vignetting, lenslets, views, s, t, u, v) as f32;
+                let shade =
+                    if grid.is_some() { 1.0 } else { vignette(d.vignetting, lenslets, views, s, t, u, v) as f32 };
                 gain[p] = prnu.sample(&mut rng).max(0.0) * shade;
             }
         }
@@ -246,8 +271,8 @@ mod tests {
     #[test]
     fn a_sensor_is_its_seeds_and_its_statistics_are_asked_for() {
         let d = SensorDescription { dark_sd_dn: 4.0, hot_fraction: 0.01, prnu: 0.02, ..SensorDescription::IDEAL };
-        let a = Sensor::new(&d, [40, 40], [5, 5], &BAND_NM, 3000.0).unwrap();
-        let b = Sensor::new(&d, [40, 40], [5, 5], &BAND_NM, 3000.0).unwrap();
+        let a = Sensor::new(&d, [40, 40], [5, 5], &BAND_NM, 3000.0, None).unwrap();
+        let b = Sensor::new(&d, [40, 40], [5, 5], &BAND_NM, 3000.0, None).unwrap();
         assert_eq!((&a.dark, &a.gain, &a.hot), (&b.dark, &b.gain, &b.hot));
         let n = a.dark.len() as f64;
         let hot = a.hot.len() as f64 / n;
@@ -259,7 +284,7 @@ mod tests {
         let mean = g.iter().sum::<f64>() / n;
         let gsd = (g.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / n).sqrt();
         assert!((mean - 1.0).abs() < 0.002 && (0.019..0.021).contains(&gsd), "gain {mean} sd {gsd}");
-        let other = Sensor::new(&SensorDescription { seed: 2, ..d }, [40, 40], [5, 5], &BAND_NM, 3000.0).unwrap();
+        let other = Sensor::new(&SensorDescription { seed: 2, ..d }, [40, 40], [5, 5], &BAND_NM, 3000.0, None).unwrap();
         assert_ne!(a.dark, other.dark);
     }
 }

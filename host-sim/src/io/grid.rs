@@ -1,0 +1,213 @@
+//! The lenslet grid: where a real lenslet array sits on the sensor (issue 52).
+//!
+//! A lenslet array is glued on with a rotation of a few tenths of a degree, its pitch is a
+//! non-integer number of pixels, and its first lenslet is not on pixel (0, 0). A
+//! [`LensletGrid`] says all three, as `capture.json` and `calibration.json` record it
+//! (`lenslet_grid`), and maps a point of the sensor to its place in the light field.
+//!
+//! Coordinates. A sensor point is `(row, col)` in pixels, `(0, 0)` the top-left corner of
+//! pixel `(0, 0)` (its centre is `(0.5, 0.5)`). Lenslet `(s, t)`'s micro-image is centred
+//! at `offset + R (s * pitch[0], t * pitch[1])`, where `R` turns the lenslet columns' axis
+//! `(0, 1)` to `(sin a, cos a)` and the rows' axis `(1, 0)` to `(cos a, -sin a)`:
+//! `rotation_deg` positive tilts the lenslet rows down to the right, as a frame is shown
+//! (row 0 on top). The grid's *view cells* divide each micro-image into `U x V` equal
+//! cells, the views: a sensor point lies in view cell `(i, j)` = `(s U + u, t V + v)`, at
+//! cell coordinates `q = (d_row / pitch[0] * U + U / 2, d_col / pitch[1] * V + V / 2)`,
+//! `d = R^T (point - offset)`. On the aligned grid (no rotation, pitch `(U, V)`, offset
+//! `(U / 2, V / 2)`) pixel `(s U + u, t V + v)` is exactly view cell `(s U + u, t V + v)`:
+//! what slf assumed before grids.
+//!
+//! The grid is the micro-images' grid, as the light-field toolboxes find it from a white
+//! image (Dansereau et al. 2013): its pitch includes the main lens's chief-ray spread, so
+//! a view is an angle relative to the main lens, which is what the decode needs.
+//!
+//! A hexagonal grid (Lytro's) would give every other lenslet row a shift of half a pitch
+//! along the row, and its view cells would be a hexagon's; [`LensletGrid::cell`] is the one
+//! place that maps a point to a cell, so such a grid replaces it and the cell polygon.
+
+use anyhow::{Result, ensure};
+use serde::{Deserialize, Serialize};
+
+use crate::io::message::number;
+
+/// `v` as [`number`] writes it.
+fn number_f64(v: f64) -> String {
+    number(v as f32)
+}
+
+/// The largest rotation a grid may state, degrees: a lenslet array glued on more than a few
+/// degrees off is not aligned but turned, and its sensor would lose whole lenslet rows.
+pub const MAX_ROTATION_DEG: f64 = 10.0;
+
+/// How far a grid's pitch may lie from its views, as a fraction (5 views: 4 to 6 px).
+pub const MAX_PITCH_OFF: f64 = 0.2;
+
+/// `lenslet_grid` in `capture.json` and `calibration.json`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LensletGrid {
+    /// The lenslet rows' angle to the sensor's rows, degrees; positive turns them down to
+    /// the right.
+    pub rotation_deg: f64,
+    /// Pixels from one micro-image centre to the next `[down a column, along a row]`.
+    pub pitch: [f64; 2],
+    /// The sensor point `[row, col]` of lenslet (0, 0)'s micro-image centre, pixels.
+    pub offset: [f64; 2],
+    /// The sensor's size `[rows, cols]` in pixels: the frames'.
+    pub sensor: [usize; 2],
+    /// How far the micro-image centres a calibration found lie from this grid, RMS
+    /// pixels (`slf calibrate`'s; absent on a grid that was stated).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub centres_rms_px: Option<f64>,
+}
+
+impl LensletGrid {
+    /// The aligned grid of `lenslets` lenslets of `views` views: what slf assumes without
+    /// a grid.
+    pub fn aligned(lenslets: [usize; 2], views: [usize; 2]) -> Self {
+        Self {
+            rotation_deg: 0.0,
+            pitch: [views[0] as f64, views[1] as f64],
+            offset: [views[0] as f64 / 2.0, views[1] as f64 / 2.0],
+            sensor: [lenslets[0] * views[0], lenslets[1] * views[1]],
+            centres_rms_px: None,
+        }
+    }
+
+    /// The grid `rotation_deg` and `pitch` describe, centred on a sensor just large enough
+    /// for `lenslets` lenslets unrotated (`round(S * pitch)` x `round(T * pitch)`): the array's
+    /// middle on the sensor's middle, its corners cut off by a rotation as a real sensor
+    /// cuts them.
+    pub fn centred(lenslets: [usize; 2], rotation_deg: f64, pitch: [f64; 2]) -> Self {
+        let sensor =
+            [(lenslets[0] as f64 * pitch[0]).round() as usize, (lenslets[1] as f64 * pitch[1]).round() as usize];
+        let mid = [(lenslets[0] as f64 - 1.0) / 2.0 * pitch[0], (lenslets[1] as f64 - 1.0) / 2.0 * pitch[1]];
+        let turned = rotate(rotation_deg, mid);
+        Self {
+            rotation_deg,
+            pitch,
+            offset: [sensor[0] as f64 / 2.0 - turned[0], sensor[1] as f64 / 2.0 - turned[1]],
+            sensor,
+            centres_rms_px: None,
+        }
+    }
+
+    /// Whether this is exactly the aligned grid of `lenslets` x `views` (then the decode
+    /// and the simulator take the aligned path, and give the same bytes as before grids).
+    pub fn is_aligned(&self, lenslets: [usize; 2], views: [usize; 2]) -> bool {
+        Self { centres_rms_px: None, ..*self } == Self::aligned(lenslets, views)
+    }
+
+    /// Checks the grid against a light field of `lenslets` x `views`.
+    ///
+    /// # Errors
+    /// A message naming the field out of its range.
+    pub fn check(&self, lenslets: [usize; 2], views: [usize; 2]) -> Result<()> {
+        ensure!(
+            self.rotation_deg.is_finite() && self.rotation_deg.abs() <= MAX_ROTATION_DEG,
+            "lenslet_grid.rotation_deg {}: must be within +-{MAX_ROTATION_DEG} degrees",
+            number_f64(self.rotation_deg)
+        );
+        #[allow(clippy::needless_range_loop)] // four arrays, one axis
+        for a in 0..2 {
+            let n = views[a] as f64;
+            ensure!(
+                self.pitch[a].is_finite() && (self.pitch[a] - n).abs() <= MAX_PITCH_OFF * n,
+                "lenslet_grid.pitch[{a}] {} px: must be within {} % of the {} views (a micro-image of {} to {} px)",
+                number_f64(self.pitch[a]),
+                MAX_PITCH_OFF * 100.0,
+                views[a],
+                number_f64(n * (1.0 - MAX_PITCH_OFF)),
+                number_f64(n * (1.0 + MAX_PITCH_OFF))
+            );
+            ensure!(
+                (1..=usize::from(u16::MAX)).contains(&self.sensor[a]),
+                "lenslet_grid.sensor[{a}] {}: must be in 1..={}",
+                self.sensor[a],
+                u16::MAX
+            );
+            // The grid must put the light field's lenslets on the sensor, not beside it.
+            let reach = lenslets[0] as f64 * self.pitch[0] + lenslets[1] as f64 * self.pitch[1];
+            ensure!(
+                self.offset[a].is_finite() && self.offset[a].abs() <= reach + self.sensor[a] as f64,
+                "lenslet_grid.offset[{a}] {} px: lenslet (0, 0) must lie on or near the {} x {} sensor",
+                number_f64(self.offset[a]),
+                self.sensor[0],
+                self.sensor[1]
+            );
+        }
+        if let Some(r) = self.centres_rms_px {
+            ensure!(r.is_finite() && r >= 0.0, "lenslet_grid.centres_rms_px {}: must be at or above 0", number_f64(r));
+        }
+        Ok(())
+    }
+
+    /// The micro-image centre of lenslet `(s, t)`, a sensor point.
+    pub fn centre(&self, s: f64, t: f64) -> [f64; 2] {
+        let d = rotate(self.rotation_deg, [s * self.pitch[0], t * self.pitch[1]]);
+        [self.offset[0] + d[0], self.offset[1] + d[1]]
+    }
+
+    /// The view-cell coordinates of sensor point `p` for `views` views: cell
+    /// `(floor(q0), floor(q1))` = `(s U + u, t V + v)` holds it (module docs).
+    pub fn cell(&self, views: [usize; 2], p: [f64; 2]) -> [f64; 2] {
+        let d = rotate(-self.rotation_deg, [p[0] - self.offset[0], p[1] - self.offset[1]]);
+        let q = |a: usize| d[a] / self.pitch[a] * views[a] as f64 + views[a] as f64 / 2.0;
+        [q(0), q(1)]
+    }
+}
+
+/// `v` turned by `deg` degrees: the columns' axis `(0, 1)` to `(sin, cos)`.
+pub fn rotate(deg: f64, v: [f64; 2]) -> [f64; 2] {
+    let (sin, cos) = deg.to_radians().sin_cos();
+    [v[0] * cos + v[1] * sin, -v[0] * sin + v[1] * cos]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_aligned_grid_puts_each_pixel_in_its_own_view_cell() {
+        let g = LensletGrid::aligned([3, 4], [5, 5]);
+        assert_eq!(LensletGrid::centred([3, 4], 0.0, [5.0, 5.0]), g);
+        g.check([3, 4], [5, 5]).unwrap();
+        for row in 0..15 {
+            for col in 0..20 {
+                let q = g.cell([5, 5], [row as f64 + 0.5, col as f64 + 0.5]);
+                assert_eq!([q[0].floor(), q[1].floor()], [row as f64, col as f64]);
+            }
+        }
+        assert_eq!(g.centre(1.0, 2.0), [7.5, 12.5]);
+    }
+
+    #[test]
+    fn centres_and_cells_agree_on_a_turned_grid() {
+        let g = LensletGrid::centred([20, 30], 0.7, [5.04, 4.97]);
+        g.check([20, 30], [5, 5]).unwrap();
+        for (s, t) in [(0.0, 0.0), (3.0, 17.0), (19.0, 29.0)] {
+            // A micro-image centre is the middle of its lenslet's cells: (s U + 2.5, t V + 2.5).
+            let q = g.cell([5, 5], g.centre(s, t));
+            assert!((q[0] - (5.0 * s + 2.5)).abs() < 1e-9 && (q[1] - (5.0 * t + 2.5)).abs() < 1e-9, "{q:?}");
+        }
+        // Down one lenslet column moves along (cos, -sin): the rows tilt down to the right.
+        let (a, b) = (g.centre(0.0, 0.0), g.centre(0.0, 1.0));
+        assert!(b[0] > a[0] && (b[0] - a[0] - 4.97 * 0.7f64.to_radians().sin()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn grids_out_of_range_are_refused_by_field() {
+        let ok = LensletGrid::centred([10, 10], 0.3, [5.02, 5.02]);
+        for (bad, says) in [
+            (LensletGrid { rotation_deg: 45.0, ..ok }, "rotation_deg"),
+            (LensletGrid { pitch: [5.0, 7.0], ..ok }, "pitch[1]"),
+            (LensletGrid { pitch: [f64::NAN, 5.0], ..ok }, "pitch[0]"),
+            (LensletGrid { sensor: [0, 50], ..ok }, "sensor[0]"),
+            (LensletGrid { offset: [1e9, 0.0], ..ok }, "offset[0]"),
+            (LensletGrid { centres_rms_px: Some(-1.0), ..ok }, "centres_rms_px"),
+        ] {
+            let e = bad.check([10, 10], [5, 5]).unwrap_err().to_string();
+            assert!(e.contains(says), "{e}");
+        }
+    }
+}
