@@ -214,6 +214,9 @@ def simulate(
     prnu: Optional[float] = None,
     vignetting: Optional[float] = None,
     sensor_seed: Optional[int] = None,
+    rotation: Optional[float] = None,
+    pitch: Optional[Union[float, Sequence[float]]] = None,
+    grid_offset: Optional[Sequence[float]] = None,
     calibration_captures: Optional[PathLike] = None,
     exposures: int = 8,
 ) -> Capture:
@@ -232,7 +235,15 @@ def simulate(
     ``secondary_nm`` and ``leak_floor``; ``dark_sd`` (DN) and ``hot_pixels`` (fraction),
     ``prnu`` (gain spread), ``vignetting`` (light the corner view loses) and ``sensor_seed``
     (one sensor for every capture made with it). Such a capture records its sensor in its
-    description's ``simulated_sensor`` (format version 2). ``calibration_captures``: a
+    description's ``simulated_sensor`` (format version 2).
+
+    A real lenslet array, off by default (``--rotation``, ``--pitch``, ``--grid-offset``):
+    ``rotation`` (degrees, positive turns the lenslet rows down to the right), ``pitch``
+    (pixels per lenslet, one number or ``(rows, cols)``), ``grid_offset`` (lenslet (0, 0)'s
+    micro-image centre, ``(row, col)`` pixels; default the array centred). The frames are
+    then the grid's sensor's size and the description records ``lenslet_grid``.
+
+    ``calibration_captures``: a
     folder to write the sensor's dark, flat and band-sweep captures into, ``exposures``
     (1..=256) of each, as ``--calibration-captures DIR --exposures N`` does, for
     :func:`calibrate`.
@@ -258,6 +269,9 @@ def simulate(
         prnu=prnu,
         vignetting=vignetting,
         sensor_seed=sensor_seed,
+        rotation=rotation,
+        pitch=pitch,
+        grid_offset=grid_offset,
     )
     cal = None if calibration_captures is None else _path("calibration_captures", calibration_captures)
     frames, text, notes = _slf.simulate(arr, args, cal, exposures)

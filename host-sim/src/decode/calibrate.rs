@@ -16,6 +16,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail, ensure};
 
+use crate::decode::grid_fit::fit_grid;
 use crate::io::calibration::{
     Calibration, CalibrationDescription, FORMAT, Sources, VERSION, check_response, read_response,
 };
@@ -122,8 +123,9 @@ pub fn calibrate(captures: &[(String, Capture)], response: Option<Vec<Vec<f32>>>
                 && d.bands_nm == d0.bands_nm
                 && d.mask == d0.mask
                 && d.black_level == d0.black_level
-                && d.white_level == d0.white_level,
-            "{name}: another camera than {first_name}'s (lenslets, views, bands, mask or levels differ)"
+                && d.white_level == d0.white_level
+                && d.lenslet_grid.map(|g| g.sensor) == d0.lenslet_grid.map(|g| g.sensor),
+            "{name}: another camera than {first_name}'s (lenslets, views, bands, mask, levels or sensor size differ)"
         );
         // One sensor throughout: a folder holding another simulated sensor's captures
         // beside these once calibrated with rc 0 and cost the decode 5.5 dB.
@@ -183,11 +185,32 @@ pub fn calibrate(captures: &[(String, Capture)], response: Option<Vec<Vec<f32>>>
     let hot_pixels: Vec<[u32; 2]> =
         (0..rows * cols).filter(|&p| bad[p]).map(|p| [(p / cols) as u32, (p % cols) as u32]).collect();
 
-    // Vignetting per view: the mean flat of the working pixels at each view.
+    // Behind a lenslet grid, the grid from the flats, hot pixels replaced by their working
+    // neighbours' mean.
     let [u_n, v_n] = d0.views;
+    let fit = match &d0.lenslet_grid {
+        None => None,
+        Some(_) => {
+            let mended = mend(&flat, &bad, (rows, cols));
+            Some(fit_grid(&mended, (rows, cols), d0.lenslets, d0.views).context("the lenslet grid")?)
+        }
+    };
+    // Vignetting per view: the mean flat of the working pixels at each view (behind a
+    // grid, the view cell a pixel's centre lies in, pixels off the light field left out).
     let mut sums = vec![(0.0f64, 0usize); u_n * v_n];
     for p in (0..rows * cols).filter(|&p| !bad[p]) {
-        let (u, v) = ((p / cols) % u_n, (p % cols) % v_n);
+        let (u, v) = match &fit {
+            None => ((p / cols) % u_n, (p % cols) % v_n),
+            Some(fit) => {
+                let q = fit.grid.cell(d0.views, [(p / cols) as f64 + 0.5, (p % cols) as f64 + 0.5]);
+                let (i, j) = (q[0].floor() as i64, q[1].floor() as i64);
+                let (s, t) = (i.div_euclid(u_n as i64), j.div_euclid(v_n as i64));
+                if s < 0 || t < 0 || s >= d0.lenslets[0] as i64 || t >= d0.lenslets[1] as i64 {
+                    continue;
+                }
+                (i.rem_euclid(u_n as i64) as usize, j.rem_euclid(v_n as i64) as usize)
+            }
+        };
         let s = &mut sums[u * v_n + v];
         *s = (s.0 + f64::from(flat[p]), s.1 + 1);
     }
@@ -287,6 +310,7 @@ pub fn calibrate(captures: &[(String, Capture)], response: Option<Vec<Vec<f32>>>
         vignetting,
         hot_pixels,
         sources: Sources { dark: darks.len(), flat: flats.len(), band: band_count },
+        lenslet_grid: fit.map(|f| f.grid),
         files: None,
     };
     let report = Report {
@@ -309,7 +333,43 @@ pub fn calibrate(captures: &[(String, Capture)], response: Option<Vec<Vec<f32>>>
             ),
         ],
     };
+    let mut report = report;
+    if let Some(f) = &fit {
+        let g = &f.grid;
+        report.lines.push(format!(
+            "lenslet grid: rotation {:.4} degrees, pitch {:.4} x {:.4} px, lenslet (0, 0) at ({:.3}, {:.3}); {} \
+             micro-image centres within {:.3} px RMS ({} left out)",
+            g.rotation_deg,
+            g.pitch[0],
+            g.pitch[1],
+            g.offset[0],
+            g.offset[1],
+            f.centres,
+            g.centres_rms_px.unwrap_or(0.0),
+            f.outliers
+        ));
+    }
     Ok((Calibration::new(description, dark, flat)?, report))
+}
+
+/// `flat` with each of its `bad` pixels the mean of its working 8 neighbours (1 where it
+/// has none): the grid is found from the flat's shape, which a hot pixel would bend.
+fn mend(flat: &[f32], bad: &[bool], (rows, cols): (usize, usize)) -> Vec<f32> {
+    let mut out = flat.to_vec();
+    for p in (0..rows * cols).filter(|&p| bad[p]) {
+        let (r, c) = (p / cols, p % cols);
+        let (mut sum, mut n) = (0.0f32, 0u32);
+        for rr in r.saturating_sub(1)..=(r + 1).min(rows - 1) {
+            for cc in c.saturating_sub(1)..=(c + 1).min(cols - 1) {
+                if !bad[rr * cols + cc] {
+                    sum += flat[rr * cols + cc];
+                    n += 1;
+                }
+            }
+        }
+        out[p] = if n > 0 { sum / n as f32 } else { 1.0 };
+    }
+    out
 }
 
 /// `capture` corrected by `cal` for its dark levels and flats: each raw value becomes

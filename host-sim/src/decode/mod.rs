@@ -2,6 +2,8 @@
 //! is measured against.
 //!
 //! - [`calibrate`]: a sensor's calibration from its calibration captures (`slf calibrate`);
+//! - [`grid_fit`]: the lenslet grid found from the calibration's flats (micro-image
+//!   centres, then a least-squares grid);
 //! - [`cs`]: the firmware's tile decoder over a capture in parallel (rayon), with
 //!   overlapping patches, white balance, the noise model and the depth search, as asked by
 //!   its [`options`]: a frame's [`plan`] made once, then its rows decoded down the frame by
@@ -24,6 +26,7 @@ pub mod baselines;
 pub mod calibrate;
 pub mod cs;
 pub mod device;
+pub mod grid_fit;
 pub mod options;
 pub mod paper_1d;
 pub mod plan;

@@ -13,6 +13,7 @@ use crate::io::folder::{FileRecord, Kind, WholeFolder, record, verify};
 use serde::{Deserialize, Serialize};
 
 use crate::io::capture::{MAX_DESCRIPTION, read_small_file};
+use crate::io::grid::LensletGrid;
 use crate::io::lightfield::write_npy_f32_2d;
 use crate::io::message::number;
 use crate::io::npy::{self, Element, Values};
@@ -61,6 +62,10 @@ pub struct CalibrationDescription {
     /// `[row, col]` of pixels whose dark level or flat is no working pixel's.
     pub hot_pixels: Vec<[u32; 2]>,
     pub sources: Sources,
+    /// The lenslet grid found from the flats ([`crate::io::grid`]), when the captures were
+    /// taken behind one; the frames are then its sensor's size.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lenslet_grid: Option<LensletGrid>,
     /// `dark.npy`'s and `flat.npy`'s sizes and CRC-32s as written ([`crate::io::folder`]),
     /// checked on load; a loaded calibration's description holds none. Absent in folders
     /// written before they were (loaded with a note).
@@ -122,6 +127,13 @@ impl CalibrationDescription {
             self.lenslets,
             self.views
         );
+        let (rows, cols) = match &self.lenslet_grid {
+            Some(g) => {
+                g.check(self.lenslets, self.views)?;
+                (g.sensor[0], g.sensor[1])
+            }
+            None => (rows, cols),
+        };
         let b = self.bands_nm.len();
         ensure!((2..=32).contains(&b), "bands_nm has {b} entries, expected 2..=32");
         ensure!(
@@ -244,7 +256,10 @@ impl Calibration {
     /// The frame size.
     pub fn frame_size(&self) -> (usize, usize) {
         let d = &self.description;
-        (d.lenslets[0] * d.views[0], d.lenslets[1] * d.views[1])
+        match &d.lenslet_grid {
+            Some(g) => (g.sensor[0], g.sensor[1]),
+            None => (d.lenslets[0] * d.views[0], d.lenslets[1] * d.views[1]),
+        }
     }
 
     /// The response matrix row-major, `[filter][band]`.

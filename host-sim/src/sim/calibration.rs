@@ -44,7 +44,10 @@ pub fn calibration_captures(
     // Every capture is held until written, beside one light field a kind: checked before
     // any is made (--exposures 256 at 100 x 100 lenslets once took 2.1 GB unannounced).
     let kinds = 2 + bands as u64;
-    let pixels = (lenslets[0] * views[0]) as u64 * (lenslets[1] * views[1]) as u64;
+    let pixels = match &cam.grid {
+        Some(g) => g.grid(lenslets, views).sensor.iter().map(|&n| n as u64).product(),
+        None => (lenslets[0] * views[0]) as u64 * (lenslets[1] * views[1]) as u64,
+    };
     let snapshots = match &cam.mask {
         MaskDescription::Kronecker { snapshots, .. } => u64::from(*snapshots),
         MaskDescription::Pixel(m) | MaskDescription::Lenslet(m) => {

@@ -71,17 +71,18 @@ pub struct CameraConfig {
 pub struct GridSettings {
     /// Degrees (positive turns the lenslet rows down to the right).
     pub rotation_deg: f64,
-    /// Pixels per lenslet, `[rows, cols]`.
-    pub pitch: [f64; 2],
+    /// Pixels per lenslet, `[rows, cols]`; `None`: the light field's views.
+    pub pitch: Option<[f64; 2]>,
     /// Lenslet (0, 0)'s micro-image centre `[row, col]`, pixels; `None`: the array
     /// centred on the sensor.
     pub offset: Option<[f64; 2]>,
 }
 
 impl GridSettings {
-    /// The grid for a light field of `lenslets` lenslets.
-    pub fn grid(&self, lenslets: [usize; 2]) -> LensletGrid {
-        let centred = LensletGrid::centred(lenslets, self.rotation_deg, self.pitch);
+    /// The grid for a light field of `lenslets` lenslets of `views` views.
+    pub fn grid(&self, lenslets: [usize; 2], views: [usize; 2]) -> LensletGrid {
+        let pitch = self.pitch.unwrap_or([views[0] as f64, views[1] as f64]);
+        let centred = LensletGrid::centred(lenslets, self.rotation_deg, pitch);
         LensletGrid { offset: self.offset.unwrap_or(centred.offset), ..centred }
     }
 }
@@ -173,7 +174,8 @@ pub fn simulate_under(lf: &LightField, cam: &CameraConfig, light: Light) -> Resu
     let white = black + cam.white_fraction * (top - black);
     let (lu, lv) = lf.views;
     // The aligned grid is no grid: its captures are made and written as before grids.
-    let grid = cam.grid.map(|g| g.grid([lf.rows, lf.cols])).filter(|g| !g.is_aligned([lf.rows, lf.cols], [lu, lv]));
+    let grid =
+        cam.grid.map(|g| g.grid([lf.rows, lf.cols], [lu, lv])).filter(|g| !g.is_aligned([lf.rows, lf.cols], [lu, lv]));
     if let Some(g) = &grid {
         g.check([lf.rows, lf.cols], [lu, lv])?;
     }

@@ -8,9 +8,10 @@ use clap::{Args, ValueEnum};
 use slf_firmware::MaskFamily;
 
 use crate::io::capture::{Capture, MaskDescription};
+use crate::io::grid::MAX_ROTATION_DEG;
 use crate::io::lightfield::LightField;
 use crate::io::sensor::{FilterDescription, SensorDescription};
-use crate::sim::camera::{CameraConfig, simulate};
+use crate::sim::camera::{CameraConfig, GridSettings, simulate};
 use crate::sim::flags::{parse, positive};
 use crate::sim::import::{check_decodable, with_camera_bands};
 
@@ -98,6 +99,55 @@ pub struct SimulateSettings {
     /// A real sensor (all off by default: the ideal sensor the decoder assumes).
     #[command(flatten)]
     pub sensor: SensorSettings,
+    /// A real lenslet array (off by default: `U x V` pixels under every lenslet).
+    #[command(flatten)]
+    pub grid: GridFlags,
+}
+
+/// `slf simulate`'s lenslet-grid flags ([`crate::io::grid`]): any of them puts the
+/// lenslet array where they say; the capture records it (`lenslet_grid`, version 2).
+#[derive(Args, Clone, Debug, Default)]
+pub struct GridFlags {
+    /// The lenslet rows' angle to the sensor's rows, degrees in [-10, 10] (positive turns
+    /// them down to the right): a real array is glued on a few tenths of a degree off.
+    #[arg(long, value_parser = rotation)]
+    pub rotation: Option<f64>,
+    /// Pixels from one micro-image centre to the next (PX, or ROWS,COLS), within 20 % of
+    /// the views (default: the views, 5).
+    #[arg(long, value_parser = pair)]
+    pub pitch: Option<[f64; 2]>,
+    /// Lenslet (0, 0)'s micro-image centre on the sensor, ROW,COL in pixels (default: the
+    /// array centred on the sensor).
+    #[arg(long, value_parser = pair, allow_hyphen_values = true)]
+    pub grid_offset: Option<[f64; 2]>,
+}
+
+impl GridFlags {
+    /// The grid these flags describe; `None` if none is given.
+    pub fn settings(&self) -> Option<GridSettings> {
+        if self.rotation.is_none() && self.pitch.is_none() && self.grid_offset.is_none() {
+            return None;
+        }
+        Some(GridSettings { rotation_deg: self.rotation.unwrap_or(0.0), pitch: self.pitch, offset: self.grid_offset })
+    }
+}
+
+/// A rotation in degrees, within [`MAX_ROTATION_DEG`] (read as f64: the grid's own type).
+fn rotation(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v.abs() <= MAX_ROTATION_DEG => Ok(v),
+        _ => Err(format!("{s:?} is not a number in [-{MAX_ROTATION_DEG}, {MAX_ROTATION_DEG}] (degrees)")),
+    }
+}
+
+/// `X` or `X,Y`: one finite number for both axes, or one each.
+fn pair(s: &str) -> Result<[f64; 2], String> {
+    let v: Vec<Option<f64>> = s.split(',').map(|x| x.trim().parse::<f64>().ok().filter(|v| v.is_finite())).collect();
+    match v.as_slice() {
+        [Some(x)] => Ok([*x, *x]),
+        [Some(x), Some(y)] => Ok([*x, *y]),
+        _ => Err(format!("{s:?} is not one finite number or two, comma-separated")),
+    }
 }
 
 /// `slf simulate`'s real-sensor flags ([`crate::sim::sensor`]); a capture made with any of
@@ -217,6 +267,7 @@ impl SimulateSettings {
         cam.defect_fraction = self.defects;
         cam.frame_ext = self.format.extension().to_string();
         cam.sensor = self.sensor.description();
+        cam.grid = self.grid.settings();
         if self.no_noise { cam.noiseless() } else { cam }
     }
 
