@@ -15,10 +15,10 @@
 //! From the sensor to decoded patches, one folder each; a layer uses only the layers
 //! before it (the repository's `tests/layers.rs` checks every `crate::` path):
 //!
-//! - **sensor** ([`sensor`]: [`raw`], [`source`](sensor::source), [`defects`], [`spi`],
+//! - **sensor** ([`sensor`]: [`raw`], [`source`](sensor::source), [`defects`], [`grid`], [`spi`],
 //!   [`mask`], [`gains`], [`response`]): samples, which of them are measurements, frames in memory or
 //!   flash, a frame buffer read over `embedded-hal` SPI, the [`TileSource`] trait they all
-//!   implement; which band each pixel sees in each snapshot (the three mask families
+//!   implement; the lenslet grid (where a real, turned lenslet array puts each view); which band each pixel sees in each snapshot (the three mask families
 //!   `kronecker`, `lenslet`, `pixel`); the white balance, a gain per band that the decode
 //!   divides out of the measurements and multiplies back; and the filters' [`response`]
 //!   matrix, what a real filter lets through of each band.
@@ -121,7 +121,7 @@ pub mod solver;
 // Every module by its path of before the layer folders, for integrators' code.
 pub use decode::{overlap, tile, trial};
 pub use operators::{blob, dct, dictionary, disparity, schedule, shape, transform};
-pub use sensor::{defects, gains, mask, raw, response, spi};
+pub use sensor::{defects, gains, grid, mask, raw, response, spi};
 pub use solver::{
     ascent, ball, choice, fractional, holdout, interpolate, mixing, picked, pinv, plausible, projection, sl0, workspace,
 };
@@ -143,6 +143,7 @@ pub use operators::disparity::{Disparity, DisparityRange};
 pub use operators::shape::{FullViewShape, PaperShape, PatchShape};
 pub use prelude::{PAPER_N, PaperDecoder, PaperDictionary, PaperEnsemble, PaperEnsembleModel, PaperPatch, SetupError};
 pub use sensor::defects::{DefectList, Pixel};
+pub use sensor::grid::{GridError, LensletGrid};
 pub use sensor::mask::{BandTile, LensletSize, Mask, MaskFamily, SensingError};
 pub use sensor::raw::{Frame, FrameSource, LeU16Frame, RawFormat, RawFrame};
 pub use sensor::response::Response;

@@ -141,7 +141,11 @@ fn the_aligned_grid_is_todays_capture_byte_for_byte() {
 }
 
 /// The micro-image grid's RMS distance between two grids' centres of the `S x T` lenslets.
-fn centres_rms(a: &slf_host::io::grid::LensletGrid, b: &slf_host::io::grid::LensletGrid, lenslets: [usize; 2]) -> f64 {
+fn centres_rms(
+    a: &slf_host::io::grid::GridDescription,
+    b: &slf_host::io::grid::GridDescription,
+    lenslets: [usize; 2],
+) -> f64 {
     let mut sq = 0.0;
     for s in 0..lenslets[0] {
         for t in 0..lenslets[1] {
@@ -200,4 +204,68 @@ fn flats_without_micro_images_give_no_grid() {
     let captures = calibration_captures(&cam, [30, 30], [5, 5], 13, 1).unwrap();
     let e = format!("{:#}", calibrate(&captures, None).unwrap_err());
     assert!(e.contains("lenslet grid") && e.contains("micro-image") && !e.contains('\n'), "{e}");
+}
+
+/// The decode through a grid, on a capture behind a turned array (0.5 degrees, 5.08 px,
+/// noiseless, pixel k = 1, office at 30 x 30 lenslets): reading each view where the grid
+/// puts it beats reading the frame as if the array were aligned (`--grid aligned`, slf
+/// before grids) by at least 3 dB (measured 32.65 against 26.08); and the aligned grid
+/// given to the firmware's decoder reads the same pixels as no grid, so its patches are the
+/// same bits.
+#[test]
+fn the_decode_reads_each_view_where_the_grid_puts_it() {
+    use slf_host::decode::settings::DecodeSettings;
+    use slf_host::eval::metrics::evaluate;
+    use slf_host::sim::scene::SceneSize;
+    let lf = slf_host::sim::realistic::named("office").unwrap().render(SceneSize { views: (5, 5), rows: 30, cols: 30 });
+    let mut cam = CameraConfig::pixel(5, 1).noiseless();
+    cam.grid = Some(GridSettings { rotation_deg: 0.5, pitch: Some([5.08, 5.08]), offset: None });
+    let cap = simulate(&lf, &cam).unwrap();
+    let decode = |flags: &[&str]| {
+        let s = DecodeSettings::from_flags(flags.iter().copied()).unwrap();
+        evaluate(&lf, &s.run(&cap, false, &|_, _| {}).unwrap().light_field).unwrap()
+    };
+    let (grid, aligned) = (decode(&[]), decode(&["--grid", "aligned"]));
+    eprintln!("through the grid {grid:?}\nas aligned {aligned:?}");
+    assert!(grid.psnr > aligned.psnr + 3.0, "through the grid {} dB, as aligned {}", grid.psnr, aligned.psnr);
+    assert!(grid.sa < aligned.sa, "spectral angle {} through the grid, {} as aligned", grid.sa, aligned.sa);
+    // The baselines interpolate the aligned mosaic: refused behind a grid, in one line.
+    let e = DecodeSettings::from_flags(["--method", "demosaic"]).unwrap().run(&cap, false, &|_, _| {}).unwrap_err();
+    assert!(format!("{e:#}").contains("--grid aligned"), "{e:#}");
+
+    // The aligned grid through the grid's path: the same bits as the aligned path's runs.
+    let plain = simulate(&lf, &CameraConfig::pixel(5, 1)).unwrap();
+    let dec = plain.decoder::<5, 5, 8125>(slf_firmware::Sl0Config::DEFAULT).unwrap();
+    let g = slf_host::io::grid::GridDescription::aligned([30, 30], [5, 5]).firmware([5, 5]).unwrap();
+    let gridded = plain.decoder::<5, 5, 8125>(slf_firmware::Sl0Config::DEFAULT).unwrap().with_grid(Some(g)).unwrap();
+    let raw = plain.raw_frames().unwrap();
+    let dct = Box::new(slf_firmware::Dictionary::<5, 5, 5, 5, 13>::dct());
+    let mut outs = Vec::new();
+    for d in [&dec, &gridded] {
+        let mut got = Vec::new();
+        let mut ws = Box::new(slf_firmware::FullViewWorkspace::new());
+        for tile in d.tiles((2, 2)) {
+            d.decode_tile(&*dct, tile, &mut slf_firmware::FrameSource::new(&raw), &mut Collect(&mut got), &mut ws)
+                .unwrap();
+        }
+        outs.push(got);
+    }
+    assert!(!outs[0].is_empty());
+    assert!(outs[0] == outs[1], "the aligned grid's patches differ from no grid's");
+}
+
+/// Every accepted patch's values, in order.
+struct Collect<'a>(&'a mut Vec<Vec<u32>>);
+
+impl slf_firmware::PatchSink<8125> for Collect<'_> {
+    type Error = ();
+    fn accept(
+        &mut self,
+        _: slf_firmware::PatchOrigin,
+        p: &[f32; 8125],
+        _: &slf_firmware::PatchReport,
+    ) -> Result<(), ()> {
+        self.0.push(p.iter().map(|x| x.to_bits()).collect());
+        Ok(())
+    }
 }

@@ -348,6 +348,7 @@ def decode(
     blob: Optional[PathLike] = None,
     calibration: Optional[PathLike] = None,
     response_model: Optional[str] = None,
+    grid: Optional[str] = None,
     balance: Optional[str] = None,
     gains: Optional[Sequence[float]] = None,
     adaptive: Optional[float] = None,
@@ -401,7 +402,9 @@ def decode(
     wrote: dark levels, flats, hot pixels and the filters' response corrected, baselines
     too), ``response_model`` unmix (the default: each decoded spectrum unmixed by the
     response's inverse) or projection (the response in every projection of the solve),
-    ``balance`` grey or off, ``gains`` (13),
+    ``grid`` auto (the calibration's lenslet grid if it found one, else the capture's),
+    capture (the capture's ``lenslet_grid``) or aligned (the frames read as an aligned
+    array's, slf before grids), ``balance`` grey or off, ``gains`` (13),
     ``adaptive`` and the solver's ``sigma_f`` ... ``min_bands``, ``plausible``,
     ``shear_check``, ``model_trial`` (the ensemble or the DCT for the frame by their
     held-out errors on pilot patches; default True in every preset, leaning to the DCT in
@@ -457,6 +460,7 @@ def decode(
         blob=blob,
         calibration=calibration,
         response_model=response_model,
+        grid=grid,
         balance=balance,
         gains=gains,
         adaptive=adaptive,

@@ -47,10 +47,10 @@ mod device {
     use panic_semihosting as _;
     use slf_firmware::{
         ChoiceRule, DEFAULT_FULL_VIEW_ENSEMBLE, DecoderConfig, DefectList, Dictionary, Disparity, DisparityRange,
-        Ensemble, EnsembleModel, FrameSource, FullViewShape, FullViewWorkspace, HoldOut, LeU16Frame, LensletSize, Mask,
-        MemberChoice, Overlap, OverlapDecoder, PatchModel, PatchOrigin, PatchReport, PatchSink, Pick, Picked, Pixel,
-        RawFormat, Response, ResponseModel, RowSink, ScheduledDictionary, SensorGeometry, Sl0Config, TileDecoder,
-        TrialErrors,
+        Ensemble, EnsembleModel, FrameSource, FullViewShape, FullViewWorkspace, HoldOut, LeU16Frame, LensletGrid,
+        LensletSize, Mask, MemberChoice, Overlap, OverlapDecoder, PatchModel, PatchOrigin, PatchReport, PatchSink,
+        Pick, Picked, Pixel, RawFormat, Response, ResponseModel, RowSink, ScheduledDictionary, SensorGeometry,
+        Sl0Config, TileDecoder, TrialErrors,
     };
 
     use super::{bench_begin, bench_end};
@@ -96,10 +96,11 @@ mod device {
         }
     }
 
-    /// The real sensor's capture decoded with the screened ensemble: windows 8 (each tile as
-    /// the ideal sensor's, uncalibrated) and 9 (each tile with the compact calibration:
-    /// the dark level as the raw black, a flat per view, the hot pixels as defects, the
-    /// response matrix unmixing each decoded spectrum), the calibrated patches printed
+    /// The real sensor's capture decoded with the screened ensemble, through the lenslet
+    /// grid its calibration found (the array turned by a degree, 5.1 pixels a lenslet):
+    /// windows 8 (each tile as the ideal sensor's, uncalibrated) and 9 (each tile with the
+    /// compact calibration: the dark level as the raw black, a flat per view, the hot
+    /// pixels as defects, the response matrix unmixing each decoded spectrum), the calibrated patches printed
     /// after a `calibrated` line for `slf device-check`. Returns the failures.
     #[inline(never)]
     fn calibrated(
@@ -109,7 +110,12 @@ mod device {
     ) -> u32 {
         static DEFECTS: [Pixel; SENSOR_DEFECTS.len()] = SENSOR_DEFECTS;
         static VIEW_GAINS: [f32; SENSOR_VIEW_GAINS.len()] = SENSOR_VIEW_GAINS;
-        let (rows, cols) = (LENSLETS.0 as usize * VIEWS.0 as usize, LENSLETS.1 as usize * VIEWS.1 as usize);
+        let (rotation, pitch, offset, sensor) = SENSOR_GRID;
+        let Ok(grid) = LensletGrid::new(rotation, pitch, offset, VIEWS, sensor) else {
+            hprintln!("error: the real sensor's lenslet grid does not validate");
+            return 1;
+        };
+        let (rows, cols) = grid.sensor();
         let mut frames = [LeU16Frame::new(&[], 0, 0).ok(), None, None];
         for (f, file) in frames.iter_mut().zip(SENSOR_FRAMES) {
             *f = LeU16Frame::new(npy_body(file), rows, cols).ok();
@@ -121,6 +127,7 @@ mod device {
         let frames = [f0, f1, f2];
         let plain = TileDecoder::<5, 5, 5, 5, 13, 8125>::new(*config)
             .ok()
+            .and_then(|d| d.with_grid(Some(grid)).ok())
             .and_then(|d| d.estimate_gains(&mut FrameSource::new(&frames)).ok().and_then(|g| d.with_gains(&g).ok()));
         let (Ok(defects), Ok(response)) = (DefectList::new(&DEFECTS), Response::new(&SENSOR_RESPONSE)) else {
             hprintln!("error: the compact calibration does not validate");
@@ -131,6 +138,7 @@ mod device {
             .ok()
             .and_then(|d| d.with_response(&response, ResponseModel::Unmix).ok())
             .and_then(|d| d.with_view_gains(Some((&VIEW_GAINS, SENSOR_REGIONS))).ok())
+            .and_then(|d| d.with_grid(Some(grid)).ok())
             .and_then(|d| d.estimate_gains(&mut FrameSource::new(&frames)).ok().and_then(|g| d.with_gains(&g).ok()));
         let (Some(plain), Some(calibrated)) = (plain, calibrated) else {
             hprintln!("error: the real sensor's decoders were rejected");

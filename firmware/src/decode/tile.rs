@@ -26,6 +26,7 @@ use crate::operators::disparity::{
 };
 use crate::operators::shape::PatchShape;
 use crate::sensor::defects::DefectList;
+use crate::sensor::grid::LensletGrid;
 use crate::sensor::mask::{LensletSize, Mask, MaskFamily};
 use crate::sensor::raw::{Invalid, RawFormat};
 use crate::sensor::response::Response;
@@ -320,6 +321,8 @@ pub enum ConfigError {
     Plausibility,
     /// Held-out measurements of a fold below 2.
     HoldOut,
+    /// A lenslet grid of other views than the sensor's, or on a lenslet or kronecker mask.
+    Grid,
 }
 
 impl fmt::Display for ConfigError {
@@ -334,6 +337,7 @@ impl fmt::Display for ConfigError {
             Self::Stride => f.write_str("overlap stride must be in 1..=patch size per axis"),
             Self::Gains => f.write_str("band gains must each be in [1/64, 64]"),
             Self::Response => f.write_str("a response matrix that mixes bands needs a pixel or lenslet mask"),
+            Self::Grid => f.write_str("a lenslet grid needs a pixel mask and the sensor's views"),
             Self::ViewGains => f.write_str("view gains: one per view of a lenslet, each in [1/64, 64]"),
             Self::Plausibility => f.write_str("plausibility bound: factor >= 1 and margin >= 0"),
             Self::HoldOut => f.write_str("held-out measurements: one in 2 or more"),
@@ -417,6 +421,7 @@ pub struct TileDecoder<
     plausibility: Plausibility,
     holdout: Option<HoldOut>,
     shear_check: bool,
+    grid: Option<LensletGrid>,
 }
 
 /// Where a decode puts the filters' response matrix ([`TileDecoder::with_response`]).
@@ -502,6 +507,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             plausibility: Plausibility::DEFAULT,
             holdout: None,
             shear_check: false,
+            grid: None,
         })
     }
 
@@ -585,6 +591,37 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             }
         }
         Ok(Self { view_gains: gains, ..self })
+    }
+
+    /// This decoder reading a sensor behind a real lenslet array: view `(u, v)` of lenslet
+    /// `(s, t)` from the pixel under its view cell's centre ([`LensletGrid::pixel`]), the
+    /// frames `grid.sensor()` pixels, tiles and patches on the lenslet grid. Each
+    /// measurement is still one pixel's, through its own filter; a view read half a pixel
+    /// off its cell's centre is the model's error (measured in `docs/results-grid.md`).
+    /// `None`: the aligned grid, `U x V` pixels under every lenslet (the same bytes as
+    /// before grids).
+    ///
+    /// # Errors
+    /// [`ConfigError::Grid`] for a grid of other views than the sensor's lenslets, or on a
+    /// lenslet or kronecker mask (whose filters sit on the lenslets).
+    pub fn with_grid(self, grid: Option<LensletGrid>) -> Result<Self, ConfigError> {
+        if let Some(g) = &grid {
+            let l = self.config.sensor.lenslet;
+            if g.views() != (l.rows, l.cols) || self.config.mask.family() != MaskFamily::Pixel {
+                return Err(ConfigError::Grid);
+            }
+        }
+        Ok(Self { grid, ..self })
+    }
+
+    /// The lenslet grid the decode reads through, if not the aligned one.
+    pub fn grid(&self) -> Option<&LensletGrid> {
+        self.grid.as_ref()
+    }
+
+    /// The raw frames' size `(rows, cols)`: the grid's sensor, or the aligned lenslets'.
+    pub fn frame_size(&self) -> (usize, usize) {
+        self.grid.map_or_else(|| self.config.sensor.frame_size(), |g| g.sensor())
     }
 
     /// The flat field per view and region the decode divides out, if any.
@@ -849,7 +886,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     pub fn estimate_gains<S: TileSource>(&self, source: &mut S) -> Result<[f32; B], S::Error> {
         const RUN: usize = 16;
         let c = &self.config;
-        let (rows, cols) = c.sensor.frame_size();
+        let (rows, cols) = self.frame_size();
         let k = c.mask.snapshots();
         let mut sums = [0.0f32; B];
         let mut counts = [0u32; B];
@@ -969,7 +1006,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         for s in 0..PS {
             for u in 0..PU {
                 for t in 0..PT {
-                    if origin.disparity == Disparity::ZERO {
+                    if origin.disparity == Disparity::ZERO && self.grid.is_none() {
                         // One run of the lenslet's view row per snapshot.
                         let row = (origin.lenslet_row as usize + s) * lu + origin.view_row as usize + u;
                         let col0 = (origin.lenslet_col as usize + t) * lv + origin.view_col as usize;
@@ -1017,6 +1054,9 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let c = &self.config;
         let lr = usize::try_from(lr).ok().filter(|&r| r < usize::from(c.sensor.lenslets.0))?;
         let lc = usize::try_from(lc).ok().filter(|&c0| c0 < usize::from(c.sensor.lenslets.1))?;
+        if let Some(g) = &self.grid {
+            return g.pixel((lr as isize, lc as isize), (u, v));
+        }
         Some((lr * usize::from(c.sensor.lenslet.rows) + u, lc * usize::from(c.sensor.lenslet.cols) + v))
     }
 
@@ -1035,15 +1075,21 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let Some((table, (rr, rc))) = self.view_gains else { return 1.0 };
         let (lenslet, lenslets) = (self.config.sensor.lenslet, self.config.sensor.lenslets);
         let (lu, lv) = (usize::from(lenslet.rows), usize::from(lenslet.cols));
-        let (u, v) = (row.checked_rem(lu).unwrap_or(0), col.checked_rem(lv).unwrap_or(0));
-        let region = |pixel: usize, views: usize, count: u16, regions: u16| {
-            let l = pixel.checked_div(views).unwrap_or(0);
+        // The pixel's lenslet and view: on the grid, the cell its centre lies in.
+        let ((s, t), (u, v)) = match &self.grid {
+            Some(g) => g.view_of(row, col).unwrap_or(((0, 0), (0, 0))),
+            None => (
+                (row.checked_div(lu).unwrap_or(0), col.checked_div(lv).unwrap_or(0)),
+                (row.checked_rem(lu).unwrap_or(0), col.checked_rem(lv).unwrap_or(0)),
+            ),
+        };
+        let region = |l: usize, count: u16, regions: u16| {
             (l * usize::from(regions))
                 .checked_div(usize::from(count))
                 .unwrap_or(0)
                 .min(usize::from(regions).saturating_sub(1))
         };
-        let (i, j) = (region(row, lu, lenslets.0, rr), region(col, lv, lenslets.1, rc));
+        let (i, j) = (region(s, lenslets.0, rr), region(t, lenslets.1, rc));
         table.get(((i * usize::from(rc) + j) * lu + u) * lv + v).copied().unwrap_or(1.0)
     }
 

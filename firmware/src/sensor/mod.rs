@@ -7,6 +7,7 @@
 //! - [`defects`]: the sensor's defect list;
 //! - [`mask`]: which band each pixel sees in each snapshot (the three mask families), and
 //!   [`MAX_BANDS`](mask::MAX_BANDS);
+//! - [`grid`]: the lenslet grid, where a real lenslet array puts each (lenslet, view);
 //! - [`gains`]: the white balance, a gain per band;
 //! - [`response`]: the filters' response matrix (what each filter lets through of each
 //!   band), checked and inverted.
@@ -16,6 +17,7 @@
 
 pub mod defects;
 pub mod gains;
+pub mod grid;
 pub mod mask;
 pub mod raw;
 pub mod response;

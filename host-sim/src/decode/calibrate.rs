@@ -313,7 +313,7 @@ pub fn calibrate(captures: &[(String, Capture)], response: Option<Vec<Vec<f32>>>
         lenslet_grid: fit.map(|f| f.grid),
         files: None,
     };
-    let report = Report {
+    let mut report = Report {
         lines: vec![
             format!(
                 "calibration: {} dark, {} flat and {} band captures of {} x {} lenslets, {} x {} views",
@@ -333,7 +333,6 @@ pub fn calibrate(captures: &[(String, Capture)], response: Option<Vec<Vec<f32>>>
             ),
         ],
     };
-    let mut report = report;
     if let Some(f) = &fit {
         let g = &f.grid;
         report.lines.push(format!(
@@ -376,7 +375,8 @@ fn mend(flat: &[f32], bad: &[bool], (rows, cols): (usize, usize)) -> Vec<f32> {
 /// `black + (raw - dark) / flat` (DN), so a pixel reads as an ideal, unvignetted one of the
 /// capture's black and white levels; hot, dead and saturated pixels join the defects. The
 /// corrected capture's saturation level is the top of 16 bits (a vignetted pixel corrected
-/// may read above the sensor's top code and is still a measurement).
+/// may read above the sensor's top code and is still a measurement). A lenslet grid the
+/// calibration found replaces the capture's.
 ///
 /// # Errors
 /// A calibration of another geometry, bands or levels.
@@ -405,6 +405,12 @@ pub fn corrected(capture: &Capture, cal: &Calibration) -> Result<Capture> {
         c.white_level,
         d.black_level,
         d.white_level
+    );
+    ensure!(
+        capture.frame_size() == cal.frame_size(),
+        "the calibration is of a {:?} sensor, the capture's frames are {:?} (another lenslet grid's)",
+        cal.frame_size(),
+        capture.frame_size()
     );
     let (_, cols) = capture.frame_size();
     let saturation = d.saturation_level;
@@ -435,6 +441,8 @@ pub fn corrected(capture: &Capture, cal: &Calibration) -> Result<Capture> {
     }
     let mut description = d.clone();
     description.saturation_level = top;
+    // The grid the calibration found from its flats replaces the one the capture states.
+    description.lenslet_grid = c.lenslet_grid.or(d.lenslet_grid);
     description.defective_pixels = defects.into_iter().collect();
     Capture::new(description, frames)
 }

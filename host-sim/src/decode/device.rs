@@ -27,7 +27,7 @@ use crate::io::calibration::Calibration;
 use crate::io::capture::Capture;
 use crate::io::sensor::{FilterDescription, SensorDescription};
 use crate::sim::calibration::calibration_captures;
-use crate::sim::camera::{CameraConfig, simulate};
+use crate::sim::camera::{CameraConfig, GridSettings, simulate};
 use crate::sim::scene::{self, SceneSize};
 
 /// Writes the device's capture and constants into `dir`.
@@ -94,6 +94,7 @@ fn write_sensor_capture(truth: &crate::io::lightfield::LightField, dir: &Path) -
     let mut cam = CameraConfig::pixel(7, 3);
     cam.frame_ext = "npy".into();
     cam.sensor = real_sensor();
+    cam.grid = Some(SENSOR_GRID);
     let capture = simulate(truth, &cam)?;
     capture.save(&dir.join(SENSOR_CAPTURE))?;
     let views = [capture.description.views[0], capture.description.views[1]];
@@ -102,6 +103,7 @@ fn write_sensor_capture(truth: &crate::io::lightfield::LightField, dir: &Path) -
     let (cal, _) = calibrate(&captures, None)?;
     cal.save(&dir.join(CALIBRATION))?;
     let c = Compact::of(&cal, regions_for(capture.description.lenslets))?;
+    let grid = c.grid.context("the calibration found no lenslet grid")?;
     let list = |v: &[f32]| v.iter().map(|x| format!("{x:?}")).collect::<Vec<_>>().join(", ");
     let response = c.response.iter().map(|r| format!("[{}]", list(r))).collect::<Vec<_>>().join(",\n    ");
     let defects =
@@ -115,7 +117,10 @@ fn write_sensor_capture(truth: &crate::io::lightfield::LightField, dir: &Path) -
          pub const SENSOR_REGIONS: (u16, u16) = ({}, {});\n\
          pub const SENSOR_VIEW_GAINS: [f32; {}] = [{}];\n\
          pub const SENSOR_DEFECTS: [Pixel; {}] = [{}];\n\
-         pub const SENSOR_RESPONSE: [[f32; 13]; 13] = [\n    {}\n];\n",
+         pub const SENSOR_RESPONSE: [[f32; 13]; 13] = [\n    {}\n];\n\
+         // The lenslet grid `slf calibrate` found from the flats: the array turned and its\n\
+         // pitch not the views' (`LensletGrid::new`'s rotation, pitch, offset, sensor).\n\
+         pub const SENSOR_GRID: ((f32, f32), (f32, f32), (f32, f32), (u16, u16)) = ({:?}, {:?}, {:?}, {:?});\n",
         c.black,
         c.white,
         c.regions.0,
@@ -124,9 +129,18 @@ fn write_sensor_capture(truth: &crate::io::lightfield::LightField, dir: &Path) -
         list(&c.view_gains),
         c.defects.len(),
         defects,
-        response
+        response,
+        grid.rotation(),
+        grid.pitch(),
+        grid.offset(),
+        (grid.sensor().0 as u16, grid.sensor().1 as u16)
     ))
 }
+
+/// The real sensor's lenslet grid: turned by a degree, 5.1 pixels a lenslet, centred
+/// (issue 52): the device decodes a capture behind a real array with the grid its
+/// calibration found.
+pub const SENSOR_GRID: GridSettings = GridSettings { rotation_deg: 1.0, pitch: Some([5.1, 5.1]), offset: None };
 
 /// Lenslets per side of a region of the compact flat: the vignetting drifts across the
 /// sensor with the micro-image centre, and one flat per view for the whole sensor lost 4.7
@@ -163,6 +177,8 @@ pub struct Compact {
     /// Sorted.
     pub defects: Vec<Pixel>,
     pub response: [[f32; 13]; 13],
+    /// The lenslet grid the calibration found, as the firmware reads it.
+    pub grid: Option<slf_firmware::LensletGrid>,
 }
 
 impl Compact {
@@ -195,14 +211,27 @@ impl Compact {
         let (u, v) = (d.views[0], d.views[1]);
         let (lr, lc) = (d.lenslets[0], d.lenslets[1]);
         let (rr, rc) = (usize::from(regions.0).clamp(1, lr.max(1)), usize::from(regions.1).clamp(1, lc.max(1)));
+        let grid = match &d.lenslet_grid {
+            Some(g) => Some(g.firmware(d.views)?),
+            None => None,
+        };
         let mut sums = vec![(0.0f64, 0usize); rr * rc * u * v];
         for (p, &f) in cal.flat.iter().enumerate() {
             let (row, col) = (p / cols, p % cols);
             if hot.contains(&(row as u16, col as u16)) {
                 continue;
             }
-            let (i, j) = ((row / u) * rr / lr, (col / v) * rc / lc);
-            if let Some(s) = sums.get_mut(((i.min(rr - 1) * rc + j.min(rc - 1)) * u + row % u) * v + col % v) {
+            // A pixel's lenslet and view: behind a grid, the cell its centre lies in (as the
+            // decoder reads it, `LensletGrid::view_of`); off the lenslets, none.
+            let ((s, t), (pu, pv)) = match &grid {
+                Some(g) => match g.view_of(row, col) {
+                    Some(at) if at.0.0 < lr && at.0.1 < lc => at,
+                    _ => continue,
+                },
+                None => ((row / u, col / v), (row % u, col % v)),
+            };
+            let (i, j) = (s * rr / lr, t * rc / lc);
+            if let Some(s) = sums.get_mut(((i.min(rr - 1) * rc + j.min(rc - 1)) * u + pu) * v + pv) {
                 *s = (s.0 + f64::from(f), s.1 + 1);
             }
         }
@@ -214,6 +243,7 @@ impl Compact {
             regions: (rr as u16, rc as u16),
             defects: hot.into_iter().map(|(row, col)| Pixel { row, col }).collect(),
             response,
+            grid,
         })
     }
 }
@@ -462,6 +492,7 @@ fn check_calibrated(
     let unsheared =
         crate::decode::cs::DecodeOptions { disparities: Some(slf_firmware::DisparityRange::OFF), ..Default::default() };
     let plain = crate::decode::cs::tile_decoder::<5, 5, 8125>(&capture, &unsheared)?;
+    ensure!(plain.grid().is_some(), "{}: the device's real sensor is behind a turned lenslet grid", capture.source());
     let raw = capture.raw_frames()?;
     let err = |e: slf_firmware::ConfigError| anyhow::anyhow!("{e}");
     let defects = slf_firmware::DefectList::new(&c.defects).map_err(|e| anyhow::anyhow!("{e}"))?;
@@ -476,6 +507,8 @@ fn check_calibrated(
     .with_response(&response, slf_firmware::ResponseModel::Unmix)
     .map_err(err)?
     .with_view_gains(Some((&c.view_gains, c.regions)))
+    .map_err(err)?
+    .with_grid(c.grid)
     .map_err(err)?;
     let host_gains = decoder
         .estimate_gains(&mut FrameSource::new(&raw))
@@ -506,9 +539,13 @@ fn check_calibrated(
         worst = worse(worst, d.values.iter().zip(h).map(|(a, b)| f64::from((a - b).abs() / scale)).fold(0.0, worse));
     }
     outln!(
-        "device vs host, calibrated real sensor ({} hot pixels, a flat per view and region, the response unmixed): {} patches, \
-         largest relative difference {worst:.2e} (limit 1e-5); gains {worst_gain:.2e}",
+        "device vs host, calibrated real sensor ({} hot pixels, a flat per view and region, the response unmixed, behind a \
+         lenslet grid turned {:.3} degrees at {:.3} x {:.3} px): {} patches, largest relative difference {worst:.2e} (limit \
+         1e-5); gains {worst_gain:.2e}",
         c.defects.len(),
+        cal.description.lenslet_grid.map_or(0.0, |g| g.rotation_deg),
+        cal.description.lenslet_grid.map_or(0.0, |g| g.pitch[0]),
+        cal.description.lenslet_grid.map_or(0.0, |g| g.pitch[1]),
         host.0.len()
     )?;
     ensure!(within(worst), "the device's calibrated patches differ from the host's by {worst:.2e} relative");

@@ -19,7 +19,7 @@
 
 use anyhow::{Result, bail, ensure};
 
-use crate::io::grid::{LensletGrid, rotate};
+use crate::io::grid::{GridDescription, rotate};
 
 /// A centre farther than this from the grid fitted to all is left out of the fit, pixels.
 pub const OUTLIER_PX: f64 = 0.5;
@@ -37,7 +37,7 @@ const MIN_CENTRES: usize = 9;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GridFit {
     /// The grid, its `centres_rms_px` set.
-    pub grid: LensletGrid,
+    pub grid: GridDescription,
     /// Micro-image centres the grid was fitted to.
     pub centres: usize,
     /// Centres left out as outliers.
@@ -197,7 +197,7 @@ fn solve3(m: [[f64; 3]; 3], rhs: [f64; 3]) -> Option<[f64; 3]> {
 ///
 /// # Errors
 /// A flat without micro-images to find (no vignetting, too much noise), or a grid outside
-/// what [`LensletGrid::check`] accepts.
+/// what [`GridDescription::check`] accepts.
 pub fn fit_grid(
     flat: &[f32],
     (rows, cols): (usize, usize),
@@ -294,7 +294,7 @@ pub fn fit_grid(
             }
         }
     }
-    let mut grid = LensletGrid {
+    let mut grid = GridDescription {
         rotation_deg,
         pitch,
         offset: lattice.at(near[0] as f64, near[1] as f64),

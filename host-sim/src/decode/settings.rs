@@ -355,6 +355,10 @@ pub struct DecodeSettings {
     /// With --calibration, where the decode puts the filters' response matrix.
     #[arg(long, value_enum, default_value_t = ResponseChoice::Unmix, requires = "calibration")]
     pub response_model: ResponseChoice,
+    /// Which lenslet grid the decode reads the frames through (a capture behind a turned,
+    /// non-integer-pitch lenslet array: `lenslet_grid`).
+    #[arg(long, value_enum, default_value_t = GridChoice::Auto)]
+    pub grid: GridChoice,
     /// White balance: each band divided by a gain before the solve and multiplied back
     /// (grey: each band's mean over the frame, as the device does it).
     #[arg(long, value_enum, default_value_t = WhiteBalance::Grey)]
@@ -678,6 +682,7 @@ impl DecodeSettings {
         // The output contract, on the capture as recorded: a corrected capture's saturation
         // is the top of 16 bits.
         let (lo, hi) = capture.raw_format().range();
+        let stated = capture.description.lenslet_grid;
         let calibrated;
         let (capture, inverse, response) = match &self.calibration {
             Some(dir) => {
@@ -696,6 +701,28 @@ impl DecodeSettings {
             }
             None => (capture, None, None),
         };
+        let regridded;
+        let capture = match self.grid {
+            GridChoice::Auto => capture,
+            GridChoice::Capture => {
+                let mut c = capture.clone();
+                c.description.lenslet_grid = stated;
+                regridded = c;
+                &regridded
+            }
+            GridChoice::Aligned => {
+                regridded = capture.aligned()?;
+                &regridded
+            }
+        };
+        // The baselines interpolate the aligned mosaic: behind a grid its pixels are not
+        // where they assume.
+        ensure!(
+            self.method.baseline().is_none() || capture.description.lenslet_grid.is_none(),
+            "{}: the baseline methods read the aligned grid, and this capture has a lenslet_grid: give --grid \
+             aligned to decode it as aligned, or --method cs",
+            capture.source()
+        );
         // Compressed sensing puts the response in the firmware's decode; baselines unmix
         // their spectra here.
         let rows: Option<Vec<[f32; PATCH_BANDS]>> =
@@ -795,6 +822,19 @@ impl Outcome {
 
 /// Bands of the decoder's patch (the camera's 13).
 const PATCH_BANDS: usize = 13;
+
+/// `--grid`: which lenslet grid a decode reads the frames through.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum GridChoice {
+    /// The calibration's grid (found from its flats) if it has one, else the capture's.
+    #[default]
+    Auto,
+    /// The capture's own `lenslet_grid`, even with a calibration that found another.
+    Capture,
+    /// The aligned grid whatever the capture says: `U x V` pixels under each lenslet from
+    /// pixel (0, 0), the frames cut to `S*U x T*V` (slf's decode before grids).
+    Aligned,
+}
 
 /// `--response-model`: where a calibrated decode puts the filters' response matrix
 /// ([`ResponseModel`]).

@@ -13,7 +13,7 @@ use crate::io::folder::{FileRecord, Kind, WholeFolder, record, verify};
 use serde::{Deserialize, Serialize};
 
 use crate::io::capture::{MAX_DESCRIPTION, read_small_file};
-use crate::io::grid::LensletGrid;
+use crate::io::grid::GridDescription;
 use crate::io::lightfield::write_npy_f32_2d;
 use crate::io::message::number;
 use crate::io::npy::{self, Element, Values};
@@ -65,7 +65,7 @@ pub struct CalibrationDescription {
     /// The lenslet grid found from the flats ([`crate::io::grid`]), when the captures were
     /// taken behind one; the frames are then its sensor's size.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub lenslet_grid: Option<LensletGrid>,
+    pub lenslet_grid: Option<GridDescription>,
     /// `dark.npy`'s and `flat.npy`'s sizes and CRC-32s as written ([`crate::io::folder`]),
     /// checked on load; a loaded calibration's description holds none. Absent in folders
     /// written before they were (loaded with a note).

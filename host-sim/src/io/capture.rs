@@ -14,7 +14,7 @@ use slf_firmware::{
 };
 
 use crate::io::folder::{FileRecord, Kind, WholeFolder, record, verify};
-use crate::io::grid::LensletGrid;
+use crate::io::grid::GridDescription;
 use crate::io::lightfield::{read_npy_u16_2d, write_npy_u16_2d};
 use crate::io::message::one_line;
 use crate::io::output::{write_bytes, write_whole};
@@ -131,7 +131,7 @@ pub struct CaptureDescription {
     /// Where the lenslet array sits on the sensor (version 2, [`crate::io::grid`]): the
     /// frames are then its sensor's size, not `S*U x T*V`. Absent: the aligned grid.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub lenslet_grid: Option<LensletGrid>,
+    pub lenslet_grid: Option<GridDescription>,
     /// Each frame's size and CRC-32 as written ([`crate::io::folder`]), checked on load; a
     /// loaded capture's description holds none (they describe the files, not the capture).
     /// Absent in folders written before they were (loaded with a note).
@@ -369,7 +369,40 @@ impl Capture {
         let mask = self.mask().map_err(|e| anyhow!("{}: {}", self.source(), one_line(&e)))?;
         let config =
             DecoderConfig { sensor: self.sensor(), mask, raw: self.raw_format(), defects: self.defects(), sl0 };
-        TileDecoder::new(config).map_err(|e| anyhow!("{}: the decoder does not take this capture: {e}", self.source()))
+        let grid = match &self.description.lenslet_grid {
+            Some(g) => Some(g.firmware(self.description.views)?),
+            None => None,
+        };
+        TileDecoder::new(config)
+            .and_then(|d| d.with_grid(grid))
+            .map_err(|e| anyhow!("{}: the decoder does not take this capture: {e}", self.source()))
+    }
+
+    /// This capture read as if its lenslet array were aligned: `U x V` pixels under each
+    /// lenslet from pixel (0, 0), the frames cut to `S*U x T*V`, no `lenslet_grid` (slf's
+    /// reading before grids, which a turned array's capture is measured against).
+    ///
+    /// # Errors
+    /// A sensor smaller than `S*U x T*V` (a pitch below the views).
+    pub fn aligned(&self) -> Result<Self> {
+        let d = &self.description;
+        let (rows, cols) = (d.lenslets[0] * d.views[0], d.lenslets[1] * d.views[1]);
+        let (r0, c0) = self.frame_size();
+        ensure!(
+            rows <= r0 && cols <= c0,
+            "{}: read as aligned, {:?} lenslets of {:?} views need a {rows} x {cols} sensor, and it is {r0} x {c0}",
+            self.source(),
+            d.lenslets,
+            d.views
+        );
+        let frames =
+            self.frames.iter().map(|f| (0..rows).flat_map(|r| f[r * c0..r * c0 + cols].to_vec()).collect()).collect();
+        let mut description = d.clone();
+        description.lenslet_grid = None;
+        description.defective_pixels.retain(|p| (p[0] as usize) < rows && (p[1] as usize) < cols);
+        let mut c = Self::new(description, frames)?;
+        c.source.clone_from(&self.source);
+        Ok(c)
     }
 
     /// The frames as the decoder reads them.

@@ -2,7 +2,7 @@
 //!
 //! A lenslet array is glued on with a rotation of a few tenths of a degree, its pitch is a
 //! non-integer number of pixels, and its first lenslet is not on pixel (0, 0). A
-//! [`LensletGrid`] says all three, as `capture.json` and `calibration.json` record it
+//! [`GridDescription`] says all three, as `capture.json` and `calibration.json` record it
 //! (`lenslet_grid`), and maps a point of the sensor to its place in the light field.
 //!
 //! Coordinates. A sensor point is `(row, col)` in pixels, `(0, 0)` the top-left corner of
@@ -22,11 +22,12 @@
 //! a view is an angle relative to the main lens, which is what the decode needs.
 //!
 //! A hexagonal grid (Lytro's) would give every other lenslet row a shift of half a pitch
-//! along the row, and its view cells would be a hexagon's; [`LensletGrid::cell`] is the one
+//! along the row, and its view cells would be a hexagon's; [`GridDescription::cell`] is the one
 //! place that maps a point to a cell, so such a grid replaces it and the cell polygon.
 
 use anyhow::{Result, ensure};
 use serde::{Deserialize, Serialize};
+use slf_firmware::LensletGrid;
 
 use crate::io::message::number;
 
@@ -45,7 +46,7 @@ pub const MAX_PITCH_OFF: f64 = 0.2;
 /// `lenslet_grid` in `capture.json` and `calibration.json`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct LensletGrid {
+pub struct GridDescription {
     /// The lenslet rows' angle to the sensor's rows, degrees; positive turns them down to
     /// the right.
     pub rotation_deg: f64,
@@ -61,7 +62,7 @@ pub struct LensletGrid {
     pub centres_rms_px: Option<f64>,
 }
 
-impl LensletGrid {
+impl GridDescription {
     /// The aligned grid of `lenslets` lenslets of `views` views: what slf assumes without
     /// a grid.
     pub fn aligned(lenslets: [usize; 2], views: [usize; 2]) -> Self {
@@ -157,6 +158,25 @@ impl LensletGrid {
     }
 }
 
+impl GridDescription {
+    /// The firmware's grid for lenslets of `views` views (the rotation as its `f32` cosine
+    /// and sine, computed here in `f64`: the device is given the same numbers).
+    ///
+    /// # Errors
+    /// What the firmware refuses (checked here first, so not expected).
+    pub fn firmware(&self, views: [usize; 2]) -> Result<LensletGrid> {
+        let (sin, cos) = self.rotation_deg.to_radians().sin_cos();
+        LensletGrid::new(
+            (cos as f32, sin as f32),
+            (self.pitch[0] as f32, self.pitch[1] as f32),
+            (self.offset[0] as f32, self.offset[1] as f32),
+            (views[0] as u8, views[1] as u8),
+            (self.sensor[0] as u16, self.sensor[1] as u16),
+        )
+        .map_err(|e| anyhow::anyhow!("lenslet_grid: {e}"))
+    }
+}
+
 /// `v` turned by `deg` degrees: the columns' axis `(0, 1)` to `(sin, cos)`.
 pub fn rotate(deg: f64, v: [f64; 2]) -> [f64; 2] {
     let (sin, cos) = deg.to_radians().sin_cos();
@@ -169,8 +189,8 @@ mod tests {
 
     #[test]
     fn the_aligned_grid_puts_each_pixel_in_its_own_view_cell() {
-        let g = LensletGrid::aligned([3, 4], [5, 5]);
-        assert_eq!(LensletGrid::centred([3, 4], 0.0, [5.0, 5.0]), g);
+        let g = GridDescription::aligned([3, 4], [5, 5]);
+        assert_eq!(GridDescription::centred([3, 4], 0.0, [5.0, 5.0]), g);
         g.check([3, 4], [5, 5]).unwrap();
         for row in 0..15 {
             for col in 0..20 {
@@ -183,7 +203,7 @@ mod tests {
 
     #[test]
     fn centres_and_cells_agree_on_a_turned_grid() {
-        let g = LensletGrid::centred([20, 30], 0.7, [5.04, 4.97]);
+        let g = GridDescription::centred([20, 30], 0.7, [5.04, 4.97]);
         g.check([20, 30], [5, 5]).unwrap();
         for (s, t) in [(0.0, 0.0), (3.0, 17.0), (19.0, 29.0)] {
             // A micro-image centre is the middle of its lenslet's cells: (s U + 2.5, t V + 2.5).
@@ -197,14 +217,14 @@ mod tests {
 
     #[test]
     fn grids_out_of_range_are_refused_by_field() {
-        let ok = LensletGrid::centred([10, 10], 0.3, [5.02, 5.02]);
+        let ok = GridDescription::centred([10, 10], 0.3, [5.02, 5.02]);
         for (bad, says) in [
-            (LensletGrid { rotation_deg: 45.0, ..ok }, "rotation_deg"),
-            (LensletGrid { pitch: [5.0, 7.0], ..ok }, "pitch[1]"),
-            (LensletGrid { pitch: [f64::NAN, 5.0], ..ok }, "pitch[0]"),
-            (LensletGrid { sensor: [0, 50], ..ok }, "sensor[0]"),
-            (LensletGrid { offset: [1e9, 0.0], ..ok }, "offset[0]"),
-            (LensletGrid { centres_rms_px: Some(-1.0), ..ok }, "centres_rms_px"),
+            (GridDescription { rotation_deg: 45.0, ..ok }, "rotation_deg"),
+            (GridDescription { pitch: [5.0, 7.0], ..ok }, "pitch[1]"),
+            (GridDescription { pitch: [f64::NAN, 5.0], ..ok }, "pitch[0]"),
+            (GridDescription { sensor: [0, 50], ..ok }, "sensor[0]"),
+            (GridDescription { offset: [1e9, 0.0], ..ok }, "offset[0]"),
+            (GridDescription { centres_rms_px: Some(-1.0), ..ok }, "centres_rms_px"),
         ] {
             let e = bad.check([10, 10], [5, 5]).unwrap_err().to_string();
             assert!(e.contains(says), "{e}");

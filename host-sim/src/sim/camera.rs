@@ -29,7 +29,7 @@ use crate::io::capture::{
     Capture, CaptureDescription, FORMAT, Light, MaskDescription, MaskSource, NoiseDescription, VERSION, VERSION_SENSOR,
     frame_names,
 };
-use crate::io::grid::LensletGrid;
+use crate::io::grid::GridDescription;
 use crate::io::lightfield::LightField;
 use crate::io::sensor::SensorDescription;
 use crate::sim::footprint::footprint;
@@ -66,7 +66,7 @@ pub struct CameraConfig {
 }
 
 /// A lenslet grid as a user states it: the sensor's size and the offset follow from the
-/// light field's lenslets ([`LensletGrid::centred`]) unless given.
+/// light field's lenslets ([`GridDescription::centred`]) unless given.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GridSettings {
     /// Degrees (positive turns the lenslet rows down to the right).
@@ -80,10 +80,10 @@ pub struct GridSettings {
 
 impl GridSettings {
     /// The grid for a light field of `lenslets` lenslets of `views` views.
-    pub fn grid(&self, lenslets: [usize; 2], views: [usize; 2]) -> LensletGrid {
+    pub fn grid(&self, lenslets: [usize; 2], views: [usize; 2]) -> GridDescription {
         let pitch = self.pitch.unwrap_or([views[0] as f64, views[1] as f64]);
-        let centred = LensletGrid::centred(lenslets, self.rotation_deg, pitch);
-        LensletGrid { offset: self.offset.unwrap_or(centred.offset), ..centred }
+        let centred = GridDescription::centred(lenslets, self.rotation_deg, pitch);
+        GridDescription { offset: self.offset.unwrap_or(centred.offset), ..centred }
     }
 }
 

@@ -8,7 +8,7 @@
 //! parallelogram, clipped against each cell it reaches (Sutherland-Hodgman, against the
 //! cell's four sides) and measured with the shoelace formula.
 
-use crate::io::grid::LensletGrid;
+use crate::io::grid::GridDescription;
 
 /// The most vertices a clipped parallelogram can have (4 sides cut by 4 more).
 const MAX_VERTICES: usize = 8;
@@ -60,7 +60,7 @@ impl Polygon {
 /// Pixel `(row, col)`'s footprint on `grid`'s view cells for `views` views, into `out`:
 /// each cell `(i, j)` it covers (`(s U + u, t V + v)`, possibly outside the light field)
 /// with the share of the pixel's area it covers. The shares sum to 1.
-pub fn footprint(grid: &LensletGrid, views: [usize; 2], row: usize, col: usize, out: &mut Vec<([i64; 2], f64)>) {
+pub fn footprint(grid: &GridDescription, views: [usize; 2], row: usize, col: usize, out: &mut Vec<([i64; 2], f64)>) {
     out.clear();
     let (r, c) = (row as f64, col as f64);
     let corners = [[r, c], [r, c + 1.0], [r + 1.0, c + 1.0], [r + 1.0, c]].map(|p| grid.cell(views, p));
@@ -93,7 +93,7 @@ mod tests {
 
     #[test]
     fn an_aligned_pixel_is_its_own_cell() {
-        let g = LensletGrid::aligned([4, 4], [5, 5]);
+        let g = GridDescription::aligned([4, 4], [5, 5]);
         let mut out = Vec::new();
         for (row, col) in [(0, 0), (7, 13), (19, 19)] {
             footprint(&g, [5, 5], row, col, &mut out);
@@ -106,14 +106,14 @@ mod tests {
     #[test]
     fn shares_sum_to_one_and_follow_a_shift() {
         // Shifted by a quarter pixel down: a pixel covers 3/4 of its cell and 1/4 of the one above.
-        let g = LensletGrid { offset: [2.75, 2.5], ..LensletGrid::aligned([4, 4], [5, 5]) };
+        let g = GridDescription { offset: [2.75, 2.5], ..GridDescription::aligned([4, 4], [5, 5]) };
         let mut out = Vec::new();
         footprint(&g, [5, 5], 7, 3, &mut out);
         out.sort_by_key(|c| c.0);
         assert_eq!(out.len(), 2);
         assert_eq!((out[0].0, out[1].0), ([6, 3], [7, 3]));
         assert!((out[0].1 - 0.25).abs() < 1e-12 && (out[1].1 - 0.75).abs() < 1e-12, "{out:?}");
-        let g = LensletGrid::centred([10, 10], 0.8, [5.1, 4.95]);
+        let g = GridDescription::centred([10, 10], 0.8, [5.1, 4.95]);
         for (row, col) in [(0, 0), (23, 31), (40, 12)] {
             footprint(&g, [5, 5], row, col, &mut out);
             assert!((out.iter().map(|c| c.1).sum::<f64>() - 1.0).abs() < 1e-12);

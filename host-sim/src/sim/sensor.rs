@@ -36,7 +36,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 
-use crate::io::grid::LensletGrid;
+use crate::io::grid::GridDescription;
 use crate::io::sensor::{FilterDescription, SensorDescription};
 
 /// How far the micro-image's centre moves at the sensor's edges, in views.
@@ -170,7 +170,7 @@ impl Sensor {
         views: [usize; 2],
         bands_nm: &[f32],
         range_dn: f32,
-        grid: Option<&LensletGrid>,
+        grid: Option<&GridDescription>,
     ) -> Result<Self> {
         d.check()?;
         let response = response(&d.filters, bands_nm)?;
