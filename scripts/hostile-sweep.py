@@ -284,10 +284,17 @@ def main():
 
     # The real sensor's flags of simulate, with values no flag takes.
     for flag in ["--leakage", "--filter-width", "--secondary", "--secondary-nm", "--leak-floor", "--dark-sd",
-                 "--hot-pixels", "--prnu", "--vignetting", "--sensor-seed", "--exposures"]:
+                 "--hot-pixels", "--prnu", "--vignetting", "--sensor-seed", "--exposures", "--rotation", "--pitch",
+                 "--grid-offset"]:
         for v in ["nan", "inf", "-1", "1e39", "", "x", "0.99"]:
             s.run(["simulate", "truth.npy", "-o", "sim-out", "--calibration-captures", "cal-caps", flag, v],
                   f"simulate {flag} {v!r}")
+
+    # A lenslet grid a decode is asked to read through, named wrongly or on an aligned capture.
+    for v in ["", "x", "nan", "Aligned", "capture,aligned"]:
+        s.run(["decode", "cap", "-o", "x.npy", "-q", "--grid", v], f"decode --grid {v!r}")
+    for v in ["auto", "capture", "aligned"]:
+        s.run(["decode", "cap", "-o", "x.npy", "-q", "--grid", v, "--method", "demosaic"], f"decode --grid {v} (aligned)")
 
     # Every numeric flag of decode, with values no flag takes, for each method.
     flags = ["--sigma-f", "--steps", "--mu", "--sigma-min", "--max-iterations", "--noise", "--shot",

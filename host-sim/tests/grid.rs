@@ -269,3 +269,29 @@ impl slf_firmware::PatchSink<8125> for Collect<'_> {
         Ok(())
     }
 }
+
+/// A `lenslet_grid` out of its ranges, in a version-1 capture, under a lenslet mask, or of
+/// another size than the frames is refused in one line naming the field.
+#[test]
+fn captures_with_a_wrong_grid_are_refused_by_field() {
+    use slf_host::io::capture::{Capture, MaskDescription};
+    let lf = field();
+    let cam = camera(Some(GridSettings { rotation_deg: 0.3, pitch: Some([5.04, 5.04]), offset: None }), 0.0);
+    let cap = simulate(&lf, &cam).unwrap();
+    let edit = |f: &dyn Fn(&mut slf_host::io::capture::CaptureDescription)| {
+        let mut d = cap.description.clone();
+        f(&mut d);
+        let e = Capture::new(d, cap.frames.clone()).unwrap_err();
+        format!("{e:#}")
+    };
+    for (says, e) in [
+        ("rotation_deg", edit(&|d| d.lenslet_grid.as_mut().unwrap().rotation_deg = 30.0)),
+        ("pitch[0]", edit(&|d| d.lenslet_grid.as_mut().unwrap().pitch[0] = 9.0)),
+        ("offset[1]", edit(&|d| d.lenslet_grid.as_mut().unwrap().offset[1] = f64::INFINITY)),
+        ("expected 31 x 36", edit(&|d| d.lenslet_grid.as_mut().unwrap().sensor = [31, 36])),
+        ("needs version 2", edit(&|d| d.version = 1)),
+        ("lenslet mask", edit(&|d| d.mask = MaskDescription::seeded(slf_firmware::MaskFamily::Lenslet, 3, 2))),
+    ] {
+        assert!(e.contains(says) && !e.contains('\n'), "{says}: {e}");
+    }
+}
