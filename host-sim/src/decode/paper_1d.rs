@@ -226,6 +226,11 @@ pub fn analyze_5d<T: Real>(factors: &Factors<T>, x: &[T]) -> Vec<T> {
     modes(&factors.0, x, true)
 }
 
+/// The 5D synthesis `c x_i D_i` in `T` (mode products one at a time, in mode order).
+pub fn synthesize_5d<T: Real>(factors: &Factors<T>, c: &[T]) -> Vec<T> {
+    modes(&factors.0, c, false)
+}
+
 /// 5D SL0 (fast path) in `T`: the reference for the firmware's f32 decoder and for the
 /// 1D method. `measured[i]` is `Some(y)` for a measured entry.
 pub fn solve_5d<T: Real>(factors: &Factors<T>, measured: &[Option<T>], cfg: &Sl0Config) -> (Vec<T>, u32) {
