@@ -33,5 +33,9 @@ pub const SENSOR_RESPONSE: [[f32; 13]; 13] = [
     [0.005699804, 0.0056920005, 0.0056847734, 0.0056685098, 0.0056544906, 0.0056651044, 0.0063352054, 0.031504437, 0.006392977, 0.0057022297, 0.0056851446, 0.010184471, 0.8998453]
 ];
 // The lenslet grid `slf calibrate` found from the flats: the array turned and its
-// pitch not the views' (`LensletGrid::new`'s rotation, pitch, offset, sensor).
-pub const SENSOR_GRID: ((f32, f32), (f32, f32), (f32, f32), (u16, u16)) = ((0.9998462, 0.017537955), (5.088778, 5.09908), (2.4240263, 2.7342093), (26, 51));
+// pitch not the views' (`LensletGrid::new`'s rotation as (cos, sin), pitch, offset,
+// sensor).
+pub const SENSOR_GRID_ROTATION: (f32, f32) = (0.9998462, 0.017537955);
+pub const SENSOR_GRID_PITCH: (f32, f32) = (5.088778, 5.09908);
+pub const SENSOR_GRID_OFFSET: (f32, f32) = (2.4240263, 2.7342093);
+pub const SENSOR_GRID_SENSOR: (u16, u16) = (26, 51);

@@ -110,8 +110,9 @@ mod device {
     ) -> u32 {
         static DEFECTS: [Pixel; SENSOR_DEFECTS.len()] = SENSOR_DEFECTS;
         static VIEW_GAINS: [f32; SENSOR_VIEW_GAINS.len()] = SENSOR_VIEW_GAINS;
-        let (rotation, pitch, offset, sensor) = SENSOR_GRID;
-        let Ok(grid) = LensletGrid::new(rotation, pitch, offset, VIEWS, sensor) else {
+        let grid =
+            LensletGrid::new(SENSOR_GRID_ROTATION, SENSOR_GRID_PITCH, SENSOR_GRID_OFFSET, VIEWS, SENSOR_GRID_SENSOR);
+        let Ok(grid) = grid else {
             hprintln!("error: the real sensor's lenslet grid does not validate");
             return 1;
         };

@@ -119,8 +119,12 @@ fn write_sensor_capture(truth: &crate::io::lightfield::LightField, dir: &Path) -
          pub const SENSOR_DEFECTS: [Pixel; {}] = [{}];\n\
          pub const SENSOR_RESPONSE: [[f32; 13]; 13] = [\n    {}\n];\n\
          // The lenslet grid `slf calibrate` found from the flats: the array turned and its\n\
-         // pitch not the views' (`LensletGrid::new`'s rotation, pitch, offset, sensor).\n\
-         pub const SENSOR_GRID: ((f32, f32), (f32, f32), (f32, f32), (u16, u16)) = ({:?}, {:?}, {:?}, {:?});\n",
+         // pitch not the views' (`LensletGrid::new`'s rotation as (cos, sin), pitch, offset,\n\
+         // sensor).\n\
+         pub const SENSOR_GRID_ROTATION: (f32, f32) = {:?};\n\
+         pub const SENSOR_GRID_PITCH: (f32, f32) = {:?};\n\
+         pub const SENSOR_GRID_OFFSET: (f32, f32) = {:?};\n\
+         pub const SENSOR_GRID_SENSOR: (u16, u16) = {:?};\n",
         c.black,
         c.white,
         c.regions.0,
