@@ -144,7 +144,10 @@ impl LensletGrid {
         }
         let (i, j) = (floor(a * nu) as usize, floor(b * nv) as usize);
         let (nu, nv) = (usize::from(self.views.0), usize::from(self.views.1));
-        Some(((i / nu, j / nv), (i % nu, j % nv)))
+        // Views are above 0 by `new`; `checked_*` says so without a panic path.
+        let (s, u) = (i.checked_div(nu)?, i.checked_rem(nu)?);
+        let (t, v) = (j.checked_div(nv)?, j.checked_rem(nv)?);
+        Some(((s, t), (u, v)))
     }
 }
 
