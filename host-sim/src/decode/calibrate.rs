@@ -21,6 +21,7 @@ use crate::io::calibration::{
     Calibration, CalibrationDescription, FORMAT, Sources, VERSION, check_response, read_response,
 };
 use crate::io::capture::{Capture, DESCRIPTION, Light};
+use crate::io::grid::lenslet_view;
 use crate::io::output::Outputs;
 
 /// A pixel whose dark level lies more than this fraction of the range (white - black) above
@@ -203,12 +204,9 @@ pub fn calibrate(captures: &[(String, Capture)], response: Option<Vec<Vec<f32>>>
             None => ((p / cols) % u_n, (p % cols) % v_n),
             Some(fit) => {
                 let q = fit.grid.cell(d0.views, [(p / cols) as f64 + 0.5, (p % cols) as f64 + 0.5]);
-                let (i, j) = (q[0].floor() as i64, q[1].floor() as i64);
-                let (s, t) = (i.div_euclid(u_n as i64), j.div_euclid(v_n as i64));
-                if s < 0 || t < 0 || s >= d0.lenslets[0] as i64 || t >= d0.lenslets[1] as i64 {
-                    continue;
-                }
-                (i.rem_euclid(u_n as i64) as usize, j.rem_euclid(v_n as i64) as usize)
+                let cell = [q[0].floor() as i64, q[1].floor() as i64];
+                let Some((_, [u, v])) = lenslet_view(cell, d0.lenslets, d0.views) else { continue };
+                (u, v)
             }
         };
         let s = &mut sums[u * v_n + v];

@@ -177,6 +177,18 @@ impl GridDescription {
     }
 }
 
+/// View cell `cell` (`(s U + u, t V + v)`, [`GridDescription::cell`]'s whole parts) as
+/// lenslet `(s, t)` and view `(u, v)`; `None` outside the light field's `lenslets`.
+pub fn lenslet_view(cell: [i64; 2], lenslets: [usize; 2], views: [usize; 2]) -> Option<([usize; 2], [usize; 2])> {
+    let split = |a: usize| {
+        let n = views[a] as i64;
+        let l = usize::try_from(cell[a].div_euclid(n)).ok().filter(|&l| l < lenslets[a])?;
+        Some((l, cell[a].rem_euclid(n) as usize))
+    };
+    let ((s, u), (t, v)) = (split(0)?, split(1)?);
+    Some(([s, t], [u, v]))
+}
+
 /// `v` turned by `deg` degrees: the columns' axis `(0, 1)` to `(sin, cos)`.
 pub fn rotate(deg: f64, v: [f64; 2]) -> [f64; 2] {
     let (sin, cos) = deg.to_radians().sin_cos();

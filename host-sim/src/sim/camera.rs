@@ -29,7 +29,7 @@ use crate::io::capture::{
     Capture, CaptureDescription, FORMAT, Light, MaskDescription, MaskSource, NoiseDescription, VERSION, VERSION_SENSOR,
     frame_names,
 };
-use crate::io::grid::GridDescription;
+use crate::io::grid::{GridDescription, lenslet_view};
 use crate::io::lightfield::LightField;
 use crate::io::sensor::SensorDescription;
 use crate::sim::footprint::footprint;
@@ -234,14 +234,10 @@ pub fn simulate_under(lf: &LightField, cam: &CameraConfig, light: Light) -> Resu
                 None => lf.get(u, v, s, t, b),
                 Some(_) => cells
                     .iter()
-                    .filter_map(|&([i, j], share)| {
-                        let (s, u) = (i.div_euclid(lu as i64), i.rem_euclid(lu as i64) as usize);
-                        let (t, v) = (j.div_euclid(lv as i64), j.rem_euclid(lv as i64) as usize);
-                        let (s, t) = (usize::try_from(s).ok()?, usize::try_from(t).ok()?);
-                        (s < lf.rows && t < lf.cols).then(|| {
-                            let shade = if real { vignette_on_grid(vignetting, [lu, lv], u, v) } else { 1.0 };
-                            share * shade * f64::from(lf.get(u, v, s, t, b).max(0.0))
-                        })
+                    .filter_map(|&(cell, share)| {
+                        let ([s, t], [u, v]) = lenslet_view(cell, [lf.rows, lf.cols], [lu, lv])?;
+                        let shade = if real { vignette_on_grid(vignetting, [lu, lv], u, v) } else { 1.0 };
+                        Some(share * shade * f64::from(lf.get(u, v, s, t, b).max(0.0)))
                     })
                     .sum::<f64>() as f32,
             };
