@@ -49,7 +49,7 @@ disjoint_stack = int(re.search(r"^disjoint stack peak bytes (\d+)", log, re.M).g
 ws = int(re.search(r"workspace bytes (\d+)", log).group(1))
 # The device's workspace (the full-view patch's) is the size firmware/tests/solver.rs pins on
 # the host and the README and crate docs give.
-assert ws == 107_124, f"the device's Workspace is {ws} B; firmware/tests/solver.rs, the README and lib.rs say 107,124"
+assert ws == 108_400, f"the device's Workspace is {ws} B; firmware/tests/solver.rs, the README and lib.rs say 108,400"
 camera = re.search(r"^camera frame 100 x 100 band (\d+) patch-solves (\d+) full-width (\d+)", log, re.M)
 camera_band, camera_solves, camera_full = (int(x) for x in camera.groups())
 strip = int(re.search(r"strip bytes (\d+)", log).group(1))

@@ -28,13 +28,14 @@
 //!   schedules of their solves) and the separable
 //!   synthesis and analysis transforms.
 //! - **solver** ([`solver`]: [`error`](solver::error), [`workspace`], [`sl0`], [`ascent`],
-//!   [`ball`], [`projection`], [`mixing`], [`fractional`], [`pinv`], [`fill`](solver::fill), [`choice`],
+//!   [`ball`], [`projection`], [`mixing`], [`fractional`], [`shares`], [`pinv`], [`fill`](solver::fill), [`choice`],
 //!   [`picked`], [`interpolate`], [`plausible`], [`holdout`]): the caller-owned workspace every path works in, nD SL0 (its hand-set
 //!   schedule, or the trained ones a blob carries) with the
 //!   orthonormal fast path and its cold start from the band-gain fill, the
 //!   noise ball a projection moves onto, the projection for filters whose response mixes
 //!   bands (a `k x k` solve per pixel), the projection of half-pixel sheared patches (whose
-//!   measurements interpolate them), the paper's general pseudo-inverse path for kronecker
+//!   measurements interpolate them) and of patches behind a turned lenslet grid (whose
+//!   pixels share view cells), the paper's general pseudo-inverse path for kronecker
 //!   masks, the choice of an ensemble member per patch (exhaustive or screened, or seeded:
 //!   one solve from an estimate of the patch), and per-pixel spectral interpolation for
 //!   patches that measure too few distinct bands; the plausibility check of a decoded
@@ -89,7 +90,8 @@
 //! Configuration (dictionaries, masks, defect lists, solver parameters) is immutable and
 //! can live in flash; all mutable state is one caller-owned [`Workspace`], whose size is the
 //! decoder's whole RAM need besides the stack: three patch buffers, a flag per value, a
-//! gain per band and the filters' response matrix with its inverse, 69,100 bytes for the paper's 5 x 5 x 4 x 4 x 13 patch and 107,124 for the
+//! gain per band, the filters' response matrix with its inverse and each pixel's place in its
+//! view cell behind a lenslet grid, 70,376 bytes for the paper's 5 x 5 x 4 x 4 x 13 patch and 108,400 for the
 //! full-view 5 x 5 x 5 x 5 x 13 patch ([`FullViewWorkspace`], the device's). Overlapping patches
 //! ([`OverlapDecoder`]) add a caller-owned strip of lenslet rows, 7,000 bytes per lenslet
 //! column of 5 x 5 views, or 12,600 with sheared patches ([`disparity`]: the default range
@@ -123,7 +125,8 @@ pub use decode::{overlap, tile, trial};
 pub use operators::{blob, dct, dictionary, disparity, schedule, shape, transform};
 pub use sensor::{defects, gains, grid, mask, raw, response, spi};
 pub use solver::{
-    ascent, ball, choice, fractional, holdout, interpolate, mixing, picked, pinv, plausible, projection, sl0, workspace,
+    ascent, ball, choice, fractional, holdout, interpolate, mixing, picked, pinv, plausible, projection, shares, sl0,
+    workspace,
 };
 
 pub mod prelude;

@@ -207,9 +207,11 @@ fn flats_without_micro_images_give_no_grid() {
 }
 
 /// The decode through a grid, on a capture behind a turned array (0.5 degrees, 5.08 px,
-/// noiseless, pixel k = 1, office at 30 x 30 lenslets): reading each view where the grid
-/// puts it beats reading the frame as if the array were aligned (`--grid aligned`, slf
-/// before grids) by at least 3 dB (measured 32.65 against 26.08); and the aligned grid
+/// noiseless, pixel k = 1, office at 30 x 30 lenslets): decoding each pixel as the shares
+/// of the view cells it covers beats reading the frame as if the array were aligned
+/// (`--grid aligned`, slf before grids) by at least 7.5 dB (measured 34.75 against 26.08;
+/// reading each view at the pixel under its cell's centre, the decode before the shares,
+/// gave 32.65, so a return to it fails); and the aligned grid
 /// given to the firmware's decoder reads the same pixels as no grid, so its patches are the
 /// same bits.
 #[test]
@@ -227,7 +229,7 @@ fn the_decode_reads_each_view_where_the_grid_puts_it() {
     };
     let (grid, aligned) = (decode(&[]), decode(&["--grid", "aligned"]));
     eprintln!("through the grid {grid:?}\nas aligned {aligned:?}");
-    assert!(grid.psnr > aligned.psnr + 3.0, "through the grid {} dB, as aligned {}", grid.psnr, aligned.psnr);
+    assert!(grid.psnr > aligned.psnr + 7.5, "through the grid {} dB, as aligned {}", grid.psnr, aligned.psnr);
     assert!(grid.sa < aligned.sa, "spectral angle {} through the grid, {} as aligned", grid.sa, aligned.sa);
     // The baselines interpolate the aligned mosaic: refused behind a grid, in one line.
     let e = DecodeSettings::from_flags(["--method", "demosaic"]).unwrap().run(&cap, false, &|_, _| {}).unwrap_err();

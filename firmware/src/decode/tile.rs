@@ -36,8 +36,9 @@ use crate::solver::holdout::{HoldOut, estimate, hold_out};
 use crate::solver::interpolate::{bands_measured, interpolate_bands};
 use crate::solver::mixing::{mix_all, unmix_all};
 use crate::solver::plausible::{Plausibility, clip, implausible};
+use crate::solver::shares;
 use crate::solver::sl0::{Ended, Outcome, Sl0Config, SolveError, solve};
-use crate::solver::workspace::Workspace;
+use crate::solver::workspace::{CellShares, MAX_PLACES, MAX_SHARE_VIEWS, Workspace};
 
 /// The source trait lives with the raw frames (the sensor layer); named here too, where the
 /// decoder that reads it is.
@@ -596,10 +597,15 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     /// This decoder reading a sensor behind a real lenslet array: view `(u, v)` of lenslet
     /// `(s, t)` from the pixel under its view cell's centre ([`LensletGrid::pixel`]), the
     /// frames `grid.sensor()` pixels, tiles and patches on the lenslet grid. Each
-    /// measurement is still one pixel's, through its own filter; a view read half a pixel
-    /// off its cell's centre is the model's error (measured in `docs/results-grid.md`).
-    /// `None`: the aligned grid, `U x V` pixels under every lenslet (the same bytes as
-    /// before grids).
+    /// measurement is one pixel's, through its own filter, and the solve takes it as what
+    /// it is: the shares of the view cells its square covers, across micro-image borders
+    /// too ([`crate::solver::shares`], from the pixel's place in its cell,
+    /// [`LensletGrid::cell_position`]). A pixel whose centre lies in another cell is that
+    /// cell's, so no pixel is read twice. Patches at a half-pixel shear, or whose solved
+    /// response mixes bands, read the pixel under the cell's centre as the cell's value
+    /// (neither projection is built with shares). `None`: the aligned grid, `U x V`
+    /// pixels under every lenslet (the same bytes as before grids; so is a grid that
+    /// [`LensletGrid::is_aligned`]).
     ///
     /// # Errors
     /// [`ConfigError::Grid`] for a grid of other views than the sensor's lenslets, or on a
@@ -775,6 +781,10 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         if !half.is_none() {
             to_sensor::<PS, PT, PU, PV, B, N>(half, &mut ws.signal);
         }
+        // Behind a lenslet grid, the held-out pixels as they measured the decode (the
+        // coefficients are not needed after the solve).
+        let Workspace { signal, coeffs, measurements, .. } = ws;
+        shares::to_sensor::<PS, PT, PU, PV, B, N>(measurements, signal, coeffs);
         let cfg = &self.config.sl0;
         Ok((estimate::<PS, PT, PU, PV, B, N>(hold, ws.measurements(), ws.patch(), cfg.noise, cfg.shot), solves))
     }
@@ -1003,6 +1013,13 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let mut run = [[0.0f32; PV]; B];
         let half = HalfViews::of(origin.disparity, (origin.view_row as usize, origin.view_col as usize), (lu, lv));
         m.set_half_views(half);
+        // Behind a lenslet grid each pixel is the shares of the cells it covers; with a
+        // half-pixel shear or a response that mixes bands, the cell under its centre.
+        let shares = self.cell_shares(origin, half);
+        if m.set_shares(shares).is_err() {
+            let _ = m.set_shares(None);
+        }
+        let shared = m.shares().is_some();
         for s in 0..PS {
             for u in 0..PU {
                 for t in 0..PT {
@@ -1034,10 +1051,21 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                             else {
                                 continue;
                             };
+                            let at = PatchShape::<PS, PT, PU, PV, B, N>::pixel_index(s, t, u, v);
+                            if shared {
+                                // The pixel's place in its cell; a pixel whose centre lies
+                                // in another cell is that cell's measurement, not this one's.
+                                let Some(place) = origin
+                                    .lenslet::<PS, PT>(s, t, u, v, (lu, lv))
+                                    .and_then(|l| self.place_in_cell(l, (vr, vc), (row, col)))
+                                else {
+                                    continue;
+                                };
+                                let _ = m.set_place(at / B, place);
+                            }
                             for (j, r) in run.iter_mut().enumerate().take(k) {
                                 source.read(j, row, col, &mut r[..1])?;
                             }
-                            let at = PatchShape::<PS, PT, PU, PV, B, N>::pixel_index(s, t, u, v);
                             self.put_pixel(m, at, row, col, |j| run.get(j).map(|r| r[0]), &mut flags, &mut excluded);
                         }
                     }
@@ -1045,6 +1073,43 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             }
         }
         Ok((flags, excluded))
+    }
+
+    /// How the pixels of a patch at `origin` share view cells behind the lenslet grid:
+    /// `None` on the aligned sensor (each pixel its cell, the selection's bits), for a half-pixel shear (its own interpolation) and for
+    /// a solved response that mixes bands (neither projection is built with shares).
+    fn cell_shares(&self, origin: PatchOrigin, half: HalfViews) -> Option<CellShares> {
+        let g = self.grid.as_ref().filter(|g| !g.is_aligned())?;
+        let fits = PU <= MAX_SHARE_VIEWS && PV <= MAX_SHARE_VIEWS && PS * PT * PU * PV <= MAX_PLACES;
+        if !half.is_none() || !self.solved_response().is_identity() || !fits {
+            return None;
+        }
+        let (lu, lv) = (usize::from(self.config.sensor.lenslet.rows), usize::from(self.config.sensor.lenslet.cols));
+        let mut shares = CellShares::unsheared(g.pixel_width());
+        let d = origin.disparity;
+        for (u, o) in shares.shift.0.iter_mut().enumerate().take(PU) {
+            *o = i8::try_from(shift(d, origin.view_row as usize + u, lu)).ok()?;
+        }
+        for (v, o) in shares.shift.1.iter_mut().enumerate().take(PV) {
+            *o = i8::try_from(shift(d, origin.view_col as usize + v, lv)).ok()?;
+        }
+        Some(shares)
+    }
+
+    /// Where pixel `(row, col)`'s centre lies in the view cell of view `(u, v)` of lenslet
+    /// `(lr, lc)`: cells off the cell's centre (rows, cols), `None` if outside that cell.
+    fn place_in_cell(
+        &self,
+        (lr, lc): (isize, isize),
+        (u, v): (usize, usize),
+        (row, col): (usize, usize),
+    ) -> Option<(f32, f32)> {
+        let g = self.grid.as_ref()?;
+        let (a, b) = g.cell_position(row, col)?;
+        let (nu, nv) = g.views();
+        let centre = |l: isize, n: u8, w: usize| l as f32 * f32::from(n) + w as f32 + 0.5;
+        let (dr, dc) = (a - centre(lr, nu, u), b - centre(lc, nv, v));
+        ((-0.5..0.5).contains(&dr) && (-0.5..0.5).contains(&dc)).then_some((dr, dc))
     }
 
     /// The sensor pixel `(row, col)` of view `(u, v)` of lenslet `(lr, lc)` (a shear can

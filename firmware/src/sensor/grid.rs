@@ -7,7 +7,9 @@
 //! into `U x V` equal view cells. The decoder reads view `(u, v)` of lenslet `(s, t)` from
 //! the pixel that holds its view cell's centre ([`LensletGrid::pixel`]): the pixel's own
 //! measurement, through its own filter, never a resampling of neighbours behind other
-//! filters. The pixel lies within half a pixel of the cell's centre on each axis.
+//! filters. The pixel lies within half a pixel of the cell's centre on each axis; where
+//! exactly ([`LensletGrid::cell_position`]) tells the solve which cells its square covers
+//! (`crate::solver::shares`).
 //!
 //! The host finds the grid (`slf calibrate`, from the flats) and gives its rotation as a
 //! cosine and sine: the device does the same `f32` arithmetic as the host, in the same
@@ -134,6 +136,21 @@ impl LensletGrid {
     /// centre; `None` for a pixel before lenslet (0, 0)'s row or column.
     #[inline(never)]
     pub fn view_of(&self, row: usize, col: usize) -> Option<((usize, usize), (usize, usize))> {
+        let (a, b) = self.cell_position(row, col)?;
+        let (i, j) = (floor(a) as usize, floor(b) as usize);
+        let (nu, nv) = (usize::from(self.views.0), usize::from(self.views.1));
+        // Views are above 0 by `new`; `checked_*` says so without a panic path.
+        let (s, u) = (i.checked_div(nu)?, i.checked_rem(nu)?);
+        let (t, v) = (j.checked_div(nv)?, j.checked_rem(nv)?);
+        Some(((s, t), (u, v)))
+    }
+
+    /// Where sensor pixel `(row, col)`'s centre lies in view cells, `(rows, cols)`: view
+    /// cell `(s * U + u, t * V + v)` (view `(u, v)` of lenslet `(s, t)`) spans
+    /// `[s U + u, s U + u + 1) x [t V + v, t V + v + 1)`. `None` before lenslet (0, 0)'s
+    /// row or column.
+    #[inline(always)]
+    pub fn cell_position(&self, row: usize, col: usize) -> Option<(f32, f32)> {
         let (nu, nv) = (f32::from(self.views.0), f32::from(self.views.1));
         let (dr, dc) = (row as f32 + 0.5 - self.offset.0, col as f32 + 0.5 - self.offset.1);
         // The inverse rotation, then lenslets, then view cells from the micro-image's corner.
@@ -142,12 +159,26 @@ impl LensletGrid {
         if !(a >= 0.0 && b >= 0.0) {
             return None;
         }
-        let (i, j) = (floor(a * nu) as usize, floor(b * nv) as usize);
-        let (nu, nv) = (usize::from(self.views.0), usize::from(self.views.1));
-        // Views are above 0 by `new`; `checked_*` says so without a panic path.
-        let (s, u) = (i.checked_div(nu)?, i.checked_rem(nu)?);
-        let (t, v) = (j.checked_div(nv)?, j.checked_rem(nv)?);
-        Some(((s, t), (u, v)))
+        Some((a * nu, b * nv))
+    }
+
+    /// Whether the grid is the aligned sensor's: not turned, a pitch of whole views, and
+    /// every view cell exactly one pixel (lenslet (0, 0)'s corner on a pixel corner).
+    pub fn is_aligned(&self) -> bool {
+        let (nu, nv) = (f32::from(self.views.0), f32::from(self.views.1));
+        let whole = |x: f32| floor(x) == x;
+        self.cos == 1.0
+            && self.sin == 0.0
+            && self.pitch == (nu, nv)
+            && self.offset.0 >= nu / 2.0
+            && self.offset.1 >= nv / 2.0
+            && whole(self.offset.0 - nu / 2.0)
+            && whole(self.offset.1 - nv / 2.0)
+    }
+
+    /// A pixel's side in view cells, `(rows, cols)`: the views over the pitch.
+    pub fn pixel_width(&self) -> (f32, f32) {
+        (f32::from(self.views.0) / self.pitch.0, f32::from(self.views.1) / self.pitch.1)
     }
 }
 

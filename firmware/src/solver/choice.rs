@@ -486,7 +486,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let dct_wins = dct_score < DCT_MARGIN * member_score;
         // The stash keeps the DCT's solution in the unmeasured entries only, which is all
         // of it for selections; interpolating measurements re-solve instead.
-        let resolve = resolve || !ws.measurements.half.is_none();
+        let resolve = resolve || ws.measurements.interpolates();
         if dct_wins && !resolve {
             // Both meet the measurements (the member's to its noise ball: the measured
             // entries stay the member's), and so does their mean, each weighted by the
@@ -529,7 +529,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             return Ok(ModelOutcome { outcome, member: Some(k), solves: 1 });
         };
         let member = self.member(chosen)?;
-        let selection = ws.measurements.half.is_none();
+        let selection = !ws.measurements.interpolates();
         if !selection {
             let outcome = self.seeded_solve(&member, cfg, ws)?;
             return Ok(ModelOutcome { outcome, member: Some(chosen), solves: 1 });

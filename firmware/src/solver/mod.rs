@@ -11,6 +11,8 @@
 //!   measures `k` rows of it: a `k x k` solve per pixel);
 //! - [`fractional`]: the projection of half-pixel sheared patches, whose measurements
 //!   interpolate the patch;
+//! - [`shares`]: the projection behind a turned lenslet grid, whose measurements are the
+//!   shares of the view cells their pixels cover;
 //! - [`pinv`]: the paper's general pseudo-inverse path for kronecker masks;
 //! - [`fill`]: the band-gain fill, a start for the cold solve that holds the patch's
 //!   brightness and colour;
@@ -38,5 +40,6 @@ pub mod picked;
 pub mod pinv;
 pub mod plausible;
 pub mod projection;
+pub mod shares;
 pub mod sl0;
 pub mod workspace;

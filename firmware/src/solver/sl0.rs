@@ -34,6 +34,7 @@ use crate::solver::fill::fill_bands;
 use crate::solver::fractional::project_fractional;
 use crate::solver::mixing::{BandModel, min_norm, project_mixed, project_signal};
 use crate::solver::projection::project_coefficients;
+use crate::solver::shares::project_shares;
 use crate::solver::workspace::{Measurements, Workspace};
 
 /// Every solver path returns it; it lives below the workspace that checks measurements.
@@ -409,7 +410,7 @@ fn cold<const PS: usize, const PT: usize, const PU: usize, const PV: usize, cons
 ) -> Result<Outcome, SolveError> {
     let ball = start::<B, N>(cfg, &ws.measurements)?;
     let mixed = !ws.response.is_identity();
-    if !ws.measurements.half.is_none() {
+    if ws.measurements.interpolates() {
         if mixed {
             return Err(SolveError::MixedHalfViews);
         }
@@ -422,7 +423,7 @@ fn cold<const PS: usize, const PT: usize, const PU: usize, const PV: usize, cons
         } else {
             coeffs.fill(0.0);
         }
-        project_fractional(dict, coeffs, signal, m, &Ball::new(0.0, 0.0, m.count, 0));
+        project_interpolating(dict, coeffs, signal, m, &Ball::new(0.0, 0.0, m.count, 0));
         synthesize(dict, coeffs, signal);
         return descend(dict, cfg, ws, &ball, plan);
     }
@@ -567,13 +568,13 @@ pub fn seed<const PS: usize, const PT: usize, const PU: usize, const PV: usize, 
     start::<B, N>(cfg, &ws.measurements)?;
     let exact = Ball::new(0.0, 0.0, ws.measurements.count, 0);
     let mixed = !ws.response.is_identity();
-    if !ws.measurements.half.is_none() {
+    if ws.measurements.interpolates() {
         if mixed {
             return Err(SolveError::MixedHalfViews);
         }
         let Workspace { coeffs, signal, measurements: m, .. } = ws;
         analyze(dict, signal, coeffs);
-        project_fractional(dict, coeffs, signal, m, &exact);
+        project_interpolating(dict, coeffs, signal, m, &exact);
         synthesize(dict, coeffs, signal);
         return Ok(None);
     }
@@ -586,6 +587,29 @@ pub fn seed<const PS: usize, const PT: usize, const PU: usize, const PV: usize, 
         project::<B, N>(&mut ws.signal, &ws.measurements, &exact);
     }
     Ok(None)
+}
+
+/// The projection onto measurements that interpolate the patch: shares of view cells
+/// behind a lenslet grid ([`project_shares`]) or a half-pixel shear ([`project_fractional`]).
+fn project_interpolating<
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+    const N: usize,
+>(
+    dict: &Dictionary<PS, PT, PU, PV, B>,
+    coeffs: &mut [f32; N],
+    scratch: &mut [f32; N],
+    m: &Measurements<N>,
+    ball: &Ball,
+) -> f32 {
+    if m.shares.is_some() {
+        project_shares(dict, coeffs, scratch, m, ball)
+    } else {
+        project_fractional(dict, coeffs, scratch, m, ball)
+    }
 }
 
 /// How a descent walks sigma down: the hand-set schedule of the config from `scale` times
@@ -666,7 +690,7 @@ fn descend_mixed<const PS: usize, const PT: usize, const PU: usize, const PV: us
     ball: &Ball,
     plan: Plan<'_, PS, PT, PU, PV, B>,
 ) -> Result<Outcome, SolveError> {
-    if !ws.measurements.half.is_none() {
+    if ws.measurements.interpolates() {
         return Err(SolveError::MixedHalfViews);
     }
     let model = BandModel::new(&ws.response.balanced(&ws.measurements.gains), &dict.d.m5);
@@ -683,7 +707,7 @@ fn descend_with<const PS: usize, const PT: usize, const PU: usize, const PV: usi
     mixing: Option<&BandModel<B>>,
 ) -> Result<Outcome, SolveError> {
     let Workspace { coeffs, signal, measurements: m, .. } = ws;
-    let selection = m.half.is_none();
+    let selection = !m.interpolates();
     analyze(dict, signal, coeffs);
     let top = max_abs(coeffs);
     let mut step = |inv: f32, mu: f32, weights: Option<&Weights<PS, PT, PU, PV, B>>| {
@@ -696,7 +720,7 @@ fn descend_with<const PS: usize, const PT: usize, const PU: usize, const PV: usi
         } else if selection {
             project_coefficients(dict, coeffs, signal, m, ball)
         } else {
-            project_fractional(dict, coeffs, signal, m, ball)
+            project_interpolating(dict, coeffs, signal, m, ball)
         };
         // From a point that meets the measurements, the step d moves the patch by D d on
         // the unmeasured values only (the projection puts the measured ones back), and D

@@ -36,6 +36,51 @@ pub struct Measurements<const N: usize> {
     /// The views whose measurements interpolate the patch (a half-pixel shear,
     /// [`crate::operators::disparity`]); none: every measurement is one value.
     pub(crate) half: HalfViews,
+    /// Behind a turned lenslet grid: each measurement is the shares of the view cells its
+    /// pixel covers ([`crate::solver::shares`]); `None`: each is its own cell's value.
+    pub(crate) shares: Option<CellShares>,
+    /// With [`Self::shares`]: where each measured pixel's centre sits in its view cell, in
+    /// [`PLACE_UNIT`]s off the cell's centre (rows, columns), by patch pixel (a pixel's
+    /// snapshots all come from the one pixel). Two bytes a pixel for up to [`MAX_PLACES`]
+    /// pixels: 1,250 B, where a byte a patch value would have taken 8,125 and cut a camera
+    /// frame's strip by a column (the patch type cannot name its pixel count alone).
+    pub(crate) place: [[i8; 2]; MAX_PLACES],
+}
+
+/// Places per view cell: a measured pixel's centre lies within half a cell of its cell's
+/// centre, stored as `round(offset * PLACE_UNIT)` in an `i8` (steps of 1/254 cell, 0.02 of
+/// a 5-pixel lenslet's pixel, the calibration's own accuracy).
+pub const PLACE_UNIT: f32 = 254.0;
+
+/// The largest views per lenslet along an axis a patch behind a lenslet grid may have.
+pub const MAX_SHARE_VIEWS: usize = 8;
+
+/// The most pixels (`PS * PT * PU * PV`) of a patch whose measurements share view cells:
+/// the full-view patch's 625. A larger patch reads each view at the pixel under its cell's
+/// centre.
+pub const MAX_PLACES: usize = 625;
+
+/// How a lenslet grid's pixels lie over a patch's view cells ([`crate::solver::shares`]):
+/// the same for every measurement of the patch, apart from each one's place
+/// ([`Measurements::set_place`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct CellShares {
+    /// A pixel's side in view cells along the patch's rows and columns: the views per
+    /// lenslet over the grid's pitch (pixels per lenslet). Within `[1/2, 2]`.
+    pub width: (f32, f32),
+    /// The lenslet shift of each view row and view column in the patch's shear
+    /// ([`crate::operators::disparity::shift`]; all 0 unsheared): view row `u` of grid
+    /// position `s` is sensor lenslet row `origin + s + rows[u]`. A pixel's neighbouring
+    /// cells on the sensor are found through it.
+    pub shift: ([i8; MAX_SHARE_VIEWS], [i8; MAX_SHARE_VIEWS]),
+}
+
+impl CellShares {
+    /// An unsheared patch's shares for pixels `width` cells wide.
+    pub const fn unsheared(width: (f32, f32)) -> Self {
+        Self { width, shift: ([0; MAX_SHARE_VIEWS], [0; MAX_SHARE_VIEWS]) }
+    }
 }
 
 impl<const N: usize> Measurements<N> {
@@ -48,6 +93,8 @@ impl<const N: usize> Measurements<N> {
             gains: [1.0; MAX_BANDS],
             balanced: false,
             half: HalfViews::NONE,
+            shares: None,
+            place: [[0; 2]; MAX_PLACES],
         }
     }
 
@@ -63,6 +110,60 @@ impl<const N: usize> Measurements<N> {
     /// The views whose measurements interpolate the patch.
     pub fn half_views(&self) -> HalfViews {
         self.half
+    }
+
+    /// Makes the measurements shares of the view cells their pixels cover, behind a turned
+    /// lenslet grid ([`crate::solver::shares`]); `None`: each measures its own cell (the
+    /// aligned sensor). Set each measured pixel's place with [`Self::set_place`].
+    /// [`clear`](Self::clear) puts the patch back on the aligned sensor.
+    ///
+    /// # Errors
+    /// [`SolveError::InvalidConfig`] for widths outside `[1/2, 2]` or a shift beyond
+    /// `MAX_SHARE_VIEWS` views' reach; nothing changes then.
+    pub fn set_shares(&mut self, shares: Option<CellShares>) -> Result<(), SolveError> {
+        if let Some(c) = &shares {
+            let fits = |w: f32| (0.5..=2.0).contains(&w);
+            if !fits(c.width.0) || !fits(c.width.1) {
+                return Err(SolveError::InvalidConfig { field: "shares.width" });
+            }
+        }
+        self.shares = shares;
+        Ok(())
+    }
+
+    /// How the measurements share view cells, if behind a lenslet grid.
+    pub fn shares(&self) -> Option<&CellShares> {
+        self.shares.as_ref()
+    }
+
+    /// Records where patch pixel `pixel` (`PatchShape::pixel_index / B`) lies in its view
+    /// cell: its centre `offset` (rows, columns) cells off the cell's centre, each within
+    /// `(-1/2, 1/2)` (clamped there).
+    ///
+    /// # Errors
+    /// [`SolveError::IndexOutOfRange`] for a pixel at or past [`MAX_PLACES`];
+    /// [`SolveError::NonFiniteMeasurement`] for a place that is not finite.
+    pub fn set_place(&mut self, pixel: usize, offset: (f32, f32)) -> Result<(), SolveError> {
+        if !(offset.0.is_finite() && offset.1.is_finite()) {
+            return Err(SolveError::NonFiniteMeasurement);
+        }
+        let code = |x: f32| {
+            // Constant bounds: `clamp`'s check of them folds away (no panic site).
+            let y = (x * PLACE_UNIT).clamp(-127.0, 127.0);
+            // Round half away from zero; `as` of a value in [-127.5, 127.5] is exact.
+            (if y < 0.0 { y - 0.5 } else { y + 0.5 }) as i8
+        };
+        let Some(place) = self.place.get_mut(pixel) else {
+            return Err(SolveError::IndexOutOfRange);
+        };
+        *place = [code(offset.0), code(offset.1)];
+        Ok(())
+    }
+
+    /// Whether a measurement may read more than one patch value: a half-pixel shear
+    /// ([`Self::half_views`]) or shares of view cells ([`Self::shares`]).
+    pub fn interpolates(&self) -> bool {
+        !self.half.is_none() || self.shares.is_some()
     }
 
     /// Sets the gain of each band (`gains[b]` for band `b`; bands beyond `gains.len()` get
@@ -94,6 +195,7 @@ impl<const N: usize> Measurements<N> {
         self.measured.fill(false);
         self.count = 0;
         self.half = HalfViews::NONE;
+        self.shares = None;
     }
 
     /// Records that patch entry `index` measured `value` (normalised units).

@@ -1,0 +1,218 @@
+//! Pixels that share view cells behind a turned lenslet grid (issue 52): the projection's
+//! step against a dense f64 reference (`S + A^T W^-1 (y - A S)`, `A = M K`, `W` the rows of
+//! `M M^T` summed, `M` written here from the definition: a pixel `width` cells wide whose centre sits at its place in
+//! its cell records each cell's value weighted by the share of its square the cell covers,
+//! cells found on the sensor through the shear's whole-lenslet shifts, a share outside the
+//! patch given to the pixel's own cell), on grids of pixels narrower and wider than a cell,
+//! unsheared and sheared; where no measurement shares a cell, the exact projection; the
+//! prediction `to_sensor` against `M x`; on a band measured everywhere, half a cell off,
+//! the residual shrinks where a step by the diagonal alone would grow it.
+
+mod common;
+
+use common::*;
+use nalgebra::{DMatrix, DVector};
+use rand::Rng;
+use slf_firmware::ball::Ball;
+use slf_firmware::shares::{project_shares, to_sensor};
+use slf_firmware::workspace::{CellShares, MAX_SHARE_VIEWS, Measurements, PLACE_UNIT};
+use slf_firmware::*;
+
+const PS: usize = 2;
+const PT: usize = 3;
+const PU: usize = 3;
+const PV: usize = 3;
+const B: usize = 2;
+const N: usize = PS * PT * PU * PV * B;
+type Shape = PatchShape<PS, PT, PU, PV, B, N>;
+
+/// The grid position and view of sensor cell `p` along an axis, by search over the patch.
+fn find(p: i64, views: usize, len: usize, shift: &[i8]) -> Option<(usize, usize)> {
+    (0..len)
+        .flat_map(|s| (0..views).map(move |u| (s, u)))
+        .find(|&(s, u)| (s as i64 + i64::from(shift[u])) * views as i64 + u as i64 == p)
+}
+
+/// The shares of a box `[c - w/2, c + w/2]` in the unit cells `k - 1, k, k + 1` around
+/// its own cell `k` (the box's centre `c` in `[k, k + 1)`), as fractions of `w`.
+fn box_1d(c: f64, k: i64, w: f64) -> [f64; 3] {
+    let (a, b) = (c - w / 2.0, c + w / 2.0);
+    core::array::from_fn(|i| {
+        let lo = (k + i as i64 - 1) as f64;
+        ((b.min(lo + 1.0) - a.max(lo)).max(0.0)) / w
+    })
+}
+
+/// Measurement rows of pixel `(s, t, u, v)` from the definition: `(entry of band 0, weight)`.
+fn taps((s, t, u, v): (usize, usize, usize, usize), place: (f64, f64), shares: &CellShares) -> Vec<(usize, f64)> {
+    let p = (s as i64 + i64::from(shares.shift.0[u])) * PU as i64 + u as i64;
+    let q = (t as i64 + i64::from(shares.shift.1[v])) * PV as i64 + v as i64;
+    let mut rows = box_1d(p as f64 + 0.5 + place.0, p, f64::from(shares.width.0));
+    let mut cols = box_1d(q as f64 + 0.5 + place.1, q, f64::from(shares.width.1));
+    for (k, d) in [(0usize, -1i64), (2, 1)] {
+        if find(p + d, PU, PS, &shares.shift.0).is_none() {
+            rows[1] += rows[k];
+            rows[k] = 0.0;
+        }
+        if find(q + d, PV, PT, &shares.shift.1).is_none() {
+            cols[1] += cols[k];
+            cols[k] = 0.0;
+        }
+    }
+    let mut out = Vec::new();
+    for (i, wr) in rows.iter().enumerate() {
+        for (j, wc) in cols.iter().enumerate() {
+            if wr * wc > 0.0 {
+                let (s2, u2) = find(p + i as i64 - 1, PU, PS, &shares.shift.0).unwrap();
+                let (t2, v2) = find(q + j as i64 - 1, PV, PT, &shares.shift.1).unwrap();
+                out.push((Shape::index(s2, t2, u2, v2, 0), wr * wc));
+            }
+        }
+    }
+    out
+}
+
+/// A patch's measurements: `per_band` random pixels of each band, random places (whole
+/// place units, so the stored places are exact) and values. Returns the rows of `M`
+/// (entries, weights) and the values.
+type Rows = Vec<(usize, Vec<(usize, f64)>)>;
+
+/// (each row: the entry it was set at, and its taps)
+fn measure(shares: &CellShares, per_band: usize, seed: u64, place: Option<f64>) -> (Measurements<N>, Rows, Vec<f64>) {
+    let mut r = rng(seed);
+    let mut m = Measurements::<N>::new();
+    m.set_shares(Some(*shares)).unwrap();
+    let pixels: Vec<(usize, usize, usize, usize)> = (0..PS)
+        .flat_map(|s| (0..PT).flat_map(move |t| (0..PU).flat_map(move |u| (0..PV).map(move |v| (s, t, u, v)))))
+        .collect();
+    let mut places = Vec::new();
+    for &(s, t, u, v) in &pixels {
+        let unit = |r: &mut rand_chacha::ChaCha8Rng| f64::from(r.random_range(-126i32..=126)) / f64::from(PLACE_UNIT);
+        let place = place.map_or_else(|| (unit(&mut r), unit(&mut r)), |p| (p, p));
+        m.set_place(Shape::pixel_index(s, t, u, v) / B, (place.0 as f32, place.1 as f32)).unwrap();
+        places.push(place);
+    }
+    let (mut rows, mut y) = (Vec::new(), Vec::new());
+    for b in 0..B {
+        let mut order: Vec<usize> = (0..pixels.len()).collect();
+        for i in (1..order.len()).rev() {
+            order.swap(i, r.random_range(0..=i));
+        }
+        for &i in order.iter().take(per_band) {
+            let value = r.random_range(-1.0f32..1.0);
+            let entry = Shape::pixel_index(pixels[i].0, pixels[i].1, pixels[i].2, pixels[i].3) + b;
+            m.set(entry, value).unwrap();
+            rows.push((entry, taps(pixels[i], places[i], shares).into_iter().map(|(e, w)| (e + b, w)).collect()));
+            y.push(f64::from(value));
+        }
+    }
+    (m, rows, y)
+}
+
+fn shares_of(width: (f32, f32), rows: [i8; 3], cols: [i8; 3]) -> CellShares {
+    let mut c = CellShares::unsheared(width);
+    c.shift.0[..3].copy_from_slice(&rows);
+    c.shift.1[..3].copy_from_slice(&cols);
+    const { assert!(PU <= MAX_SHARE_VIEWS) };
+    c
+}
+
+/// `A = M K` and `W` (the rows of `M M^T` summed) of measurement rows.
+fn dense(rows: &Rows, kd: &[f64], n: usize) -> (DMatrix<f64>, DVector<f64>) {
+    let mut mm = DMatrix::<f64>::zeros(rows.len(), n);
+    for (i, (_, taps)) in rows.iter().enumerate() {
+        for &(e, w) in taps {
+            mm[(i, e)] += w;
+        }
+    }
+    let a = DMatrix::<f64>::from_fn(rows.len(), n, |i, j| rows[i].1.iter().map(|&(e, w)| w * kd[e * n + j]).sum());
+    let g = &mm * mm.transpose();
+    let w = DVector::from_iterator(rows.len(), g.row_iter().map(|r| r.sum()));
+    (a, w)
+}
+
+#[test]
+fn the_projection_matches_the_dense_definition() {
+    let dict = random_dictionary::<PS, PT, PU, PV, B>(5);
+    let (kd, n) = dense_kronecker(dict.synthesis());
+    for (case, shares, per_band) in [
+        // Pixels narrower than a cell (pitch 3.06 px for 3 views), unsheared.
+        (0u64, shares_of((3.0 / 3.06, 3.0 / 3.06), [0; 3], [0; 3]), 12),
+        // Wider than a cell (pitch 2.9 px): a pixel reaches three cells along an axis.
+        (1, shares_of((3.0 / 2.9, 3.0 / 2.95), [0; 3], [0; 3]), 20),
+        // Sheared by whole lenslets: a cell's neighbour on the sensor is elsewhere in the patch.
+        (2, shares_of((3.0 / 3.1, 3.0 / 3.02), [1, 0, -1], [-1, 0, 1]), 20),
+        // Every pixel measures both bands.
+        (3, shares_of((3.0 / 3.04, 3.0 / 3.04), [0; 3], [0; 3]), PS * PT * PU * PV),
+        // One measurement a band: none shares a cell with another, the step is the exact
+        // projection.
+        (4, shares_of((3.0 / 3.04, 3.0 / 3.04), [0; 3], [0; 3]), 1),
+    ] {
+        let (m, rows, y) = measure(&shares, per_band, 10 + case, None);
+        assert_eq!(m.count(), rows.len());
+        let (a, w) = dense(&rows, &kd, n);
+        let mut r = rng(case);
+        let s0: [f32; N] = core::array::from_fn(|_| r.random_range(-1.0f32..1.0));
+        let s = DVector::from_iterator(n, s0.iter().map(|&v| f64::from(v)));
+        let y = DVector::from_vec(y);
+        let want = &s + a.transpose() * (&y - &a * &s).component_div(&w);
+        let mut coeffs = s0;
+        let mut scratch = [0.0f32; N];
+        let before = project_shares(&dict, &mut coeffs, &mut scratch, &m, &Ball::new(0.0, 0.0, m.count() as u32, 0));
+        let residual = (&a * &s - &y).norm();
+        assert!((f64::from(before) - residual).abs() < 1e-4 * residual.max(1.0), "case {case}: residual norm");
+        let err = coeffs.iter().zip(want.iter()).map(|(&g, w)| (f64::from(g) - w).abs()).fold(0.0, f64::max);
+        assert!(err < 5e-5, "case {case}: step differs from the dense one by {err}");
+        if case == 4 {
+            let g = &a * a.transpose();
+            let exact = &s - a.transpose() * g.cholesky().unwrap().solve(&(&a * &s - &y));
+            let err = coeffs.iter().zip(exact.iter()).map(|(&g, w)| (f64::from(g) - w).abs()).fold(0.0, f64::max);
+            assert!(err < 5e-5, "isolated measurements: the exact projection, off by {err}");
+        }
+
+        // The prediction of every measurement from a patch: M x.
+        let x: [f32; N] = core::array::from_fn(|_| r.random_range(-1.0f32..1.0));
+        let mut predicted = x;
+        to_sensor::<PS, PT, PU, PV, B, N>(&m, &mut predicted, &mut scratch);
+        for (entry, row) in &rows {
+            let want: f64 = row.iter().map(|&(e, w)| w * f64::from(x[e])).sum();
+            assert!((f64::from(predicted[*entry]) - want).abs() < 1e-5, "case {case}: prediction at {entry}");
+        }
+    }
+}
+
+/// Every pixel measures both bands and sits half a cell off its cell's centre (less one
+/// place unit), the same phase everywhere: `M M^T`'s diagonal is about a quarter of its
+/// rows' sums away from the patch's edges. Twenty steps by the rows' sums shrink the residual (in the `W^-1` norm, where
+/// the scaled `M M^T` has every eigenvalue in `(0, 1]`); by the diagonal alone, the same
+/// steps grow it (checked on the dense definition, so the test shows why the sums).
+#[test]
+fn on_a_band_measured_everywhere_the_residual_shrinks() {
+    let dict = random_dictionary::<PS, PT, PU, PV, B>(6);
+    let (kd, n) = dense_kronecker(dict.synthesis());
+    let shares = shares_of((1.0, 1.0), [0; 3], [0; 3]);
+    let (m, rows, y) = measure(&shares, PS * PT * PU * PV, 21, Some(126.0 / f64::from(PLACE_UNIT)));
+    let (a, w) = dense(&rows, &kd, n);
+    let y = DVector::from_vec(y);
+    let norm = |c: &DVector<f64>| (&a * c - &y).component_div(&w.map(f64::sqrt)).norm();
+    let mut r = rng(3);
+    let s0: [f32; N] = core::array::from_fn(|_| r.random_range(-1.0f32..1.0));
+    let mut coeffs = s0;
+    let mut scratch = [0.0f32; N];
+    let start = DVector::from_iterator(n, s0.iter().map(|&v| f64::from(v)));
+    let mut last = norm(&start);
+    for step in 0..20 {
+        project_shares(&dict, &mut coeffs, &mut scratch, &m, &Ball::new(0.0, 0.0, m.count() as u32, 0));
+        let now = norm(&DVector::from_iterator(n, coeffs.iter().map(|&v| f64::from(v))));
+        assert!(now <= last * (1.0 + 1e-4), "step {step}: residual {last} grew to {now}");
+        last = now;
+    }
+    assert!(last < 0.5 * norm(&start), "residual {} from {}", last, norm(&start));
+    let g = &a * a.transpose();
+    let diagonal = g.diagonal();
+    let mut plain = start.clone();
+    for _ in 0..20 {
+        plain = &plain + a.transpose() * (&y - &a * &plain).component_div(&diagonal);
+    }
+    assert!(norm(&plain) > 10.0 * norm(&start), "the diagonal's steps did not diverge: {}", norm(&plain));
+}
