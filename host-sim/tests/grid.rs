@@ -256,6 +256,32 @@ fn the_decode_reads_each_view_where_the_grid_puts_it() {
     assert!(outs[0] == outs[1], "the aligned grid's patches differ from no grid's");
 }
 
+/// A grid offset by exactly half a pixel (pitch 5.00, unturned): the pixel under each view
+/// cell's centre has its own centre on the cell's border. Each cell still takes it (cells a
+/// pixel wide never share one), so every patch decodes (before, every cell refused its pixel
+/// and 156 of 169 patches failed on office at 64 x 64 lenslets), within 10 dB of the aligned
+/// sensor: each pixel is the mean of two rows of views, which costs information (measured
+/// here 35.60 against 42.85 dB: pixel k = 3, noiseless, disjoint unsheared patches).
+#[test]
+fn a_grid_half_a_pixel_off_decodes_every_patch() {
+    use slf_host::decode::settings::DecodeSettings;
+    use slf_host::eval::metrics::evaluate;
+    use slf_host::sim::scene::SceneSize;
+    let lf = slf_host::sim::realistic::named("office").unwrap().render(SceneSize { views: (5, 5), rows: 30, cols: 30 });
+    let mut cam = CameraConfig::pixel(5, 3).noiseless();
+    cam.grid = Some(GridSettings { rotation_deg: 0.0, pitch: Some([5.0, 5.0]), offset: Some([2.0, 2.5]) });
+    let cap = simulate(&lf, &cam).unwrap();
+    let s = DecodeSettings::from_flags(["--disparities", "0:0", "--stride", "5"]).unwrap();
+    let run = s.run(&cap, false, &|_, _| {}).unwrap();
+    let slf_host::decode::settings::Outcome::Cs { report, .. } = &run.outcome else { panic!("not a CS decode") };
+    assert!(report.patches.decoded > 0 && report.patches.failed == 0, "{:?}", report.patches);
+    let m = evaluate(&lf, &run.light_field).unwrap();
+    let aligned = simulate(&lf, &CameraConfig::pixel(5, 3).noiseless()).unwrap();
+    let r = evaluate(&lf, &s.run(&aligned, false, &|_, _| {}).unwrap().light_field).unwrap();
+    eprintln!("half a pixel off {m:?}\naligned {r:?}");
+    assert!(m.psnr > r.psnr - 10.0 && m.psnr > 30.0, "half a pixel off {} dB, aligned {}", m.psnr, r.psnr);
+}
+
 /// Every accepted patch's values, in order.
 struct Collect<'a>(&'a mut Vec<Vec<u32>>);
 

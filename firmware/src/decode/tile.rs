@@ -1097,7 +1097,8 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     }
 
     /// Where pixel `(row, col)`'s centre lies in the view cell of view `(u, v)` of lenslet
-    /// `(lr, lc)`: cells off the cell's centre (rows, cols), `None` if outside that cell.
+    /// `(lr, lc)`: cells off the cell's centre (rows, cols), `None` if outside that cell (so
+    /// no pixel is two cells' measurement).
     fn place_in_cell(
         &self,
         (lr, lc): (isize, isize),
@@ -1109,7 +1110,12 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let (nu, nv) = g.views();
         let centre = |l: isize, n: u8, w: usize| l as f32 * f32::from(n) + w as f32 + 0.5;
         let (dr, dc) = (a - centre(lr, nu, u), b - centre(lc, nv, v));
-        ((-0.5..0.5).contains(&dr) && (-0.5..0.5).contains(&dc)).then_some((dr, dc))
+        // Cells at least a pixel apart (pitch at least the views) never share the pixel under
+        // their centres, which may sit on the cell's border (a grid offset by half a pixel);
+        // smaller cells may, and the border then goes to the cell after it.
+        let within = |d: f32, wide: bool| if wide { (-0.5..=0.5).contains(&d) } else { (-0.5..0.5).contains(&d) };
+        let (wr, wc) = g.pixel_width();
+        (within(dr, wr <= 1.0) && within(dc, wc <= 1.0)).then_some((dr, dc))
     }
 
     /// The sensor pixel `(row, col)` of view `(u, v)` of lenslet `(lr, lc)` (a shear can
