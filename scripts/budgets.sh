@@ -86,7 +86,7 @@ steps_whole, steps_half = (int(x) / patches for x in steps.groups())
 # the strip among them); DTCM: the stack's peak over the whole run.
 flash, ram = text + rodata + data, data + bss
 print("| budget | measured | limit |\n| --- | --- | --- |")
-print(f"| flash (.text + .rodata + .data) | {flash:,} B ({flash / 1024:.1f} KiB) | 256 KiB |")
+print(f"| flash (.text + .rodata + .data) | {flash:,} B ({flash / 1024:.1f} KiB) | 320 KiB |")
 print(f"| static RAM (.data + .bss) | {data + bss:,} B | |")
 print(f"| of which the Workspace | {ws:,} B | |")
 print(f"| peak stack (painted) | {stack:,} B | |")
@@ -119,7 +119,9 @@ with open(sys.argv[5], "w") as f:
     f.write("decode,patch_solves,instructions_per_solve,clock_mhz\n")
     f.write(f'"default kind: screened ensemble, full-view patches, stride 3, sheared strip in bands",{solves_100:.0f},{ens:.0f},480\n')
     f.write(f'"preview kind: 5D DCT, full-view patches, disjoint grid, from the minimum-norm start",{20 * 20},{dct:.0f},480\n')
-ok = flash <= 256 * 1024 and ram <= 512 * 1024 and stack <= 128 * 1024
+# Flash: 320 KiB since issue 52 (a real lenslet array: the grid's read and the projection of
+# pixels that share view cells), which allows it; before, 256 KiB.
+ok = flash <= 320 * 1024 and ram <= 512 * 1024 and stack <= 128 * 1024
 _print("within budget" if ok else "OVER BUDGET")
 
 # The README's table is this one: written there with --write, compared with --check.

@@ -22,9 +22,8 @@
 
 use crate::operators::dictionary::Dictionary;
 use crate::operators::shape::PatchShape;
-use crate::operators::transform::{Slice, flat, mode_rows, slice};
 use crate::solver::ball::Ball;
-use crate::solver::projection::{apply_move, band_bits, dot, slice_analysis, slice_synthesis};
+use crate::solver::projection::{band_bits, dot, project_whole};
 use crate::solver::workspace::Measurements;
 
 /// The largest view grid (`PS * PT`) a half-pixel patch may have: one band's system of a
@@ -51,29 +50,19 @@ pub fn project_fractional<
     ball: &Ball,
 ) -> f32 {
     const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
-    let part_len = PT * PU * PV * B;
     // The pixel modes' synthesis (the fast path's), every slice back in place: each
-    // pixel's band coefficients.
-    mode_rows(&dict.d.m1, dict.synthesis_folds()[0], coeffs, scratch, part_len);
-    let mut tmp: Slice<PT, PU, PV, B> = slice();
-    for part in scratch.chunks_exact_mut(part_len) {
-        let tmp = flat(&mut tmp);
-        slice_synthesis(dict, part, tmp);
-        part.copy_from_slice(tmp);
-    }
-    let (mut r2, mut w2) = (0.0f32, 0.0f32);
-    for u in 0..PU {
-        for v in 0..PV {
-            let (r, w) = view_step::<PS, PT, PU, PV, B, N>(&dict.d.m5, scratch, m, ball, (u, v));
-            (r2, w2) = (r2 + r, w2 + w);
+    // pixel's band coefficients; then the band step view by view.
+    let mut step = |scratch: &mut [f32; N]| {
+        let (mut r2, mut w2) = (0.0f32, 0.0f32);
+        for u in 0..PU {
+            for v in 0..PV {
+                let (r, w) = view_step::<PS, PT, PU, PV, B, N>(&dict.d.m5, scratch, m, ball, (u, v));
+                (r2, w2) = (r2 + r, w2 + w);
+            }
         }
-    }
-    for part in scratch.chunks_exact_mut(part_len) {
-        let tmp = flat(&mut tmp);
-        tmp.copy_from_slice(part);
-        slice_analysis(dict, tmp, part);
-    }
-    apply_move(dict, ball, (r2, w2), scratch, coeffs)
+        (r2, w2)
+    };
+    project_whole(dict, coeffs, scratch, ball, &mut step)
 }
 
 /// The band step of view `(u, v)`: its pixels' band coefficients in `fibres` become the

@@ -114,6 +114,49 @@ pub(crate) fn project_slices<
     apply_move(dict, ball, (r2, w2), scratch, coeffs)
 }
 
+/// A step on the whole patch's band coefficients: `scratch` (every pixel's band
+/// coefficients after the pixel modes' synthesis) becomes the correction's. Returns the sums
+/// of squared residuals, plain and weighted.
+pub(crate) type PatchStep<'s, const N: usize> = dyn FnMut(&mut [f32; N]) -> (f32, f32) + 's;
+
+/// The frame of the interpolating projections ([`crate::solver::fractional`],
+/// [`crate::solver::shares`]), whose measurements read values of several spatial slices:
+/// the pixel modes' synthesis of every slice back in place, `step` on the whole patch, the
+/// analysis and the ball's move. One copy for both (through a pointer, as
+/// [`project_slices`]): a copy each took 19 KB more flash on the device.
+#[inline(never)]
+pub(crate) fn project_whole<
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+    const N: usize,
+>(
+    dict: &Dictionary<PS, PT, PU, PV, B>,
+    coeffs: &mut [f32; N],
+    scratch: &mut [f32; N],
+    ball: &Ball,
+    step: &mut PatchStep<'_, N>,
+) -> f32 {
+    const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
+    let part_len = PT * PU * PV * B;
+    mode_rows(&dict.d.m1, dict.synthesis_folds()[0], coeffs, scratch, part_len);
+    let mut tmp: Slice<PT, PU, PV, B> = slice();
+    for part in scratch.chunks_exact_mut(part_len) {
+        let tmp = flat(&mut tmp);
+        slice_synthesis(dict, part, tmp);
+        part.copy_from_slice(tmp);
+    }
+    let moved = step(scratch);
+    for part in scratch.chunks_exact_mut(part_len) {
+        let tmp = flat(&mut tmp);
+        tmp.copy_from_slice(part);
+        slice_analysis(dict, tmp, part);
+    }
+    apply_move(dict, ball, moved, scratch, coeffs)
+}
+
 /// The synthesis of one spatial slice over the pixel modes after the first: `part` (its
 /// first mode already synthesised) to each pixel's band coefficients in `fibres`; `part`
 /// is clobbered. Shared by both projections ([`crate::solver::fractional`]).

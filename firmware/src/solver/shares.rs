@@ -40,9 +40,8 @@
 
 use crate::operators::dictionary::Dictionary;
 use crate::operators::shape::PatchShape;
-use crate::operators::transform::{Slice, flat, mode_rows, slice};
 use crate::solver::ball::Ball;
-use crate::solver::projection::{apply_move, band_bits, dot, slice_analysis, slice_synthesis};
+use crate::solver::projection::{band_bits, dot, project_whole};
 use crate::solver::workspace::{CellShares, MAX_SHARE_VIEWS, Measurements, PLACE_UNIT};
 
 /// The cells a measurement covers (at most 3 x 3), with their shares.
@@ -204,26 +203,13 @@ pub fn project_shares<
     ball: &Ball,
 ) -> f32 {
     const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
-    let part_len = PT * PU * PV * B;
-    // The pixel modes' synthesis, every slice back in place: each pixel's band
-    // coefficients (the half-pixel projection's frame, `crate::solver::fractional`).
-    mode_rows(&dict.d.m1, dict.synthesis_folds()[0], coeffs, scratch, part_len);
-    let mut tmp: Slice<PT, PU, PV, B> = slice();
-    for part in scratch.chunks_exact_mut(part_len) {
-        let tmp = flat(&mut tmp);
-        slice_synthesis(dict, part, tmp);
-        part.copy_from_slice(tmp);
-    }
-    let moved = match &m.shares {
+    // The pixel modes' synthesis, every slice back in place (the half-pixel projection's
+    // frame, `crate::solver::fractional`): each pixel's band coefficients.
+    let mut step = |scratch: &mut [f32; N]| match &m.shares {
         Some(shares) => share_step::<PS, PT, PU, PV, B, N>(&dict.d.m5, scratch, m, ball, shares),
         None => (0.0, 0.0),
     };
-    for part in scratch.chunks_exact_mut(part_len) {
-        let tmp = flat(&mut tmp);
-        tmp.copy_from_slice(part);
-        slice_analysis(dict, tmp, part);
-    }
-    apply_move(dict, ball, moved, scratch, coeffs)
+    project_whole(dict, coeffs, scratch, ball, &mut step)
 }
 
 /// Calls `f((s, t, u, v), pixel, band bits)` for every patch pixel with a measurement.
