@@ -60,6 +60,24 @@ impl Footprint {
     fn taps(&self) -> impl Iterator<Item = (usize, f32)> + '_ {
         self.cells.iter().zip(&self.weights).take(self.len).map(|(&c, &w)| (usize::from(c), w))
     }
+
+    /// Band `b` of the cells covered, each by its share, summed (`cells` by patch pixel).
+    #[inline(always)]
+    fn band_sum<const B: usize>(&self, cells: &[[f32; B]], b: usize) -> f32 {
+        self.taps().map(|(c, w)| w * cells.get(c).and_then(|f| f.get(b)).copied().unwrap_or(0.0)).sum()
+    }
+}
+
+/// The bands set in `bits`, lowest first.
+#[inline(always)]
+fn bands(mut bits: u64) -> impl Iterator<Item = usize> {
+    core::iter::from_fn(move || {
+        (bits != 0).then(|| {
+            let b = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            b
+        })
+    })
 }
 
 /// The most lenslet rows times view rows (and columns times view columns) of a patch
@@ -255,7 +273,7 @@ fn share_step<const PS: usize, const PT: usize, const PU: usize, const PV: usize
     let mut res = [0.0f32; N];
     let (mut r2, mut w2) = (0.0f32, 0.0f32);
     let weighted = ball.is_weighted();
-    each_measured::<PS, PT, PU, PV, B, N>(m, |at, pixel, mut bits| {
+    each_measured::<PS, PT, PU, PV, B, N>(m, |at, pixel, bits| {
         let fp = layout.footprint(m, at, pixel);
         let mut sum = [0.0f32; B];
         for (c, w) in fp.taps() {
@@ -265,9 +283,7 @@ fn share_step<const PS: usize, const PT: usize, const PU: usize, const PV: usize
                 }
             }
         }
-        while bits != 0 {
-            let b = bits.trailing_zeros() as usize;
-            bits &= bits - 1;
+        for b in bands(bits) {
             let i = pixel * B + b;
             let (Some(row), Some(&y), Some(r)) = (m5.get(b), m.values.get(i), res.get_mut(i)) else { continue };
             *r = y - dot(row, &sum);
@@ -294,15 +310,10 @@ fn share_step<const PS: usize, const PT: usize, const PU: usize, const PV: usize
         }
     });
     // The steps: a residual over its row of `M M^T` summed.
-    each_measured::<PS, PT, PU, PV, B, N>(m, |at, pixel, mut bits| {
+    each_measured::<PS, PT, PU, PV, B, N>(m, |at, pixel, bits| {
         let fp = layout.footprint(m, at, pixel);
-        while bits != 0 {
-            let b = bits.trailing_zeros() as usize;
-            bits &= bits - 1;
-            let mut row = 0.0f32;
-            for (c, w) in fp.taps() {
-                row += w * fibres.get(c).and_then(|f| f.get(b)).copied().unwrap_or(0.0);
-            }
+        for b in bands(bits) {
+            let row = fp.band_sum(fibres, b);
             if let Some(r) = res.get_mut(pixel * B + b) {
                 *r = if row > f32::MIN_POSITIVE { *r / row } else { 0.0 };
             }
@@ -313,11 +324,9 @@ fn share_step<const PS: usize, const PT: usize, const PU: usize, const PV: usize
     for f in fibres.iter_mut() {
         *f = [0.0; B];
     }
-    each_measured::<PS, PT, PU, PV, B, N>(m, |at, pixel, mut bits| {
+    each_measured::<PS, PT, PU, PV, B, N>(m, |at, pixel, bits| {
         let mut correction = [0.0f32; B];
-        while bits != 0 {
-            let b = bits.trailing_zeros() as usize;
-            bits &= bits - 1;
+        for b in bands(bits) {
             let (Some(row), Some(&z)) = (m5.get(b), res.get(pixel * B + b)) else { continue };
             for (o, &w) in correction.iter_mut().zip(row) {
                 *o += z * w;
@@ -348,15 +357,11 @@ pub fn to_sensor<const PS: usize, const PT: usize, const PU: usize, const PV: us
     let Some(shares) = &m.shares else { return };
     let layout = Layout::<PS, PT, PU, PV, B>::new(shares);
     scratch.copy_from_slice(patch);
-    each_measured::<PS, PT, PU, PV, B, N>(m, |at, pixel, mut bits| {
+    let cells = scratch.as_chunks::<B>().0;
+    each_measured::<PS, PT, PU, PV, B, N>(m, |at, pixel, bits| {
         let fp = layout.footprint(m, at, pixel);
-        while bits != 0 {
-            let b = bits.trailing_zeros() as usize;
-            bits &= bits - 1;
-            let mut x = 0.0f32;
-            for (c, w) in fp.taps() {
-                x += w * scratch.get(c * B + b).copied().unwrap_or(0.0);
-            }
+        for b in bands(bits) {
+            let x = fp.band_sum(cells, b);
             if let Some(y) = patch.get_mut(pixel * B + b) {
                 *y = x;
             }
