@@ -44,27 +44,39 @@ use crate::solver::ball::Ball;
 use crate::solver::projection::{band_bits, dot, project_whole};
 use crate::solver::workspace::{CellShares, MAX_SHARE_VIEWS, Measurements, PLACE_UNIT};
 
-/// The cells a measurement covers (at most 3 x 3), with their shares.
+/// The cells a measurement covers (at most 3 x 3), with their shares: per axis (rows,
+/// columns), the cells before, at and after the pixel's own, each its part of a pixel index
+/// (`pixel = row part + column part`) and its share (0: not covered); a cell's share is the
+/// product of its row's and its column's.
 #[derive(Clone, Copy)]
 struct Footprint {
-    cells: [u16; 9],
-    weights: [f32; 9],
-    len: usize,
+    rows: ([u16; 3], [f32; 3]),
+    cols: ([u16; 3], [f32; 3]),
 }
 
 impl Footprint {
-    const EMPTY: Self = Self { cells: [0; 9], weights: [0.0; 9], len: 0 };
-
-    /// `(cell, share)` of each cell covered.
+    /// `f(cell, share)` for each cell covered.
     #[inline(always)]
-    fn taps(&self) -> impl Iterator<Item = (usize, f32)> + '_ {
-        self.cells.iter().zip(&self.weights).take(self.len).map(|(&c, &w)| (usize::from(c), w))
+    fn each(&self, mut f: impl FnMut(usize, f32)) {
+        let ((rp, rw), (cp, cw)) = (&self.rows, &self.cols);
+        for (&r, &wr) in rp.iter().zip(rw) {
+            if wr <= 0.0 {
+                continue;
+            }
+            for (&c, &wc) in cp.iter().zip(cw) {
+                if wc > 0.0 {
+                    f(usize::from(r.wrapping_add(c)), wr * wc);
+                }
+            }
+        }
     }
 
     /// Band `b` of the cells covered, each by its share, summed (`cells` by patch pixel).
     #[inline(always)]
     fn band_sum<const B: usize>(&self, cells: &[[f32; B]], b: usize) -> f32 {
-        self.taps().map(|(c, w)| w * cells.get(c).and_then(|f| f.get(b)).copied().unwrap_or(0.0)).sum()
+        let mut sum = 0.0f32;
+        self.each(|c, w| sum += w * cells.get(c).and_then(|f| f.get(b)).copied().unwrap_or(0.0));
+        sum
     }
 }
 
@@ -147,32 +159,10 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
             None => (OUTSIDE, OUTSIDE),
         };
         let col_parts = [before, (t * PU * PV + v) as u16, after];
-        let mut rows = box_shares(place(pr), self.half.0, self.inv.0);
-        let mut cols = box_shares(place(pc), self.half.1, self.inv.1);
-        // Shares of cells outside the patch go to the pixel's own cell.
-        for k in [0, 2] {
-            if row_parts[k] == OUTSIDE {
-                rows[1] += rows[k];
-                rows[k] = 0.0;
-            }
-            if col_parts[k] == OUTSIDE {
-                cols[1] += cols[k];
-                cols[k] = 0.0;
-            }
+        Footprint {
+            rows: axis(place(pr), self.half.0, self.inv.0, row_parts),
+            cols: axis(place(pc), self.half.1, self.inv.1, col_parts),
         }
-        let mut fp = Footprint::EMPTY;
-        for (&wr, &rp) in rows.iter().zip(&row_parts) {
-            for (&wc, &cp) in cols.iter().zip(&col_parts) {
-                let w = wr * wc;
-                if w <= 0.0 {
-                    continue;
-                }
-                let (Some(c), Some(x)) = (fp.cells.get_mut(fp.len), fp.weights.get_mut(fp.len)) else { continue };
-                (*c, *x) = (rp.wrapping_add(cp), w);
-                fp.len += 1;
-            }
-        }
-        fp
     }
 }
 
@@ -187,18 +177,25 @@ fn along(p: isize, views: usize, len: usize, shift: &[i8; MAX_SHARE_VIEWS]) -> O
     usize::try_from(s).ok().filter(|&s| s < len).map(|s| (s, view))
 }
 
-/// The shares of a pixel `2 half` cells wide (`inv` its inverse), its centre `delta`
-/// cells off its own cell's centre, in the cell before, its own and the cell after (a box
-/// against unit cells).
+/// One axis of a footprint: the shares of a pixel `2 half` cells wide (`inv` its inverse),
+/// its centre `delta` cells off its own cell's centre, in the cells before, at and after
+/// its own (`parts`, [`OUTSIDE`] beyond the patch: that share goes to its own cell). A box
+/// against unit cells: `half <= 1` and `|delta| <= 1/2`, so it reaches no further.
 #[inline(always)]
-fn box_shares(delta: f32, half: f32, inv: f32) -> [f32; 3] {
+fn axis(delta: f32, half: f32, inv: f32, parts: [u16; 3]) -> ([u16; 3], [f32; 3]) {
     let (a, b) = (delta - half, delta + half);
-    // Comparisons, not `max` / `min` (calls on a Cortex-M4F).
-    let part = |lo: f32, hi: f32| {
-        let x = (if b < hi { b } else { hi }) - (if a > lo { a } else { lo });
-        if x > 0.0 { x * inv } else { 0.0 }
-    };
-    [part(-1.5, -0.5), part(-0.5, 0.5), part(0.5, 1.5)]
+    let mut before = if a < -0.5 { (-0.5 - a) * inv } else { 0.0 };
+    let mut after = if b > 0.5 { (b - 0.5) * inv } else { 0.0 };
+    let mut own = 1.0 - before - after;
+    if parts[0] == OUTSIDE {
+        own += before;
+        before = 0.0;
+    }
+    if parts[2] == OUTSIDE {
+        own += after;
+        after = 0.0;
+    }
+    (parts, [before, own, after])
 }
 
 /// Moves the coefficients `coeffs` (of `dict`) onto the measurements `m`, whose pixels
@@ -276,13 +273,13 @@ fn share_step<const PS: usize, const PT: usize, const PU: usize, const PV: usize
     each_measured::<PS, PT, PU, PV, B, N>(m, |at, pixel, bits| {
         let fp = layout.footprint(m, at, pixel);
         let mut sum = [0.0f32; B];
-        for (c, w) in fp.taps() {
+        fp.each(|c, w| {
             if let Some(f) = fibres.get(c) {
                 for (o, &x) in sum.iter_mut().zip(f) {
                     *o += w * x;
                 }
             }
-        }
+        });
         for b in bands(bits) {
             let i = pixel * B + b;
             let (Some(row), Some(&y), Some(r)) = (m5.get(b), m.values.get(i), res.get_mut(i)) else { continue };
@@ -299,7 +296,7 @@ fn share_step<const PS: usize, const PT: usize, const PU: usize, const PV: usize
     }
     each_measured::<PS, PT, PU, PV, B, N>(m, |at, pixel, bits| {
         let fp = layout.footprint(m, at, pixel);
-        for (c, w) in fp.taps() {
+        fp.each(|c, w| {
             if let Some(f) = fibres.get_mut(c) {
                 for (b, x) in f.iter_mut().enumerate() {
                     if bits & (1 << b) != 0 {
@@ -307,7 +304,7 @@ fn share_step<const PS: usize, const PT: usize, const PU: usize, const PV: usize
                     }
                 }
             }
-        }
+        });
     });
     // The steps: a residual over its row of `M M^T` summed.
     each_measured::<PS, PT, PU, PV, B, N>(m, |at, pixel, bits| {
@@ -333,13 +330,13 @@ fn share_step<const PS: usize, const PT: usize, const PU: usize, const PV: usize
             }
         }
         let fp = layout.footprint(m, at, pixel);
-        for (c, w) in fp.taps() {
+        fp.each(|c, w| {
             if let Some(f) = fibres.get_mut(c) {
                 for (o, &x) in f.iter_mut().zip(&correction) {
                     *o += w * x;
                 }
             }
-        }
+        });
     });
     (r2, w2)
 }
