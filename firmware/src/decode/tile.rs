@@ -1076,8 +1076,9 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     }
 
     /// How the pixels of a patch at `origin` share view cells behind the lenslet grid:
-    /// `None` on the aligned sensor (each pixel its cell, the selection's bits), for a half-pixel shear (its own interpolation) and for
-    /// a solved response that mixes bands (neither projection is built with shares).
+    /// `None` on the aligned sensor (each pixel its cell, the selection's bits), for a
+    /// half-pixel shear (its own interpolation) and for a solved response that mixes bands
+    /// (neither projection is built with shares).
     fn cell_shares(&self, origin: PatchOrigin, half: HalfViews) -> Option<CellShares> {
         let g = self.grid.as_ref().filter(|g| !g.is_aligned())?;
         let fits = PU <= MAX_SHARE_VIEWS && PV <= MAX_SHARE_VIEWS && PS * PT * PU * PV <= MAX_PLACES;
