@@ -1045,22 +1045,13 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                     } else {
                         for v in 0..PV {
                             let (vr, vc) = (origin.view_row as usize + u, origin.view_col as usize + v);
-                            let Some((row, col)) = origin
-                                .lenslet::<PS, PT>(s, t, u, v, (lu, lv))
-                                .and_then(|l| self.sensor_pixel(l, vr, vc))
-                            else {
-                                continue;
-                            };
+                            let Some(lenslet) = origin.lenslet::<PS, PT>(s, t, u, v, (lu, lv)) else { continue };
+                            let Some((row, col)) = self.sensor_pixel(lenslet, vr, vc) else { continue };
                             let at = PatchShape::<PS, PT, PU, PV, B, N>::pixel_index(s, t, u, v);
                             if shared {
                                 // The pixel's place in its cell; a pixel whose centre lies
                                 // in another cell is that cell's measurement, not this one's.
-                                let Some(place) = origin
-                                    .lenslet::<PS, PT>(s, t, u, v, (lu, lv))
-                                    .and_then(|l| self.place_in_cell(l, (vr, vc), (row, col)))
-                                else {
-                                    continue;
-                                };
+                                let Some(place) = self.place_in_cell(lenslet, (vr, vc), (row, col)) else { continue };
                                 let _ = m.set_place(at / B, place);
                             }
                             for (j, r) in run.iter_mut().enumerate().take(k) {

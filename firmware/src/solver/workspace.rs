@@ -118,8 +118,7 @@ impl<const N: usize> Measurements<N> {
     /// [`clear`](Self::clear) puts the patch back on the aligned sensor.
     ///
     /// # Errors
-    /// [`SolveError::InvalidConfig`] for widths outside `[1/2, 2]` or a shift beyond
-    /// `MAX_SHARE_VIEWS` views' reach; nothing changes then.
+    /// [`SolveError::InvalidConfig`] for widths outside `[1/2, 2]`; nothing changes then.
     pub fn set_shares(&mut self, shares: Option<CellShares>) -> Result<(), SolveError> {
         if let Some(c) = &shares {
             let fits = |w: f32| (0.5..=2.0).contains(&w);
@@ -138,7 +137,7 @@ impl<const N: usize> Measurements<N> {
 
     /// Records where patch pixel `pixel` (`PatchShape::pixel_index / B`) lies in its view
     /// cell: its centre `offset` (rows, columns) cells off the cell's centre, each within
-    /// `(-1/2, 1/2)` (clamped there).
+    /// `[-1/2, 1/2]` (clamped to `127 / PLACE_UNIT` either side).
     ///
     /// # Errors
     /// [`SolveError::IndexOutOfRange`] for a pixel at or past [`MAX_PLACES`];
