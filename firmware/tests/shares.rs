@@ -6,7 +6,8 @@
 //! patch given to the pixel's own cell), on grids of pixels narrower and wider than a cell,
 //! unsheared and sheared; where no measurement shares a cell, the exact projection; the
 //! prediction `to_sensor` against `M x`; on a band measured everywhere, half a cell off,
-//! the residual shrinks where a step by the diagonal alone would grow it.
+//! the residual shrinks where a step by the diagonal alone would grow it; a second step
+//! with the row sums the first one found and kept ([`RowSums`]) against the reference too.
 
 mod common;
 
@@ -14,7 +15,7 @@ use common::*;
 use nalgebra::{DMatrix, DVector};
 use rand::Rng;
 use slf_firmware::ball::Ball;
-use slf_firmware::shares::{project_shares, to_sensor};
+use slf_firmware::shares::{RowSums, project_shares, to_sensor};
 use slf_firmware::workspace::{CellShares, MAX_SHARE_VIEWS, Measurements, PLACE_UNIT};
 use slf_firmware::*;
 
@@ -158,11 +159,22 @@ fn the_projection_matches_the_dense_definition() {
         let want = &s + a.transpose() * (&y - &a * &s).component_div(&w);
         let mut coeffs = s0;
         let mut scratch = [0.0f32; N];
-        let before = project_shares(&dict, &mut coeffs, &mut scratch, &m, &Ball::new(0.0, 0.0, m.count() as u32, 0));
+        let mut sums = RowSums::new();
+        let exact = Ball::new(0.0, 0.0, m.count() as u32, 0);
+        let before = project_shares(&dict, &mut coeffs, &mut scratch, &m, &exact, &mut sums);
         let residual = (&a * &s - &y).norm();
         assert!((f64::from(before) - residual).abs() < 1e-4 * residual.max(1.0), "case {case}: residual norm");
         let err = coeffs.iter().zip(want.iter()).map(|(&g, w)| (f64::from(g) - w).abs()).fold(0.0, f64::max);
         assert!(err < 5e-5, "case {case}: step differs from the dense one by {err}");
+        // A second step with the row sums the first one found (a descent's later steps),
+        // from another start.
+        let s1: [f32; N] = core::array::from_fn(|_| r.random_range(-1.0f32..1.0));
+        let t = DVector::from_iterator(n, s1.iter().map(|&v| f64::from(v)));
+        let want = &t + a.transpose() * (&y - &a * &t).component_div(&w);
+        let mut again = s1;
+        project_shares(&dict, &mut again, &mut scratch, &m, &exact, &mut sums);
+        let err = again.iter().zip(want.iter()).map(|(&g, w)| (f64::from(g) - w).abs()).fold(0.0, f64::max);
+        assert!(err < 5e-5, "case {case}: a step with kept row sums differs from the dense one by {err}");
         if case == 4 {
             let g = &a * a.transpose();
             let exact = &s - a.transpose() * g.cholesky().unwrap().solve(&(&a * &s - &y));
@@ -201,8 +213,9 @@ fn on_a_band_measured_everywhere_the_residual_shrinks() {
     let mut scratch = [0.0f32; N];
     let start = DVector::from_iterator(n, s0.iter().map(|&v| f64::from(v)));
     let mut last = norm(&start);
+    let mut sums = RowSums::new();
     for step in 0..20 {
-        project_shares(&dict, &mut coeffs, &mut scratch, &m, &Ball::new(0.0, 0.0, m.count() as u32, 0));
+        project_shares(&dict, &mut coeffs, &mut scratch, &m, &Ball::new(0.0, 0.0, m.count() as u32, 0), &mut sums);
         let now = norm(&DVector::from_iterator(n, coeffs.iter().map(|&v| f64::from(v))));
         assert!(now <= last * (1.0 + 1e-4), "step {step}: residual {last} grew to {now}");
         last = now;

@@ -34,7 +34,7 @@ use crate::solver::fill::fill_bands;
 use crate::solver::fractional::project_fractional;
 use crate::solver::mixing::{BandModel, min_norm, project_mixed, project_signal};
 use crate::solver::projection::project_coefficients;
-use crate::solver::shares::project_shares;
+use crate::solver::shares::{RowSums, project_shares};
 use crate::solver::workspace::{Measurements, Workspace};
 
 /// Every solver path returns it; it lives below the workspace that checks measurements.
@@ -423,7 +423,7 @@ fn cold<const PS: usize, const PT: usize, const PU: usize, const PV: usize, cons
         } else {
             coeffs.fill(0.0);
         }
-        project_interpolating(dict, coeffs, signal, m, &Ball::new(0.0, 0.0, m.count, 0));
+        project_interpolating(dict, coeffs, signal, m, &Ball::new(0.0, 0.0, m.count, 0), None);
         synthesize(dict, coeffs, signal);
         return descend(dict, cfg, ws, &ball, plan);
     }
@@ -574,7 +574,7 @@ pub fn seed<const PS: usize, const PT: usize, const PU: usize, const PV: usize, 
         }
         let Workspace { coeffs, signal, measurements: m, .. } = ws;
         analyze(dict, signal, coeffs);
-        project_interpolating(dict, coeffs, signal, m, &exact);
+        project_interpolating(dict, coeffs, signal, m, &exact, None);
         synthesize(dict, coeffs, signal);
         return Ok(None);
     }
@@ -604,12 +604,35 @@ fn project_interpolating<
     scratch: &mut [f32; N],
     m: &Measurements<N>,
     ball: &Ball,
+    rows: Option<&mut RowSums<N>>,
 ) -> f32 {
-    if m.shares.is_some() {
-        project_shares(dict, coeffs, scratch, m, ball)
-    } else {
-        project_fractional(dict, coeffs, scratch, m, ball)
+    if m.shares.is_none() {
+        return project_fractional(dict, coeffs, scratch, m, ball);
     }
+    match rows {
+        Some(rows) => project_shares(dict, coeffs, scratch, m, ball, rows),
+        None => project_shares_once(dict, coeffs, scratch, m, ball),
+    }
+}
+
+/// One projection behind a lenslet grid outside a descent (a start, a seed): its
+/// [`RowSums`] (32 KB for the full-view patch) in a frame of its own, only behind a grid.
+#[inline(never)]
+fn project_shares_once<
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+    const N: usize,
+>(
+    dict: &Dictionary<PS, PT, PU, PV, B>,
+    coeffs: &mut [f32; N],
+    scratch: &mut [f32; N],
+    m: &Measurements<N>,
+    ball: &Ball,
+) -> f32 {
+    project_shares(dict, coeffs, scratch, m, ball, &mut RowSums::new())
 }
 
 /// How a descent walks sigma down: the hand-set schedule of the config from `scale` times
@@ -674,10 +697,34 @@ fn descend<const PS: usize, const PT: usize, const PU: usize, const PV: usize, c
     ball: &Ball,
     plan: Plan<'_, PS, PT, PU, PV, B>,
 ) -> Result<Outcome, SolveError> {
-    if ws.response.is_identity() {
-        return descend_with(dict, cfg, ws, ball, plan, None);
+    if !ws.response.is_identity() {
+        return descend_mixed(dict, cfg, ws, ball, plan);
     }
-    descend_mixed(dict, cfg, ws, ball, plan)
+    if ws.measurements.shares.is_some() {
+        return descend_shared(dict, cfg, ws, ball, plan);
+    }
+    descend_with(dict, cfg, ws, ball, plan, None, None)
+}
+
+/// [`descend`] behind a lenslet grid: the solve's [`RowSums`] (32 KB for the full-view
+/// patch) in a frame of its own, so the other solves' stacks do not carry them.
+#[inline(never)]
+fn descend_shared<
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+    const N: usize,
+>(
+    dict: &Dictionary<PS, PT, PU, PV, B>,
+    cfg: &Sl0Config,
+    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ball: &Ball,
+    plan: Plan<'_, PS, PT, PU, PV, B>,
+) -> Result<Outcome, SolveError> {
+    let mut rows = RowSums::new();
+    descend_with(dict, cfg, ws, ball, plan, None, Some(&mut rows))
 }
 
 /// [`descend`] with a response that mixes bands: its [`BandModel`] (2 KB) in a frame of its
@@ -694,10 +741,11 @@ fn descend_mixed<const PS: usize, const PT: usize, const PU: usize, const PV: us
         return Err(SolveError::MixedHalfViews);
     }
     let model = BandModel::new(&ws.response.balanced(&ws.measurements.gains), &dict.d.m5);
-    descend_with(dict, cfg, ws, ball, plan, Some(&model))
+    descend_with(dict, cfg, ws, ball, plan, Some(&model), None)
 }
 
-/// [`descend`]'s body: projections onto the mixed measurements of `mixing` if given.
+/// [`descend`]'s body: projections onto the mixed measurements of `mixing` if given, and
+/// behind a lenslet grid with the solve's `rows`.
 fn descend_with<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
     dict: &Dictionary<PS, PT, PU, PV, B>,
     cfg: &Sl0Config,
@@ -705,6 +753,7 @@ fn descend_with<const PS: usize, const PT: usize, const PU: usize, const PV: usi
     ball: &Ball,
     plan: Plan<'_, PS, PT, PU, PV, B>,
     mixing: Option<&BandModel<B>>,
+    mut rows: Option<&mut RowSums<N>>,
 ) -> Result<Outcome, SolveError> {
     let Workspace { coeffs, signal, measurements: m, .. } = ws;
     let selection = !m.interpolates();
@@ -720,7 +769,7 @@ fn descend_with<const PS: usize, const PT: usize, const PU: usize, const PV: usi
         } else if selection {
             project_coefficients(dict, coeffs, signal, m, ball)
         } else {
-            project_interpolating(dict, coeffs, signal, m, ball)
+            project_interpolating(dict, coeffs, signal, m, ball, rows.as_deref_mut())
         };
         // From a point that meets the measurements, the step d moves the patch by D d on
         // the unmeasured values only (the projection puts the measured ones back), and D
