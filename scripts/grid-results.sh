@@ -44,6 +44,10 @@ calibration_for() {
 
 cell() { printf ' %.2f / %.4f / %.2f |' "$p" "$q" "$a"; }
 
+# interior_psnr: the PSNR of the last decode without the 2 lenslets at each edge of the frame
+# (`slf eval --border 2`): a turned array's corner lenslets reach past the sensor.
+interior_psnr() { "$slf" eval "$lf" "$out/rec.npy" --border 2 | awk '/^PSNR/ { print $2 }'; }
+
 echo "# A real lenslet array"
 echo
 echo "Made by \`bash scripts/grid-results.sh OUT_DIR\` (scenes of ${size} x ${size} lenslets and the HCI"
@@ -51,14 +55,16 @@ echo "crops present, 5 x 5 views; \`RAYON_NUM_THREADS=${RAYON_NUM_THREADS:-all}\
 echo "SA (degrees). (a) reads the capture as if its array were aligned (\`--grid aligned\`), (b)"
 echo "through the grid it was simulated with (\`--grid capture\`), (c) through the grid \`slf calibrate\`"
 echo "found (the default); ref is the aligned sensor's default decode. All calibrated; 30 % vignetting,"
-echo "1 % PRNU, shot and read noise. Seconds are (c)'s decode and ref's."
+echo "1 % PRNU, shot and read noise. \"Interior\" scores both without the 2 lenslets at each edge"
+echo "of the frame (\`slf eval --border 2\`): a turned array's corners reach past the sensor. Seconds"
+echo "are (c)'s decode and ref's."
 for token in $scenes; do
   scene_light_field "$token"
   echo
   echo "## $scene"
   echo
-  echo "| k | rotation deg | pitch px | (a) aligned | (b) true grid | (c) calibrated grid | ref aligned sensor | (c) - ref dB | s (c) / ref |"
-  echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+  echo "| k | rotation deg | pitch px | (a) aligned | (b) true grid | (c) calibrated grid | ref aligned sensor | (c) - ref dB | (c) - ref dB, interior | s (c) / ref |"
+  echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
   for k in $ks; do
     calibration_for aligned
     ref="$out/cap-$scene-$k-aligned"
@@ -66,6 +72,7 @@ for token in $scenes; do
     "$slf" simulate "$lf" -o "$ref" -s "$k" --seed 3 "${sensor[@]}" > /dev/null 2>&1
     decode_eval "$ref" --calibration "$cal"
     rp=$p rq=$q ra=$a rt=$t
+    rb=$(interior_psnr)
     for g in $grids; do
       rot=${g%:*} pitch=${g#*:}
       calibration_for "$rot-$pitch" --rotation "$rot" --pitch "$pitch"
@@ -76,9 +83,9 @@ for token in $scenes; do
       decode_eval "$cap" --calibration "$cal" --grid aligned; cell
       decode_eval "$cap" --calibration "$cal" --grid capture; cell
       decode_eval "$cap" --calibration "$cal"; cell
-      ct=$t cp=$p
+      ct=$t cp=$p cb=$(interior_psnr)
       printf ' %.2f / %.4f / %.2f |' "$rp" "$rq" "$ra"
-      python3 -c "import sys; print(f' {float(sys.argv[1]) - float(sys.argv[2]):+.2f} | {float(sys.argv[3]):.2f} / {float(sys.argv[4]):.2f} |')" "$cp" "$rp" "$ct" "$rt"
+      python3 -c "import sys; a = [float(x) for x in sys.argv[1:]]; print(f' {a[0] - a[1]:+.2f} | {a[2] - a[3]:+.2f} | {a[4]:.2f} / {a[5]:.2f} |')" "$cp" "$rp" "$cb" "$rb" "$ct" "$rt"
       rm -rf "$cap"
     done
     rm -rf "$ref"

@@ -1208,3 +1208,49 @@ fn the_model_trial_decodes_with_the_model_its_pilots_favour() {
         assert!(!off.contains("model trial"), "{off}");
     }
 }
+
+/// `slf eval --border N` scores the lenslets `N` in from every edge: a reconstruction off by
+/// 0.5 on its edge lenslets and by 0.01 inside scores the PSNR of 0.01 over the interior's
+/// own maximum (computed here), an error map is cut the same way, and a border that leaves
+/// nothing is one line naming the sizes.
+#[test]
+fn eval_scores_the_interior_with_a_border() {
+    use slf_host::io::lightfield::{Dtype, LightField, write_npy, write_npy_f32_2d};
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    let (rows, cols, border) = (16, 18, 2);
+    let value = |s: usize, t: usize, b: usize| 0.1 + 0.002 * (s * cols + t) as f32 + 0.01 * b as f32;
+    let truth = LightField::from_fn((3, 3), rows, cols, 13, |_, _, s, t, b| value(s, t, b));
+    let edge = |s: usize, t: usize| s < border || t < border || s >= rows - border || t >= cols - border;
+    let recon = LightField::from_fn((3, 3), rows, cols, 13, |_, _, s, t, b| {
+        value(s, t, b) + if edge(s, t) { 0.5 } else { 0.01 }
+    });
+    write_npy(&p("truth.npy"), &truth, Dtype::F32).unwrap();
+    write_npy(&p("recon.npy"), &recon, Dtype::F32).unwrap();
+    let psnr = |out: &str| -> f64 {
+        let line = out.lines().find(|l| l.starts_with("PSNR")).unwrap();
+        line.split_whitespace().nth(1).unwrap().parse().unwrap()
+    };
+    let inner_max = f64::from(value(rows - border - 1, cols - border - 1, 12));
+    let want = 10.0 * (inner_max * inner_max / (0.01f64 * 0.01)).log10();
+    let out = stdout(slf().arg("eval").arg(p("truth.npy")).arg(p("recon.npy")).args(["--border", "2"]));
+    assert!((psnr(&out) - want).abs() < 0.01, "{out}: want {want:.3}");
+    assert!(out.contains("scored: lenslets 2..14 x 2..16 of 16 x 18 (--border 2)"), "{out}");
+    // The whole frame is scored without it, edges and all: far lower.
+    let whole = stdout(slf().arg("eval").arg(p("truth.npy")).arg(p("recon.npy")));
+    assert!(psnr(&whole) < want - 20.0, "{whole}");
+    // An error map of the frame's lenslets is cut to the interior too.
+    write_npy_f32_2d(&p("map.npy"), &vec![0.01; rows * cols], rows, cols).unwrap();
+    let out = stdout(
+        slf()
+            .arg("eval")
+            .arg(p("truth.npy"))
+            .arg(p("recon.npy"))
+            .args(["--border", "2", "--error-map"])
+            .arg(p("map.npy")),
+    );
+    assert!(out.contains("estimate PSNR"), "{out}");
+    let e = failure(slf().arg("eval").arg(p("truth.npy")).arg(p("recon.npy")).args(["--border", "8"]));
+    assert!(e.contains("--border 8") && e.contains("16 x 18"), "{e}");
+    assert_eq!(e.lines().count(), 1, "{e}");
+}

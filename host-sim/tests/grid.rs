@@ -282,6 +282,28 @@ fn a_grid_half_a_pixel_off_decodes_every_patch() {
     assert!(m.psnr > r.psnr - 10.0 && m.psnr > 30.0, "half a pixel off {} dB, aligned {}", m.psnr, r.psnr);
 }
 
+/// A grid whose first lenslet column lies left of the sensor: the decode reports its 30
+/// lenslets' 750 views as off the sensor (never measured), and decodes the rest.
+#[test]
+fn the_decode_counts_the_views_off_the_sensor() {
+    use slf_host::decode::settings::DecodeSettings;
+    use slf_host::sim::scene::SceneSize;
+    let lf = slf_host::sim::realistic::named("office").unwrap().render(SceneSize { views: (5, 5), rows: 30, cols: 30 });
+    let mut cam = CameraConfig::pixel(5, 2).noiseless();
+    cam.grid = Some(GridSettings { rotation_deg: 0.0, pitch: Some([5.02, 5.02]), offset: Some([2.5, -2.5]) });
+    let cap = simulate(&lf, &cam).unwrap();
+    let s = DecodeSettings::from_flags(["--disparities", "0:0", "--stride", "5"]).unwrap();
+    let run = s.run(&cap, false, &|_, _| {}).unwrap();
+    let slf_host::decode::settings::Outcome::Cs { report, .. } = &run.outcome else { panic!("not a CS decode") };
+    assert_eq!((report.off_sensor.lenslets, report.off_sensor.views), (30, 30 * 25));
+    assert!(report.patches.decoded > 0, "{:?}", report.patches);
+    // On a grid that keeps every view on the sensor: none.
+    cam.grid = Some(GridSettings { rotation_deg: 0.0, pitch: Some([5.02, 5.02]), offset: None });
+    let run = s.run(&simulate(&lf, &cam).unwrap(), false, &|_, _| {}).unwrap();
+    let slf_host::decode::settings::Outcome::Cs { report, .. } = &run.outcome else { panic!("not a CS decode") };
+    assert_eq!(report.off_sensor.lenslets, 0);
+}
+
 /// Every accepted patch's values, in order.
 struct Collect<'a>(&'a mut Vec<Vec<u32>>);
 

@@ -386,8 +386,10 @@ def decode(
     steps, band gains, seconds, the per-lenslet disparity map (``report["disparity"]``, an
     array, or None when no disparity was searched), ``stride``, ``seeded`` (whether the shifted
     patches started from the disjoint grid's decode), ``patch_views`` (4 or 5: the views per
-    axis of the patch it decoded with) and a ``warning`` when over 1 % of the patches failed or
-    were flagged.
+    axis of the patch it decoded with), ``off_sensor_lenslets`` and ``off_sensor_views`` (what
+    the lenslet grid puts past the sensor's edges: views never measured, guessed from their
+    neighbours; ``evaluate(..., border=2)`` scores without the edge lenslets) and a
+    ``warning`` when over 1 % of the patches failed or were flagged.
 
     ``method``: cs (compressed sensing), interpolate, demosaic or ppid (baselines).
     ``preset``: preview (fast), default or best; any keyword below overrides the preset's
@@ -513,14 +515,23 @@ def _check_output(folder: str, output: str) -> None:
         raise ValueError(f"output {output}: a file of the capture {folder}, which the decode reads")
 
 
-def evaluate(truth: np.ndarray, recon: np.ndarray) -> Dict[str, float]:
+def evaluate(truth: np.ndarray, recon: np.ndarray, *, border: int = 0) -> Dict[str, float]:
     """PSNR (dB, data range = max of ``truth``), SSIM and spectral angle (degrees) of
     ``recon`` against ``truth``, both ``(U, V, H, W, B)``, as ``slf eval``:
-    ``{"psnr", "ssim", "sa", "data_range"}``."""
+    ``{"psnr", "ssim", "sa", "data_range"}``. ``border``: score only the lenslets that many
+    in from every edge (``slf eval --border``: a turned lenslet array's corners reach past
+    the sensor)."""
     t = _as_float32(truth, "truth", "(U, V, H, W, B)")
     r = _as_float32(recon, "recon", "(U, V, H, W, B)")
     if t.shape != r.shape:
         raise ValueError(f"shapes differ: truth {t.shape}, recon {r.shape}")
+    if isinstance(border, (bool, np.bool_)) or not isinstance(border, (int, np.integer)) or border < 0:
+        raise TypeError(f"border: want a whole number of lenslets at or above 0, got {border!r}")
+    b = int(border)
+    if b > 0:
+        if 2 * b >= min(t.shape[2], t.shape[3]):
+            raise ValueError(f"border {b}: the light field has {t.shape[2]} x {t.shape[3]} lenslets, nothing is {b} in from every edge")
+        t, r = (np.ascontiguousarray(a[:, :, b:-b, b:-b]) for a in (t, r))
     return dict(_slf.evaluate(t, r))
 
 

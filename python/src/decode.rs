@@ -122,6 +122,8 @@ pub fn decode<'py>(
             report.set_item("gains", r.gains.to_vec())?;
             report.set_item("seconds", r.seconds)?;
             report.set_item("rows_held", r.rows_held)?;
+            report.set_item("off_sensor_lenslets", r.off_sensor.lenslets)?;
+            report.set_item("off_sensor_views", r.off_sensor.views)?;
             report.set_item("stride", options.stride.0)?;
             report.set_item("seeded", options.seeds())?;
             report.set_item("patch_views", r.patch_views.map(PatchViews::count))?;

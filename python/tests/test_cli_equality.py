@@ -200,6 +200,15 @@ def test_evaluate_equals_cli(tmp_path, slf_bin, depth, capture):
     assert f"SSIM {m['ssim']:.4f}" in out
     assert re.search(rf"SA +{m['sa']:.3f} deg", out)
     assert 15 < m["psnr"] < 60 and 0 < m["ssim"] <= 1 and m["sa"] >= 0
+    # Without the edge lenslets: the CLI's --border, and the same as scoring the slices.
+    out = run([slf_bin, "eval", tmp_path / "t.npy", tmp_path / "r.npy", "--border", "2"]).stdout
+    inner = slf.evaluate(depth, recon, border=2)
+    assert f"PSNR {inner['psnr']:.3f} dB" in out
+    assert inner == slf.evaluate(depth[:, :, 2:-2, 2:-2], recon[:, :, 2:-2, 2:-2])
+    with pytest.raises(ValueError, match="border 99"):
+        slf.evaluate(depth, recon, border=99)
+    with pytest.raises(TypeError, match="border"):
+        slf.evaluate(depth, recon, border=-1)
 
 
 def test_an_hdf5_decode_reads_in_h5py(tmp_path, slf_bin, capture):

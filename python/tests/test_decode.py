@@ -161,6 +161,8 @@ def test_output_streams_to_a_file_and_returns_its_memory_map(capture, tmp_path):
     assert np.array_equal(mapped, slf.decode(capture))
     assert np.array_equal(np.load(out), mapped)
     assert 0 < report["rows_held"] <= 20
+    # An aligned sensor puts no view past its edges.
+    assert (report["off_sensor_lenslets"], report["off_sensor_views"]) == (0, 0)
     # A baseline too (decoded whole, then written by rows).
     base = slf.decode(capture, method="demosaic", output=tmp_path / "d.npy")
     assert np.array_equal(base, slf.decode(capture, method="demosaic"))

@@ -21,7 +21,6 @@ use crate::io::calibration::{
     Calibration, CalibrationDescription, FORMAT, Sources, VERSION, check_response, read_response,
 };
 use crate::io::capture::{Capture, DESCRIPTION, Light};
-use crate::io::grid::lenslet_view;
 use crate::io::output::Outputs;
 
 /// A pixel whose dark level lies more than this fraction of the range (white - black) above
@@ -197,17 +196,17 @@ pub fn calibrate(captures: &[(String, Capture)], response: Option<Vec<Vec<f32>>>
         }
     };
     // Vignetting per view: the mean flat of the working pixels at each view (behind a
-    // grid, the view cell a pixel's centre lies in, pixels off the light field left out).
+    // grid, the view cell a pixel's centre lies in as the decode maps it, the firmware's
+    // `LensletGrid::view_of`; pixels off the light field left out).
+    let mapping = fit.as_ref().map(|f| f.grid.firmware(d0.views)).transpose()?;
     let mut sums = vec![(0.0f64, 0usize); u_n * v_n];
     for p in (0..rows * cols).filter(|&p| !bad[p]) {
-        let (u, v) = match &fit {
+        let (u, v) = match &mapping {
             None => ((p / cols) % u_n, (p % cols) % v_n),
-            Some(fit) => {
-                let q = fit.grid.cell(d0.views, [(p / cols) as f64 + 0.5, (p % cols) as f64 + 0.5]);
-                let cell = [q[0].floor() as i64, q[1].floor() as i64];
-                let Some((_, [u, v])) = lenslet_view(cell, d0.lenslets, d0.views) else { continue };
-                (u, v)
-            }
+            Some(g) => match g.view_of(p / cols, p % cols) {
+                Some(((s, t), uv)) if s < d0.lenslets[0] && t < d0.lenslets[1] => uv,
+                _ => continue,
+            },
         };
         let s = &mut sums[u * v_n + v];
         *s = (s.0 + f64::from(flat[p]), s.1 + 1);

@@ -5,6 +5,7 @@ use slf_firmware::disparity::Disparity;
 use slf_firmware::{Ended, PatchOrigin, PatchReport, TileReport};
 
 use crate::decode::options::PatchViews;
+use crate::io::grid::OffSensor;
 
 /// Which decoder made a patch: a row of [`DecodeReport::member_map`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -79,6 +80,10 @@ pub struct DecodeReport {
     /// What the shear trial found ([`crate::decode::options::DecodeOptions::shear_trial`]; `None` without it or
     /// without half-pixel disparities).
     pub shear_trial: Option<ShearTrialReport>,
+    /// What the decode's lenslet grid puts off the sensor: views never measured, their
+    /// values guessed from their neighbours (a turned array's corners; none on the
+    /// aligned grid).
+    pub off_sensor: OffSensor,
 }
 
 /// The shear trial's finding in a decode ([`crate::decode::trial::frame_shear_trial`]).

@@ -262,6 +262,15 @@ pub fn run(args: Args) -> Result<()> {
             r.filled
         )?;
     }
+    let off = r.off_sensor;
+    if off.lenslets > 0 {
+        outln!(
+            "lenslet grid: {} lenslets reach past the sensor's edges ({} of their views unmeasured, guessed from their \
+             neighbours; `slf eval --border` scores without the edge lenslets)",
+            off.lenslets,
+            off.views
+        )?;
+    }
     let p = opts.plausibility;
     if p.is_off() {
         outln!("plausibility: off")?;

@@ -3,9 +3,9 @@
 use std::io::Write;
 use std::path::PathBuf;
 
-use anyhow::Result;
+use anyhow::{Result, ensure};
 use slf_host::eval::metrics::{BLOCK, blocks_over, evaluate, map_accuracy};
-use slf_host::io::lightfield::{read_npy, read_npy_f32_2d};
+use slf_host::io::lightfield::{LightField, read_npy, read_npy_f32_2d};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -17,20 +17,62 @@ pub struct Args {
     /// the true one, and how well it ranks the true error of blocks of 5 x 5 lenslets.
     #[arg(long)]
     pub error_map: Option<PathBuf>,
+    /// Score only the lenslets at least this many in from every edge of the frame: a turned
+    /// lenslet array's corner lenslets reach past the sensor (`slf decode` says how many),
+    /// and their views there were never measured.
+    #[arg(long, default_value_t = 0)]
+    pub border: usize,
+}
+
+/// The lenslets `border` in from every edge of `lf`.
+fn interior(lf: LightField, border: usize, what: &str) -> Result<LightField> {
+    if border == 0 {
+        return Ok(lf);
+    }
+    ensure!(
+        2 * border < lf.rows && 2 * border < lf.cols,
+        "--border {border}: the {what} has {} x {} lenslets, nothing is {border} in from every edge",
+        lf.rows,
+        lf.cols
+    );
+    Ok(lf.window(border, border, lf.rows - 2 * border, lf.cols - 2 * border))
 }
 
 pub fn run(args: Args) -> Result<()> {
     let (truth, recon) = (read_npy(&args.truth)?, read_npy(&args.recon)?);
+    ensure!(
+        truth.shape() == recon.shape(),
+        "shapes differ: truth {:?}, reconstruction {:?}",
+        truth.shape(),
+        recon.shape()
+    );
+    let (full_rows, full_cols) = (truth.rows, truth.cols);
+    let b = args.border;
+    let (truth, recon) = (interior(truth, b, "ground truth")?, interior(recon, b, "reconstruction")?);
     let m = evaluate(&truth, &recon)?;
     let (over, blocks) = blocks_over(&truth, &recon);
     // Written, not `println!`: a reader that stops early (`slf eval A B | head -1`)
     // closes the pipe, and `println!` panics on that.
     let mut out = std::io::stdout().lock();
+    if b > 0 {
+        writeln!(
+            out,
+            "scored: lenslets {b}..{} x {b}..{} of {full_rows} x {full_cols} (--border {b})",
+            full_rows - b,
+            full_cols - b
+        )?;
+    }
     writeln!(out, "PSNR {:.3} dB (data range {:.6} = max of ground truth)", m.psnr, m.data_range)?;
     writeln!(out, "SSIM {:.4}", m.ssim)?;
     writeln!(out, "SA   {:.3} deg", m.sa)?;
     if let Some(path) = &args.error_map {
-        let map = read_npy_f32_2d(path, (truth.rows, truth.cols))?;
+        let full = read_npy_f32_2d(path, (full_rows, full_cols))?;
+        let map: Vec<f32> = full
+            .chunks_exact(full_cols)
+            .skip(b)
+            .take(truth.rows)
+            .flat_map(|row| row.iter().skip(b).take(truth.cols).copied())
+            .collect();
         let a = map_accuracy(&truth, &recon, &map)?;
         writeln!(
             out,
