@@ -304,6 +304,29 @@ fn the_decode_counts_the_views_off_the_sensor() {
     assert_eq!(report.off_sensor.lenslets, 0);
 }
 
+/// At pixel k = 1 the default searches half-pixel disparities on the aligned sensor, and
+/// whole ones only behind a grid (where a half-pixel patch would read its views at the
+/// cells' centres, not their shares); asked for, halves are searched there too.
+#[test]
+fn behind_a_grid_the_default_disparities_are_whole() {
+    use slf_host::decode::settings::{DecodeSettings, Outcome};
+    use slf_host::sim::scene::SceneSize;
+    let lf = slf_host::sim::realistic::named("office").unwrap().render(SceneSize { views: (5, 5), rows: 30, cols: 30 });
+    let halves = |cap: &slf_host::io::capture::Capture, flags: &[&str]| {
+        let run = DecodeSettings::from_flags(flags.iter().copied()).unwrap().run(cap, false, &|_, _| {}).unwrap();
+        let Outcome::Cs { report, .. } = &run.outcome else { panic!("not a CS decode") };
+        assert!(!report.disparity_map.is_empty());
+        report.disparity_map.iter().filter(|(_, d)| d.in_halves() % 2 != 0).count()
+    };
+    let mut cam = CameraConfig::pixel(5, 1).noiseless();
+    cam.grid = Some(GridSettings { rotation_deg: 0.3, pitch: Some([5.04, 5.04]), offset: None });
+    let gridded = simulate(&lf, &cam).unwrap();
+    assert_eq!(halves(&gridded, &["--shear-trial", "false"]), 0);
+    assert!(halves(&gridded, &["--shear-trial", "false", "--disparities", "-1:1:0.5"]) > 0);
+    let aligned = simulate(&lf, &CameraConfig::pixel(5, 1).noiseless()).unwrap();
+    assert!(halves(&aligned, &["--shear-trial", "false"]) > 0);
+}
+
 /// Every accepted patch's values, in order.
 struct Collect<'a>(&'a mut Vec<Vec<u32>>);
 

@@ -369,7 +369,7 @@ pub struct DecodeSettings {
     pub gains: Option<Vec<f32>>,
     /// Disparities (pixels per view step) each 5 x 5-lenslet block may be sheared to
     /// before decoding, MIN:MAX[:STEP] (default -1:1:0.5 for a single snapshot, -1:1 for
-    /// more and with --preset preview; 0:0 decodes unsheared; a STEP of 0.5 adds the
+    /// more, behind a lenslet grid and with --preset preview; 0:0 decodes unsheared; a STEP of 0.5 adds the
     /// half-pixel shears, whose measurements interpolate the patch); chosen per block by
     /// how well the views' same-band samples agree.
     #[arg(long, value_parser = disparity_range, value_name = "MIN:MAX[:STEP]", allow_hyphen_values = true)]
