@@ -1254,3 +1254,37 @@ fn eval_scores_the_interior_with_a_border() {
     assert!(e.contains("--border 8") && e.contains("16 x 18"), "{e}");
     assert_eq!(e.lines().count(), 1, "{e}");
 }
+
+/// Behind a turned lenslet grid the summary names the grid it decoded through, counts the
+/// lenslets whose views fall past the sensor, and says when half-pixel shears (asked for)
+/// read views at their cells' centres; the aligned sensor's summary has no such line.
+#[test]
+fn the_decode_names_its_lenslet_grid() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    stdout(slf().args(["scene", "smooth", "--size", "30", "-o"]).arg(p("lf.npy")));
+    let sim = |out: &str, extra: &[&str]| {
+        stdout(
+            slf().arg("simulate").arg(p("lf.npy")).arg("-o").arg(p(out)).args(["-s", "1", "--seed", "2"]).args(extra),
+        )
+    };
+    sim("cap", &["--rotation", "1", "--pitch", "5.1"]);
+    let out = stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("x.npy")).arg("-q"));
+    let line = out.lines().find(|l| l.starts_with("lenslet grid:")).unwrap_or_else(|| panic!("{out}"));
+    assert!(line.starts_with("lenslet grid: turned 1.0000 degrees, pitch 5.1000 x 5.1000 px"), "{line}");
+    assert!(line.contains("lenslets reach past the sensor's edges") && !line.contains("half-pixel"), "{line}");
+    let out = stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("x.npy")).args([
+        "-q",
+        "--disparities",
+        "-1:1:0.5",
+        "--shear-trial",
+        "false",
+    ]));
+    assert!(
+        out.contains("the half-pixel sheared patches read each view at the pixel under its cell's centre"),
+        "{out}"
+    );
+    sim("aligned", &[]);
+    let out = stdout(slf().arg("decode").arg(p("aligned")).arg("-o").arg(p("x.npy")).arg("-q"));
+    assert!(!out.contains("lenslet grid"), "{out}");
+}

@@ -298,7 +298,8 @@ where
     report.gains = *plan.decoder.gains();
     report.patch_views = PatchViews::of_views(PU, PV);
     let d = &capture.description;
-    report.off_sensor = d.lenslet_grid.map(|g| g.off_sensor(d.lenslets, d.views)).unwrap_or_default();
+    report.grid = d.lenslet_grid.filter(|g| !g.is_aligned(d.lenslets, d.views));
+    report.off_sensor = report.grid.map(|g| g.off_sensor(d.lenslets, d.views)).unwrap_or_default();
     // A pilot of either trial costs three solves: three estimating ones for the shear
     // trial, the DCT's one and the ensemble's two for the model trial.
     let pilots = |t: &Option<slf_firmware::TrialErrors>| u64::from(t.as_ref().map_or(0, |t| t.pilots));

@@ -5,7 +5,7 @@ use slf_firmware::disparity::Disparity;
 use slf_firmware::{Ended, PatchOrigin, PatchReport, TileReport};
 
 use crate::decode::options::PatchViews;
-use crate::io::grid::OffSensor;
+use crate::io::grid::{GridDescription, OffSensor};
 
 /// Which decoder made a patch: a row of [`DecodeReport::member_map`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -80,9 +80,10 @@ pub struct DecodeReport {
     /// What the shear trial found ([`crate::decode::options::DecodeOptions::shear_trial`]; `None` without it or
     /// without half-pixel disparities).
     pub shear_trial: Option<ShearTrialReport>,
-    /// What the decode's lenslet grid puts off the sensor: views never measured, their
-    /// values guessed from their neighbours (a turned array's corners; none on the
-    /// aligned grid).
+    /// The lenslet grid the decode read the frames through (`None`: the aligned sensor).
+    pub grid: Option<GridDescription>,
+    /// What that grid puts off the sensor: views never measured, their values guessed from
+    /// their neighbours (a turned array's corners; none on the aligned grid).
     pub off_sensor: OffSensor,
 }
 

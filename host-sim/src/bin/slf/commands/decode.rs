@@ -262,13 +262,28 @@ pub fn run(args: Args) -> Result<()> {
             r.filled
         )?;
     }
-    let off = r.off_sensor;
-    if off.lenslets > 0 {
+    if let Some(g) = &r.grid {
+        let off = r.off_sensor;
+        let edges = if off.lenslets > 0 {
+            format!(
+                "; {} lenslets reach past the sensor's edges ({} of their views unmeasured, guessed from their \
+                 neighbours; `slf eval --border` scores without the edge lenslets)",
+                off.lenslets, off.views
+            )
+        } else {
+            String::new()
+        };
+        let halves = if r.disparity_map.iter().any(|(_, d)| d.in_halves() % 2 != 0) {
+            "; the half-pixel sheared patches read each view at the pixel under its cell's centre"
+        } else {
+            ""
+        };
         outln!(
-            "lenslet grid: {} lenslets reach past the sensor's edges ({} of their views unmeasured, guessed from their \
-             neighbours; `slf eval --border` scores without the edge lenslets)",
-            off.lenslets,
-            off.views
+            "lenslet grid: turned {:.4} degrees, pitch {:.4} x {:.4} px, each pixel the shares of the view cells it \
+             covers{edges}{halves}",
+            g.rotation_deg,
+            g.pitch[0],
+            g.pitch[1]
         )?;
     }
     let p = opts.plausibility;
