@@ -32,6 +32,7 @@ pub use crate::decode::report::{
 use crate::decode::strip::decode_rows;
 use crate::decode::trial::{DCT_LEAN, rms};
 use crate::io::capture::Capture;
+use crate::io::grid::OffSensor;
 use crate::io::lightfield::LightField;
 use crate::io::rows::{RowShape, RowSink};
 
@@ -297,9 +298,8 @@ where
     report.seconds = start.elapsed().as_secs_f64();
     report.gains = *plan.decoder.gains();
     report.patch_views = PatchViews::of_views(PU, PV);
-    let d = &capture.description;
-    report.grid = d.lenslet_grid.filter(|g| !g.is_aligned(d.lenslets, d.views));
-    report.off_sensor = report.grid.map(|g| g.off_sensor(d.lenslets, d.views)).unwrap_or_default();
+    report.grid = capture.description.turned_grid();
+    report.off_sensor = plan.decoder.grid().map(|g| OffSensor::of(g, capture.description.lenslets)).unwrap_or_default();
     // A pilot of either trial costs three solves: three estimating ones for the shear
     // trial, the DCT's one and the ensemble's two for the model trial.
     let pilots = |t: &Option<slf_firmware::TrialErrors>| u64::from(t.as_ref().map_or(0, |t| t.pilots));

@@ -334,7 +334,7 @@ impl DecodeOptions {
     pub fn disparities_for(&self, capture: &Capture) -> DisparityRange {
         let d = &capture.description;
         let snapshots = u8::try_from(d.frames.len()).unwrap_or(u8::MAX);
-        let gridded = d.lenslet_grid.is_some_and(|g| !g.is_aligned(d.lenslets, d.views));
+        let gridded = d.turned_grid().is_some();
         let default = DisparityRange::for_snapshots(snapshots);
         self.disparities.unwrap_or(if gridded { default.with_halves(false) } else { default })
     }

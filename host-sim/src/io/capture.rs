@@ -761,6 +761,12 @@ fn inside(dir: &Path, path: &Path) -> Result<()> {
 }
 
 impl CaptureDescription {
+    /// The lenslet grid the frames were taken through, unless it is the aligned one (which
+    /// the decode reads as no grid).
+    pub fn turned_grid(&self) -> Option<GridDescription> {
+        self.lenslet_grid.filter(|g| !g.is_aligned(self.lenslets, self.views))
+    }
+
     /// Checks the geometry, format and levels, and returns the frame size `(rows, cols)`.
     ///
     /// # Errors

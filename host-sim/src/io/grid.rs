@@ -152,32 +152,6 @@ impl GridDescription {
         [self.offset[0] + d[0], self.offset[1] + d[1]]
     }
 
-    /// The view cells of a light field of `lenslets` x `views` whose centres lie off the
-    /// sensor (no pixel holds them: never measured, the decode's guesses from their
-    /// neighbours), and the lenslets they belong to. A turned array centred on a sensor
-    /// its own size ([`Self::centred`]) puts its corners past the sensor's edges.
-    pub fn off_sensor(&self, lenslets: [usize; 2], views: [usize; 2]) -> OffSensor {
-        let mut off = OffSensor::default();
-        for s in 0..lenslets[0] {
-            for t in 0..lenslets[1] {
-                let mut cells = 0;
-                for u in 0..views[0] {
-                    for v in 0..views[1] {
-                        // The cell's centre in lenslet units: its lenslet's centre moved by
-                        // the view's place in the micro-image.
-                        let at = |l: usize, i: usize, n: usize| l as f64 + (i as f64 + 0.5) / n as f64 - 0.5;
-                        let p = self.centre(at(s, u, views[0]), at(t, v, views[1]));
-                        let inside = |a: usize| (0.0..self.sensor[a] as f64).contains(&p[a]);
-                        cells += usize::from(!(inside(0) && inside(1)));
-                    }
-                }
-                off.views += cells;
-                off.lenslets += usize::from(cells > 0);
-            }
-        }
-        off
-    }
-
     /// The view-cell coordinates of sensor point `p` for `views` views: cell
     /// `(floor(q0), floor(q1))` = `(s U + u, t V + v)` holds it (module docs).
     pub fn cell(&self, views: [usize; 2], p: [f64; 2]) -> [f64; 2] {
@@ -206,13 +180,36 @@ impl GridDescription {
     }
 }
 
-/// What of a light field a grid puts off its sensor ([`GridDescription::off_sensor`]).
+/// What of a light field a grid puts off its sensor: view cells whose centres no pixel
+/// holds, never measured (the decode's guesses from their neighbours). A turned array
+/// centred on a sensor its own size ([`GridDescription::centred`]) puts its corners past
+/// the sensor's edges.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct OffSensor {
     /// Lenslets with at least one view off the sensor.
     pub lenslets: usize,
     /// Their views off the sensor, all told.
     pub views: usize,
+}
+
+impl OffSensor {
+    /// Of `lenslets` lenslets behind `grid`, as the decode reads them: the view cells
+    /// whose centre [`LensletGrid::pixel`] finds no pixel under.
+    pub fn of(grid: &LensletGrid, lenslets: [usize; 2]) -> Self {
+        let (nu, nv) = grid.views();
+        let mut off = Self::default();
+        for s in 0..lenslets[0] {
+            for t in 0..lenslets[1] {
+                let cells = (0..usize::from(nu))
+                    .flat_map(|u| (0..usize::from(nv)).map(move |v| (u, v)))
+                    .filter(|&uv| grid.pixel((s as isize, t as isize), uv).is_none())
+                    .count();
+                off.views += cells;
+                off.lenslets += usize::from(cells > 0);
+            }
+        }
+        off
+    }
 }
 
 /// View cell `cell` (`(s U + u, t V + v)`, [`GridDescription::cell`]'s whole parts) as
@@ -268,23 +265,24 @@ mod tests {
     #[test]
     fn views_off_the_sensor_are_counted() {
         // The aligned grid: every view on the sensor.
-        assert_eq!(GridDescription::aligned([4, 6], [5, 5]).off_sensor([4, 6], [5, 5]), OffSensor::default());
+        let off = |g: &GridDescription, lenslets: [usize; 2]| OffSensor::of(&g.firmware([5, 5]).unwrap(), lenslets);
+        assert_eq!(off(&GridDescription::aligned([4, 6], [5, 5]), [4, 6]), OffSensor::default());
         // Moved a lenslet left: the first lenslet column lies wholly off the sensor, and the
         // last column's right neighbour would be on it (no lenslet there to count).
         let mut g = GridDescription::aligned([4, 6], [5, 5]);
         g.offset[1] -= 5.0;
-        assert_eq!(g.off_sensor([4, 6], [5, 5]), OffSensor { lenslets: 4, views: 4 * 25 });
+        assert_eq!(off(&g, [4, 6]), OffSensor { lenslets: 4, views: 4 * 25 });
         // Moved 2.2 px up: the first lenslet row's top two view rows (centres at 0.5 and 1.5
         // px, now above the top edge) of every lenslet in it.
         let mut g = GridDescription::aligned([4, 6], [5, 5]);
         g.offset[0] -= 2.2;
-        assert_eq!(g.off_sensor([4, 6], [5, 5]), OffSensor { lenslets: 6, views: 6 * 2 * 5 });
+        assert_eq!(off(&g, [4, 6]), OffSensor { lenslets: 6, views: 6 * 2 * 5 });
         // Turned a degree on a sensor its own size: some corner views are off, and only
         // lenslets near the edges have any.
         let g = GridDescription::centred([64, 64], 1.0, [5.1, 5.1]);
-        let off = g.off_sensor([64, 64], [5, 5]);
-        assert!(off.lenslets > 0 && off.views >= off.lenslets, "{off:?}");
-        assert!(off.lenslets < 4 * 64, "only edge lenslets: {off:?}");
+        let turned = off(&g, [64, 64]);
+        assert!(turned.lenslets > 0 && turned.views >= turned.lenslets, "{turned:?}");
+        assert!(turned.lenslets < 4 * 64, "only edge lenslets: {turned:?}");
     }
 
     #[test]
