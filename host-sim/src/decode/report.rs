@@ -62,8 +62,8 @@ pub struct DecodeReport {
     /// The disparity each spatial block was sheared to, by its first patch's origin
     /// (empty when the decode searched no disparity).
     pub disparity_map: Vec<(PatchOrigin, Disparity)>,
-    /// The most lenslet rows of sums the streamed decode held at once (each row's sums and
-    /// weights: 8 bytes a value of the row), besides a batch's tiles: what its memory grows
+    /// The most lenslet rows of sums the streamed decode held at once (each row's sums, 4
+    /// bytes a value, and a weight a pixel, 4 bytes for its 13 values), besides a batch's tiles: what its memory grows
     /// with, bounded by the tiles' height, not the frame's ([`crate::decode::strip`]).
     pub rows_held: usize,
     /// Wall time, seconds.

@@ -78,7 +78,7 @@ impl<T> Rows<T> {
     }
 }
 
-/// A row's sums and weights, [`RowShape::row_len`] each.
+/// A row's sums ([`RowShape::row_len`]) and weights (one a pixel: [`RowShape::pixels`]).
 struct SumRow {
     sum: Vec<f32>,
     weight: Vec<f32>,
@@ -87,7 +87,7 @@ struct SumRow {
 impl SumRow {
     /// A row of `shape` no estimate has reached.
     fn zeros(shape: RowShape) -> Self {
-        Self { sum: vec![0.0; shape.row_len()], weight: vec![0.0; shape.row_len()] }
+        Self { sum: vec![0.0; shape.row_len()], weight: vec![0.0; shape.pixels()] }
     }
 }
 
@@ -133,30 +133,36 @@ impl<const PU: usize, const PV: usize, const N: usize> PatchSeed<N> for FrameSee
     }
 }
 
-/// Adds a tile's sums into the rows it reaches (made where not held yet).
+/// Adds a tile's sums into the rows it reaches (made where not held yet): per lenslet row
+/// and view, the run of the tile's columns on the sensor, a slice onto a slice.
 fn add_tile<const PU: usize, const PV: usize>(rows: &mut Rows<SumRow>, sums: &TileSums<PU, PV>, shape: RowShape) {
     let zero = || SumRow::zeros(shape);
     let tile = sums.tile;
     let (extent_rows, extent_cols) = sums.extent();
+    // The tile's columns on the sensor: `t0..t1` of the buffer, from sensor column `c`.
+    let left = tile.lenslet_col as usize;
+    let t0 = sums.halo.saturating_sub(left);
+    let t1 = extent_cols.min((shape.cols + sums.halo).saturating_sub(left));
+    if t0 >= t1 {
+        return;
+    }
+    let (c, len) = (left + t0 - sums.halo, t1 - t0);
     for s in 0..extent_rows {
         let Some(r) = (tile.lenslet_row as usize + s).checked_sub(sums.halo) else { continue };
         if r >= shape.rows {
             continue;
         }
         let row = rows.row_mut(r, zero);
-        for t in 0..extent_cols {
-            let Some(c) = (tile.lenslet_col as usize + t).checked_sub(sums.halo) else { continue };
-            if c >= shape.cols {
-                continue;
-            }
-            for u in 0..shape.views.0 {
-                for v in 0..shape.views.1 {
-                    let src = sums.at(s, t, u, v, 0);
-                    let dst = shape.at(u, v, c, 0);
-                    for b in 0..13 {
-                        row.sum[dst + b] += sums.sum[src + b];
-                        row.weight[dst + b] += sums.weight[src + b];
-                    }
+        for u in 0..shape.views.0 {
+            for v in 0..shape.views.1 {
+                let src = sums.pixel(s, t0, u, v);
+                let dst = shape.pixel(u, v, c);
+                for (d, &x) in row.sum[dst * 13..(dst + len) * 13].iter_mut().zip(&sums.sum[src * 13..(src + len) * 13])
+                {
+                    *d += x;
+                }
+                for (d, &x) in row.weight[dst..dst + len].iter_mut().zip(&sums.weight[src..src + len]) {
+                    *d += x;
                 }
             }
         }
@@ -177,28 +183,40 @@ struct Fill {
 /// mean of its lenslet's covered views, as the overlap ring does; a lenslet with none 0.
 /// Each mean adds the covered views in view order.
 fn finish_row(row: &SumRow, shape: RowShape, (lo, hi): (f32, f32), out: &mut Vec<f32>, fill: &mut Fill) {
+    let bands = shape.bands;
     out.clear();
-    out.extend(row.sum.iter().zip(&row.weight).map(|(&s, &w)| if w > 0.0 { (s / w).clamp(lo, hi) } else { 0.0 }));
+    out.extend(
+        row.sum
+            .chunks_exact(bands)
+            .zip(&row.weight)
+            .flat_map(|(s, &w)| s.iter().map(move |&s| if w > 0.0 { (s / w).clamp(lo, hi) } else { 0.0 })),
+    );
     let run = shape.run_len();
-    let (mut mean, mut covered) = (vec![0.0f32; run], vec![0u32; run]);
-    for (data, weight) in out.chunks_exact(run).zip(row.weight.chunks_exact(run)) {
-        for (((m, n), &x), &w) in mean.iter_mut().zip(covered.iter_mut()).zip(data).zip(weight) {
+    let (mut mean, mut covered) = (vec![0.0f32; run], vec![0u32; shape.cols]);
+    for (data, weight) in out.chunks_exact(run).zip(row.weight.chunks_exact(shape.cols)) {
+        for (((m, n), x), &w) in
+            mean.chunks_exact_mut(bands).zip(covered.iter_mut()).zip(data.chunks_exact(bands)).zip(weight)
+        {
             if w > 0.0 {
-                *m += x;
+                for (m, &x) in m.iter_mut().zip(x) {
+                    *m += x;
+                }
                 *n += 1;
             }
         }
     }
-    for (data, weight) in out.chunks_exact_mut(run).zip(row.weight.chunks_exact(run)) {
-        for (((x, &w), &m), &n) in data.iter_mut().zip(weight).zip(&mean).zip(&covered) {
+    for (data, weight) in out.chunks_exact_mut(run).zip(row.weight.chunks_exact(shape.cols)) {
+        for ((x, &w), (m, &n)) in data.chunks_exact_mut(bands).zip(weight).zip(mean.chunks_exact(bands).zip(&covered)) {
             if w > 0.0 {
                 continue;
             }
             if n > 0 {
-                *x = (m / n as f32).clamp(lo, hi);
-                fill.filled += 1;
+                for (x, &m) in x.iter_mut().zip(m) {
+                    *x = (m / n as f32).clamp(lo, hi);
+                }
+                fill.filled += bands;
             } else {
-                fill.uncovered += 1;
+                fill.uncovered += bands;
             }
         }
     }

@@ -1,6 +1,14 @@
 //! One tile's decoded patches as weighted sums over its lenslets ([`TileSums`]), the
 //! [`PatchSink`] a tile decodes into before its sums join the frame's rows
 //! ([`crate::decode::strip`]).
+//!
+//! The layout is the frame rows' own, per lenslet row: `(s, u, v, t, b)` for the sums and
+//! `(s, u, v, t)` for the weights (one a pixel: its 13 bands share it). So a tile's lenslet
+//! row of one view is one contiguous run of `extent columns x 13` sums in the tile and in
+//! the frame's row, and joining the rows is a slice added to a slice. With the pixel's
+//! position innermost and a weight for each band, the join was 9.8 % of a default decode's
+//! one-thread time (`perf record`, depth 100 x 100, pixel k = 1); each value is still the
+//! sum of the same estimates in the same order, so the bits are the same.
 
 use slf_firmware::disparity::Disparity;
 use slf_firmware::overlap::Window;
@@ -15,7 +23,9 @@ pub(crate) struct TileSums<const PU: usize, const PV: usize> {
     views: (usize, usize),
     window: Window,
     pub halo: usize,
+    /// `(s, u, v, t, b)`.
     pub sum: Vec<f32>,
+    /// `(s, u, v, t)`: a pixel's weights, the same for each of its bands.
     pub weight: Vec<f32>,
     pub steps: u64,
     pub solves: u64,
@@ -27,15 +37,14 @@ pub(crate) struct TileSums<const PU: usize, const PV: usize> {
 impl<const PU: usize, const PV: usize> TileSums<PU, PV> {
     pub fn new(tile: Tile, views: (usize, usize), window: Window, halo: usize) -> Self {
         let (rows, cols) = (tile.lenslet_rows as usize + 2 * halo, tile.lenslet_cols as usize + 2 * halo);
-        let n = rows * cols * views.0 * views.1 * 13;
-        let (sum, weight) = (vec![0.0; n], vec![0.0; n]);
+        let pixels = rows * cols * views.0 * views.1;
         Self {
             tile,
             views,
             window,
             halo,
-            sum,
-            weight,
+            sum: vec![0.0; pixels * 13],
+            weight: vec![0.0; pixels],
             steps: 0,
             solves: 0,
             members: Vec::new(),
@@ -49,9 +58,10 @@ impl<const PU: usize, const PV: usize> TileSums<PU, PV> {
         (self.tile.lenslet_rows as usize + 2 * self.halo, self.tile.lenslet_cols as usize + 2 * self.halo)
     }
 
-    /// Index in the buffer's `(s, t, u, v, b)` order, `(s, t)` counted from the halo's corner.
-    pub fn at(&self, s: usize, t: usize, u: usize, v: usize, b: usize) -> usize {
-        (((s * self.extent().1 + t) * self.views.0 + u) * self.views.1 + v) * 13 + b
+    /// The pixel index (into [`Self::weight`]; times 13 into [`Self::sum`]) of lenslet
+    /// `(s, t)` of the buffer, counted from the halo's corner, view `(u, v)`.
+    pub fn pixel(&self, s: usize, t: usize, u: usize, v: usize) -> usize {
+        ((s * self.views.0 + u) * self.views.1 + v) * self.extent().1 + t
     }
 }
 
@@ -84,12 +94,12 @@ impl<const PU: usize, const PV: usize, const N: usize> PatchSink<N> for TileSums
             if r >= rows || c >= cols {
                 continue;
             }
-            let j = self.at(r, c, o.view_row as usize + u, o.view_col as usize + v, 0);
+            let j = self.pixel(r, c, o.view_row as usize + u, o.view_col as usize + v);
             let w = scale * self.window.weight::<5, 5>(s, t);
-            for ((sum, weight), &x) in self.sum[j..j + 13].iter_mut().zip(&mut self.weight[j..j + 13]).zip(bands) {
+            for (sum, &x) in self.sum[j * 13..j * 13 + 13].iter_mut().zip(bands) {
                 *sum += w * x;
-                *weight += w;
             }
+            self.weight[j] += w;
         }
         Ok(())
     }

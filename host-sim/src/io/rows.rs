@@ -33,6 +33,17 @@ impl RowShape {
         self.cols * self.bands
     }
 
+    /// Pixels in one row: `U x V x W`.
+    pub fn pixels(&self) -> usize {
+        self.views.0 * self.views.1 * self.cols
+    }
+
+    /// Index of pixel `(u, v, x)` in a row's pixels (times the bands: of its first value).
+    #[inline]
+    pub fn pixel(&self, u: usize, v: usize, x: usize) -> usize {
+        (u * self.views.1 + v) * self.cols + x
+    }
+
     /// Index in a row of `(u, v, x, b)`.
     #[inline]
     pub fn at(&self, u: usize, v: usize, x: usize, b: usize) -> usize {

@@ -344,7 +344,8 @@ pub fn run(args: Args) -> Result<()> {
         per(r.solves),
         per(r.steps)
     )?;
-    let row_mb = (2 * output_shape(&cap).row_len() * 4) as f64 / 1e6;
+    let shape = output_shape(&cap);
+    let row_mb = ((shape.row_len() + shape.pixels()) * 4) as f64 / 1e6;
     outln!(
         "memory: the decode held at most {} of the frame's {rows} lenslet rows of sums at once ({:.1} MB; the \
          light field is written to {} as its rows are finished)",
