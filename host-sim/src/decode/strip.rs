@@ -185,12 +185,14 @@ struct Fill {
 fn finish_row(row: &SumRow, shape: RowShape, (lo, hi): (f32, f32), out: &mut Vec<f32>, fill: &mut Fill) {
     let bands = shape.bands;
     out.clear();
-    out.extend(
-        row.sum
-            .chunks_exact(bands)
-            .zip(&row.weight)
-            .flat_map(|(s, &w)| s.iter().map(move |&s| if w > 0.0 { (s / w).clamp(lo, hi) } else { 0.0 })),
-    );
+    out.resize(row.sum.len(), 0.0);
+    for ((x, s), &w) in out.chunks_exact_mut(bands).zip(row.sum.chunks_exact(bands)).zip(&row.weight) {
+        if w > 0.0 {
+            for (x, &s) in x.iter_mut().zip(s) {
+                *x = (s / w).clamp(lo, hi);
+            }
+        }
+    }
     let run = shape.run_len();
     let (mut mean, mut covered) = (vec![0.0f32; run], vec![0u32; shape.cols]);
     for (data, weight) in out.chunks_exact(run).zip(row.weight.chunks_exact(shape.cols)) {

@@ -116,13 +116,18 @@ impl NpyRows {
 impl RowSink for NpyRows {
     fn put_row(&mut self, y: usize, row: &[f32]) -> Result<()> {
         check_row(self.shape, self.next, y, row, self.file.path())?;
-        for &x in row {
-            self.max = self.max.max(x);
-            match self.dtype {
-                Dtype::F32 => self.block.extend_from_slice(&x.to_le_bytes()),
-                Dtype::U16 => {
-                    self.block.extend_from_slice(&((x.clamp(0.0, 1.0) * 65535.0).round() as u16).to_le_bytes())
-                }
+        // One pass a purpose, each a loop the compiler vectorises (a value at a time, the
+        // maximum and the bytes together, this was 2 % of a preview's one-thread time).
+        self.max = row.iter().fold(self.max, |m, &x| m.max(x));
+        match self.dtype {
+            Dtype::F32 => {
+                self.block.reserve(4 * row.len());
+                self.block.extend(row.iter().flat_map(|x| x.to_le_bytes()));
+            }
+            Dtype::U16 => {
+                self.block.reserve(2 * row.len());
+                self.block
+                    .extend(row.iter().flat_map(|x| ((x.clamp(0.0, 1.0) * 65535.0).round() as u16).to_le_bytes()));
             }
         }
         self.next += 1;
