@@ -228,12 +228,18 @@ impl Stream {
 
     /// The first `k` entries of a random permutation of `0..n` (partial Fisher-Yates).
     fn distinct(&mut self, k: usize, n: usize) -> BandList {
+        let mut out = BandList::new();
+        if k == 1 && n > 0 {
+            // One draw: the permutation's first entry is where its first swap goes (the
+            // loop below without its table, for a camera's single snapshot).
+            let _ = out.push(self.below(n.min(MAX_BANDS)) as u8);
+            return out;
+        }
         let mut all = [0u8; MAX_BANDS];
         for (i, b) in all.iter_mut().enumerate() {
             *b = i as u8;
         }
         let n = n.min(MAX_BANDS);
-        let mut out = BandList::new();
         for j in 0..k.min(n) {
             // r < n <= MAX_BANDS; the `min` lets the compiler see it (no panic path).
             let r = (j + self.below(n - j)).min(MAX_BANDS - 1);
@@ -429,4 +435,37 @@ pub struct KroneckerPhi<const PS: usize, const PT: usize, const PU: usize, const
     pub shuffle3: [u8; PU],
     pub shuffle4: [u8; PV],
     pub bands: BandList,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The partial Fisher-Yates over a whole table, as written before the one-draw path.
+    fn reference(stream: &mut Stream, k: usize, n: usize) -> BandList {
+        let mut all: [u8; MAX_BANDS] = core::array::from_fn(|i| i as u8);
+        let n = n.min(MAX_BANDS);
+        let mut out = BandList::new();
+        for j in 0..k.min(n) {
+            let r = (j + stream.below(n - j)).min(MAX_BANDS - 1);
+            all.swap(j, r);
+            let _ = out.push(all[j]);
+        }
+        out
+    }
+
+    /// Every count of draws and bands gives the table's bands, and leaves the stream where
+    /// the table's walk leaves it.
+    #[test]
+    fn the_one_draw_path_is_the_permutations_first_entry() {
+        for key in 0..2_000usize {
+            for n in 0..=MAX_BANDS + 2 {
+                for k in 0..=3 {
+                    let (mut a, mut b) = (Stream::new(7, TAG_PIXEL, key, n), Stream::new(7, TAG_PIXEL, key, n));
+                    assert_eq!(a.distinct(k, n), reference(&mut b, k, n), "key {key}, k {k}, n {n}");
+                    assert_eq!(a.0, b.0, "key {key}, k {k}, n {n}: the streams part");
+                }
+            }
+        }
+    }
 }
