@@ -462,12 +462,24 @@ fn short_path<const PS: usize, const PT: usize, const PU: usize, const PV: usize
 ) -> Option<Outcome> {
     let Workspace { signal, measurements: m, response, .. } = ws;
     let (mut lo, mut hi, mut sum, mut count) = ([f32::INFINITY; B], [f32::NEG_INFINITY; B], [0.0f32; B], [0u32; B]);
-    // The band is the last (contiguous) axis of the patch layout.
+    // The band is the last (contiguous) axis of the patch layout. Pixel by pixel, each
+    // measured band from the pixel's flags as bits (each band's sum in the same order as a
+    // pass over every entry), and out at the first band whose spread passes `flat`: a
+    // spread only grows, so the answer is already no (on a noisy patch within a few pixels;
+    // the whole pass was 2 % of a one-thread default decode, `perf record`).
     for (values, measured) in m.values.as_chunks::<B>().0.iter().zip(m.measured.as_chunks::<B>().0) {
-        for b in 0..B {
-            if measured[b] {
-                let y = values[b];
-                (lo[b], hi[b], sum[b], count[b]) = (lo[b].min(y), hi[b].max(y), sum[b] + y, count[b] + 1);
+        let mut bits = band_bits(measured);
+        while bits != 0 {
+            let b = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            let (Some(&y), Some(l), Some(h), Some(s), Some(n)) =
+                (values.get(b), lo.get_mut(b), hi.get_mut(b), sum.get_mut(b), count.get_mut(b))
+            else {
+                continue;
+            };
+            (*l, *h, *s, *n) = (l.min(y), h.max(y), *s + y, *n + 1);
+            if *h - *l > cfg.flat {
+                return None;
             }
         }
     }
