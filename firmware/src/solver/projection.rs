@@ -252,6 +252,21 @@ fn band_step<const B: usize, const WEIGHTED: bool>(
     (r2, w2)
 }
 
+/// The indices of the set flags among the first 64 of `flags`, in order: [`band_bits`]
+/// walked lowest bit first (a pixel's measured bands, without a branch a band).
+#[inline(always)]
+pub(crate) fn set_flags(flags: &[bool]) -> impl Iterator<Item = usize> {
+    let mut bits = band_bits(flags);
+    core::iter::from_fn(move || {
+        if bits == 0 {
+            return None;
+        }
+        let b = bits.trailing_zeros() as usize;
+        bits &= bits - 1;
+        Some(b)
+    })
+}
+
 /// Up to 64 flags as a bit mask, bit `j` for flag `j` (any further flags are not read):
 /// eight flags at a time, read as
 /// the bytes of a `u64` (each 0 or 1) and gathered into one byte by a multiply whose

@@ -33,7 +33,7 @@ use crate::solver::ball::{Ball, Move};
 use crate::solver::fill::fill_bands;
 use crate::solver::fractional::project_fractional;
 use crate::solver::mixing::{BandModel, min_norm, project_mixed, project_signal};
-use crate::solver::projection::{band_bits, project_coefficients};
+use crate::solver::projection::{project_coefficients, set_flags};
 use crate::solver::shares::{RowSums, project_shares};
 use crate::solver::workspace::{Measurements, Workspace};
 
@@ -272,10 +272,7 @@ fn project<const B: usize, const N: usize>(x: &mut [f32; N], m: &Measurements<N>
     let weighted = ball.is_weighted();
     let measured = m.values.as_chunks::<B>().0.iter().zip(m.measured.as_chunks::<B>().0);
     for (xs, (ys, flags)) in x.as_chunks::<B>().0.iter().zip(measured) {
-        let mut bits = band_bits(flags);
-        while bits != 0 {
-            let b = bits.trailing_zeros() as usize;
-            bits &= bits - 1;
+        for b in set_flags(flags) {
             let (Some(&x), Some(&y)) = (xs.get(b), ys.get(b)) else { continue };
             let r = y - x;
             r2 += r * r;
@@ -290,10 +287,7 @@ fn project<const B: usize, const N: usize>(x: &mut [f32; N], m: &Measurements<N>
     };
     let (xs, _) = x.as_chunks_mut::<B>();
     for ((xs, ys), flags) in xs.iter_mut().zip(m.values.as_chunks::<B>().0).zip(m.measured.as_chunks::<B>().0) {
-        let mut bits = band_bits(flags);
-        while bits != 0 {
-            let b = bits.trailing_zeros() as usize;
-            bits &= bits - 1;
+        for b in set_flags(flags) {
             let (Some(x), Some(&y)) = (xs.get_mut(b), ys.get(b)) else { continue };
             // The exact projection (scale 1) puts the measured values back as they are.
             *x = if scale == 1.0 { y } else { *x + scale * (y - *x) };
@@ -468,10 +462,7 @@ fn short_path<const PS: usize, const PT: usize, const PU: usize, const PV: usize
     // spread only grows, so the answer is already no (on a noisy patch within a few pixels;
     // the whole pass was 2 % of a one-thread default decode, `perf record`).
     for (values, measured) in m.values.as_chunks::<B>().0.iter().zip(m.measured.as_chunks::<B>().0) {
-        let mut bits = band_bits(measured);
-        while bits != 0 {
-            let b = bits.trailing_zeros() as usize;
-            bits &= bits - 1;
+        for b in set_flags(measured) {
             let (Some(&y), Some(l), Some(h), Some(s), Some(n)) =
                 (values.get(b), lo.get_mut(b), hi.get_mut(b), sum.get_mut(b), count.get_mut(b))
             else {

@@ -63,8 +63,9 @@ pub struct DecodeReport {
     /// (empty when the decode searched no disparity).
     pub disparity_map: Vec<(PatchOrigin, Disparity)>,
     /// The most lenslet rows of sums the streamed decode held at once (each row's sums, 4
-    /// bytes a value, and a weight a pixel, 4 bytes for its 13 values), besides a batch's tiles: what its memory grows
-    /// with, bounded by the tiles' height, not the frame's ([`crate::decode::strip`]).
+    /// bytes a value, and a weight a pixel, 4 bytes for its 13 values), besides a batch's
+    /// tiles: what its memory grows with, bounded by the tiles' height, not the frame's
+    /// ([`crate::decode::strip`]).
     pub rows_held: usize,
     /// Wall time, seconds.
     pub seconds: f64,
