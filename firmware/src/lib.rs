@@ -93,10 +93,12 @@
 //! gain per band, the filters' response matrix with its inverse and each pixel's place in its
 //! view cell behind a lenslet grid, 70,376 bytes for the paper's 5 x 5 x 4 x 4 x 13 patch and 108,400 for the
 //! full-view 5 x 5 x 5 x 5 x 13 patch ([`FullViewWorkspace`], the device's). Overlapping patches
-//! ([`OverlapDecoder`]) add a caller-owned strip of lenslet rows, 7,000 bytes per lenslet
-//! column of 5 x 5 views, or 12,600 with sheared patches ([`disparity`]: the default range
-//! -1..=1 reaches 2 rows beyond a patch); a strip narrower than the sensor decodes it in
-//! bands.
+//! ([`OverlapDecoder`], the device's driver of [`decode::engine`]) add a caller-owned strip
+//! of lenslet rows: per lenslet column of 5 x 5 views and row held, 1,400 bytes (13 sums and
+//! a weight a view), 2,700 seeded (and 13 seeds); the rows held are the schedule's
+//! ([`OverlapDecoder::slots`]: 5 on the device's 5-row capture, 17 on a tall sensor with
+//! the default shears), and a strip narrower than the sensor decodes it in bands
+//! ([`OverlapDecoder::strip_len`]).
 //!
 //! # Errors
 //!

@@ -330,8 +330,8 @@ fn overlap_rows(
     raw: &[RawFrame<f32>],
     columns: usize,
 ) -> (Vec<(u16, u16, Vec<f32>)>, OverlapReport) {
-    let od = OverlapDecoder::new(dec, Overlap::DEFAULT).unwrap();
-    let mut strip = vec![0.0f32; od.strip_per_column() * columns];
+    let od = OverlapDecoder::new(dec, Overlap { stride: (3, 3), window: Window::Tapered, seeded: false }).unwrap();
+    let mut strip = vec![0.0f32; od.strip_len(columns)];
     let mut out = Rows(Vec::new());
     let mut ws = Box::new(PaperWorkspace::new());
     let r = od.decode_frame(&Dictionary::dct(), &mut FrameSource::new(raw), &mut strip, &mut out, &mut ws).unwrap();
@@ -361,8 +361,10 @@ fn a_sheared_plane_decodes_better() {
         // Mean squared error over the sensor.
         let mut err = 0.0f64;
         for (row, c0, values) in &out {
+            // `(u, v, x, b)` over the band's columns.
+            let width = values.len() / (25 * 13);
             for (i, x) in values.chunks(13).enumerate() {
-                let (c, u, v) = (*c0 as usize + i / 25, (i / 5) % 5, i % 5);
+                let (c, u, v) = (*c0 as usize + i % width, (i / width) / 5, (i / width) % 5);
                 let p = (*row as usize * 5 + u) * cols + c * 5 + v;
                 for (b, &xb) in x.iter().enumerate() {
                     err += f64::from(xb - truth(p / cols, p % cols, b)).powi(2);

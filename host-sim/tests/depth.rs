@@ -118,8 +118,9 @@ fn ring_matches_the_host<const PU: usize, const PV: usize, const N: usize>(views
     let (host, report) = decode_with(&capture, &Basis::Dct, &opts).unwrap();
     let sheared = report.disparity_map.iter().filter(|(_, d)| *d != Disparity::ZERO).count();
     assert!(sheared > 10, "{views} views: {sheared} sheared blocks");
-    let od = OverlapDecoder::new(tile_decoder::<PU, PV, N>(&capture, &opts).unwrap(), Overlap::DEFAULT).unwrap();
-    let mut strip = vec![0.0f32; od.strip_per_column() * 6];
+    let overlap = Overlap { seeded: false, ..Overlap::DEFAULT };
+    let od = OverlapDecoder::new(tile_decoder::<PU, PV, N>(&capture, &opts).unwrap(), overlap).unwrap();
+    let mut strip = vec![0.0f32; od.strip_len(6)];
     let mut rows = Rows(LightField::zeros(truth.views, truth.rows, truth.cols, 13));
     let raw = capture.raw_frames().unwrap();
     let mut ws = Box::new(Workspace::<5, 5, PU, PV, 13, N>::new());

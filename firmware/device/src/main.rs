@@ -7,8 +7,10 @@
 //! (f32 bit patterns) for `slf device-check` to compare with the host's decode. Then it
 //! decodes the same tiles with the 5D DCT, runs the model trial (a pilot on each tile's
 //! block: the DCT against the ensemble by their held-out errors, printed with its pick), and
-//! last decodes the whole frame with the picked model in overlapping patches (stride 3,
-//! tapered window) through a strip of lenslet rows, printing each finished row.
+//! last decodes the whole frame with the picked model as the host's default decodes it
+//! (overlapping patches at stride 2, tapered window, the shifted grids seeded from the
+//! disjoint grid's decode: the engine the host drives) through a strip of lenslet rows,
+//! printing each finished row.
 //! `bench_begin` / `bench_end` bracket one synthesis, then each ensemble tile, then each
 //! DCT tile, then each pilot, then the overlapped frame, then one block's disparity
 //! choice, then the DCT tiles sheared to whole and to half-pixel disparities, then a real
@@ -208,16 +210,14 @@ mod device {
         }
     }
 
-    /// Lenslet columns of the overlapped decode's strip: with the default disparities
-    /// (-1..=1, sheared patches reach 2 lenslet rows beyond their own) the ring is 9 lenslet
-    /// rows x 25 views x (13 sums + 1 weight) f32, 12,600 B a column, so the capture's 10
-    /// columns take 126,000 B: one band, in the part's 512 KiB RAM beside the workspace (in
-    /// the 128 KiB of the emulated M4F it took four bands of 3; see README, "Overlap on the
-    /// device").
+    /// Lenslet columns of the overlapped decode's strip: the capture's 10, in one band.
     const STRIP_COLUMNS: usize = 10;
     /// The part's RAM for statics (`memory.x`: 512 KiB), for the camera-sized frame's band.
     const RAM_BYTES: usize = 512 * 1024;
-    const STRIP_LEN: usize = STRIP_COLUMNS * 9 * 25 * 14;
+    /// The strip of the host's default (stride 2, seeded) on the capture: its 5 lenslet
+    /// rows (all a patch reaches) x 10 columns x 25 views x (13 sums, 1 weight and 13
+    /// seeds) f32, 135,000 B, in the part's 512 KiB RAM beside the workspace.
+    const STRIP_LEN: usize = 5 * STRIP_COLUMNS * 25 * 27;
 
     /// Prints each finished row of the overlapped decode, folds it into a checksum.
     struct PrintRows {
@@ -378,8 +378,8 @@ mod device {
         );
         let picked = Picked { first: &*scheduled, second: &model, pick };
 
-        // Window 3: the whole frame with overlapping patches (the host's default stride 3,
-        // tapered window) through the strip, printed row by row for `slf device-check`.
+        // Window 3: the whole frame as the host's default decodes it (stride 2, tapered
+        // window, seeded) through the strip, printed row by row for `slf device-check`.
         let Some(strip) = cortex_m::singleton!(: [f32; STRIP_LEN] = [0.0; STRIP_LEN]) else {
             return debug::EXIT_FAILURE;
         };
@@ -389,12 +389,16 @@ mod device {
         let Ok(overlapped) = OverlapDecoder::new(depth, Overlap::DEFAULT) else {
             return debug::EXIT_FAILURE;
         };
-        if overlapped.strip_per_column() * STRIP_COLUMNS != STRIP_LEN {
-            hprintln!("error: the strip is not {} columns of the ring", STRIP_COLUMNS);
+        if overlapped.strip_len(STRIP_COLUMNS) > STRIP_LEN {
+            hprintln!("error: the strip holds less than {} columns", STRIP_COLUMNS);
             return debug::EXIT_FAILURE;
         }
         let mut rows = PrintRows { checksum: 0, rows: 0 };
-        hprintln!("overlap stride 3 tapered disparities -1..1 strip columns {}", STRIP_COLUMNS);
+        hprintln!(
+            "overlap stride 2 tapered seeded disparities -1..1 strip columns {} rows {}",
+            STRIP_COLUMNS,
+            overlapped.slots()
+        );
         bench_begin(3);
         let r = overlapped.decode_frame(&picked, &mut FrameSource::new(&frames), strip, &mut rows, ws);
         bench_end(3);
@@ -413,20 +417,28 @@ mod device {
         }
         // The patch solves of a camera-sized frame (100 x 100 lenslets, the capture's mask
         // and sheared overlap) through the strip this part's RAM holds beside the workspace:
-        // `scripts/budgets.sh` projects the frame's time from them.
+        // `scripts/budgets.sh` projects the frame's time from them. The seeded default holds
+        // the rows from the first a pending shifted patch reaches to the last an added
+        // disjoint patch reaches, over a band and the columns its seeds are read from: more
+        // than the part's RAM at any band width (`band 0`); unseeded, bands fit.
         let camera = SensorGeometry { lenslets: (100, 100), lenslet };
         let ram_left = RAM_BYTES.saturating_sub(core::mem::size_of::<FullViewWorkspace>());
-        if let Ok(camera) = TileDecoder::<5, 5, 5, 5, 13, 8125>::new(DecoderConfig { sensor: camera, ..config })
-            .map(|d| d.with_disparities(DisparityRange::for_snapshots(SNAPSHOTS)))
-            .and_then(|d| OverlapDecoder::new(d, Overlap::DEFAULT))
-        {
-            let band = ram_left / (4 * camera.strip_per_column()).max(1);
-            hprintln!(
-                "camera frame 100 x 100 band {} patch-solves {} full-width {}",
-                band,
-                camera.patch_decodes(band.max(1)),
-                camera.patch_decodes(100)
-            );
+        for overlap in [Overlap::DEFAULT, Overlap { seeded: false, ..Overlap::DEFAULT }] {
+            if let Ok(camera) = TileDecoder::<5, 5, 5, 5, 13, 8125>::new(DecoderConfig { sensor: camera, ..config })
+                .map(|d| d.with_disparities(DisparityRange::for_snapshots(SNAPSHOTS)))
+                .and_then(|d| OverlapDecoder::new(d, overlap))
+            {
+                let band = camera.band_width(ram_left / 4).unwrap_or(0);
+                hprintln!(
+                    "camera frame 100 x 100 seeded {} rows {} band {} patch-solves {} full-width {} full-width-bytes {}",
+                    overlap.seeded as u8,
+                    camera.slots(),
+                    band,
+                    if band > 0 { camera.patch_decodes(band) } else { 0 },
+                    camera.patch_decodes(100),
+                    4 * camera.strip_len(100)
+                );
+            }
         }
         bench_begin(5);
         let chosen = depth.choose_disparity(2, 3, &mut FrameSource::new(&frames));

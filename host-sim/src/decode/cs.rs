@@ -25,7 +25,7 @@ pub use crate::decode::options::{
     Balance, Basis, DEFAULT_STRIDE, DecodeOptions, MAX_BLOB, NoiseSource, PatchViews, SolveSchedule, Window, read_blob,
 };
 use crate::decode::plan::FramePlan;
-pub use crate::decode::plan::{ModelPick, shifted_tiles, tile_decoder};
+pub use crate::decode::plan::{ModelPick, tile_decoder};
 pub use crate::decode::report::{
     DecodeReport, PatchDecoder, ShearTrialReport, TrialReport, disparity_per_lenslet, error_per_lenslet, estimated_psnr,
 };

@@ -7,9 +7,9 @@
 //! `slf device-check LOG` parses the device's semihosting output, decodes the same tiles on
 //! the host with the same firmware code and model, and fails when any patch differs by more
 //! than 1e-5 relative (to the patch's largest magnitude). The rows of the device's
-//! overlapped decode (its strip) are checked the same way against the host's default decode
-//! (stride 3, tapered window) with every patch decoded from nothing (not seeded, as the
-//! device's strip decodes), relative to the light field's largest magnitude. The device's
+//! overlapped decode (its strip: the firmware's engine, which the host's decode drives too)
+//! are checked the same way against the host's default decode (`Preset::Default`: stride 2,
+//! tapered window, seeded), relative to the light field's largest magnitude. The device's
 //! model trial (one pilot a tile, [`slf_firmware::trial`]) must print the host's sums to
 //! 1e-5 relative and its pick; its overlapped frame is decoded by the picked model.
 
@@ -564,16 +564,10 @@ fn check_rows(
     model: &EnsembleModel<'_, 5, 5, 5, 5, 13>,
     pick: Pick,
 ) -> Result<()> {
-    // The device's strip decodes every patch from nothing: the seeded decode needs the
-    // disjoint grid's sums kept apart from the rest, rows ahead of the walk and columns
-    // beyond a band (`docs/bench/README.md`), more than the emulated part's RAM.
-    // The device's strip: full-view patches at stride 3, tapered (`Overlap::DEFAULT`).
+    // The host's default, full-view patches (the device's), no flags.
     let opts = crate::decode::cs::DecodeOptions {
-        seeded: false,
-        stride: slf_firmware::Overlap::DEFAULT.stride,
-        window: slf_firmware::Overlap::DEFAULT.window,
         patch_views: Some(crate::decode::cs::PatchViews::Five),
-        ..Default::default()
+        ..crate::decode::preset::Preset::Default.options()
     };
     // With the model the trial picked (the device's, checked above).
     let (lf, _) = crate::decode::cs::decode_picked::<5, 5, 8125, _, _>(
@@ -596,9 +590,10 @@ fn check_rows(
         );
         let cols = values.len() / per_col;
         ensure!(first + cols <= lf.cols, "device row {row}: columns {first}..{} outside the sensor", first + cols);
+        // `(u, v, x, b)` over the band's columns.
         for (i, x) in values.iter().enumerate() {
-            let (c, rest) = (i / per_col, i % per_col);
-            let (u, v, b) = (rest / (lf.views.1 * lf.bands), (rest / lf.bands) % lf.views.1, rest % lf.bands);
+            let (b, c, view) = (i % lf.bands, (i / lf.bands) % cols, i / (lf.bands * cols));
+            let (u, v) = (view / lf.views.1, view % lf.views.1);
             let h = lf.data[lf.index(u, v, row, first + c, b)];
             worst = worse(worst, f64::from((x - h).abs() / scale));
             covered[row * lf.cols + first + c] = true;
@@ -608,9 +603,10 @@ fn check_rows(
     ensure!(!rows.is_empty(), "the device printed no rows of its overlapped decode");
     ensure!(missing == 0, "the device's overlapped decode left {missing} lenslets out");
     outln!(
-        "device strip vs host (stride {:?}, {:?}): {} rows, largest relative difference {worst:.2e} (limit 1e-5)",
+        "device strip vs host's default (stride {:?}, {:?}, seeded {}): {} rows, largest relative difference {worst:.2e} (limit 1e-5)",
         opts.stride,
         opts.window,
+        opts.seeds(),
         rows.len()
     )?;
     if !within(worst) {

@@ -1,10 +1,11 @@
 //! A frame's plan ([`FramePlan`]), made once before its rows are decoded: the firmware's
 //! tile decoder with the capture's mask, noise model, white balance and disparities, the
-//! trials' picks (half-pixel shears, DCT or ensemble), and the tiles of the disjoint grid
-//! and of the grids shifted by the stride, in the order the strip decodes them
-//! ([`crate::decode::strip`]).
+//! trials' picks (half-pixel shears, DCT or ensemble), and the patch grids (the firmware
+//! engine's [`Grids`]: the disjoint grid and the grids shifted by the stride, in the order
+//! the strip decodes them, [`crate::decode::strip`]).
 
 use anyhow::{Result, anyhow, ensure};
+use slf_firmware::decode::engine::plan::Grids;
 use slf_firmware::{FrameSource, HoldOut, PatchModel, Pick, RawFrame, Tile, TileDecoder, TrialErrors};
 
 use crate::decode::options::{Balance, DecodeOptions};
@@ -12,31 +13,19 @@ use crate::decode::trial::{frame_shear_trial, frame_trial, halves_alias, pilot_b
 use crate::io::capture::Capture;
 use crate::io::rows::RowShape;
 
-/// A tile and its place in the decode's canonical order (the disjoint grid row by row,
-/// then each shifted grid in turn): the order its patches are listed in the report's maps.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Planned {
-    pub tile: Tile,
-    pub order: usize,
-}
-
 /// What a decode of one frame does, decided before its first row.
 pub struct FramePlan<'a, const PU: usize, const PV: usize, const N: usize> {
     /// The tile decoder, with the shear trial's disparities.
     pub decoder: TileDecoder<'a, 5, 5, PU, PV, 13, N>,
     /// Which of the two models decodes the frame.
     pub pick: Pick,
-    /// The disjoint grid's tiles, row by row (their first rows never decrease).
-    pub disjoint: Vec<Planned>,
-    /// The shifted grids' tiles (with the adaptive rule: their single patches, the
-    /// candidates), ordered by first row; empty at stride 5.
-    pub shifted: Vec<Planned>,
+    /// The patch grids: the disjoint grid's tiles row by row, the shifted grids' (with the
+    /// adaptive rule: their single patches, the candidates) by first row; none at stride 5.
+    pub grids: Grids,
     /// Start the shifted patches from the disjoint grid's decode.
     pub seeded: bool,
     /// Decode a shifted candidate only where its seam score is above this.
     pub adaptive: Option<f32>,
-    /// Lenslets a sheared patch reaches beyond its tile on every side.
-    pub halo: usize,
     /// The light field's rows.
     pub shape: RowShape,
     /// The sensor's range of decoded values.
@@ -122,22 +111,18 @@ impl<'a, const PU: usize, const PV: usize, const N: usize> FramePlan<'a, PU, PV,
         // The shifted grids: every tile, or with the adaptive rule every single patch (the
         // candidates its seams choose from). Their canonical order is grid by grid; the
         // strip takes them by first row, the order their sums join the rows in.
-        let per = if opts.adaptive.is_some() { (1, 1) } else { opts.tile_patches };
-        let shifted = if opts.stride == (5, 5) { Vec::new() } else { shifted_tiles(lenslets, opts.stride, per) };
-        let disjoint: Vec<Planned> =
-            base.into_iter().enumerate().map(|(order, tile)| Planned { tile, order }).collect();
-        let mut shifted: Vec<Planned> =
-            shifted.into_iter().enumerate().map(|(i, tile)| Planned { tile, order: disjoint.len() + i }).collect();
-        shifted.sort_by_key(|p| p.tile.lenslet_row);
+        let tile = (opts.tile_patches.0.max(1), opts.tile_patches.1.max(1));
+        let per = if opts.adaptive.is_some() { (1, 1) } else { tile };
+        let grids = Grids::new(lenslets_u16(lenslets)?, (5, 5), opts.stride, tile, per, halo).ok_or_else(|| {
+            anyhow!("tiles of {:?} and {per:?} patches at stride {:?}", opts.tile_patches, opts.stride)
+        })?;
         let range = decoder.config().raw.range();
         Ok(Self {
             decoder,
             pick,
-            disjoint,
-            shifted,
+            grids,
             seeded: opts.seeds(),
             adaptive: opts.adaptive,
-            halo,
             shape: RowShape { views, rows: lenslets.0, cols: lenslets.1, bands: 13 },
             range,
             window: opts.window,
@@ -145,12 +130,6 @@ impl<'a, const PU: usize, const PV: usize, const N: usize> FramePlan<'a, PU, PV,
             alias,
             model_trial,
         })
-    }
-
-    /// Lenslet rows a tile's sums reach: its own and the halo beside them, on the sensor.
-    pub fn reach(&self, tile: &Tile) -> core::ops::Range<usize> {
-        let row = usize::from(tile.lenslet_row);
-        row.saturating_sub(self.halo)..(row + usize::from(tile.lenslet_rows) + self.halo).min(self.shape.rows)
     }
 }
 
@@ -210,33 +189,8 @@ pub fn tile_decoder<'a, const PU: usize, const PV: usize, const N: usize>(
         .with_shear_check(opts.shear_check))
 }
 
-/// The tiles of the patch grids shifted by `(dy, dx)` lenslets for every multiple of the
-/// stride below 5 other than (0, 0), each of at most `per` patches, whole patches only
-/// (the unshifted grid, with its edge strips, already covers every lenslet).
-pub fn shifted_tiles(lenslets: (usize, usize), stride: (u8, u8), per: (u16, u16)) -> Vec<Tile> {
-    let offsets = |s: u8| (0..5usize).step_by(usize::from(s.clamp(1, 5)));
-    let spans = |total: usize, off: usize, per: usize| -> Vec<(usize, usize)> {
-        let whole = total.saturating_sub(off) / 5;
-        let per = per.max(1);
-        (0..whole.div_ceil(per)).map(|i| (off + i * per * 5, per.min(whole - i * per) * 5)).collect()
-    };
-    let mut tiles = Vec::new();
-    for dy in offsets(stride.0) {
-        for dx in offsets(stride.1) {
-            if (dy, dx) == (0, 0) {
-                continue;
-            }
-            for &(r0, nr) in &spans(lenslets.0, dy, usize::from(per.0)) {
-                for &(c0, nc) in &spans(lenslets.1, dx, usize::from(per.1)) {
-                    tiles.push(Tile {
-                        lenslet_row: r0 as u16,
-                        lenslet_col: c0 as u16,
-                        lenslet_rows: nr as u16,
-                        lenslet_cols: nc as u16,
-                    });
-                }
-            }
-        }
-    }
-    tiles
+/// The sensor's lenslets as a tile's `u16`s.
+fn lenslets_u16((rows, cols): (usize, usize)) -> Result<(u16, u16)> {
+    let fit = |n: usize| u16::try_from(n).map_err(|_| anyhow!("{rows} x {cols} lenslets: at most 65,535 a side"));
+    Ok((fit(rows)?, fit(cols)?))
 }

@@ -32,9 +32,11 @@ pub struct Rows(pub LightField);
 impl RowSink for Rows {
     type Error = core::convert::Infallible;
     fn row(&mut self, row: u16, first_col: u16, values: &[f32]) -> Result<(), Self::Error> {
+        // `(u, v, x, b)` over the band's columns.
         let (vu, vv) = self.0.views;
+        let width = values.len() / (vu * vv * 13);
         for (i, x) in values.chunks(13).enumerate() {
-            let (c, u, v) = (i / (vu * vv), (i / vv) % vu, i % vv);
+            let (c, u, v) = (i % width, (i / width) / vv, (i / width) % vv);
             let at = self.0.index(u, v, row as usize, first_col as usize + c, 0);
             self.0.data[at..at + 13].copy_from_slice(x);
         }

@@ -222,7 +222,7 @@ mod device {
                         }
                     }
                 }
-                let overlap = Overlap { stride: (black_box(3), 3), window: Window::Tapered };
+                let overlap = Overlap { stride: (black_box(2), 2), window: Window::Tapered, seeded: black_box(true) };
                 if let Ok(od) = FullViewOverlapDecoder::new(decoder, overlap) {
                     let mut rows = Rows::default();
                     let _ = od.decode_frame(&full_dct, &mut FrameSource::new(&[*a, *b]), strip, &mut rows, full_ws);
