@@ -323,16 +323,18 @@ fn bad_strides_and_strips_are_refused() {
         let od = Overlapped::new(dec, overlap).unwrap();
         // Rows of 25 views of 13 sums and a weight (and 13 seeds) per lenslet column held:
         // a band and, seeded, the columns its shifted patches reach beside it.
-        let per = if overlap.seeded { 27 } else { 14 };
+        let needs = od.slots();
+        let per = needs.rows * 14 + if overlap.seeded { needs.seed_rows * 13 } else { 0 };
         let margin = if overlap.seeded { 5 } else { 0 };
         for width in [1, 4, COLS] {
-            assert_eq!(od.strip_len(width), od.slots() * (width + 2 * margin).min(COLS) * 25 * per);
+            assert_eq!(od.strip_len(width), per * (width + 2 * margin).min(COLS) * 25);
             // (A seeded band whose margins reach past the sensor holds every column: wider
             // bands cost no more.)
             assert!(od.band_width(od.strip_len(width)) >= Some(width));
             assert!(od.strip_len(width) >= od.strip_len(width.saturating_sub(1).max(1)));
         }
-        assert!(od.slots() >= 5 && od.slots() <= ROWS, "{} rows", od.slots());
+        assert!(needs.rows >= 5 && needs.rows <= ROWS, "{needs:?}");
+        assert!(needs.seed_rows >= 1 && needs.seed_rows <= needs.rows, "{needs:?}");
         let mut strip = vec![0.0f32; od.strip_len(1) - 1];
         let mut ws = Box::new(PaperWorkspace::new());
         let mut sink = rows();
@@ -370,14 +372,14 @@ fn the_devices_overlapped_decode_fits_its_part() {
     assert!(ws + 4 * device.strip_len(10) <= 512 * 1024, "{ws} + {} the full width", 4 * device.strip_len(10));
     // A camera-sized sensor, 100 x 100 lenslets. Seeded, a band holds the rows from the
     // first a pending shifted patch reaches to the last an added disjoint patch reaches (17
-    // with this halo of 2), over its columns and the 8 beside it on each side that its
-    // seeds are read from: more than the 512 KiB part holds for even one column
-    // (`docs/design.md`, "One decode engine"). Unseeded, the RAM beside the workspace holds
+    // with this halo of 2) and the seeds of those final in the disjoint grid (12), over its
+    // columns and the 8 beside it on each side that its seeds are read from: more than the
+    // 512 KiB part holds for even one column (`docs/design.md`, "One decode engine"). Unseeded, the RAM beside the workspace holds
     // a band narrower than the sensor, and the patch solves that costs against the full
     // width's (`scripts/budgets.sh` projects the frame with it).
     let ram = 512 * 1024 - ws;
     let camera = full((100, 100));
-    assert_eq!(camera.slots(), 17);
+    assert_eq!(camera.slots().rows, 17);
     assert_eq!(camera.band_width(ram / 4), None, "{} B for one column", 4 * camera.strip_len(1));
     let camera = OverlapDecoder::new(*camera.tiles(), Overlap { seeded: false, ..Overlap::DEFAULT }).unwrap();
     let band = camera.band_width(ram / 4).unwrap();
@@ -385,7 +387,7 @@ fn the_devices_overlapped_decode_fits_its_part() {
     let (banded, whole) = (camera.patch_decodes(band), camera.patch_decodes(100));
     let disjoint = 20 * 20;
     eprintln!(
-        "100 x 100, full-view, unseeded: {banded} patch solves in bands of {band} ({:.3} x the disjoint grid), {whole} at full width ({:.3} x), {} rows held",
+        "100 x 100, full-view, unseeded: {banded} patch solves in bands of {band} ({:.3} x the disjoint grid), {whole} at full width ({:.3} x), {:?} rows held",
         banded as f64 / disjoint as f64,
         whole as f64 / disjoint as f64,
         camera.slots()

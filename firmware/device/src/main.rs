@@ -395,9 +395,10 @@ mod device {
         }
         let mut rows = PrintRows { checksum: 0, rows: 0 };
         hprintln!(
-            "overlap stride 2 tapered seeded disparities -1..1 strip columns {} rows {}",
+            "overlap stride 2 tapered seeded disparities -1..1 strip columns {} rows {} seed-rows {}",
             STRIP_COLUMNS,
-            overlapped.slots()
+            overlapped.slots().rows,
+            overlapped.slots().seed_rows
         );
         bench_begin(3);
         let r = overlapped.decode_frame(&picked, &mut FrameSource::new(&frames), strip, &mut rows, ws);
@@ -432,7 +433,7 @@ mod device {
                 hprintln!(
                     "camera frame 100 x 100 seeded {} rows {} band {} patch-solves {} full-width {} full-width-bytes {}",
                     overlap.seeded as u8,
-                    camera.slots(),
+                    camera.slots().rows,
                     band,
                     if band > 0 { camera.patch_decodes(band) } else { 0 },
                     camera.patch_decodes(100),

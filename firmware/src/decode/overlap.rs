@@ -20,7 +20,7 @@ use crate::decode::engine::band::Band;
 use crate::decode::engine::plan::Grids;
 use crate::decode::engine::rows::Fill;
 pub use crate::decode::engine::rows::RowSink;
-use crate::decode::engine::schedule::{Next, Schedule};
+use crate::decode::engine::schedule::{Needs, Next, Schedule};
 use crate::decode::engine::strip::{SeedPatches, Strip, StripShape};
 pub use crate::decode::engine::window::Window;
 use crate::decode::tile::{ConfigError, TileDecoder, TileReport};
@@ -99,7 +99,7 @@ pub struct OverlapDecoder<
     overlap: Overlap,
     grids: Grids,
     /// Lenslet rows the strip holds: the schedule of the whole width run dry.
-    slots: usize,
+    needs: Needs,
 }
 
 impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
@@ -115,8 +115,8 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let halo = tiles.disparities().halo(vu.max(vv));
         let grids =
             Grids::new(c.lenslets, (PS, PT), overlap.stride, (1, 1), (1, 1), halo).ok_or(ConfigError::Stride)?;
-        let slots = Schedule::new(grids, grids.disjoint(), grids.shifted()).rows_needed(1).max(1);
-        Ok(Self { tiles, overlap, grids, slots })
+        let needs = Schedule::new(grids, grids.disjoint(), grids.shifted()).needs(1);
+        Ok(Self { tiles, overlap, grids, needs })
     }
 
     /// The tile decoder underneath.
@@ -140,9 +140,9 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         (l.rows as usize, l.cols as usize)
     }
 
-    /// Lenslet rows the strip holds at once.
-    pub fn slots(&self) -> usize {
-        self.slots
+    /// Lenslet rows the strip holds at once: of sums and of seeds.
+    pub fn slots(&self) -> Needs {
+        self.needs
     }
 
     /// Columns a band holds beyond its own on each side, at most: a seeded band reads the
@@ -157,8 +157,8 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let cols = self.grids.lenslets().1;
         let held = (width + 2 * self.margin()).min(cols);
         let (u, v) = self.views();
-        let per_pixel = B + 1 + if self.seeded() { B } else { 0 };
-        self.slots * held * u * v * per_pixel
+        let seeds = if self.seeded() { self.needs.seed_rows * B } else { 0 };
+        (self.needs.rows * (B + 1) + seeds) * held * u * v
     }
 
     /// The widest band a strip of `len` `f32`s holds; `None` below one column.
@@ -192,7 +192,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         ws: &mut Workspace<PS, PT, PU, PV, B, N>,
     ) -> Result<OverlapReport, OverlapError<K::Error>> {
         let width = self.band_width(strip.len()).ok_or(OverlapError::Strip)?;
-        let (grids, seeded, slots) = (self.grids, self.seeded(), self.slots);
+        let (grids, seeded, needs) = (self.grids, self.seeded(), self.needs);
         let (rows, cols) = grids.lenslets();
         let range = self.tiles.config().raw.range();
         let mut report = OverlapReport::default();
@@ -203,7 +203,8 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                 frame_rows: rows,
                 held: band.held.clone(),
                 out: band.out.clone(),
-                slots,
+                slots: needs.rows,
+                seed_slots: needs.seed_rows,
                 seeded,
             };
             let mut rows_held =
@@ -211,7 +212,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             let mut schedule = Schedule::new(grids, band.disjoint(&grids), band.shifted(&grids));
             let (mut fill, mut unused) = (Fill::default(), Fill::default());
             loop {
-                let (planned, seed) = match schedule.next(1, slots) {
+                let (planned, seed) = match schedule.next(1, needs.rows) {
                     Next::Disjoint(_) => (schedule.take_disjoint(), false),
                     Next::Shifted(_) => (schedule.take_shifted(), seeded),
                     Next::Done => break,

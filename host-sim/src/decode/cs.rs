@@ -34,7 +34,7 @@ use crate::decode::trial::{DCT_LEAN, rms};
 use crate::io::capture::Capture;
 use crate::io::grid::OffSensor;
 use crate::io::lightfield::LightField;
-use crate::io::rows::{RowShape, RowSink};
+use crate::io::rows::{RowShape, Rows};
 
 /// A dictionary of the paper's patch: 5 x 5 lenslets x 4 x 4 views x 13 bands.
 pub type PaperDictionary = Dictionary<5, 5, 4, 4, 13>;
@@ -74,7 +74,7 @@ pub fn decode_into(
     basis: &Basis,
     opts: &DecodeOptions,
     observer: &(dyn Fn(usize, usize) + Sync),
-    sink: &mut dyn RowSink,
+    sink: &mut Rows<'_>,
 ) -> Result<DecodeReport> {
     match opts.patch_views_for(capture, basis)? {
         PatchViews::Four => decode_basis::<4, 4, 5200>(capture, basis, opts, observer, sink),
@@ -88,7 +88,7 @@ fn decode_basis<const PU: usize, const PV: usize, const N: usize>(
     basis: &Basis,
     opts: &DecodeOptions,
     observer: &(dyn Fn(usize, usize) + Sync),
-    sink: &mut dyn RowSink,
+    sink: &mut Rows<'_>,
 ) -> Result<DecodeReport> {
     let trained = opts.schedule == SolveSchedule::Trained;
     match basis {
@@ -140,7 +140,7 @@ fn trial_decode<const PU: usize, const PV: usize, const N: usize>(
     pick: ModelPick,
     opts: &DecodeOptions,
     observer: &(dyn Fn(usize, usize) + Sync),
-    sink: &mut dyn RowSink,
+    sink: &mut Rows<'_>,
 ) -> Result<DecodeReport> {
     let model = slf_firmware::EnsembleModel::new(ensemble::<PU, PV>(blob)?, choice);
     let model = if opts.schedule == SolveSchedule::Trained { model } else { model.with_schedules(None) };
@@ -235,7 +235,7 @@ pub fn decode_observed_into<
     model: &M,
     opts: &DecodeOptions,
     observer: &(dyn Fn(usize, usize) + Sync),
-    sink: &mut dyn RowSink,
+    sink: &mut Rows<'_>,
 ) -> Result<DecodeReport> {
     decode_picked_into(capture, model, model, ModelPick::Given(Pick::Second), opts, observer, sink)
 }
@@ -284,7 +284,7 @@ pub fn decode_picked_into<const PU: usize, const PV: usize, const N: usize, A, Z
     pick: ModelPick,
     opts: &DecodeOptions,
     observer: &(dyn Fn(usize, usize) + Sync),
-    sink: &mut dyn RowSink,
+    sink: &mut Rows<'_>,
 ) -> Result<DecodeReport>
 where
     A: PatchModel<5, 5, PU, PV, 13, N> + Sync,

@@ -28,7 +28,7 @@ use crate::io::calibration::Calibration;
 use crate::io::capture::Capture;
 use crate::io::lightfield::LightField;
 use crate::io::message::number as show;
-use crate::io::rows::{MapRows, RowShape, RowSink, put_light_field};
+use crate::io::rows::{MapRows, RowShape, Rows, put_light_field};
 use crate::sim::flags::parse;
 
 /// Decode method: compressed sensing, or a baseline without it.
@@ -645,7 +645,7 @@ impl DecodeSettings {
         capture: &Capture,
         progress: bool,
         observer: &(dyn Fn(usize, usize) + Sync),
-        sink: &mut dyn RowSink,
+        sink: &mut Rows<'_>,
     ) -> Result<Outcome> {
         // Values that would be accepted and ignored: the projection needs a calibration's
         // response, and turns half-pixel shears off (`-1:1:0.5` once gave `-1:1`'s bytes).
@@ -757,7 +757,7 @@ impl DecodeSettings {
         response: Option<(Response<PATCH_BANDS>, ResponseModel)>,
         progress: bool,
         observer: &(dyn Fn(usize, usize) + Sync),
-        sink: &mut dyn RowSink,
+        sink: &mut Rows<'_>,
     ) -> Result<Outcome> {
         if let Some(baseline) = self.method.baseline() {
             let given = self.compressed_sensing_flags();

@@ -2,7 +2,7 @@
 //! ([`slf_firmware::decode::engine`]) driven with batches of tiles, each batch decoded in
 //! parallel into tiles' own sums and joined in the plan's order; only the lenslet rows that
 //! tiles still add to are held (the engine's strip), and every finished row is handed to a
-//! [`RowSink`]. Peak memory is the rows of a band of tiles (and their halo) across the
+//! [`RowSink`](crate::io::rows::RowSink). Peak memory is the rows of a band of tiles (and their halo) across the
 //! frame, not the frame.
 //!
 //! The order of the sums is the engine's, whatever the batches: a decode is the same bit
@@ -17,7 +17,7 @@ use anyhow::Result;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use slf_firmware::decode::engine::plan::Planned;
-use slf_firmware::decode::engine::rows::{Fill, RowSink as EngineSink};
+use slf_firmware::decode::engine::rows::Fill;
 use slf_firmware::decode::engine::schedule::{Next, Schedule};
 use slf_firmware::decode::engine::strip::{SeedPatches, Seeds, Strip, StripShape};
 use slf_firmware::{FrameSource, PatchModel, RawFrame, TileReport, Workspace};
@@ -26,7 +26,7 @@ use crate::decode::plan::FramePlan;
 use crate::decode::report::DecodeReport;
 use crate::decode::seams::{Spectra, seam_score};
 use crate::decode::tile_sums::TileSums;
-use crate::io::rows::{RowShape, RowSink};
+use crate::io::rows::{RowShape, Rows};
 
 /// Tiles a batch holds by default, per worker thread: enough that the threads rarely wait
 /// at a batch's end, few enough that the batch's sums stay small beside the rows held.
@@ -52,17 +52,6 @@ impl Spectra for SeedRows<'_> {
     }
 }
 
-/// A host [`RowSink`] as the engine's sink.
-struct Sink<'a>(&'a mut dyn RowSink);
-
-impl EngineSink for Sink<'_> {
-    type Error = anyhow::Error;
-
-    fn row(&mut self, lenslet_row: u16, _: u16, values: &[f32]) -> Result<(), Self::Error> {
-        self.0.put_row(usize::from(lenslet_row), values)
-    }
-}
-
 /// A batch's tiles, decoded.
 type Decoded<const PU: usize, const PV: usize> = Vec<(Planned, TileSums<PU, PV>, Result<TileReport, String>)>;
 
@@ -80,7 +69,7 @@ pub fn decode_rows<const PU: usize, const PV: usize, const N: usize, M>(
     batch: usize,
     progress: bool,
     observer: &(dyn Fn(usize, usize) + Sync),
-    sink: &mut dyn RowSink,
+    sink: &mut Rows<'_>,
 ) -> Result<DecodeReport>
 where
     M: PatchModel<5, 5, PU, PV, 13, N> + Sync,
@@ -152,19 +141,20 @@ where
     let seeds_needed = plan.seeded || plan.adaptive.is_some();
     let mut schedule = Schedule::new(grids, grids.disjoint(), grids.shifted());
     // The rows the batches need: the schedule run dry (no stall, and the batches as sized).
-    let slots = schedule.clone().rows_needed(batch);
+    let needs = schedule.clone().needs(batch);
+    let slots = needs.rows;
     let held = StripShape {
         views: shape.views,
         frame_rows: shape.rows,
         held: 0..shape.cols,
         out: 0..shape.cols,
         slots,
+        seed_slots: needs.seed_rows,
         seeded: seeds_needed,
     };
     let mut buf = vec![0.0f32; held.buffer_len::<13>()];
     let mut strip = Strip::<13>::new(&mut buf, held, plan.range, plan.window)
         .ok_or_else(|| anyhow::anyhow!("a strip of {slots} rows of {} x {} lenslets", shape.rows, shape.cols))?;
-    let mut sink = Sink(sink);
     let (mut fill, mut unused) = (Fill::default(), Fill::default());
     loop {
         match schedule.next(batch, slots) {
@@ -201,7 +191,7 @@ where
             Next::Stalled => anyhow::bail!("the streamed decode stalled at row {}", schedule.put()),
         }
         report.rows_held = report.rows_held.max(schedule.end() - schedule.put());
-        strip.advance(&mut schedule, &mut sink, &mut fill, &mut unused)?;
+        strip.advance(&mut schedule, sink, &mut fill, &mut unused)?;
     }
     bar.finish_and_clear();
     // The maps in the canonical order (the disjoint grid, then grid by grid), whatever

@@ -15,7 +15,7 @@ use anyhow::{Context, Result, ensure};
 use hdf5_pure::{AttrValue, FileBuilder};
 
 use crate::io::output::WholeFile;
-use crate::io::rows::{RowShape, RowSink, check_row};
+use crate::io::rows::{RowShape, RowSink, check_row, whole_width};
 
 /// The dataset's name.
 pub const DATASET: &str = "lightfield";
@@ -100,7 +100,11 @@ impl Hdf5Rows {
 }
 
 impl RowSink for Hdf5Rows {
-    fn put_row(&mut self, y: usize, row: &[f32]) -> Result<()> {
+    type Error = anyhow::Error;
+
+    fn row(&mut self, y: u16, first_col: u16, row: &[f32]) -> Result<()> {
+        whole_width(first_col)?;
+        let y = usize::from(y);
         check_row(self.shape, self.next, y, row, self.file.path())?;
         let run = self.shape.run_len();
         for (p, values) in row.chunks_exact(run).enumerate() {
@@ -149,7 +153,7 @@ mod tests {
         }
         let unfinished = dir.path().join("unfinished.h5");
         let mut w = Hdf5Rows::create(&unfinished, shape, &nm, None).unwrap();
-        w.put_row(0, &vec![0.5; shape.row_len()]).unwrap();
+        crate::io::rows::put_row(&mut w, 0, &vec![0.5; shape.row_len()]).unwrap();
         assert!(w.finish().is_err(), "rows missing");
         let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
         assert!(!unfinished.exists() && left.len() == 1, "left behind: {left:?}");

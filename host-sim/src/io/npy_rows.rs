@@ -12,7 +12,7 @@ use npyz::WriterBuilder;
 
 use crate::io::lightfield::Dtype;
 use crate::io::output::WholeFile;
-use crate::io::rows::{RowShape, RowSink, check_row};
+use crate::io::rows::{RowShape, RowSink, check_row, whole_width};
 
 /// Bytes of rows gathered before they are written: each write is then one run per view
 /// of many rows, not of one.
@@ -114,7 +114,11 @@ impl NpyRows {
 }
 
 impl RowSink for NpyRows {
-    fn put_row(&mut self, y: usize, row: &[f32]) -> Result<()> {
+    type Error = anyhow::Error;
+
+    fn row(&mut self, y: u16, first_col: u16, row: &[f32]) -> Result<()> {
+        whole_width(first_col)?;
+        let y = usize::from(y);
         check_row(self.shape, self.next, y, row, self.file.path())?;
         // One pass a purpose, each a loop the compiler vectorises (a value at a time, the
         // maximum and the bytes together, this was 2 % of a preview's one-thread time).
@@ -167,20 +171,20 @@ mod tests {
                         }
                     }
                 }
-                w.put_row(y, &row).unwrap();
+                crate::io::rows::put_row(&mut w, y, &row).unwrap();
                 // Blocks of one row and of three, besides the default's one block.
                 if y % 3 == 2 {
                     w.flush_block().unwrap();
                 }
             }
-            assert!(w.put_row(rows, &vec![0.0; shape.row_len()]).is_err(), "a row past the end");
+            assert!(crate::io::rows::put_row(&mut w, rows, &vec![0.0; shape.row_len()]).is_err(), "a row past the end");
             w.finish().unwrap();
             assert_eq!(std::fs::read(&streamed).unwrap(), std::fs::read(&whole).unwrap(), "{dtype:?}");
         }
         let unfinished = dir.path().join("unfinished.npy");
         let mut w = NpyRows::create(&unfinished, shape, Dtype::F32).unwrap();
-        w.put_row(0, &vec![0.5; shape.row_len()]).unwrap();
-        assert!(w.put_row(2, &vec![0.5; shape.row_len()]).is_err(), "a row skipped");
+        crate::io::rows::put_row(&mut w, 0, &vec![0.5; shape.row_len()]).unwrap();
+        assert!(crate::io::rows::put_row(&mut w, 2, &vec![0.5; shape.row_len()]).is_err(), "a row skipped");
         assert!(w.finish().is_err(), "rows missing");
         let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
         assert!(!unfinished.exists() && left.len() == 2, "left behind: {left:?}");

@@ -6,8 +6,31 @@
 //! the light field's memory (and of its `.npy` file's data).
 
 use anyhow::{Result, ensure};
+pub use slf_firmware::decode::engine::rows::RowSink;
 
 use crate::io::lightfield::LightField;
+
+/// The host's row sinks: the firmware's [`RowSink`] (the one the decode engine puts its
+/// finished rows into), failing with an `anyhow` error, taking whole rows (first column 0).
+pub type Rows<'a> = dyn RowSink<Error = anyhow::Error> + 'a;
+
+/// Puts row `y` of a whole width into `sink`.
+///
+/// # Errors
+/// A row past the 65,535 a tile's `u16` names, or what the sink returns.
+pub fn put_row(sink: &mut Rows<'_>, y: usize, row: &[f32]) -> Result<()> {
+    let y = u16::try_from(y).map_err(|_| anyhow::anyhow!("lenslet row {y}: at most 65,535 rows"))?;
+    sink.row(y, 0, row)
+}
+
+/// Checks that a row put to a host sink is of the whole width (first column 0).
+///
+/// # Errors
+/// A row of a band of columns.
+pub fn whole_width(first_col: u16) -> Result<()> {
+    ensure!(first_col == 0, "a row from lenslet column {first_col}: this sink takes whole rows");
+    Ok(())
+}
 
 /// The shape of the rows a sink takes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -92,19 +115,14 @@ pub fn check_row(shape: RowShape, next: usize, y: usize, row: &[f32], path: &std
     Ok(())
 }
 
-/// Where finished lenslet rows go, each once, in order from row 0.
-pub trait RowSink {
-    /// Row `y` of the light field ([`RowShape::row_len`] values, views outermost).
-    ///
-    /// # Errors
-    /// A write that failed, or a row out of order or of the wrong length.
-    fn put_row(&mut self, y: usize, row: &[f32]) -> Result<()>;
-}
-
 /// A light field in memory, filled a row at a time (a decode into memory: the Python
 /// package's return value, the evaluations').
 impl RowSink for LightField {
-    fn put_row(&mut self, y: usize, row: &[f32]) -> Result<()> {
+    type Error = anyhow::Error;
+
+    fn row(&mut self, y: u16, first_col: u16, row: &[f32]) -> Result<()> {
+        whole_width(first_col)?;
+        let y = usize::from(y);
         let shape = RowShape { views: self.views, rows: self.rows, cols: self.cols, bands: self.bands };
         ensure!(y < self.rows && row.len() == shape.row_len(), "row {y} of {} values does not fit", row.len());
         let run = shape.run_len();
@@ -120,7 +138,7 @@ impl RowSink for LightField {
 ///
 /// # Errors
 /// What the sink returns.
-pub fn put_light_field(lf: &LightField, sink: &mut dyn RowSink) -> Result<()> {
+pub fn put_light_field(lf: &LightField, sink: &mut Rows<'_>) -> Result<()> {
     let shape = RowShape { views: lf.views, rows: lf.rows, cols: lf.cols, bands: lf.bands };
     let run = shape.run_len();
     let mut row = vec![0.0; shape.row_len()];
@@ -129,7 +147,7 @@ pub fn put_light_field(lf: &LightField, sink: &mut dyn RowSink) -> Result<()> {
             let at = (p * lf.rows + y) * run;
             values.copy_from_slice(&lf.data[at..at + run]);
         }
-        sink.put_row(y, &row)?;
+        put_row(sink, y, &row)?;
     }
     Ok(())
 }
@@ -137,24 +155,26 @@ pub fn put_light_field(lf: &LightField, sink: &mut dyn RowSink) -> Result<()> {
 /// A sink that passes each row on after `f` has changed it in place (a calibrated decode's
 /// unmixing of every spectrum).
 pub struct MapRows<'a, F> {
-    inner: &'a mut dyn RowSink,
+    inner: &'a mut Rows<'a>,
     f: F,
     row: Vec<f32>,
 }
 
 impl<'a, F: FnMut(&mut [f32])> MapRows<'a, F> {
     /// Rows through `f` into `inner`.
-    pub fn new(inner: &'a mut dyn RowSink, f: F) -> Self {
+    pub fn new(inner: &'a mut Rows<'a>, f: F) -> Self {
         Self { inner, f, row: Vec::new() }
     }
 }
 
 impl<F: FnMut(&mut [f32])> RowSink for MapRows<'_, F> {
-    fn put_row(&mut self, y: usize, row: &[f32]) -> Result<()> {
+    type Error = anyhow::Error;
+
+    fn row(&mut self, y: u16, first_col: u16, row: &[f32]) -> Result<()> {
         self.row.clear();
         self.row.extend_from_slice(row);
         (self.f)(&mut self.row);
-        self.inner.put_row(y, &self.row)
+        self.inner.row(y, first_col, &self.row)
     }
 }
 
@@ -181,10 +201,11 @@ mod tests {
                     }
                 }
             }
-            got.put_row(y, &row).unwrap();
+            put_row(&mut got, y, &row).unwrap();
         }
         assert_eq!(got, want);
-        assert!(got.put_row(rows, &vec![0.0; shape.row_len()]).is_err());
-        assert!(got.put_row(0, &[0.0; 3]).is_err());
+        assert!(put_row(&mut got, rows, &vec![0.0; shape.row_len()]).is_err());
+        assert!(put_row(&mut got, 0, &[0.0; 3]).is_err());
+        assert!(got.row(0, 1, &vec![0.0; shape.row_len()]).is_err(), "a band's row");
     }
 }

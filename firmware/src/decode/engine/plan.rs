@@ -42,12 +42,21 @@ pub struct Grids {
     halo: usize,
 }
 
-/// Spans `(start, length)` along one axis of `total` lenslets of the grid shifted by
-/// `offset`, for patches of `patch` lenslets, `per` patches a span, whole patches only.
-fn shifted_spans(total: usize, offset: usize, patch: Nz, per: Nz) -> impl Iterator<Item = (usize, usize)> + Clone {
+/// Spans along one axis of `total` lenslets of the grid shifted by `offset`, for patches of
+/// `patch` lenslets, `per` patches a span, whole patches only.
+fn spans(total: usize, offset: usize, patch: Nz, per: Nz) -> usize {
+    (total.saturating_sub(offset) / patch + per.get() - 1) / per
+}
+
+/// Span `i` `(start, length)` of [`spans`].
+fn span(total: usize, offset: usize, patch: Nz, per: Nz, i: usize) -> (usize, usize) {
     let whole = total.saturating_sub(offset) / patch;
-    let spans = (whole + per.get() - 1) / per;
-    (0..spans).map(move |i| (offset + i * per.get() * patch.get(), per.get().min(whole - i * per.get()) * patch.get()))
+    (offset + i * per.get() * patch.get(), per.get().min(whole.saturating_sub(i * per.get())) * patch.get())
+}
+
+/// The spans of [`spans`], in order.
+fn shifted_spans(total: usize, offset: usize, patch: Nz, per: Nz) -> impl Iterator<Item = (usize, usize)> + Clone {
+    (0..spans(total, offset, patch, per)).map(move |i| span(total, offset, patch, per, i))
 }
 
 /// Spans `(start, length)` of the disjoint grid along one axis: the grid from 0, then an
@@ -136,37 +145,13 @@ impl Grids {
     fn grid_len(&self, (dy, dx): (usize, usize)) -> usize {
         let (rows, cols) = self.lenslets;
         let (sr, sc) = self.shifted_per;
-        shifted_spans(rows, dy, self.patch.0, sr).count() * shifted_spans(cols, dx, self.patch.1, sc).count()
+        spans(rows, dy, self.patch.0, sr) * spans(cols, dx, self.patch.1, sc)
     }
 
     /// The shifted grids' tiles by their first lenslet row; at one row grid by grid, each
     /// grid's tiles left to right (the grid-by-grid order sorted stably by first row).
-    pub fn shifted(&self) -> impl Iterator<Item = Planned> + Clone + use<> {
-        let g = *self;
-        let (rows, cols) = g.lenslets;
-        let (ps, pt) = g.patch;
-        let (sr, sc) = g.shifted_per;
-        let first = g.disjoint_len();
-        (0..rows).flat_map(move |r| {
-            // Every grid's rows start at its offset plus multiples of `ps` times its tiles'
-            // rows: at row `r`, only the grids of offset `r % ps` can start a tile.
-            let dy = r % ps;
-            let step = ps.saturating_mul(sr);
-            let i = (r - dy) / step;
-            let starts = dy % g.stride.0 == 0 && (r - dy) % step == 0 && i < shifted_spans(rows, dy, ps, sr).count();
-            let span = shifted_spans(rows, dy, ps, sr).nth(i);
-            let offsets = g.offsets().filter(move |&(y, _)| starts && y == dy);
-            offsets.flat_map(move |(dy, dx)| {
-                // The grid's place in the order: the disjoint grid's tiles and the grids
-                // before it, then its tiles before row span `i`.
-                let before = first + g.offsets().take_while(|&o| o != (dy, dx)).map(|o| g.grid_len(o)).sum::<usize>();
-                let per_row = shifted_spans(cols, dx, pt, sc).count();
-                shifted_spans(cols, dx, pt, sc).enumerate().filter_map(move |(j, c)| {
-                    let span = span?;
-                    Some(Planned { tile: tile(span, c), order: (before + i * per_row + j) as u32 })
-                })
-            })
-        })
+    pub fn shifted(&self) -> Shifted {
+        Shifted { grids: *self, row: 0, dx: 0, col: 0 }
     }
 
     /// Tiles of the shifted grids.
@@ -186,6 +171,54 @@ impl Grids {
     pub fn cols(&self, tile: &Tile) -> core::ops::Range<usize> {
         let col = usize::from(tile.lenslet_col);
         col.saturating_sub(self.halo)..(col + usize::from(tile.lenslet_cols) + self.halo).min(self.lenslets.1)
+    }
+}
+
+/// The shifted grids' tiles in the plan's order ([`Grids::shifted`]): a walk down the
+/// sensor's rows, at each row the grids whose tiles start there.
+#[derive(Clone, Debug)]
+pub struct Shifted {
+    grids: Grids,
+    /// The lenslet row walked, the grid's column offset (its index) and the column span.
+    row: usize,
+    dx: usize,
+    col: usize,
+}
+
+impl Iterator for Shifted {
+    type Item = Planned;
+
+    fn next(&mut self) -> Option<Planned> {
+        let g = self.grids;
+        let (rows, cols) = g.lenslets;
+        let ((ps, pt), (sy, sx), (sr, sc)) = (g.patch, g.stride, g.shifted_per);
+        let offsets_x = (pt.get() + sx.get() - 1) / sx;
+        // Each step moves to the next span, grid or row: at most rows x grids x spans.
+        while self.row < rows {
+            // At row `r`, only the grids of offset `r % ps` can start a tile: their rows
+            // start at the offset plus multiples of `ps` times their tiles' rows.
+            let dy = self.row % ps;
+            let step = ps.saturating_mul(sr);
+            let i = (self.row - dy) / step;
+            let starts = dy % sy == 0 && (self.row - dy) % step == 0 && i < spans(rows, dy, ps, sr);
+            if starts && self.dx < offsets_x {
+                let dx = self.dx * sx.get();
+                if (dy, dx) == (0, 0) || self.col >= spans(cols, dx, pt, sc) {
+                    (self.dx, self.col) = (self.dx + 1, 0);
+                    continue;
+                }
+                let j = self.col;
+                self.col += 1;
+                // The grid's place in the order: the disjoint grid's tiles and the grids
+                // before it, then its tiles before row span `i`.
+                let before: usize = g.offsets().take_while(|&o| o != (dy, dx)).map(|o| g.grid_len(o)).sum();
+                let order = g.disjoint_len() + before + i * spans(cols, dx, pt, sc) + j;
+                let tile = tile(span(rows, dy, ps, sr, i), span(cols, dx, pt, sc, j));
+                return Some(Planned { tile, order: order as u32 });
+            }
+            (self.row, self.dx, self.col) = (self.row + 1, 0, 0);
+        }
+        None
     }
 }
 

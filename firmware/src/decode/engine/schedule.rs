@@ -134,16 +134,17 @@ impl<D: Iterator<Item = Planned> + Clone, S: Iterator<Item = Planned> + Clone> S
     }
 
     /// Rows a strip must hold for batches of `max` tiles: the schedule run dry, the most
-    /// rows any disjoint tile reached beyond the first unfinished row. (Every step of the
-    /// plan is visited once: bounded by the frame's tiles.)
-    pub fn rows_needed(mut self, max: usize) -> usize {
-        let mut needed = 0;
+    /// rows any disjoint tile reached beyond the first unfinished row, and the most rows
+    /// final in the disjoint grid and not finished (their seeds). Every step of the plan is
+    /// visited once: bounded by the frame's tiles.
+    pub fn needs(mut self, max: usize) -> Needs {
+        let mut needs = Needs { rows: 1, seed_rows: 1 };
         loop {
             match self.next(max, usize::MAX) {
                 Next::Disjoint(n) => {
                     for _ in 0..n {
                         if let Some(p) = self.take_disjoint() {
-                            needed = needed.max(self.grids.rows(&p.tile).end.saturating_sub(self.put));
+                            needs.rows = needs.rows.max(self.grids.rows(&p.tile).end.saturating_sub(self.put));
                         }
                     }
                 }
@@ -152,9 +153,20 @@ impl<D: Iterator<Item = Planned> + Clone, S: Iterator<Item = Planned> + Clone> S
                         self.take_shifted();
                     }
                 }
-                Next::Done | Next::Stalled => return needed,
+                Next::Done | Next::Stalled => return needs,
             }
-            self.advance();
+            let a = self.advance();
+            needs.seed_rows = needs.seed_rows.max(a.seeds.end.saturating_sub(a.finished.start));
         }
     }
+}
+
+/// The rows a strip holds ([`Schedule::needs`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Needs {
+    /// Rows of sums, from the first unfinished.
+    pub rows: usize,
+    /// Rows of seeds, from the first unfinished.
+    pub seed_rows: usize,
 }

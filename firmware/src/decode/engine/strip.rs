@@ -3,7 +3,8 @@
 //! sums, its weights (one a pixel) and, where the decode is seeded, the disjoint grid's
 //! finished values of the row (the seeds of the shifted patches that reach it).
 //!
-//! Lenslet row `y` is in slot `y % slots`. Which rows are held and when they are final is
+//! Lenslet row `y` is in slot `y % slots` (its seeds in `y % seed_slots`: fewer rows are
+//! final in the disjoint grid and unfinished than are held). Which rows are held and when they are final is
 //! the [`Schedule`]'s; the strip adds tiles' sums ([`Strip::join`]) or single patches
 //! ([`StripSink`]) to its rows, makes seeds and finishes rows as the schedule says
 //! ([`Strip::advance`]), and reads seeds ([`Seeds`]).
@@ -34,8 +35,10 @@ pub struct StripShape {
     pub held: Range<usize>,
     /// Lenslet columns put to the sink (inside `held`).
     pub out: Range<usize>,
-    /// Lenslet rows held at once.
+    /// Lenslet rows of sums held at once.
     pub slots: usize,
+    /// Lenslet rows of seeds held at once (from the first unfinished).
+    pub seed_slots: usize,
     /// Whether the rows keep the disjoint grid's finished values (the seeds).
     pub seeded: bool,
 }
@@ -46,15 +49,10 @@ impl StripShape {
         RowLayout { views: self.views, cols: self.held.len() }
     }
 
-    /// `f32`s of one slot with `B` bands.
-    pub fn slot_len<const B: usize>(&self) -> usize {
-        let pixels = self.layout().pixels();
-        pixels * B + pixels + if self.seeded { pixels * B } else { 0 }
-    }
-
     /// `f32`s of the strip's buffer with `B` bands.
     pub fn buffer_len<const B: usize>(&self) -> usize {
-        self.slots * self.slot_len::<B>()
+        let pixels = self.layout().pixels();
+        self.slots * pixels * (B + 1) + if self.seeded { self.seed_slots * pixels * B } else { 0 }
     }
 }
 
@@ -62,7 +60,7 @@ impl StripShape {
 pub struct Strip<'s, const B: usize> {
     /// The slots' sums and weights: `slots x (pixels x B + pixels)`.
     sums: &'s mut [f32],
-    /// The slots' seeds: `slots x pixels x B` (empty unless seeded).
+    /// The seeds' slots: `seed_slots x pixels x B` (empty unless seeded).
     seeds: &'s mut [f32],
     ring: Ring,
     /// The sensor's range of decoded values.
@@ -74,8 +72,9 @@ pub struct Strip<'s, const B: usize> {
 #[derive(Clone, Debug)]
 struct Ring {
     shape: StripShape,
-    /// `shape.slots`, checked.
+    /// `shape.slots` and `shape.seed_slots`, checked.
     slots: NonZeroUsize,
+    seed_slots: NonZeroUsize,
     layout: RowLayout,
     /// Rows below are finished.
     first: usize,
@@ -85,6 +84,11 @@ impl Ring {
     /// Row `y`'s slot, if held.
     fn slot(&self, y: usize) -> Option<usize> {
         (y >= self.first && y < self.first + self.slots.get()).then(|| y % self.slots)
+    }
+
+    /// Row `y`'s seed slot, if held.
+    fn seed_slot(&self, y: usize) -> Option<usize> {
+        (y >= self.first && y < self.first + self.seed_slots.get()).then(|| y % self.seed_slots)
     }
 }
 
@@ -100,11 +104,12 @@ impl<'s, const B: usize> Strip<'s, B> {
             && shape.held.start <= shape.out.start
             && shape.out.end <= shape.held.end;
         let slots = NonZeroUsize::new(shape.slots)?;
+        let seed_slots = NonZeroUsize::new(shape.seed_slots)?;
         let buf = buf.get_mut(..shape.buffer_len::<B>()).filter(|_| ok)?;
         buf.fill(0.0);
         let layout = shape.layout();
         let (sums, seeds) = buf.split_at_mut_checked(shape.slots * layout.pixels() * (B + 1))?;
-        Some(Self { sums, seeds, ring: Ring { shape, slots, layout, first: 0 }, range, window })
+        Some(Self { sums, seeds, ring: Ring { shape, slots, seed_slots, layout, first: 0 }, range, window })
     }
 
     /// What the strip holds.
@@ -174,7 +179,7 @@ impl<'s, const B: usize> Strip<'s, B> {
     }
 
     /// Finishes row `y` ([`finish`]), puts its `out` columns to `sink` and clears its slot.
-    fn finish_row<K: RowSink>(&mut self, y: usize, sink: &mut K, fill: &mut Fill) -> Result<(), K::Error> {
+    fn finish_row<K: RowSink + ?Sized>(&mut self, y: usize, sink: &mut K, fill: &mut Fill) -> Result<(), K::Error> {
         let (layout, range) = (self.ring.layout, self.range);
         let (held, out) = (self.ring.shape.held.clone(), self.ring.shape.out.clone());
         let views = layout.views.0 * layout.views.1;
@@ -226,7 +231,7 @@ impl<'s, const B: usize> Strip<'s, B> {
     where
         D: Iterator<Item = Planned> + Clone,
         S: Iterator<Item = Planned> + Clone,
-        K: RowSink,
+        K: RowSink + ?Sized,
     {
         let a = schedule.advance();
         if self.ring.shape.seeded {
@@ -266,7 +271,10 @@ fn slot_parts<'a, const B: usize>(
     let pixels = ring.layout.pixels();
     let slot = sums.get_mut(i * pixels * (B + 1)..(i + 1) * pixels * (B + 1))?;
     let (sums, weights) = slot.split_at_mut_checked(pixels * B)?;
-    let seeds = seeds.get_mut(i * pixels * B..(i + 1) * pixels * B).unwrap_or_default();
+    let seeds = match ring.seed_slot(y) {
+        Some(j) => seeds.get_mut(j * pixels * B..(j + 1) * pixels * B).unwrap_or_default(),
+        None => Default::default(),
+    };
     Some((sums, weights, seeds))
 }
 
@@ -288,7 +296,7 @@ impl<const B: usize> Seeds<'_, B> {
     /// the strip holds no seeds of it.
     pub fn spectrum(&self, u: usize, v: usize, y: usize, x: usize) -> Option<&[f32]> {
         let r = self.ring;
-        let i = r.slot(y).filter(|_| r.shape.seeded && r.shape.held.contains(&x))?;
+        let i = r.seed_slot(y).filter(|_| r.shape.seeded && r.shape.held.contains(&x))?;
         let at = (i * r.layout.pixels() + r.layout.pixel(u, v, x - r.shape.held.start)) * B;
         self.seeds.get(at..at + B)
     }

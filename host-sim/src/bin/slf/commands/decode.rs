@@ -18,7 +18,7 @@ use slf_host::io::hdf5_rows::Hdf5Rows;
 use slf_host::io::lightfield::{Dtype, write_npy_f32_2d};
 use slf_host::io::npy_rows::NpyRows;
 use slf_host::io::output::{Outputs, write_bytes};
-use slf_host::io::rows::RowSink;
+use slf_host::io::rows::{RowSink, Rows};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -67,13 +67,15 @@ static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 
 /// A sink that refuses the next row once the run is interrupted.
 struct Interruptible<'a> {
-    inner: &'a mut dyn RowSink,
+    inner: &'a mut Rows<'a>,
 }
 
 impl RowSink for Interruptible<'_> {
-    fn put_row(&mut self, y: usize, row: &[f32]) -> Result<()> {
+    type Error = anyhow::Error;
+
+    fn row(&mut self, y: u16, first_col: u16, row: &[f32]) -> Result<()> {
         anyhow::ensure!(!INTERRUPTED.load(Ordering::Relaxed), "interrupted at lenslet row {y}: nothing written");
-        self.inner.put_row(y, row)
+        self.inner.row(y, first_col, row)
     }
 }
 
@@ -95,7 +97,7 @@ enum OutputFile {
 }
 
 impl OutputFile {
-    fn sink(&mut self) -> &mut dyn RowSink {
+    fn sink(&mut self) -> &mut Rows<'static> {
         match self {
             Self::Npy(f) => f,
             Self::Hdf5(f) => f,
