@@ -24,7 +24,7 @@ KINDS = [
     ("plausibility", r"solver::plausible::"),
     ("disparity choice", r"choose_disparity|operators::disparity::"),
     ("measurements read (mask, frame)", r"sensor::mask::|sensor::raw::|sensor::source::|read_patch|TileDecoder.*::read"),
-    ("strip (sums, seeds, rows)", r"decode::strip::|decode::tile_sums::|FrameSeed|io::npy_rows|io::rows::"),
+    ("strip (sums, seeds, rows)", r"decode::strip::|decode::tile_sums::|decode::engine::|FrameSeed|io::npy_rows|io::rows::"),
     ("solver, rest", r"solver::sl0::|solver::"),
     ("tile decoder, rest", r"decode::tile::|decode::overlap::"),
     ("trials and plan", r"decode::trial::|decode::plan::"),

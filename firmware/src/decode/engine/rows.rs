@@ -110,3 +110,48 @@ pub fn finish<const B: usize>(
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A row of 2 x 2 views and 3 columns of 2 bands, finished, against each value worked by
+    /// hand: column 0 every view covered, column 1 two views covered (the other two take
+    /// their mean), column 2 none (left 0); a sum past the range is clamped.
+    #[test]
+    fn a_row_is_its_weighted_means_with_uncovered_views_filled() {
+        let layout = RowLayout { views: (2, 2), cols: 3 };
+        // Pixels `(u, v, x)`: view-major, `cols` apart.
+        let mut weights = [0.0f32; 12];
+        let mut values = [0.0f32; 24];
+        let mut set = |view: usize, x: usize, w: f32, sum: [f32; 2]| {
+            let p = view * 3 + x;
+            weights[p] = w;
+            values[p * 2..p * 2 + 2].copy_from_slice(&sum);
+        };
+        for view in 0..4 {
+            set(view, 0, 2.0, [0.2 * view as f32, 0.4]);
+        }
+        set(1, 1, 4.0, [0.8, 1.2]);
+        set(2, 1, 1.0, [0.5, 9.0]);
+        let mut fill = Fill::default();
+        finish::<2>(&mut values, &weights, layout, (0.0, 1.0), &mut fill);
+        let at = |view: usize, x: usize| {
+            let p = (view * 3 + x) * 2;
+            [values[p], values[p + 1]]
+        };
+        for view in 0..4 {
+            assert_eq!(at(view, 0), [0.1 * view as f32, 0.2]);
+        }
+        // Covered: (0.2, 0.3) and (0.5, 9.0 clamped to 1.0); the others their mean.
+        assert_eq!(at(1, 1), [0.2, 0.3]);
+        assert_eq!(at(2, 1), [0.5, 1.0]);
+        for view in [0, 3] {
+            assert_eq!(at(view, 1), [(0.2 + 0.5) / 2.0, (0.3 + 1.0) / 2.0]);
+        }
+        for view in 0..4 {
+            assert_eq!(at(view, 2), [0.0, 0.0]);
+        }
+        assert_eq!(fill, Fill { filled: 4, uncovered: 8 });
+    }
+}
