@@ -114,7 +114,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let (vu, vv) = (usize::from(c.lenslet.rows), usize::from(c.lenslet.cols));
         let halo = tiles.disparities().halo(vu.max(vv));
         let grids =
-            Grids::new(c.lenslets, (PS, PT), overlap.stride, (1, 1), (1, 1), halo).ok_or(ConfigError::Stride)?;
+            Grids::new(c.lenslets, (PS, PT), overlap.stride, (1, 1), (1, 1), halo).map_err(|_| ConfigError::Stride)?;
         let needs = Schedule::new(grids, grids.disjoint(), grids.shifted()).needs(1);
         Ok(Self { tiles, overlap, grids, needs })
     }
@@ -208,7 +208,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                 seeded,
             };
             let mut rows_held =
-                Strip::<B>::new(&mut *strip, shape, range, self.overlap.window).ok_or(OverlapError::Strip)?;
+                Strip::<B>::new(&mut *strip, shape, range, self.overlap.window).map_err(|_| OverlapError::Strip)?;
             let mut schedule = Schedule::new(grids, band.disjoint(&grids), band.shifted(&grids));
             let (mut fill, mut unused) = (Fill::default(), Fill::default());
             loop {

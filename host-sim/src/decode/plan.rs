@@ -113,8 +113,8 @@ impl<'a, const PU: usize, const PV: usize, const N: usize> FramePlan<'a, PU, PV,
         // strip takes them by first row, the order their sums join the rows in.
         let tile = (opts.tile_patches.0.max(1), opts.tile_patches.1.max(1));
         let per = if opts.adaptive.is_some() { (1, 1) } else { tile };
-        let grids = Grids::new(lenslets_u16(lenslets)?, (5, 5), opts.stride, tile, per, halo).ok_or_else(|| {
-            anyhow!("tiles of {:?} and {per:?} patches at stride {:?}", opts.tile_patches, opts.stride)
+        let grids = Grids::new(lenslets_u16(lenslets)?, (5, 5), opts.stride, tile, per, halo).map_err(|e| {
+            anyhow!("tiles of {:?} and {per:?} patches at stride {:?}: {e}", opts.tile_patches, opts.stride)
         })?;
         let range = decoder.config().raw.range();
         Ok(Self {

@@ -154,7 +154,7 @@ where
     };
     let mut buf = vec![0.0f32; held.buffer_len::<13>()];
     let mut strip = Strip::<13>::new(&mut buf, held, plan.range, plan.window)
-        .ok_or_else(|| anyhow::anyhow!("a strip of {slots} rows of {} x {} lenslets", shape.rows, shape.cols))?;
+        .map_err(|e| anyhow::anyhow!("{e} ({slots} rows of {} x {} lenslets)", shape.rows, shape.cols))?;
     let (mut fill, mut unused) = (Fill::default(), Fill::default());
     loop {
         match schedule.next(batch, slots) {

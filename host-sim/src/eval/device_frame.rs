@@ -1,7 +1,7 @@
 //! The device's frame figure: projected seconds for a camera-sized frame on the device,
 //! from instruction counts on the emulated core.
 //!
-//! `scripts/budgets.sh` counts the instructions of a patch solve on qemu's Cortex-M4F and
+//! `scripts/budgets.sh` counts the instructions of a patch solve on qemu's Cortex-M7 (`mps2-an500`) and
 //! writes, per kind of decode, how many patch solves a 100 x 100-lenslet frame takes, the
 //! instructions of one solve and the clock they are projected at
 //! (`target/device-frame.csv`). `slf bench --device FILE` puts that table beside the host's
@@ -99,7 +99,7 @@ pub fn parse(text: &str) -> Result<Vec<DeviceFrame>> {
 pub fn markdown(frames: &[DeviceFrame]) -> String {
     let mut md = String::from(
         "\n## The device's frame figure\n\nA 100 x 100-lenslet frame (5 x 5 views) on the device, projected from instruction \
-         counts on qemu's Cortex-M4F (`scripts/budgets.sh`) at one instruction a cycle:\n\n\
+         counts on qemu's Cortex-M7 `mps2-an500` (`scripts/budgets.sh`) at one instruction a cycle:\n\n\
          | decode | patch solves | instructions a solve | clock, MHz | seconds a frame |\n| --- | --- | --- | --- | --- |\n",
     );
     for f in frames {

@@ -69,3 +69,34 @@ impl Band {
         (0..bands).map(move |i| Band::new(&g, i * width.get()..(i + 1) * width.get(), seeded))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::decode::engine::schedule::Schedule;
+
+    /// A band's schedule never holds more rows than the whole width's: a strip sized for the
+    /// whole width's rows decodes every band (the device's driver relies on it).
+    #[test]
+    fn a_band_holds_no_more_rows_than_the_whole_width() {
+        for lenslets in [(8, 11), (17, 16), (23, 31), (12, 5)] {
+            for stride in [(1, 1), (2, 2), (3, 2), (5, 5)] {
+                for halo in [0, 1, 2] {
+                    let g = Grids::new(lenslets, (5, 5), stride, (1, 1), (1, 1), halo).unwrap();
+                    let whole = Schedule::new(g, g.disjoint(), g.shifted()).needs(1);
+                    for width in 1..=usize::from(lenslets.1) {
+                        for band in Band::across(&g, width, true) {
+                            let n = Schedule::new(g, band.disjoint(&g), band.shifted(&g)).needs(1);
+                            let what = (lenslets, stride, halo, width, &band);
+                            assert!(
+                                n.rows <= whole.rows && n.seed_rows <= whole.seed_rows,
+                                "{what:?}: {n:?} > {whole:?}"
+                            );
+                            assert!(band.held.start <= band.out.start && band.out.end <= band.held.end, "{what:?}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+}

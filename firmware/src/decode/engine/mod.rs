@@ -16,7 +16,8 @@
 //! - [`rows`]: the rows' layout, how a row is finished, the sink;
 //! - [`band`]: a band of the sensor's columns decoded on its own, for a strip narrower than
 //!   the sensor;
-//! - [`window`]: how overlapping estimates are weighed.
+//! - [`window`]: how overlapping estimates are weighed;
+//! - [`error`]: what the engine refuses.
 //!
 //! The drivers sit on top: the host decodes the ready tiles of a batch in parallel, each
 //! into its [`tile_sums::TileSums`], and joins them in the plan's order; the device
@@ -26,6 +27,7 @@
 //! device adds each patch to the rows, so the two agree to float rounding.
 
 pub mod band;
+pub mod error;
 pub mod plan;
 pub mod rows;
 pub mod schedule;

@@ -10,6 +10,7 @@
 
 use core::num::NonZeroUsize;
 
+use crate::decode::engine::error::EngineError;
 use crate::decode::tile::Tile;
 
 /// A size that is never zero: dividing by one has no division-by-zero panic path.
@@ -80,8 +81,11 @@ fn tile(r: (usize, usize), c: (usize, usize)) -> Tile {
 impl Grids {
     /// The grids of a sensor of `lenslets` for patches of `patch` lenslets at `stride`,
     /// with `disjoint_per` and `shifted_per` patches a tile and sheared patches reaching
-    /// `halo` lenslets beyond their tile. `None` for a stride axis outside `1..=` the
-    /// patch's size, an empty patch or tile, or a sensor larger than a tile's `u16`s.
+    /// `halo` lenslets beyond their tile.
+    ///
+    /// # Errors
+    /// [`EngineError::Grids`] for a stride axis outside `1..=` the patch's size, an empty
+    /// patch or tile, or a patch or halo over 64 lenslets.
     pub fn new(
         lenslets: (u16, u16),
         patch: (usize, usize),
@@ -89,13 +93,13 @@ impl Grids {
         disjoint_per: (u16, u16),
         shifted_per: (u16, u16),
         halo: usize,
-    ) -> Option<Self> {
+    ) -> Result<Self, EngineError> {
         let ok = |s: u8, p: usize| (1..=p).contains(&usize::from(s)) && p <= 64;
         if !ok(stride.0, patch.0) || !ok(stride.1, patch.1) || halo > 64 {
-            return None;
+            return Err(EngineError::Grids);
         }
-        let nz = |a: usize, b: usize| Some((Nz::new(a)?, Nz::new(b)?));
-        Some(Self {
+        let nz = |a: usize, b: usize| Nz::new(a).zip(Nz::new(b)).ok_or(EngineError::Grids);
+        Ok(Self {
             lenslets: (usize::from(lenslets.0), usize::from(lenslets.1)),
             patch: nz(patch.0, patch.1)?,
             stride: nz(usize::from(stride.0), usize::from(stride.1))?,
@@ -292,8 +296,8 @@ mod tests {
                 }
             }
         }
-        assert!(Grids::new((10, 10), (5, 5), (0, 2), (1, 1), (1, 1), 0).is_none());
-        assert!(Grids::new((10, 10), (5, 5), (2, 6), (1, 1), (1, 1), 0).is_none());
-        assert!(Grids::new((10, 10), (5, 5), (2, 2), (0, 1), (1, 1), 0).is_none());
+        assert!(Grids::new((10, 10), (5, 5), (0, 2), (1, 1), (1, 1), 0).is_err());
+        assert!(Grids::new((10, 10), (5, 5), (2, 6), (1, 1), (1, 1), 0).is_err());
+        assert!(Grids::new((10, 10), (5, 5), (2, 2), (0, 1), (1, 1), 0).is_err());
     }
 }

@@ -16,10 +16,11 @@
 use core::num::NonZeroUsize;
 use core::ops::Range;
 
+use crate::decode::engine::error::EngineError;
 use crate::decode::engine::plan::Planned;
 use crate::decode::engine::rows::{Fill, RowLayout, RowSink, finish};
 use crate::decode::engine::schedule::Schedule;
-use crate::decode::engine::tile_sums::{TileSums, weigh};
+use crate::decode::engine::tile_sums::{TileSums, pixel_at, weigh};
 use crate::decode::engine::window::Window;
 use crate::decode::tile::{PatchOrigin, PatchReport, PatchSeed, PatchSink};
 use crate::solver::sl0::SolveError;
@@ -94,9 +95,16 @@ impl Ring {
 
 impl<'s, const B: usize> Strip<'s, B> {
     /// A strip of `shape` on `buf` (zeroed), finishing values into `range` and weighing
-    /// estimates by `window`; `None` when `buf` is shorter than [`StripShape::buffer_len`], `out`
-    /// is not inside `held`, or there is no slot or no view.
-    pub fn new(buf: &'s mut [f32], shape: StripShape, range: (f32, f32), window: Window) -> Option<Self> {
+    /// estimates by `window`.
+    ///
+    /// # Errors
+    /// [`EngineError::Strip`] when `buf` is shorter than [`StripShape::buffer_len`], `out` is
+    /// not inside `held`, or there is no slot or no view.
+    pub fn new(buf: &'s mut [f32], shape: StripShape, range: (f32, f32), window: Window) -> Result<Self, EngineError> {
+        Self::checked(buf, shape, range, window).ok_or(EngineError::Strip)
+    }
+
+    fn checked(buf: &'s mut [f32], shape: StripShape, range: (f32, f32), window: Window) -> Option<Self> {
         let ok = shape.slots > 0
             && shape.views.0 > 0
             && shape.views.1 > 0
@@ -316,10 +324,7 @@ impl<const B: usize> Seeds<'_, B> {
             return false;
         }
         for (p, bands) in patch.as_chunks_mut::<B>().0.iter_mut().enumerate() {
-            let v = p % PV;
-            let u = (p / PV) % PU;
-            let t = (p / (PV * PU)) % PT;
-            let s = p / (PV * PU * PT);
+            let (s, t, u, v) = pixel_at::<PT, PU, PV>(p);
             let Some((r, c)) = o.lenslet::<PS, PT>(s, t, u, v, views) else { continue };
             // (`max` then `min`: `clamp` asserts its bounds, a panic path.)
             let (r, c) = (r.max(0).min(rows - 1) as usize, c.max(0).min(cols - 1) as usize);

@@ -9,9 +9,17 @@
 //! position innermost and a weight for each band, the join was 9.8 % of a default decode's
 //! one-thread time on the host; `perf record`, depth 100 x 100, pixel k = 1.)
 
+use crate::decode::engine::error::EngineError;
 use crate::decode::engine::window::Window;
 use crate::decode::tile::{PatchOrigin, Tile};
 use crate::operators::disparity::FALLBACK_WEIGHT;
+
+/// Lenslet `(s, t)` and view `(u, v)` of pixel `p` of a `PS x PT x PU x PV` patch, pixels in
+/// the patch's order ([`crate::shape::PatchShape::index`] without the band).
+#[inline]
+pub(crate) fn pixel_at<const PT: usize, const PU: usize, const PV: usize>(p: usize) -> (usize, usize, usize, usize) {
+    (p / (PV * PU * PT), (p / (PV * PU)) % PT, (p / PV) % PU, p % PV)
+}
 
 /// A patch's estimates weighed into pixels: for each pixel `(s, t, u, v)` of the patch at
 /// `origin`, in the patch's order, `add(row, col, view_row, view_col, weight, values)` with
@@ -29,10 +37,7 @@ pub fn weigh<const PS: usize, const PT: usize, const PU: usize, const PV: usize,
 ) {
     let scale = if fallback { FALLBACK_WEIGHT } else { 1.0 };
     for (p, bands) in patch.as_chunks::<B>().0.iter().enumerate() {
-        let v = p % PV;
-        let u = (p / PV) % PU;
-        let t = (p / (PV * PU)) % PT;
-        let s = p / (PV * PU * PT);
+        let (s, t, u, v) = pixel_at::<PT, PU, PV>(p);
         let Some((r, c)) = origin.lenslet::<PS, PT>(s, t, u, v, views) else { continue };
         let w = scale * window.weight::<PS, PT>(s, t);
         add(r, c, origin.view_row as usize + u, origin.view_col as usize + v, w, bands);
@@ -66,8 +71,11 @@ impl<'b, const B: usize> TileSums<'b, B> {
         (pixels * B, pixels)
     }
 
-    /// The sums of `tile` on `sum` and `weight`, zeroed; `None` when they are shorter than
-    /// [`Self::lens`] says (the rest of a longer slice is not used).
+    /// The sums of `tile` on `sum` and `weight`, zeroed (the rest of a longer slice is not
+    /// used).
+    ///
+    /// # Errors
+    /// [`EngineError::TileSums`] when they are shorter than [`Self::lens`] says.
     pub fn new(
         tile: Tile,
         views: (usize, usize),
@@ -75,12 +83,14 @@ impl<'b, const B: usize> TileSums<'b, B> {
         halo: usize,
         sum: &'b mut [f32],
         weight: &'b mut [f32],
-    ) -> Option<Self> {
+    ) -> Result<Self, EngineError> {
         let (s, w) = Self::lens(&tile, views, halo);
-        let (sum, weight) = (sum.get_mut(..s)?, weight.get_mut(..w)?);
+        let (Some(sum), Some(weight)) = (sum.get_mut(..s), weight.get_mut(..w)) else {
+            return Err(EngineError::TileSums);
+        };
         sum.fill(0.0);
         weight.fill(0.0);
-        Some(Self { tile, views, window, halo, sum, weight })
+        Ok(Self { tile, views, window, halo, sum, weight })
     }
 
     /// Lenslet rows and columns of the sums.
