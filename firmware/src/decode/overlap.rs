@@ -154,11 +154,21 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     /// `f32`s of a strip that decodes bands of `width` lenslet columns (the whole width in
     /// one band at the sensor's columns).
     pub fn strip_len(&self, width: usize) -> usize {
-        let cols = self.grids.lenslets().1;
-        let held = (width + 2 * self.margin()).min(cols);
-        let (u, v) = self.views();
-        let seeds = if self.seeded() { self.needs.seed_rows * B } else { 0 };
-        (self.needs.rows * (B + 1) + seeds) * held * u * v
+        let held = (width + 2 * self.margin()).min(self.grids.lenslets().1);
+        self.strip_shape(0..held, 0..held).buffer_len::<B>()
+    }
+
+    /// The strip of a band holding columns `held` and putting `out`.
+    fn strip_shape(&self, held: core::ops::Range<usize>, out: core::ops::Range<usize>) -> StripShape {
+        StripShape {
+            views: self.views(),
+            frame_rows: self.grids.lenslets().0,
+            held,
+            out,
+            slots: self.needs.rows,
+            seed_slots: self.needs.seed_rows,
+            seeded: self.seeded(),
+        }
     }
 
     /// The widest band a strip of `len` `f32`s holds; `None` below one column.
@@ -198,15 +208,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let mut report = OverlapReport::default();
         for band in Band::across(&grids, width, seeded) {
             report.bands += 1;
-            let shape = StripShape {
-                views: self.views(),
-                frame_rows: rows,
-                held: band.held.clone(),
-                out: band.out.clone(),
-                slots: needs.rows,
-                seed_slots: needs.seed_rows,
-                seeded,
-            };
+            let shape = self.strip_shape(band.held.clone(), band.out.clone());
             let mut rows_held =
                 Strip::<B>::new(&mut *strip, shape, range, self.overlap.window).map_err(|_| OverlapError::Strip)?;
             let mut schedule = Schedule::new(grids, band.disjoint(&grids), band.shifted(&grids));
