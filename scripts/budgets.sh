@@ -50,7 +50,7 @@ disjoint_stack = int(re.search(r"^disjoint stack peak bytes (\d+)", log, re.M).g
 ws = int(re.search(r"workspace bytes (\d+)", log).group(1))
 # The device's workspace (the full-view patch's) is the size firmware/tests/solver.rs pins on
 # the host and the README and crate docs give.
-assert ws == 108_400, f"the device's Workspace is {ws} B; firmware/tests/solver.rs, the README and lib.rs say 108,400"
+assert ws == 140_900, f"the device's Workspace is {ws} B; firmware/tests/solver.rs, the README and lib.rs say 140,900"
 cameras = {
     int(m[0]): [int(x) for x in m[1:]]
     for m in re.findall(

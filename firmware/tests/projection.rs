@@ -6,7 +6,7 @@ mod common;
 use common::*;
 use rand::Rng;
 use slf_firmware::ball::Ball;
-use slf_firmware::projection::project_coefficients;
+use slf_firmware::projection::{project_coefficients, project_weighed, weigh};
 use slf_firmware::transform::analyze_preserving;
 use slf_firmware::{Dictionary, Measurements};
 
@@ -106,7 +106,18 @@ fn check<const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                     ones.clone()
                 };
                 let ball = Ball::new(noise as f32, shot as f32, idx.len() as u32, 0).balanced(balanced); // radius^2 = m
+                let start = coeffs.clone();
                 let residual = project_coefficients(&dict, &mut coeffs, &mut scratch, &m, &ball);
+                if ball.is_weighted() {
+                    // The solver's path: the weights made once, read by each step. The same
+                    // sums in the same order: the same bits.
+                    let mut weights = Box::new([f32::NAN; N]);
+                    weigh::<B, N>(&m, &ball, &mut weights);
+                    let mut weighed = start.clone();
+                    let r = project_weighed(&dict, &mut weighed, &mut scratch, &m, &ball, &weights);
+                    assert_eq!(r.to_bits(), residual.to_bits(), "noise {noise} shot {shot}: residual");
+                    assert!(weighed.iter().zip(coeffs.iter()).all(|(a, b)| a.to_bits() == b.to_bits()));
+                }
                 let (reference, norm) = dense_projection(&k, n, &s, &idx, &y, (noise, shot), &g64);
                 let e = rel_err(&coeffs[..], &reference);
                 assert!(e <= 2e-6, "dict {dseed}, {per_pixel} per pixel, noise {noise} shot {shot}: rel err {e}");

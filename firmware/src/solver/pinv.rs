@@ -173,7 +173,7 @@ pub fn solve_pinv<
     cfg: &Sl0Config,
     ws: &mut Workspace<PS, PT, PU, PV, B, N>,
 ) -> Result<Outcome, SolveError> {
-    let Workspace { coeffs, signal, measurements: m, response } = ws;
+    let Workspace { coeffs, signal, measurements: m, response, .. } = ws;
     if !response.is_identity() {
         // The paper's operator is a selection of the patch's entries: no mixed filters.
         return Err(SolveError::InvalidConfig { field: "response" });

@@ -63,10 +63,48 @@ pub fn project_coefficients<
     let weighted = ball.is_weighted();
     let mut step = |fibres: &mut [[f32; B]], values: &[f32], measured: &[bool]| {
         if weighted {
-            band_step::<B, true>(&dict.d.m5, fibres, values, measured, ball, &m.gains)
+            band_step::<B, COMPUTED>(&dict.d.m5, fibres, values, measured, ball, &m.gains, values)
         } else {
-            band_step::<B, false>(&dict.d.m5, fibres, values, measured, ball, &m.gains)
+            band_step::<B, PLAIN>(&dict.d.m5, fibres, values, measured, ball, &m.gains, values)
         }
+    };
+    project_slices(dict, coeffs, scratch, m, ball, &mut step)
+}
+
+/// Each measured entry's weight in `ball` ([`Ball::weight`]) into `weights`, in patch
+/// order (the other entries are left as they are): what [`project_weighed`] reads.
+pub fn weigh<const B: usize, const N: usize>(m: &Measurements<N>, ball: &Ball, weights: &mut [f32; N]) {
+    let measured = m.values.as_chunks::<B>().0.iter().zip(m.measured.as_chunks::<B>().0);
+    for (ws, (ys, flags)) in weights.as_chunks_mut::<B>().0.iter_mut().zip(measured) {
+        for b in set_flags(flags) {
+            let (Some(w), Some(&y)) = (ws.get_mut(b), ys.get(b)) else { continue };
+            *w = ball.weight(y, m.gains.get(b).copied().unwrap_or(1.0));
+        }
+    }
+}
+
+/// [`project_coefficients`] onto a weighted ball ([`Ball::is_weighted`]) with each
+/// measurement's weight read from `weights` ([`weigh`] of the same measurements and ball)
+/// instead of computed: the same sums, without two divisions a measurement a step.
+pub fn project_weighed<
+    const PS: usize,
+    const PT: usize,
+    const PU: usize,
+    const PV: usize,
+    const B: usize,
+    const N: usize,
+>(
+    dict: &Dictionary<PS, PT, PU, PV, B>,
+    coeffs: &mut [f32; N],
+    scratch: &mut [f32; N],
+    m: &Measurements<N>,
+    ball: &Ball,
+    weights: &[f32; N],
+) -> f32 {
+    let mut parts = weights.chunks_exact(PT * PU * PV * B);
+    let mut step = |fibres: &mut [[f32; B]], values: &[f32], measured: &[bool]| {
+        let weights = parts.next().unwrap_or(values);
+        band_step::<B, TABLE>(&dict.d.m5, fibres, values, measured, ball, &m.gains, weights)
     };
     project_slices(dict, coeffs, scratch, m, ball, &mut step)
 }
@@ -206,11 +244,18 @@ pub(crate) fn apply_move<const PS: usize, const PT: usize, const PU: usize, cons
     norm
 }
 
+/// How a band step weighs a residual: not at all (an exact or uniform ball), by
+/// [`Ball::weight`] computed from the value and its band's gain, or read from a table.
+const PLAIN: u8 = 0;
+const COMPUTED: u8 = 1;
+const TABLE: u8 = 2;
+
 /// The band step on a slice's pixels: `fibres` hold each pixel's band coefficients after
 /// the pixel modes' synthesis and become the correction's; `values` / `measured` are the
-/// slice's measurements in patch order. Returns the sum of squared residuals and, with
-/// `WEIGHTED`, of each over its measurement's variance ([`Ball::weight`]: one division per
-/// measurement, only in that mode, with the band's gain from `gains`).
+/// slice's measurements in patch order. Returns the sum of squared residuals and, unless
+/// `PLAIN`, of each over its measurement's variance ([`Ball::weight`]: `COMPUTED` from the
+/// value and the band's gain in `gains`, two divisions; `TABLE` read from `weights`, the
+/// slice's weights in patch order).
 ///
 /// A pixel's measured bands are found from a bit mask of its flags ([`band_bits`]),
 /// lowest set bit first: scanning the flags one by one took a data-dependent branch per
@@ -220,18 +265,20 @@ pub(crate) fn apply_move<const PS: usize, const PT: usize, const PU: usize, cons
 /// 3.1 us at three; criterion, paper patch); the bit mask (two multiplies a pixel instead
 /// of 128-bit arithmetic a band) took the projection from 5.98 to 5.75 us at one.
 #[inline(always)]
-fn band_step<const B: usize, const WEIGHTED: bool>(
+#[allow(clippy::too_many_arguments)] // the band step's inputs, inlined into two callers
+fn band_step<const B: usize, const WEIGH: u8>(
     m5: &[[f32; B]; B],
     fibres: &mut [[f32; B]],
     values: &[f32],
     measured: &[bool],
     ball: &Ball,
     gains: &[f32],
+    weights: &[f32],
 ) -> (f32, f32) {
     const { assert!(B <= 64, "a pixel's flags fit one mask (B <= MAX_BANDS)") };
     let (mut r2, mut w2) = (0.0f32, 0.0f32);
-    for ((fibre, values), measured) in fibres.iter_mut().zip(values.as_chunks::<B>().0).zip(measured.as_chunks::<B>().0)
-    {
+    let pixels = fibres.iter_mut().zip(values.as_chunks::<B>().0).zip(measured.as_chunks::<B>().0);
+    for (((fibre, values), measured), weights) in pixels.zip(weights.as_chunks::<B>().0) {
         let mut correction = [0.0f32; B];
         let mut bits = band_bits(measured);
         while bits != 0 {
@@ -240,8 +287,10 @@ fn band_step<const B: usize, const WEIGHTED: bool>(
             let (Some(row), Some(&y)) = (m5.get(b), values.get(b)) else { break };
             let r = y - dot(row, fibre);
             r2 += r * r;
-            if WEIGHTED {
+            if WEIGH == COMPUTED {
                 w2 += r * r * ball.weight(y, gains.get(b).copied().unwrap_or(1.0));
+            } else if WEIGH == TABLE {
+                w2 += r * r * weights.get(b).copied().unwrap_or(0.0);
             }
             for (c, &w) in correction.iter_mut().zip(row) {
                 *c += r * w;

@@ -33,7 +33,7 @@ use crate::solver::ball::{Ball, Move};
 use crate::solver::fill::fill_bands;
 use crate::solver::fractional::project_fractional;
 use crate::solver::mixing::{BandModel, min_norm, project_mixed, project_signal};
-use crate::solver::projection::{project_coefficients, set_flags};
+use crate::solver::projection::{project_coefficients, project_weighed, set_flags, weigh};
 use crate::solver::shares::{RowSums, project_shares};
 use crate::solver::workspace::{Measurements, Workspace};
 
@@ -766,10 +766,17 @@ fn descend_with<const PS: usize, const PT: usize, const PU: usize, const PV: usi
     mixing: Option<&BandModel<B>>,
     mut rows: Option<&mut RowSums<N>>,
 ) -> Result<Outcome, SolveError> {
-    let Workspace { coeffs, signal, measurements: m, .. } = ws;
+    let Workspace { coeffs, signal, measurements: m, weights, .. } = ws;
     let selection = !m.interpolates();
     analyze(dict, signal, coeffs);
     let top = max_abs(coeffs);
+    // The measurements' weights once a solve, not once a step (one-hot measurements only).
+    let table = if selection && mixing.is_none() && ball.is_weighted() {
+        weigh::<B, N>(m, ball, weights);
+        Some(&*weights)
+    } else {
+        None
+    };
     let mut step = |inv: f32, mu: f32, weights: Option<&Weights<PS, PT, PU, PV, B>>| {
         let step2 = match weights {
             Some(w) => ascend_weighted(coeffs, mu, inv, w),
@@ -777,6 +784,8 @@ fn descend_with<const PS: usize, const PT: usize, const PU: usize, const PV: usi
         };
         let residual = if let Some(model) = mixing {
             project_mixed(dict, model, coeffs, signal, m, ball)
+        } else if let Some(weights) = table {
+            project_weighed(dict, coeffs, signal, m, ball, weights)
         } else if selection {
             project_coefficients(dict, coeffs, signal, m, ball)
         } else {

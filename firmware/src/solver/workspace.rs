@@ -1,8 +1,9 @@
 //! The caller-owned workspace: every buffer the decoder needs for one patch.
 //!
 //! `size_of::<Workspace<..>>()` is the decoder's whole RAM need besides the stack (a test
-//! pins it at or under 96 KiB for the paper's patch). It is three patch-sized buffers and
-//! one flag per patch value: coefficients, signal, and the measurements. `new` is a
+//! pins it at or under 96 KiB for the paper's patch). It is four patch-sized buffers and
+//! one flag per patch value: coefficients, signal, the measurements and their weights in a
+//! noise ball. `new` is a
 //! `const fn`, so a device can place it in a `static`.
 
 use crate::operators::disparity::HalfViews;
@@ -273,6 +274,12 @@ pub struct Workspace<const PS: usize, const PT: usize, const PU: usize, const PV
     pub(crate) coeffs: [f32; N],
     pub(crate) signal: [f32; N],
     pub(crate) measurements: Measurements<N>,
+    /// Each measurement's weight in a noise ball that weighs them ([`crate::solver::ball::Ball::weight`],
+    /// in patch order; other entries are stale): made once a solve, read by every step's
+    /// projection. Computed in each step instead, its two divisions a measurement held the
+    /// projection's band step up (`perf annotate`: a fifth of a default decode's samples in
+    /// the step stood on the division's result at pixel k = 3).
+    pub(crate) weights: [f32; N],
     /// The filters' response matrix the measurements are taken through (in the sensor's
     /// units; the solve balances it by the measurements' gains): the identity for one-hot
     /// filters ([`crate::solver::mixing`]).
@@ -285,7 +292,13 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
     /// A zeroed workspace.
     pub const fn new() -> Self {
         const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
-        Self { coeffs: [0.0; N], signal: [0.0; N], measurements: Measurements::new(), response: Response::IDENTITY }
+        Self {
+            coeffs: [0.0; N],
+            signal: [0.0; N],
+            measurements: Measurements::new(),
+            weights: [0.0; N],
+            response: Response::IDENTITY,
+        }
     }
 
     /// Sets the response matrix the next solves take the measurements through (kept by
