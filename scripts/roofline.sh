@@ -163,8 +163,9 @@ PY
 echo
 echo "## Against issue 62's targets"
 echo
-python3 - "$shares" README.md <<'PY'
+python3 - "$shares" README.md "$kernel_peak" <<'PY'
 import re, statistics, sys
+KERNEL_PEAK = float(sys.argv[3])
 rows = [l[4:].strip().strip("|").split("|") for l in open(sys.argv[1]) if l.startswith("ROW ")]
 rows = [[c.strip() for c in r] for r in rows]
 readme = open(sys.argv[2]).read()
@@ -180,15 +181,33 @@ for preset, target in (("default", 10), ("preview", 3)):
           f"{100 * min(left):.0f} to {100 * max(left):.0f} % of it ({1 / max(left):.2f} to {1 / min(left):.2f} times "
           f"faster): the rest of each step (the ascent's weights, the strip, the reads, the solver's "
           f"bookkeeping) and the number of steps must fall too.")
+    # The arithmetic's own bound: this decode's multiply-adds at the core's full peak.
+    at_peak = [float(r[3]) * float(r[8].rstrip(" %")) / 100 for r in rs]
+    print(f"  Its arithmetic alone (the multiply-adds a patch above, at least) at 100 % of the core's peak "
+          f"would take {min(at_peak):.1f} to {max(at_peak):.1f} times the demosaic's time: to meet {target}x the "
+          f"whole decode would have to run at {100 * min(at_peak) / target:.0f} to {100 * max(at_peak) / target:.0f} % "
+          f"of the peak (it runs at {min(float(r[8].rstrip(' %')) for r in rs):.1f} to "
+          f"{max(float(r[8].rstrip(' %')) for r in rs):.1f} %, its kernels alone at {100 * KERNEL_PEAK:.0f} %)"
+          + (", more than the machine has: the target needs fewer multiply-adds, not faster ones."
+             if max(at_peak) > target else "."))
 macs = statistics.median(float(r[6]) for r in rows if r[2] == "default") if rows else 0
 m = re.search(r"^\| instructions per patch, ensemble \(8 members\), screened[^|]*\| ([0-9,]+)", readme, re.M)
 if m and macs:
     n = int(m.group(1).replace(",", ""))
     print(f"- **device**: a default patch's arithmetic (the median above, {macs:.1f} M multiply-adds, at "
           f"least) at one multiply-add a cycle is {1000 * macs * 1e6 / 480e6:.0f} ms at 480 MHz; the device's "
-          f"screened patch (its own options and steps, not the host's default yet) takes {n / 1e6:.1f} M "
+          f"screened patch (the budget table's, a disjoint patch's cold solve and screen) takes {n / 1e6:.1f} M "
           f"instructions ({1000 * n / 480e6:.0f} ms at one a cycle), {n / (macs * 1e6):.1f} instructions a "
           f"multiply-add of that arithmetic.")
+solves = re.search(r"the host's default \(stride 2, seeded\), screened ensemble \(([0-9,]+) patch solves", readme)
+if solves and rows:
+    per_solve = statistics.median(float(r[6]) / float(r[5].split("/")[0]) for r in rows if r[2] == "default")
+    n = int(solves.group(1).replace(",", ""))
+    secs = n * per_solve * 1e6 / 480e6
+    print(f"- **device frame**: the 100 x 100-lenslet frame's {n:,} patch solves (README's budget table) at "
+          f"{per_solve:.1f} M multiply-adds a solve (the median default's, at least) take {secs:.0f} s at one "
+          f"multiply-add a cycle at 480 MHz: the target of 60 s needs {100 * secs / 60:.0f} % of that peak"
+          + (", more than the core has." if secs > 60 else "."))
 PY
 echo
 echo "Fused multiply-adds, the device's cheapest lever (one VFMA.F32 instead of a VMUL and a VADD):"
