@@ -65,13 +65,16 @@ fn benches(c: &mut Criterion) {
         let exact = Ball::new(0.0, 0.0, count as u32, 0);
         analyze_preserving(&dict, ws.patch(), &mut coeffs);
         c.bench_function(&format!("project pixel k={k}"), |bench| {
-            bench.iter(|| project_coefficients(&dict, black_box(&mut coeffs), &mut scratch, ws.measurements(), &exact))
+            bench.iter(|| {
+                project_coefficients(&dict, black_box(&mut coeffs), &mut scratch, ws.measurements(), &exact, None)
+            })
         });
         let ensemble = Ensemble::<5, 5, 4, 4, 13>::new(DEFAULT_ENSEMBLE).unwrap();
         let member = ensemble.member(1).unwrap(); // 0 is the DCT
         c.bench_function(&format!("project pixel k={k} learned member"), |bench| {
-            bench
-                .iter(|| project_coefficients(&member, black_box(&mut coeffs), &mut scratch, ws.measurements(), &exact))
+            bench.iter(|| {
+                project_coefficients(&member, black_box(&mut coeffs), &mut scratch, ws.measurements(), &exact, None)
+            })
         });
         if k == 1 {
             // The step is branch-free on the host: its time does not depend on sigma.

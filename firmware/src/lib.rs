@@ -90,8 +90,9 @@
 //! Configuration (dictionaries, masks, defect lists, solver parameters) is immutable and
 //! can live in flash; all mutable state is one caller-owned [`Workspace`], whose size is the
 //! decoder's whole RAM need besides the stack: four patch buffers (coefficients, signal,
-//! measurements and their weights in a noise ball), a flag per value, a gain per band, the filters' response matrix with its inverse and each pixel's place in its
-//! view cell behind a lenslet grid, 91,176 bytes for the paper's 5 x 5 x 4 x 4 x 13 patch and 140,900 for the
+//! measurements and their weights in a noise ball), a flag per value, a gain per band, the
+//! filters' response matrix with its inverse and each pixel's place in its view cell behind a
+//! lenslet grid, 91,176 bytes for the paper's 5 x 5 x 4 x 4 x 13 patch and 140,900 for the
 //! full-view 5 x 5 x 5 x 5 x 13 patch ([`FullViewWorkspace`], the device's). Overlapping patches
 //! ([`OverlapDecoder`], the device's driver of [`decode::engine`]) add a caller-owned strip
 //! of lenslet rows: per lenslet column of 5 x 5 views and row held, 1,400 bytes (13 sums and

@@ -6,7 +6,7 @@ mod common;
 use common::*;
 use rand::Rng;
 use slf_firmware::ball::Ball;
-use slf_firmware::projection::{project_coefficients, project_weighed, weigh};
+use slf_firmware::projection::{project_coefficients, weigh};
 use slf_firmware::transform::analyze_preserving;
 use slf_firmware::{Dictionary, Measurements};
 
@@ -107,14 +107,14 @@ fn check<const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                 };
                 let ball = Ball::new(noise as f32, shot as f32, idx.len() as u32, 0).balanced(balanced); // radius^2 = m
                 let start = coeffs.clone();
-                let residual = project_coefficients(&dict, &mut coeffs, &mut scratch, &m, &ball);
+                let residual = project_coefficients(&dict, &mut coeffs, &mut scratch, &m, &ball, None);
                 if ball.is_weighted() {
                     // The solver's path: the weights made once, read by each step. The same
                     // sums in the same order: the same bits.
                     let mut weights = Box::new([f32::NAN; N]);
                     weigh::<B, N>(&m, &ball, &mut weights);
                     let mut weighed = start.clone();
-                    let r = project_weighed(&dict, &mut weighed, &mut scratch, &m, &ball, &weights);
+                    let r = project_coefficients(&dict, &mut weighed, &mut scratch, &m, &ball, Some(&weights));
                     assert_eq!(r.to_bits(), residual.to_bits(), "noise {noise} shot {shot}: residual");
                     assert!(weighed.iter().zip(coeffs.iter()).all(|(a, b)| a.to_bits() == b.to_bits()));
                 }

@@ -135,7 +135,7 @@ fn main() -> anyhow::Result<()> {
         report("analysis", ns, transform);
         let ns = time(|| {
             a.copy_from_slice(&start[..]);
-            black_box(project_coefficients(&dict, black_box(&mut a), &mut b, &m, &ball));
+            black_box(project_coefficients(&dict, black_box(&mut a), &mut b, &m, &ball, None));
         });
         report("projection", ns, projection);
     }

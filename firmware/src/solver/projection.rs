@@ -43,6 +43,11 @@ pub const fn projection_macs<const PS: usize, const PT: usize, const PU: usize, 
 /// `scratch` is clobbered. Returns the residual norm `||I - P D S||` before the move. This
 /// is the projection of every step of [`crate::solve`].
 ///
+/// A weighted ball ([`Ball::is_weighted`]) weighs each residual by [`Ball::weight`]: read
+/// from `weights` when given ([`weigh`] of the same measurements and ball, as the solver
+/// makes them once a solve), else computed, two divisions a measurement; the same sums
+/// either way.
+///
 /// Kept out of line: inlined into the solver's step loop, the band step ran about twice
 /// as slow as in this function alone (`perf annotate` of `slf bench`), and a decode with
 /// the DCT took 0.80 against 0.68 ms a patch at pixel k = 3 (0.49 against 0.47 at k = 1).
@@ -59,20 +64,23 @@ pub fn project_coefficients<
     scratch: &mut [f32; N],
     m: &Measurements<N>,
     ball: &Ball,
+    weights: Option<&[f32; N]>,
 ) -> f32 {
     let weighted = ball.is_weighted();
+    let mut parts = weights.map(|w| w.chunks_exact(PT * PU * PV * B));
     let mut step = |fibres: &mut [[f32; B]], values: &[f32], measured: &[bool]| {
-        if weighted {
-            band_step::<B, COMPUTED>(&dict.d.m5, fibres, values, measured, ball, &m.gains, values)
-        } else {
-            band_step::<B, PLAIN>(&dict.d.m5, fibres, values, measured, ball, &m.gains, values)
+        let (m5, gains) = (&dict.d.m5, &m.gains);
+        match parts.as_mut().and_then(Iterator::next) {
+            Some(w) if weighted => band_step::<B, TABLE>(m5, fibres, values, measured, ball, gains, w),
+            _ if weighted => band_step::<B, COMPUTED>(m5, fibres, values, measured, ball, gains, values),
+            _ => band_step::<B, PLAIN>(m5, fibres, values, measured, ball, gains, values),
         }
     };
     project_slices(dict, coeffs, scratch, m, ball, &mut step)
 }
 
 /// Each measured entry's weight in `ball` ([`Ball::weight`]) into `weights`, in patch
-/// order (the other entries are left as they are): what [`project_weighed`] reads.
+/// order (the other entries are left as they are): what [`project_coefficients`] reads.
 pub fn weigh<const B: usize, const N: usize>(m: &Measurements<N>, ball: &Ball, weights: &mut [f32; N]) {
     let measured = m.values.as_chunks::<B>().0.iter().zip(m.measured.as_chunks::<B>().0);
     for (ws, (ys, flags)) in weights.as_chunks_mut::<B>().0.iter_mut().zip(measured) {
@@ -81,32 +89,6 @@ pub fn weigh<const B: usize, const N: usize>(m: &Measurements<N>, ball: &Ball, w
             *w = ball.weight(y, m.gains.get(b).copied().unwrap_or(1.0));
         }
     }
-}
-
-/// [`project_coefficients`] onto a weighted ball ([`Ball::is_weighted`]) with each
-/// measurement's weight read from `weights` ([`weigh`] of the same measurements and ball)
-/// instead of computed: the same sums, without two divisions a measurement a step.
-pub fn project_weighed<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
->(
-    dict: &Dictionary<PS, PT, PU, PV, B>,
-    coeffs: &mut [f32; N],
-    scratch: &mut [f32; N],
-    m: &Measurements<N>,
-    ball: &Ball,
-    weights: &[f32; N],
-) -> f32 {
-    let mut parts = weights.chunks_exact(PT * PU * PV * B);
-    let mut step = |fibres: &mut [[f32; B]], values: &[f32], measured: &[bool]| {
-        let weights = parts.next().unwrap_or(values);
-        band_step::<B, TABLE>(&dict.d.m5, fibres, values, measured, ball, &m.gains, weights)
-    };
-    project_slices(dict, coeffs, scratch, m, ball, &mut step)
 }
 
 /// A band step: one spatial slice's pixels, their band coefficients in `fibres` (after the
@@ -265,7 +247,7 @@ const TABLE: u8 = 2;
 /// 3.1 us at three; criterion, paper patch); the bit mask (two multiplies a pixel instead
 /// of 128-bit arithmetic a band) took the projection from 5.98 to 5.75 us at one.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)] // the band step's inputs, inlined into two callers
+#[allow(clippy::too_many_arguments)] // the band step's inputs, inlined into its one caller
 fn band_step<const B: usize, const WEIGH: u8>(
     m5: &[[f32; B]; B],
     fibres: &mut [[f32; B]],

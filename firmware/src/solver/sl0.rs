@@ -33,7 +33,7 @@ use crate::solver::ball::{Ball, Move};
 use crate::solver::fill::fill_bands;
 use crate::solver::fractional::project_fractional;
 use crate::solver::mixing::{BandModel, min_norm, project_mixed, project_signal};
-use crate::solver::projection::{project_coefficients, project_weighed, set_flags, weigh};
+use crate::solver::projection::{project_coefficients, set_flags, weigh};
 use crate::solver::shares::{RowSums, project_shares};
 use crate::solver::workspace::{Measurements, Workspace};
 
@@ -784,10 +784,8 @@ fn descend_with<const PS: usize, const PT: usize, const PU: usize, const PV: usi
         };
         let residual = if let Some(model) = mixing {
             project_mixed(dict, model, coeffs, signal, m, ball)
-        } else if let Some(weights) = table {
-            project_weighed(dict, coeffs, signal, m, ball, weights)
         } else if selection {
-            project_coefficients(dict, coeffs, signal, m, ball)
+            project_coefficients(dict, coeffs, signal, m, ball, table)
         } else {
             project_interpolating(dict, coeffs, signal, m, ball, rows.as_deref_mut())
         };

@@ -274,8 +274,9 @@ pub struct Workspace<const PS: usize, const PT: usize, const PU: usize, const PV
     pub(crate) coeffs: [f32; N],
     pub(crate) signal: [f32; N],
     pub(crate) measurements: Measurements<N>,
-    /// Each measurement's weight in a noise ball that weighs them ([`crate::solver::ball::Ball::weight`],
-    /// in patch order; other entries are stale): made once a solve, read by every step's
+    /// Each measurement's weight in a noise ball that weighs them
+    /// ([`crate::solver::ball::Ball::weight`], in patch order; other entries are stale):
+    /// made once a solve, read by every step's
     /// projection. Computed in each step instead, its two divisions a measurement held the
     /// projection's band step up (`perf annotate`: a fifth of a default decode's samples in
     /// the step stood on the division's result at pixel k = 3).

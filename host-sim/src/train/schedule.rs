@@ -252,7 +252,7 @@ pub fn start<const PU: usize, const PV: usize, const N: usize>(
     let mut c: Box<[f32; N]> = Box::new([0.0; N]);
     analyze(dict, &mut x, &mut c);
     let exact = Ball::new(0.0, 0.0, problem.measurements.count() as u32, 0);
-    project_coefficients(dict, &mut c, &mut x, &problem.measurements, &exact);
+    project_coefficients(dict, &mut c, &mut x, &problem.measurements, &exact, None);
     c.to_vec()
 }
 
@@ -287,7 +287,7 @@ pub fn unroll<const PU: usize, const PV: usize, const N: usize>(
         let sigma = if floored { SIGMA_MIN } else { sigma };
         let inv = 1.0 / (2.0 * sigma * sigma);
         ascend_weighted(&mut c[..], mu, inv, schedule.weights());
-        project_coefficients(dict, &mut c, &mut scratch, &problem.measurements, &exact);
+        project_coefficients(dict, &mut c, &mut scratch, &problem.measurements, &exact, None);
         out.coeffs.push(c.to_vec());
         out.inv.push((inv, floored));
     }
@@ -343,7 +343,7 @@ pub fn loss_and_gradient<const PU: usize, const PV: usize, const N: usize>(
     let mu_all = schedule.mu();
     for t in (0..steps).rev() {
         // Through the projection: its linear part is its own adjoint.
-        project_coefficients(dict, &mut g, &mut scratch, &problem.zero, &exact);
+        project_coefficients(dict, &mut g, &mut scratch, &problem.zero, &exact, None);
         let (inv, floored) = path.inv[t];
         let mu = mu_all[t];
         let (mut dmu, mut dinv) = (0.0f64, 0.0f64);
