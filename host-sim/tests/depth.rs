@@ -7,7 +7,8 @@ use assert_cmd::Command;
 use slf_host::decode::cs::{Basis, DecodeOptions, PatchViews, decode_with, disparity_per_lenslet, tile_decoder};
 use slf_host::eval::metrics::psnr;
 use slf_host::firmware::disparity::Disparity;
-use slf_host::firmware::{DisparityRange, FrameSource, Overlap, OverlapDecoder, Workspace};
+use slf_host::firmware::{DisparityRange, FrameSource, MaskFamily, Overlap, OverlapDecoder, Workspace};
+use slf_host::io::capture::MaskDescription;
 use slf_host::io::lightfield::{Dtype, LightField, write_npy};
 use slf_host::sim::camera::{CameraConfig, simulate};
 use slf_host::sim::scene::{Layer, Scene, SceneSize, Shape, Texture};
@@ -179,13 +180,17 @@ fn the_command_line_writes_the_disparity_map_and_refuses_bad_ranges() {
 }
 
 #[test]
-fn the_default_search_is_in_half_pixels_for_a_single_snapshot_only() {
+fn the_default_search_is_in_half_pixels_for_a_single_snapshot_and_on_the_lenslet_mask() {
     let truth = planes(&[(0.5, Shape::Everywhere)], 10);
-    for (k, halves) in [(1u8, true), (2, false), (3, false)] {
-        let capture = simulate(&truth, &CameraConfig::pixel(3, k)).unwrap();
-        let default = DecodeOptions::default().disparities_for(&capture);
-        assert_eq!((default.min(), default.max(), default.has_halves()), (-1, 1, halves), "k = {k}");
-        let given = DecodeOptions { disparities: range(0, 0), ..DecodeOptions::default() };
-        assert!(given.disparities_for(&capture).is_off(), "k = {k}: a given range is kept");
+    for family in [MaskFamily::Pixel, MaskFamily::Lenslet, MaskFamily::Kronecker] {
+        for k in [1u8, 2, 3] {
+            let camera = CameraConfig::pixel(3, k).with_mask(MaskDescription::seeded(family, 3, k));
+            let capture = simulate(&truth, &camera).unwrap();
+            let halves = k == 1 || family == MaskFamily::Lenslet;
+            let default = DecodeOptions::default().disparities_for(&capture);
+            assert_eq!((default.min(), default.max(), default.has_halves()), (-1, 1, halves), "{family:?} k = {k}");
+            let given = DecodeOptions { disparities: range(0, 0), ..DecodeOptions::default() };
+            assert!(given.disparities_for(&capture).is_off(), "{family:?} k = {k}: a given range is kept");
+        }
     }
 }

@@ -35,6 +35,7 @@
 //! half view naming no pixel ([`crate::decode::tile::PatchOrigin::lenslet`]).
 
 use crate::operators::shape::MAX_BANDS;
+use crate::sensor::mask::MaskFamily;
 
 /// The largest disparity magnitude a decoder searches (pixels per view step): a shear of
 /// `d` reaches `d (U - 1) / 2` lenslets beyond the patch, and sinks keep that halo.
@@ -125,15 +126,23 @@ impl DisparityRange {
     /// keeps from 2 to 4 lenslets.
     pub const DEFAULT: Self = Self { min: -1, max: 1, halves: false };
 
-    /// The default search of a capture of `snapshots` snapshots: [`DEFAULT`](Self::DEFAULT),
-    /// with half-pixel disparities for a single snapshot. On the realistic set with the
-    /// shipped ensemble (`docs/results-depth.md`) halves gained +0.77 dB at pixel k = 1
-    /// (every scene, 1.3 times the integers' time), but lost 0.44 dB at pixel k = 3 and
-    /// gained 0.31 at lenslet k = 3 for 1.5 times the time: with more snapshots a
-    /// point's views are measured often enough that the interpolating measurements' lost
-    /// detail outweighs the better alignment.
-    pub const fn for_snapshots(snapshots: u8) -> Self {
-        Self::DEFAULT.with_halves(snapshots == 1)
+    /// The default search of a capture of `snapshots` snapshots through a mask of `family`:
+    /// [`DEFAULT`](Self::DEFAULT), with half-pixel disparities for a single snapshot and on
+    /// the lenslet mask at any count.
+    ///
+    /// Measured on the realistic set with the shipped ensemble (`docs/results-depth.md`):
+    /// halves gained +0.77 dB at pixel k = 1 (every scene, 1.3 times the integers' time) but
+    /// lost 0.44 dB at pixel k = 3: with more snapshots a point's views are measured often
+    /// enough that the interpolating measurements' lost detail outweighs the better
+    /// alignment. On the lenslet mask every view of a lenslet sees one band a snapshot, so
+    /// a view's other bands come only from its neighbours, through the alignment: halves
+    /// with the shear trial deciding per frame gained more than 0.1 dB on 14, 15 and 11 of
+    /// issue 62's 21 scenes at k = 2, 3 and 5 (up to +7.55), +1.3 to +1.7 dB on average,
+    /// and lost on 3 of the 63 decodes (canopy-dim k = 2 -0.94, office k = 3 -0.23,
+    /// tungsten k = 2 -0.11), at 1.3 to 1.9 times the time (medians; up to 3.3)
+    /// (`docs/bench/README.md`).
+    pub const fn for_capture(family: MaskFamily, snapshots: u8) -> Self {
+        Self::DEFAULT.with_halves(snapshots == 1 || matches!(family, MaskFamily::Lenslet))
     }
 
     /// The integers `min..=max`; `None` unless `-MAX_DISPARITY <= min <= 0 <= max <=

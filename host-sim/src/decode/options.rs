@@ -219,9 +219,9 @@ pub struct DecodeOptions {
     /// The white balance.
     pub balance: Balance,
     /// The disparities each spatial block may be sheared to ([`slf_firmware::disparity`]);
-    /// `None` (the default): the capture's, [`DisparityRange::for_snapshots`] (-1..=1, in
-    /// half pixels for a single snapshot on the aligned sensor; whole ones behind a lenslet
-    /// grid, [`Self::disparities_for`]); [`DisparityRange::OFF`] decodes every patch
+    /// `None` (the default): the capture's, [`DisparityRange::for_capture`] (-1..=1, in
+    /// half pixels for a single snapshot and on the lenslet mask on the aligned sensor; whole
+    /// ones behind a lenslet grid, [`Self::disparities_for`]); [`DisparityRange::OFF`] decodes every patch
     /// unsheared.
     pub disparities: Option<DisparityRange>,
     /// Whether a block sheared at the frame's edge is decoded unsheared as well
@@ -324,7 +324,7 @@ impl DecodeOptions {
     }
 
     /// The disparities a decode of `capture` searches: [`Self::disparities`], or the
-    /// capture's default: [`DisparityRange::for_snapshots`] on the aligned sensor, whole
+    /// capture's default: [`DisparityRange::for_capture`] on the aligned sensor, whole
     /// disparities only behind a lenslet grid. There a patch at a half-pixel disparity reads
     /// each view at the pixel under its cell's centre (its interpolation is not built with
     /// the view cells' shares, [`slf_firmware::shares`]): at pixel k = 1 the default's
@@ -335,7 +335,7 @@ impl DecodeOptions {
         let d = &capture.description;
         let snapshots = u8::try_from(d.frames.len()).unwrap_or(u8::MAX);
         let gridded = d.turned_grid().is_some();
-        let default = DisparityRange::for_snapshots(snapshots);
+        let default = DisparityRange::for_capture(d.mask.family(), snapshots);
         self.disparities.unwrap_or(if gridded { default.with_halves(false) } else { default })
     }
 

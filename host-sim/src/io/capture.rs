@@ -60,6 +60,15 @@ impl MaskDescription {
         }
     }
 
+    /// The family.
+    pub fn family(&self) -> MaskFamily {
+        match self {
+            Self::Pixel(_) => MaskFamily::Pixel,
+            Self::Lenslet(_) => MaskFamily::Lenslet,
+            Self::Kronecker { .. } => MaskFamily::Kronecker,
+        }
+    }
+
     /// The family's name, as `capture.json` writes it.
     pub fn family_name(&self) -> &'static str {
         match self {
