@@ -16,7 +16,8 @@ run() {
 }
 run 3 target/profile-ensemble.log
 tiles=$(grep -c '^tile ' target/profile-device.log)
-python3 scripts/device-profile.py "$elf" target/profile-ensemble.log 3 3 "screened ensemble tile (4 patches)"
+patches=$(awk '/^tile / { print $5; exit }' target/profile-device.log)
+python3 scripts/device-profile.py "$elf" target/profile-ensemble.log 3 3 "screened ensemble tile ($patches full-view patch(es))"
 echo
 run $((3 + tiles)) target/profile-dct.log
-python3 scripts/device-profile.py "$elf" target/profile-dct.log $((3 + tiles)) $((3 + tiles)) "DCT tile (4 patches)"
+python3 scripts/device-profile.py "$elf" target/profile-dct.log $((3 + tiles)) $((3 + tiles)) "DCT tile ($patches full-view patch(es))"

@@ -13,7 +13,8 @@
 #    multiply-adds those steps stand for, and the share of the samples by kind of work
 #    (scripts/roofline-kinds.py), with the demosaic's time beside.
 # 3. The device: instructions a transform multiply-add and a patch, from the README's budget
-#    table (written by `bash scripts/budgets.sh --write`; CI checks it within 3 %).
+#    table (written by `bash scripts/budgets.sh --write`; CI checks it within 3 %), and where a
+#    patch's instructions go (scripts/device-profile.sh, where qemu-system-arm is installed).
 #
 #   bash scripts/roofline.sh OUT_DIR > docs/results-roofline.md
 #   SLF_SCENES="depth" SLF_SETTINGS="pixel:1" bash scripts/roofline.sh OUT_DIR
@@ -161,6 +162,15 @@ for label, pattern in [("a patch, 5D DCT", r"instructions per patch, 5D DCT "),
         print(f"| {label} | {n:,} | | {n / 480e3:.0f} ms |")
 PY
 echo
+if command -v qemu-system-arm > /dev/null; then
+  echo "### Where the device's instructions go"
+  echo
+  echo "\`bash scripts/device-profile.sh\`: the counting plugin's profile of one tile (a full-view"
+  echo "patch) of the device binary, per function of the binary and per innermost source function."
+  echo
+  bash scripts/device-profile.sh
+  echo
+fi
 echo "## Against issue 62's targets"
 echo
 python3 - "$shares" README.md "$kernel_peak" <<'PY'

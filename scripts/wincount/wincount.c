@@ -60,8 +60,10 @@ static uint64_t in_window; /* instructions in the open window */
 static uint64_t windows;   /* windows closed so far */
 static int open;           /* a window is open */
 
-/* The profile: one counter per 2-byte instruction address of the 1 MiB flash. */
-#define FLASH_BASE 0x08000000u
+/* The profile: one counter per 2-byte instruction address of the 1 MiB flash, at memory.x's
+ * FLASH origin on the emulator (mps2-an500: its ZBT SSRAM1 at 0; an H743's 0x08000000 is not
+ * where qemu runs the code, and a profile there counted nothing). */
+#define FLASH_BASE 0x00000000u
 #define FLASH_SIZE 0x00100000u
 static uint64_t *prof;     /* NULL without prof= */
 static uint64_t prof_first, prof_last;

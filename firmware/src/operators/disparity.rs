@@ -137,10 +137,10 @@ impl DisparityRange {
     /// alignment. On the lenslet mask every view of a lenslet sees one band a snapshot, so
     /// a view's other bands come only from its neighbours, through the alignment: halves
     /// with the shear trial deciding per frame gained more than 0.1 dB on 14, 15 and 11 of
-    /// issue 62's 21 scenes at k = 2, 3 and 5 (up to +7.55), +1.3 to +1.7 dB on average,
-    /// and lost on 3 of the 63 decodes (canopy-dim k = 2 -0.94, office k = 3 -0.23,
-    /// tungsten k = 2 -0.11), at 1.3 to 1.9 times the time (medians; up to 3.3)
-    /// (`docs/bench/README.md`).
+    /// issue 62's 21 scenes at k = 2, 3 and 5 (up to +9.53), +1.3 to +1.7 dB on average,
+    /// and lost on 3 of the 63 decodes (canopy-dim k = 2 -0.94, depth k = 3 -0.86,
+    /// tungsten k = 2 -0.11), at 1.3 to 1.8 times the time (medians; up to 3.3)
+    /// (`scripts/halves-check.sh`, `docs/bench/README.md`).
     pub const fn for_capture(family: MaskFamily, snapshots: u8) -> Self {
         Self::DEFAULT.with_halves(snapshots == 1 || matches!(family, MaskFamily::Lenslet))
     }

@@ -257,7 +257,7 @@ fn settings(quick: bool) -> Vec<(String, Decoder, DecodeOptions)> {
             unsheared(3, Window::Tapered, None),
         ),
         (
-            "ensemble screened, noise model, stride 3 tapered, disparities -1:1 (default for k > 1)".to_string(),
+            "ensemble screened, noise model, stride 3 tapered, disparities -1:1 (the default's search at k > 1 off the lenslet mask)".to_string(),
             screened(),
             decode(3, Window::Tapered, None),
         ),
@@ -289,7 +289,7 @@ fn settings(quick: bool) -> Vec<(String, Decoder, DecodeOptions)> {
             DecodeOptions { disparities: Some(halves), ..decode(3, Window::Tapered, None) },
         ));
         decode_points.push((
-            "ensemble screened, noise model, stride 3 tapered, disparities -1:1:0.5 (default for k = 1)".to_string(),
+            "ensemble screened, noise model, stride 3 tapered, disparities -1:1:0.5 (the default's search at k = 1 and on the lenslet mask)".to_string(),
             screened(),
             DecodeOptions { disparities: Some(halves), ..decode(3, Window::Tapered, None) },
         ));
