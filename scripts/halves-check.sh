@@ -17,16 +17,13 @@ add_real_scenes
 export RAYON_NUM_THREADS=1
 rows="$out/halves.tsv"
 : > "$rows"
-for s in ${SLF_SETTINGS:-lenslet:2 lenslet:3 lenslet:5}; do
-  for token in $scenes; do
-    scene_light_field "$token"
-    scene_capture "$s" 2
-    decode_eval "$cap" --disparities -1:1
-    pw=$p; tw=$t
-    decode_eval "$cap" --disparities -1:1:0.5
-    printf '%s\t%s\t%s\t%s\t%s\t%s\n' "$s" "$scene" "$pw" "$tw" "$p" "$t" >> "$rows"
-  done
-done
+row() {
+  decode_eval "$cap" --disparities -1:1
+  local pw=$p tw=$t
+  decode_eval "$cap" --disparities -1:1:0.5
+  printf '%s\t%s\t%s\t%s\t%s\t%s\n' "$s" "$scene" "$pw" "$tw" "$p" "$t" >> "$rows"
+}
+each_capture "${SLF_SETTINGS:-lenslet:2 lenslet:3 lenslet:5}" 2 row
 python3 - "$rows" "$size" "$(git rev-parse --short HEAD)" <<'PY'
 import statistics, sys
 rows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1]) if l.strip()]

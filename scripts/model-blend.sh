@@ -18,16 +18,14 @@ add_real_scenes
 export RAYON_NUM_THREADS=1
 rows="$out/blend.tsv"
 : > "$rows"
-for s in ${SLF_SETTINGS:-pixel:1 pixel:3 lenslet:3}; do
-  for token in $scenes; do
-    scene_light_field "$token"
-    scene_capture "$s" 1
-    "$slf" decode "$cap" -o "$out/dct.npy" --dictionary dct --quiet > /dev/null
-    "$slf" decode "$cap" -o "$out/ens.npy" --model-trial false --quiet > /dev/null
-    pick=$("$slf" decode "$cap" -o "$out/trial.npy" --quiet | sed -n 's/^model trial: decoded by the \([A-Za-z]*\) .*/\1/p')
-    printf '%s\t%s\t%s\t%s\n' "$s" "$scene" "${pick:-none}" "$("$py" scripts/model-blend.py "$lf" "$out/dct.npy" "$out/ens.npy")" >> "$rows"
-  done
-done
+row() {
+  "$slf" decode "$cap" -o "$out/dct.npy" --dictionary dct --quiet > /dev/null
+  "$slf" decode "$cap" -o "$out/ens.npy" --model-trial false --quiet > /dev/null
+  local pick
+  pick=$("$slf" decode "$cap" -o "$out/trial.npy" --quiet | sed -n 's/^model trial: decoded by the \([A-Za-z]*\) .*/\1/p')
+  printf '%s\t%s\t%s\t%s\n' "$s" "$scene" "${pick:-none}" "$("$py" scripts/model-blend.py "$lf" "$out/dct.npy" "$out/ens.npy")" >> "$rows"
+}
+each_capture "${SLF_SETTINGS:-pixel:1 pixel:3 lenslet:3}" 1 row
 "$py" - "$rows" "$size" "$(git rev-parse --short HEAD)" <<'PY'
 import statistics, sys
 rows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1]) if l.strip()]

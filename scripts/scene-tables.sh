@@ -57,3 +57,17 @@ scene_capture() {
   [ -d "$cap" ] || "$slf" simulate "$lf" -o "$cap" --mask "$mask" -s "$k" --seed "$2" > /dev/null 2>&1
   return 0
 }
+
+# each_capture SETTINGS SEED COMMAND...: for each setting (MASK:K) and each scene of $scenes,
+# sets $s (the setting), $scene, $lf, $mask, $k and $cap (scene_light_field, scene_capture)
+# and runs COMMAND.
+each_capture() {
+  local settings=$1 seed=$2 token; shift 2
+  for s in $settings; do
+    for token in $scenes; do
+      scene_light_field "$token"
+      scene_capture "$s" "$seed"
+      "$@"
+    done
+  done
+}
