@@ -22,8 +22,9 @@ fn workspace_fits_the_ram_budget() {
     let size = core::mem::size_of::<PaperWorkspace>();
     assert!(size <= 96 * 1024, "workspace is {size} bytes");
     // Four patch buffers (coefficients, signal, values, weights), a flag per value, a gain
-    // per band (MAX_BANDS), the response matrix with its inverse (2 x 13 x 13 f32), and behind a lenslet grid each pixel's
-    // place in its view cell (2 x MAX_PLACES bytes) and the shares' widths and shifts:
+    // per band (MAX_BANDS), the response matrix with its inverse (2 x 13 x 13 f32), and
+    // behind a lenslet grid each pixel's place in its view cell (2 x MAX_PLACES bytes) and
+    // the shares' widths and shifts:
     // nothing else hides in it.
     let response = 2 * 4 * 13 * 13 + 8;
     let grid = 2 * slf_firmware::workspace::MAX_PLACES + 8 + 2 * slf_firmware::workspace::MAX_SHARE_VIEWS + 4;

@@ -384,8 +384,9 @@ mod device {
             return debug::EXIT_FAILURE;
         };
         // Window 5 (after the frame): the disparity choice of one block, alone.
-        // The host's default search for the capture (whole disparities at k > 1).
-        let depth = decoder.with_disparities(DisparityRange::for_capture(config.mask.family(), SNAPSHOTS));
+        // The host's default search for the capture (whole disparities on its pixel mask at k > 1).
+        let search = DisparityRange::for_capture(config.mask.family(), SNAPSHOTS);
+        let depth = decoder.with_disparities(search);
         let Ok(overlapped) = OverlapDecoder::new(depth, Overlap::DEFAULT) else {
             return debug::EXIT_FAILURE;
         };
@@ -426,7 +427,7 @@ mod device {
         let ram_left = RAM_BYTES.saturating_sub(core::mem::size_of::<FullViewWorkspace>());
         for overlap in [Overlap::DEFAULT, Overlap { seeded: false, ..Overlap::DEFAULT }] {
             if let Ok(camera) = TileDecoder::<5, 5, 5, 5, 13, 8125>::new(DecoderConfig { sensor: camera, ..config })
-                .map(|d| d.with_disparities(DisparityRange::for_capture(config.mask.family(), SNAPSHOTS)))
+                .map(|d| d.with_disparities(search))
                 .and_then(|d| OverlapDecoder::new(d, overlap))
             {
                 let band = camera.band_width(ram_left / 4).unwrap_or(0);

@@ -221,8 +221,8 @@ pub struct DecodeOptions {
     /// The disparities each spatial block may be sheared to ([`slf_firmware::disparity`]);
     /// `None` (the default): the capture's, [`DisparityRange::for_capture`] (-1..=1, in
     /// half pixels for a single snapshot and on the lenslet mask on the aligned sensor; whole
-    /// ones behind a lenslet grid, [`Self::disparities_for`]); [`DisparityRange::OFF`] decodes every patch
-    /// unsheared.
+    /// ones behind a lenslet grid, [`Self::disparities_for`]); [`DisparityRange::OFF`]
+    /// decodes every patch unsheared.
     pub disparities: Option<DisparityRange>,
     /// Whether a block sheared at the frame's edge is decoded unsheared as well
     /// ([`slf_firmware::TileDecoder::with_edge_fallback`]); off, the views no sheared patch reached are
