@@ -373,6 +373,7 @@ def decode(
     model_trial: Optional[bool] = None,
     shear_trial: Optional[bool] = None,
     error_map: bool = False,
+    estimate_by: Optional[str] = None,
     threads: Optional[int] = None,
     progress: Any = None,
     report: bool = False,
@@ -413,7 +414,10 @@ def decode(
     the preview, False where ``dictionary`` is named: ``report["trial"]`` says which and the
     errors), ``shear_trial`` (whole disparities only for the frame where pilot patches
     estimate them clearly better than the half-pixel ones; default True:
-    ``report["shear_trial"]``), ``error_map``.
+    ``report["shear_trial"]``), ``error_map`` (the decode's error per lenslet in
+    ``report["error_map"]`` and its estimated PSNR), ``estimate_by`` decode (the frame
+    decoded again from seven in eight samples by the same plan, the default: a second
+    decode's time) or patches (each patch solved once more, a solve a patch).
 
     ``threads``: threads of this decode (None: one per core; 1 inside a Dask task).
     ``progress``: True for a bar (tqdm if installed), or a callable ``f(done, total)``
@@ -487,6 +491,7 @@ def decode(
         model_trial=model_trial,
         shear_trial=shear_trial,
         estimate=True if error_map else None,
+        estimate_by=estimate_by,
     )
     frames = _raw_frames(cap.frames)
     path = None if output is None else os.fspath(output)

@@ -7,7 +7,7 @@ use numpy::{PyArrayDyn, PyReadonlyArrayDyn};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use slf_host::decode::cs::{PatchViews, disparity_per_lenslet, error_per_lenslet, estimated_psnr};
+use slf_host::decode::cs::{PatchViews, disparity_per_lenslet, estimated_psnr};
 use slf_host::decode::settings::{DecodeSettings, Outcome, output_shape};
 use slf_host::io::lightfield::Dtype;
 use slf_host::io::npy_rows::NpyRows;
@@ -150,11 +150,11 @@ pub fn decode<'py>(
                 trial.set_item("ensemble_error", t.ensemble_error)?;
                 report.set_item("trial", trial)?;
             }
-            if !r.error_map.is_empty() {
-                let (rows, cols) = (d.lenslets[0], d.lenslets[1]);
-                let map = error_per_lenslet(&r.error_map, rows, cols);
+            let (rows, cols) = (d.lenslets[0], d.lenslets[1]);
+            if let Some(map) = r.error_per_lenslet(rows, cols) {
                 report.set_item("estimated_psnr", estimated_psnr(&map, f64::from(peak)))?;
                 report.set_item("error_map", plane(py, map, rows, cols)?)?;
+                report.set_item("estimate_seconds", r.estimate_seconds)?;
             }
         }
     }

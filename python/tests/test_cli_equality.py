@@ -188,6 +188,11 @@ def test_error_map_equals_cli(tmp_path, slf_bin, depth, capture):
     np.save(tmp_path / "t.npy", depth)
     printed = run([slf_bin, "eval", tmp_path / "t.npy", tmp_path / "o.npy", "--error-map", tmp_path / "e.npy"]).stdout
     assert re.search(r"estimate PSNR [0-9.]+ dB \(true [0-9.]+\); blocks of 5 x 5 lenslets: rank correlation", printed)
+    # The estimate by the held-out decode (the default) costs that decode; by the patches, a solve each.
+    assert report["estimate_seconds"] > 0.0
+    _, by_patches = slf.decode(capture, error_map=True, estimate_by="patches")
+    assert "estimate_seconds" not in by_patches or by_patches["estimate_seconds"] == 0.0
+    assert not np.array_equal(by_patches["error_map"], emap, equal_nan=True)
 
 
 def test_evaluate_equals_cli(tmp_path, slf_bin, depth, capture):

@@ -1131,6 +1131,25 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         self.config.raw.classify(raw).map(|y| y / gain)
     }
 
+    /// A raw sample of sensor pixel `(row, col)` in the decoded light field's units:
+    /// normalised and divided by its view's flat field (the band gains are divided out
+    /// before the solve and multiplied back into its output), or why it is not a
+    /// measurement. On the aligned grid with the identity response it is the light field's
+    /// value at the pixel's lenslet, view and band: what a held-out sample is compared with.
+    #[inline]
+    pub fn light_field_value(&self, raw: f32, (row, col): (usize, usize)) -> Result<f32, Invalid> {
+        let gain = self.view_gain(row, col);
+        self.config.raw.classify(raw).map(|y| y / gain)
+    }
+
+    /// Whether the decode's light field holds each sample's own value: no lenslet grid
+    /// (every pixel under one lenslet's view) and the identity response (a pixel measures
+    /// one band). Then a sample the decode was not given can be compared with the output
+    /// ([`Self::light_field_value`]).
+    pub fn samples_are_values(&self) -> bool {
+        self.grid.is_none() && self.solved_response().is_identity()
+    }
+
     /// The flat field of sensor pixel `(row, col)`'s view ([`Self::with_view_gains`]); 1
     /// without one.
     #[inline(always)]

@@ -332,6 +332,12 @@ impl<'a> Mask<'a> {
         self.family
     }
 
+    /// The lenslets `(rows, cols)` that see the same bands in a snapshot: a kronecker
+    /// mask's block, `(1, 1)` on the others.
+    pub fn block(&self) -> (u8, u8) {
+        self.block
+    }
+
     /// Snapshots `k`.
     pub fn snapshots(&self) -> usize {
         self.snapshots as usize

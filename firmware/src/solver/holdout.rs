@@ -34,9 +34,10 @@ impl HoldOut {
     pub const DEFAULT: Self = Self { fold: 8 };
 
     /// Whether `key` is held out: a hash of it, so the held-out keys spread over the
-    /// patch's lenslets, views and bands.
+    /// patch's lenslets, views and bands (or a frame's samples, for a held-out decode of the
+    /// whole frame).
     #[inline(always)]
-    fn holds(&self, key: usize) -> bool {
+    pub fn holds(&self, key: usize) -> bool {
         let mut z = (key as u32).wrapping_mul(0x9E37_79B9) ^ 0x5bd1_e995;
         z ^= z >> 15;
         z = z.wrapping_mul(0x2c1b_3c6d);

@@ -19,12 +19,14 @@
 use std::time::Instant;
 
 use anyhow::{Result, anyhow, bail};
-use slf_firmware::{Dictionary, PatchModel, Pick, Picked, Sl0Config};
+use slf_firmware::{Dictionary, HoldOut, PatchModel, Pick, Picked, Sl0Config};
 
+use crate::decode::held_out;
 pub use crate::decode::options::{
-    Balance, Basis, DEFAULT_STRIDE, DecodeOptions, MAX_BLOB, NoiseSource, PatchViews, SolveSchedule, Window, read_blob,
+    Balance, Basis, DEFAULT_STRIDE, DecodeOptions, EstimateBy, MAX_BLOB, NoiseSource, PatchViews, SolveSchedule,
+    Window, read_blob,
 };
-use crate::decode::plan::FramePlan;
+use crate::decode::plan::{FramePlan, patch_estimates};
 pub use crate::decode::plan::{ModelPick, tile_decoder};
 pub use crate::decode::report::{
     DecodeReport, PatchDecoder, ShearTrialReport, TrialReport, disparity_per_lenslet, error_per_lenslet, estimated_psnr,
@@ -296,6 +298,12 @@ where
     let model = Picked { first, second, pick: plan.pick };
     let mut report = decode_rows(&plan, &model, &raw, opts.batch_tiles, opts.progress, observer, sink)?;
     report.seconds = start.elapsed().as_secs_f64();
+    if opts.error_estimate && !patch_estimates(opts, &plan.decoder) {
+        let held = Instant::now();
+        report.error_lenslets = held_out::error_map(&plan, &model, &raw, HoldOut::DEFAULT, opts.batch_tiles)?;
+        report.estimate_seconds = held.elapsed().as_secs_f64();
+        report.seconds = start.elapsed().as_secs_f64();
+    }
     report.gains = *plan.decoder.gains();
     report.patch_views = PatchViews::of_views(PU, PV);
     report.grid = capture.description.turned_grid();

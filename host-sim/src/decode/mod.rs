@@ -8,7 +8,8 @@
 //!   overlapping patches, white balance, the noise model and the depth search, as asked by
 //!   its [`options`]: a frame's [`plan`] made once, then its rows decoded down the frame by
 //!   the [`strip`] (each tile's patches into `tile_sums`, the adaptive rule's [`seams`])
-//!   and put to a sink as they are finished; what it did in its [`report`];
+//!   and put to a sink as they are finished; what it did in its [`report`]; the error
+//!   estimate of that decode from a second one with samples [`held_out`];
 //! - [`baselines`]: decode methods without compressed sensing (per-pixel interpolation, a
 //!   neighbourhood demosaic, PPID);
 //! - [`paper_1d`]: the paper's 1D method (explicit Kronecker matrices) and a 5D SL0 in f64,
@@ -27,6 +28,7 @@ pub mod calibrate;
 pub mod cs;
 pub mod device;
 pub mod grid_fit;
+pub mod held_out;
 pub mod options;
 pub mod paper_1d;
 pub mod plan;

@@ -256,6 +256,8 @@ pub struct DecodeOptions {
     /// ([`slf_firmware::TileDecoder::with_error_estimate`], [`crate::decode::report::DecodeReport::error_map`]). Off by default:
     /// a solve more a patch.
     pub error_estimate: bool,
+    /// How the error is estimated where it is ([`EstimateBy`]).
+    pub estimate_by: EstimateBy,
     /// Whether half-pixel disparities are checked against the whole ones by the held-out
     /// error estimate ([`slf_firmware::TileDecoder::with_shear_check`]). Off by default.
     pub shear_check: bool,
@@ -273,6 +275,20 @@ pub struct DecodeOptions {
     /// ([`crate::decode::trial::halves_alias`]). Off here, on in the default and best
     /// presets.
     pub shear_trial: bool,
+}
+
+/// How a decode's error is estimated ([`DecodeOptions::error_estimate`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum EstimateBy {
+    /// The frame decoded again from seven in eight samples, by the same plan: the estimate
+    /// of the decode actually made ([`crate::decode::held_out`]); a second decode's time.
+    /// Where the light field does not hold each sample's value (a lenslet grid, a response
+    /// in the projection), the patches' estimates.
+    #[default]
+    Decode,
+    /// Each patch's own: one more solve of it from seven in eight of its measurements
+    /// ([`slf_firmware::TileDecoder::with_error_estimate`]); a solve a patch.
+    Patches,
 }
 
 /// Which schedule the solves take.
@@ -308,6 +324,7 @@ impl Default for DecodeOptions {
             response: None,
             plausibility: Plausibility::DEFAULT,
             error_estimate: false,
+            estimate_by: EstimateBy::Decode,
             shear_check: false,
             model_trial: false,
             shear_trial: false,

@@ -8,7 +8,7 @@ use anyhow::{Result, anyhow, ensure};
 use slf_firmware::decode::engine::plan::Grids;
 use slf_firmware::{FrameSource, HoldOut, PatchModel, Pick, RawFrame, Tile, TileDecoder, TrialErrors};
 
-use crate::decode::options::{Balance, DecodeOptions};
+use crate::decode::options::{Balance, DecodeOptions, EstimateBy};
 use crate::decode::trial::{frame_shear_trial, frame_trial, halves_alias, pilot_budget};
 use crate::io::capture::Capture;
 use crate::io::rows::RowShape;
@@ -178,7 +178,7 @@ pub fn tile_decoder<'a, const PU: usize, const PV: usize, const N: usize>(
     };
     let decoder = decoder.with_gains(&gains).map_err(|e| anyhow!("gains {gains:?}: {e}"))?;
     let decoder = decoder
-        .with_error_estimate(opts.error_estimate.then_some(HoldOut::DEFAULT))
+        .with_error_estimate(patch_estimates(opts, &decoder).then_some(HoldOut::DEFAULT))
         .map_err(|e| anyhow!("{e}"))?
         .with_plausibility(opts.plausibility)
         .map_err(|e| anyhow!("--plausible {}:{}: {e}", opts.plausibility.factor, opts.plausibility.margin))?;
@@ -187,6 +187,15 @@ pub fn tile_decoder<'a, const PU: usize, const PV: usize, const N: usize>(
         .with_edge_fallback(opts.edge_fallback)
         .with_sheared_fallback(opts.sheared_fallback)
         .with_shear_check(opts.shear_check))
+}
+
+/// Whether the decode estimates each patch's error ([`EstimateBy::Patches`], or where the
+/// held-out decode cannot compare samples with the light field).
+pub fn patch_estimates<const PU: usize, const PV: usize, const N: usize>(
+    opts: &DecodeOptions,
+    decoder: &TileDecoder<'_, 5, 5, PU, PV, 13, N>,
+) -> bool {
+    opts.error_estimate && (opts.estimate_by == EstimateBy::Patches || !decoder.samples_are_values())
 }
 
 /// The sensor's lenslets as a tile's `u16`s.

@@ -76,6 +76,12 @@ pub struct DecodeReport {
     /// Each estimated patch's error estimate (RMS per value, the output's units), by
     /// origin ([`crate::decode::options::DecodeOptions::error_estimate`]; empty without it).
     pub error_map: Vec<(PatchOrigin, f32)>,
+    /// The error estimate per lenslet of the decode made (row-major, RMS per value, the
+    /// output's units), from its held-out decode ([`crate::decode::held_out`]; empty
+    /// without it).
+    pub error_lenslets: Vec<f32>,
+    /// The held-out decode's wall time, seconds (0 without it; in [`Self::seconds`] too).
+    pub estimate_seconds: f64,
     /// What the model trial picked ([`crate::decode::options::DecodeOptions::model_trial`]; `None` without it).
     pub trial: Option<TrialReport>,
     /// What the shear trial found ([`crate::decode::options::DecodeOptions::shear_trial`]; `None` without it or
@@ -147,6 +153,18 @@ fn per_lenslet<'a>(
 /// lenslets cover it (every angular window, every overlapping patch), NaN where none does.
 pub fn error_per_lenslet(patches: &[(PatchOrigin, f32)], rows: usize, cols: usize) -> Vec<f32> {
     per_lenslet(patches.iter().map(|(o, e)| (o, f64::from(*e) * f64::from(*e))), rows, cols, f64::sqrt)
+}
+
+impl DecodeReport {
+    /// The error estimate per lenslet (row-major, `rows x cols`): the held-out decode's
+    /// ([`Self::error_lenslets`]), else the patches' ([`error_per_lenslet`]); `None`
+    /// without an estimate.
+    pub fn error_per_lenslet(&self, rows: usize, cols: usize) -> Option<Vec<f32>> {
+        if !self.error_lenslets.is_empty() {
+            return Some(self.error_lenslets.clone());
+        }
+        (!self.error_map.is_empty()).then(|| error_per_lenslet(&self.error_map, rows, cols))
+    }
 }
 
 /// The PSNR an error map estimates for a light field whose values span `data_range`: the

@@ -21,7 +21,8 @@ use slf_firmware::{
 use crate::decode::baselines::{Baseline, BaselineReport};
 use crate::decode::calibrate::{corrected, unmix, unmixing};
 use crate::decode::cs::{
-    Balance, Basis, DecodeOptions, DecodeReport, NoiseSource, PatchViews, SolveSchedule, Window, decode_into, read_blob,
+    Balance, Basis, DecodeOptions, DecodeReport, EstimateBy, NoiseSource, PatchViews, SolveSchedule, Window,
+    decode_into, read_blob,
 };
 use crate::decode::preset::Preset;
 use crate::io::calibration::Calibration;
@@ -403,12 +404,19 @@ pub struct DecodeSettings {
     /// counts both [default: 3:0.05].
     #[arg(long, value_parser = plausibility, value_name = "FACTOR:MARGIN|off")]
     pub plausible: Option<Plausibility>,
-    /// Estimate each solved patch's error from measurements held out of one more solve
-    /// (one in eight; the DCT from the measurements alone), in the output's units: the
-    /// summary's estimated PSNR, and `slf decode --error-map` writes it per lenslet. The
-    /// decode itself is the same bit for bit; the estimate costs a solve a patch.
+    /// Estimate the decode's error from samples held out (one in eight), in the output's
+    /// units: the summary's estimated PSNR, and `slf decode --error-map` writes it per
+    /// lenslet. The decode itself is the same bit for bit; the estimate costs what
+    /// --estimate-by says.
     #[arg(long)]
     pub estimate: bool,
+    /// How the error is estimated: `decode`, the frame decoded again by the same plan from
+    /// seven in eight samples and its predictions of the eighth (a second decode's time);
+    /// `patches`, each patch solved once more from seven in eight of its measurements (the
+    /// DCT alone; a solve a patch) [default: decode; patches behind a lenslet grid or a
+    /// response in the projection].
+    #[arg(long, value_enum, value_name = "HOW")]
+    pub estimate_by: Option<EstimateBy>,
     /// Check each half-pixel disparity against the whole ones next to it by the held-out
     /// error estimate of the block's patch at each, and decode at the one estimated best
     /// (three more solves a half-pixel block).
@@ -520,6 +528,7 @@ impl DecodeSettings {
             seeded: self.seeded.unwrap_or(base.seeded),
             plausibility: self.plausible.unwrap_or(base.plausibility),
             error_estimate: self.estimate || base.error_estimate,
+            estimate_by: self.estimate_by.unwrap_or(base.estimate_by),
             shear_check: self.shear_check || base.shear_check,
             // A dictionary named is the model asked for: no trial unless asked too.
             model_trial: self.model_trial.unwrap_or(base.model_trial && self.basis.dictionary.is_none()),

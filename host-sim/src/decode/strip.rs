@@ -20,7 +20,7 @@ use slf_firmware::decode::engine::plan::Planned;
 use slf_firmware::decode::engine::rows::Fill;
 use slf_firmware::decode::engine::schedule::{Next, Schedule};
 use slf_firmware::decode::engine::strip::{SeedPatches, Seeds, Strip, StripShape};
-use slf_firmware::{FrameSource, PatchModel, RawFrame, TileReport, Workspace};
+use slf_firmware::{Frame, FrameSource, PatchModel, TileReport, Workspace};
 
 use crate::decode::plan::FramePlan;
 use crate::decode::report::DecodeReport;
@@ -62,10 +62,10 @@ type Decoded<const PU: usize, const PV: usize> = Vec<(Planned, TileSums<PU, PV>,
 ///
 /// # Errors
 /// What the sink returns.
-pub fn decode_rows<const PU: usize, const PV: usize, const N: usize, M>(
+pub fn decode_rows<const PU: usize, const PV: usize, const N: usize, M, F>(
     plan: &FramePlan<'_, PU, PV, N>,
     model: &M,
-    raw: &[RawFrame<'_, u16>],
+    raw: &[F],
     batch: usize,
     progress: bool,
     observer: &(dyn Fn(usize, usize) + Sync),
@@ -73,6 +73,7 @@ pub fn decode_rows<const PU: usize, const PV: usize, const N: usize, M>(
 ) -> Result<DecodeReport>
 where
     M: PatchModel<5, 5, PU, PV, 13, N> + Sync,
+    F: Frame + Sync,
 {
     let start = Instant::now();
     let shape = plan.shape;

@@ -7,9 +7,7 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::{Context, Result};
-use slf_host::decode::cs::{
-    Balance, NoiseSource, PatchDecoder, disparity_per_lenslet, error_per_lenslet, estimated_psnr,
-};
+use slf_host::decode::cs::{Balance, NoiseSource, PatchDecoder, disparity_per_lenslet, estimated_psnr};
 use slf_host::decode::settings::{DecodeSettings, Outcome, output_shape};
 use slf_host::firmware::disparity::Disparity;
 use slf_host::io::calibration::Calibration;
@@ -227,7 +225,7 @@ pub fn run(args: Args) -> Result<()> {
         let map = disparity_per_lenslet(&r.disparity_map, rows, cols);
         write_npy_f32_2d(&path, &map, rows, cols).with_context(|| format!("cannot write {}", path.display()))?;
     }
-    let errors = (!r.error_map.is_empty()).then(|| error_per_lenslet(&r.error_map, rows, cols));
+    let errors = r.error_per_lenslet(rows, cols);
     if let (Some(path), Some(map)) = (&error_map, &errors) {
         write_npy_f32_2d(path, map, rows, cols).with_context(|| format!("cannot write {}", path.display()))?;
     }
@@ -331,12 +329,12 @@ pub fn run(args: Args) -> Result<()> {
     }
     if let Some(map) = &errors {
         let psnr = estimated_psnr(map, peak).map_or("none".into(), |p| format!("{p:.2} dB"));
-        outln!(
-            "error estimate: {} of {} patches from held-out measurements; estimated PSNR {psnr} (data range {peak:.4} = the \
-             decode's maximum)",
-            r.error_map.len(),
-            r.patches.decoded
-        )?;
+        let by = if r.error_lenslets.is_empty() {
+            format!("{} of {} patches from held-out measurements", r.error_map.len(), r.patches.decoded)
+        } else {
+            format!("the frame decoded again from 7 in 8 samples ({:.2} s)", r.estimate_seconds)
+        };
+        outln!("error estimate: {by}; estimated PSNR {psnr} (data range {peak:.4} = the decode's maximum)")?;
     }
     let per = |n: u64| n as f64 / f64::from(r.patches.decoded.max(1));
     outln!(

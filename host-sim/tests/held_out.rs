@@ -1,0 +1,151 @@
+//! The error estimate of the decode actually made ([`slf_host::decode::held_out`]): the frame
+//! decoded again without one sample in eight, and that decode's values at those samples
+//! against them. Checked against the slow obvious route (the held-out samples made defective
+//! pixels of a second capture, decoded by the public API, the tallies summed in f64), and for
+//! what it must not change (the decode) and must see (the model that decoded).
+
+use slf_host::decode::cs::{Balance, Basis, DecodeOptions, EstimateBy, decode_with};
+use slf_host::decode::held_out::{Held, LEVEL};
+use slf_host::firmware::HoldOut;
+use slf_host::io::capture::Capture;
+use slf_host::io::lightfield::LightField;
+use slf_host::sim::camera::{CameraConfig, simulate};
+
+mod common;
+
+fn estimating() -> DecodeOptions {
+    DecodeOptions { balance: Balance::Off, error_estimate: true, ..DecodeOptions::default() }
+}
+
+/// The error map by hand: `cap`'s held-out samples as defective pixels of a copy (one
+/// snapshot: a sample is a pixel), the copy decoded, each held-out sample's light-field
+/// value against its normalised raw value, the noise variance off, per 5 x 5 lenslets (the
+/// measured values at the lower of that and the noise's variance; a saturated held-out
+/// sample at the gap from the decode's value up to the top of the range). Also returns how
+/// many held-out samples saturated.
+fn slow_map(cap: &Capture, opts: &DecodeOptions) -> (Vec<f64>, usize) {
+    let d = &cap.description;
+    assert_eq!(cap.frames.len(), 1, "the reference holds pixels out: one snapshot");
+    let (rows, cols) = cap.frame_size();
+    let (lu, lv) = (d.views[0], d.views[1]);
+    let (lr, lc) = (d.lenslets[0], d.lenslets[1]);
+    let held: Vec<(usize, usize)> = (0..rows)
+        .flat_map(|r| (0..cols).map(move |c| (r, c)))
+        .filter(|&at| Held::Sample.holds(&HoldOut::DEFAULT, 0, at, (rows, cols)))
+        .collect();
+    let mut hidden = cap.clone();
+    hidden.description.defective_pixels = held.iter().map(|&(r, c)| [r as u32, c as u32]).collect();
+    let hidden = Capture::new(hidden.description, hidden.frames).unwrap();
+    let plain = DecodeOptions { error_estimate: false, ..*opts };
+    let lf: LightField = decode_with(&hidden, &Basis::Dct, &plain).unwrap().0;
+    let mask = cap.mask().unwrap();
+    let (noise, shot) = cap.noise_model().map_or((0.0, 0.0), |(n, s)| (f64::from(n), f64::from(s)));
+    let (black, white) = (f64::from(d.black_level), f64::from(d.white_level));
+    let top = (f64::from(d.saturation_level) - 0.5 - black) / (white - black);
+    // Per lenslet: squared error, variance, held-out samples, valid samples.
+    let mut t = vec![[0.0f64; 4]; lr * lc];
+    let mut saturated = 0;
+    for r in 0..rows {
+        for c in 0..cols {
+            let raw = f64::from(cap.frames[0][r * cols + c]);
+            let over = raw > f64::from(d.saturation_level) - 0.5;
+            let seen = (raw - black) / (white - black);
+            let (y, x, u, v) = (r / lu, c / lv, r % lu, c % lv);
+            let slot = &mut t[y * lc + x];
+            slot[3] += if over { 0.0 } else { 1.0 };
+            if held.binary_search(&(r, c)).is_err() {
+                continue;
+            }
+            let band = usize::from(mask.bands_at(r, c)[0]);
+            let value = f64::from(lf.data[lf.index(u, v, y, x, band)]);
+            if over {
+                saturated += 1;
+                slot[0] += (top - value).max(0.0).powi(2);
+            } else {
+                slot[0] += (value - seen).powi(2);
+                slot[1] += noise * noise + shot * seen.max(0.0);
+            }
+            slot[2] += 1.0;
+        }
+    }
+    let mut out = vec![f64::NAN; lr * lc];
+    for y in 0..lr {
+        for x in 0..lc {
+            let mut s = [0.0f64; 4];
+            let mut n = 0.0;
+            for yy in y.saturating_sub(2)..(y + 3).min(lr) {
+                for xx in x.saturating_sub(2)..(x + 3).min(lc) {
+                    for (a, b) in s.iter_mut().zip(&t[yy * lc + xx]) {
+                        *a += b;
+                    }
+                    n += 1.0;
+                }
+            }
+            if s[2] > 0.0 {
+                let measured = (s[3] / n / (lu * lv * 13) as f64).min(1.0);
+                let (r2, var) = (s[0] / s[2], s[1] / s[2]);
+                let unmeasured = (r2 - var).max(0.0);
+                out[y * lc + x] = (unmeasured * (1.0 - measured) + unmeasured.min(var) * measured).sqrt();
+            }
+        }
+    }
+    (out, saturated)
+}
+
+#[test]
+fn the_map_is_the_held_out_decodes_error_at_the_samples_it_was_not_given() {
+    let lf = common::small_smooth(5);
+    // The scene as it is, and three times as bright: samples saturate.
+    let bright = LightField { data: lf.data.iter().map(|x| x * 3.0).collect(), ..lf.clone() };
+    for (name, scene, saturates) in [("smooth", &lf, false), ("bright", &bright, true)] {
+        let cap = simulate(scene, &CameraConfig::pixel(3, 1)).unwrap();
+        let opts = estimating();
+        let (_, report) = decode_with(&cap, &Basis::Dct, &opts).unwrap();
+        let (slow, saturated) = slow_map(&cap, &opts);
+        assert_eq!(saturated > 0, saturates, "{name}: {saturated} held-out samples saturated");
+        assert_eq!(report.error_lenslets.len(), slow.len());
+        assert!(report.error_map.is_empty(), "{name}: the patches' estimates ran as well");
+        for (i, (&fast, &slow)) in report.error_lenslets.iter().zip(&slow).enumerate() {
+            let slow = slow * LEVEL;
+            // f32 tallies against f64 ones: well within 1e-4 relative.
+            assert!(
+                (f64::from(fast) - slow).abs() <= 1e-4 * slow.abs() + 1e-7,
+                "{name}, lenslet {i}: map {fast} against the slow route's {slow}"
+            );
+        }
+        assert!(slow.iter().all(|e| e.is_finite() && *e > 0.0), "{name}: a lenslet without an estimate");
+    }
+}
+
+#[test]
+fn the_estimate_leaves_the_decode_as_it_was() {
+    let lf = common::small_smooth(5);
+    for k in [1u8, 3] {
+        let cap = simulate(&lf, &CameraConfig::pixel(4, k)).unwrap();
+        let plain = DecodeOptions { error_estimate: false, ..estimating() };
+        let (with, report) = decode_with(&cap, &Basis::Dct, &estimating()).unwrap();
+        let (without, none) = decode_with(&cap, &Basis::Dct, &plain).unwrap();
+        assert_eq!(with.data, without.data, "k {k}: the estimate changed the decode");
+        assert!(!report.error_lenslets.is_empty() && none.error_lenslets.is_empty(), "k {k}");
+        assert!(report.estimate_seconds > 0.0, "k {k}: the held-out decode's time");
+    }
+}
+
+/// The patches' estimates were one DCT solve whatever the model: a DCT decode and an
+/// ensemble decode got the same map. The held-out decode is each decode's own.
+#[test]
+fn each_model_gets_the_map_of_its_own_decode() {
+    let lf = common::small_smooth(5);
+    let cap = simulate(&lf, &CameraConfig::pixel(5, 1)).unwrap();
+    let ensemble = Basis::default_ensemble();
+    let map = |basis: &Basis, by: EstimateBy| {
+        decode_with(&cap, basis, &DecodeOptions { estimate_by: by, ..estimating() })
+            .unwrap()
+            .1
+            .error_per_lenslet(12, 12)
+    };
+    let (dct, ens) = (map(&Basis::Dct, EstimateBy::Decode).unwrap(), map(&ensemble, EstimateBy::Decode).unwrap());
+    assert_ne!(dct, ens, "the DCT's and the ensemble's decodes estimated alike");
+    let (p_dct, p_ens) = (map(&Basis::Dct, EstimateBy::Patches).unwrap(), map(&ensemble, EstimateBy::Patches).unwrap());
+    assert_eq!(p_dct, p_ens, "the patches' estimates now follow the model: this test's premise is gone");
+}
