@@ -149,3 +149,27 @@ fn each_model_gets_the_map_of_its_own_decode() {
     let (p_dct, p_ens) = (map(&Basis::Dct, EstimateBy::Patches).unwrap(), map(&ensemble, EstimateBy::Patches).unwrap());
     assert_eq!(p_dct, p_ens, "the patches' estimates now follow the model: this test's premise is gone");
 }
+
+/// The model trial by held-out decodes: the model whose decode, made again from seven in
+/// eight samples, errs less at the eighth decodes the frame, bit for bit as that model alone
+/// does, and its held-out decode is the error map.
+#[test]
+fn the_trial_by_decode_picks_the_model_whose_held_out_decode_errs_less() {
+    use slf_host::decode::cs::TrialBy;
+    let lf = common::small_smooth(5);
+    for k in [1u8, 3] {
+        let cap = simulate(&lf, &CameraConfig::pixel(6, k)).unwrap();
+        let trial = DecodeOptions { model_trial: true, trial_by: TrialBy::Decode, ..estimating() };
+        let (out, report) = decode_with(&cap, &Basis::default_ensemble(), &trial).unwrap();
+        let t = report.trial.expect("the trial ran");
+        let (dct, ensemble) = t.by_decode.expect("the held-out decodes estimated");
+        assert!(dct > 0.0 && ensemble > 0.0, "k {k}: {dct} {ensemble}");
+        assert_eq!(t.dct, dct < ensemble, "k {k}: picked the DCT {} on {dct} against {ensemble}", t.dct);
+        // The picked model alone, with its own estimate.
+        let alone = DecodeOptions { model_trial: false, ..estimating() };
+        let basis = if t.dct { Basis::Dct } else { Basis::default_ensemble() };
+        let (same, own) = decode_with(&cap, &basis, &alone).unwrap();
+        assert_eq!(out.data, same.data, "k {k}: not the picked model's decode");
+        assert_eq!(report.error_lenslets, own.error_lenslets, "k {k}: not the picked model's map");
+    }
+}

@@ -371,6 +371,7 @@ def decode(
     plausible: Union[None, str, Tuple[float, float]] = None,
     shear_check: bool = False,
     model_trial: Optional[bool] = None,
+    trial_by: Optional[str] = None,
     shear_trial: Optional[bool] = None,
     error_map: bool = False,
     estimate_by: Optional[str] = None,
@@ -412,7 +413,9 @@ def decode(
     ``shear_check``, ``model_trial`` (the ensemble or the DCT for the frame by their
     held-out errors on pilot patches; default True in every preset, leaning to the DCT in
     the preview, False where ``dictionary`` is named: ``report["trial"]`` says which and the
-    errors), ``shear_trial`` (whole disparities only for the frame where pilot patches
+    errors; ``trial_by="decode"`` tells them apart by the frame decoded again by each from
+    seven in eight samples, two more decodes: ``report["trial"]["decode_dct_error"]`` and
+    ``["decode_ensemble_error"]``), ``shear_trial`` (whole disparities only for the frame where pilot patches
     estimate them clearly better than the half-pixel ones; default True:
     ``report["shear_trial"]``), ``error_map`` (the decode's error per lenslet in
     ``report["error_map"]`` and its estimated PSNR), ``estimate_by`` decode (the frame
@@ -489,6 +492,7 @@ def decode(
         plausible=plausible,
         shear_check=shear_check,
         model_trial=model_trial,
+        trial_by=trial_by,
         shear_trial=shear_trial,
         estimate=True if error_map else None,
         estimate_by=estimate_by,

@@ -148,6 +148,10 @@ pub fn decode<'py>(
                 trial.set_item("pilots", t.pilots)?;
                 trial.set_item("dct_error", t.dct_error)?;
                 trial.set_item("ensemble_error", t.ensemble_error)?;
+                if let Some((dct, ensemble)) = t.by_decode {
+                    trial.set_item("decode_dct_error", dct)?;
+                    trial.set_item("decode_ensemble_error", ensemble)?;
+                }
                 report.set_item("trial", trial)?;
             }
             let (rows, cols) = (d.lenslets[0], d.lenslets[1]);

@@ -21,10 +21,10 @@ use std::time::Instant;
 use anyhow::{Result, anyhow, bail};
 use slf_firmware::{Dictionary, HoldOut, PatchModel, Pick, Picked, Sl0Config};
 
-use crate::decode::held_out;
+use crate::decode::held_out::HeldOutDecode;
 pub use crate::decode::options::{
     Balance, Basis, DEFAULT_STRIDE, DecodeOptions, EstimateBy, MAX_BLOB, NoiseSource, PatchViews, SolveSchedule,
-    Window, read_blob,
+    TrialBy, Window, read_blob,
 };
 use crate::decode::plan::{FramePlan, patch_estimates};
 pub use crate::decode::plan::{ModelPick, tile_decoder};
@@ -294,16 +294,38 @@ where
 {
     let start = Instant::now();
     let raw = capture.raw_frames()?;
-    let plan = FramePlan::<PU, PV, N>::new(capture, first, second, pick, opts, &raw)?;
+    let mut plan = FramePlan::<PU, PV, N>::new(capture, first, second, pick, opts, &raw)?;
+    // The model trial by held-out decodes: both models' decodes of the frame made again
+    // without one sample in eight, the pick by their errors at those (leaning as the
+    // pilots' trial leans); the picked one's tallies are the error map's too.
+    let mut estimated = None;
+    let mut by_decode = None;
+    if let (Some(_), TrialBy::Decode, true, ModelPick::Trial { towards, margin }) =
+        (plan.model_trial, opts.trial_by, plan.decoder.samples_are_values(), pick)
+    {
+        let held = Instant::now();
+        let run =
+            |pick| HeldOutDecode::run(&plan, &Picked { first, second, pick }, &raw, HoldOut::DEFAULT, opts.batch_tiles);
+        let (a, z) = (run(Pick::First)?, run(Pick::Second)?);
+        if let (Some(ea), Some(ez)) = (a.frame_error(), z.frame_error()) {
+            let t = slf_firmware::TrialErrors { first: (ea * ea) as f32, second: (ez * ez) as f32, pilots: 1 };
+            plan.pick = t.pick_leaning(towards, margin);
+            by_decode = Some((ea, ez));
+        }
+        estimated = Some((if plan.pick == Pick::First { a } else { z }, held.elapsed().as_secs_f64()));
+    }
     let model = Picked { first, second, pick: plan.pick };
     let mut report = decode_rows(&plan, &model, &raw, opts.batch_tiles, opts.progress, observer, sink)?;
-    report.seconds = start.elapsed().as_secs_f64();
     if opts.error_estimate && !patch_estimates(opts, &plan.decoder) {
         let held = Instant::now();
-        report.error_lenslets = held_out::error_map(&plan, &model, &raw, HoldOut::DEFAULT, opts.batch_tiles)?;
-        report.estimate_seconds = held.elapsed().as_secs_f64();
-        report.seconds = start.elapsed().as_secs_f64();
+        let (decode, seconds) = match estimated.take() {
+            Some(e) => e,
+            None => (HeldOutDecode::run(&plan, &model, &raw, HoldOut::DEFAULT, opts.batch_tiles)?, 0.0),
+        };
+        report.error_lenslets = decode.map();
+        report.estimate_seconds = seconds + held.elapsed().as_secs_f64();
     }
+    report.seconds = start.elapsed().as_secs_f64();
     report.gains = *plan.decoder.gains();
     report.patch_views = PatchViews::of_views(PU, PV);
     report.grid = capture.description.turned_grid();
@@ -318,7 +340,7 @@ where
     });
     report.trial = plan.model_trial.map(|t| {
         let (dct_error, ensemble_error) = rms(&t);
-        TrialReport { pilots: t.pilots, dct: plan.pick == Pick::First, dct_error, ensemble_error }
+        TrialReport { pilots: t.pilots, dct: plan.pick == Pick::First, dct_error, ensemble_error, by_decode }
     });
     Ok(report)
 }

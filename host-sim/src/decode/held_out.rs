@@ -226,49 +226,74 @@ impl<const PU: usize, const PV: usize, const N: usize> RowSink for Tallies<'_, P
     }
 }
 
-/// The error estimate per lenslet (row-major, RMS per value in the output's units, NaN
-/// where no held-out sample is within reach) of the decode `plan` makes with `model` from
-/// `raw`: the frame decoded again from all but the samples `hold` names, its predictions of
-/// those, over the 5 x 5 lenslets around each.
-///
-/// # Errors
-/// What the held-out decode reports.
-pub fn error_map<const PU: usize, const PV: usize, const N: usize, M>(
-    plan: &FramePlan<'_, PU, PV, N>,
-    model: &M,
-    raw: &[RawFrame<'_, u16>],
-    hold: HoldOut,
-    batch: usize,
-) -> Result<Vec<f32>>
-where
-    M: PatchModel<5, 5, PU, PV, 13, N> + Sync,
-{
-    let held = Held::of(&plan.decoder);
-    let hidden = HeldOutFrame::of(raw, hold, held);
-    let shape = plan.shape;
-    let reach = held.reach(shape.views);
-    let mut sink = Tallies {
-        decoder: &plan.decoder,
-        raw,
-        hold,
-        held,
-        shape,
-        tallies: vec![Tally::default(); shape.rows * shape.cols],
-    };
-    decode_rows(plan, model, &hidden, batch, false, &|_, _| {}, &mut sink)?;
-    let values = (shape.views.0 * shape.views.1 * shape.bands) as f64;
-    Ok(boxed(&sink.tallies, (shape.rows, shape.cols), reach)
-        .iter()
-        .map(|t| {
-            if t.held == 0 {
-                return f32::NAN;
-            }
-            let (r2, var) = (t.squared / f64::from(t.held), t.variance / f64::from(t.held));
-            let measured = (t.measured / values).min(1.0);
-            let unmeasured = (r2 - var).max(0.0);
-            (LEVEL * (unmeasured * (1.0 - measured) + unmeasured.min(var) * measured).sqrt()) as f32
-        })
-        .collect())
+/// What a held-out decode found: its tallies per lenslet.
+pub struct HeldOutDecode {
+    tallies: Vec<Tally>,
+    shape: RowShape,
+    held: Held,
+}
+
+impl HeldOutDecode {
+    /// The decode `plan` makes with `model` from `raw`, made again from all but the samples
+    /// `hold` names, and its values at those against them.
+    ///
+    /// # Errors
+    /// What the held-out decode reports.
+    pub fn run<const PU: usize, const PV: usize, const N: usize, M>(
+        plan: &FramePlan<'_, PU, PV, N>,
+        model: &M,
+        raw: &[RawFrame<'_, u16>],
+        hold: HoldOut,
+        batch: usize,
+    ) -> Result<Self>
+    where
+        M: PatchModel<5, 5, PU, PV, 13, N> + Sync,
+    {
+        let held = Held::of(&plan.decoder);
+        let hidden = HeldOutFrame::of(raw, hold, held);
+        let shape = plan.shape;
+        let mut sink = Tallies {
+            decoder: &plan.decoder,
+            raw,
+            hold,
+            held,
+            shape,
+            tallies: vec![Tally::default(); shape.rows * shape.cols],
+        };
+        decode_rows(plan, model, &hidden, batch, false, &|_, _| {}, &mut sink)?;
+        Ok(Self { tallies: sink.tallies, shape, held })
+    }
+
+    /// The error estimate of the frame's values nobody measured (RMS, the output's units,
+    /// scaled by [`LEVEL`]): every held-out sample's squared error, less the noise's
+    /// variance; `None` without a held-out sample.
+    pub fn frame_error(&self) -> Option<f64> {
+        let mut all = Tally::default();
+        for t in &self.tallies {
+            all.add(t);
+        }
+        (all.held > 0).then(|| LEVEL * ((all.squared - all.variance) / f64::from(all.held)).max(0.0).sqrt())
+    }
+
+    /// The error estimate per lenslet (row-major, RMS per value in the output's units, NaN
+    /// where no held-out sample is within reach), over the lenslets around each
+    /// ([`Held::reach`]).
+    pub fn map(&self) -> Vec<f32> {
+        let shape = self.shape;
+        let values = (shape.views.0 * shape.views.1 * shape.bands) as f64;
+        boxed(&self.tallies, (shape.rows, shape.cols), self.held.reach(shape.views))
+            .iter()
+            .map(|t| {
+                if t.held == 0 {
+                    return f32::NAN;
+                }
+                let (r2, var) = (t.squared / f64::from(t.held), t.variance / f64::from(t.held));
+                let measured = (t.measured / values).min(1.0);
+                let unmeasured = (r2 - var).max(0.0);
+                (LEVEL * (unmeasured * (1.0 - measured) + unmeasured.min(var) * measured).sqrt()) as f32
+            })
+            .collect()
+    }
 }
 
 /// Each lenslet's tally summed with its neighbours' within `reach` lenslets (a box clipped

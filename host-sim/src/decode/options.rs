@@ -258,6 +258,8 @@ pub struct DecodeOptions {
     pub error_estimate: bool,
     /// How the error is estimated where it is ([`EstimateBy`]).
     pub estimate_by: EstimateBy,
+    /// How the model trial tells the models apart ([`TrialBy`]).
+    pub trial_by: TrialBy,
     /// Whether half-pixel disparities are checked against the whole ones by the held-out
     /// error estimate ([`slf_firmware::TileDecoder::with_shear_check`]). Off by default.
     pub shear_check: bool,
@@ -275,6 +277,19 @@ pub struct DecodeOptions {
     /// ([`crate::decode::trial::halves_alias`]). Off here, on in the default and best
     /// presets.
     pub shear_trial: bool,
+}
+
+/// How the model trial tells the DCT from the ensemble ([`DecodeOptions::model_trial`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum TrialBy {
+    /// Pilot patches, each decoded by both models from seven in eight of its measurements
+    /// (about 0.1 of a solve a patch).
+    #[default]
+    Pilots,
+    /// The frame decoded by each model again, as the decode makes it (seeds, overlap), from
+    /// seven in eight samples ([`crate::decode::held_out`]): two more decodes of the frame.
+    /// Where the light field does not hold each sample's value, the pilots.
+    Decode,
 }
 
 /// How a decode's error is estimated ([`DecodeOptions::error_estimate`]).
@@ -325,6 +340,7 @@ impl Default for DecodeOptions {
             plausibility: Plausibility::DEFAULT,
             error_estimate: false,
             estimate_by: EstimateBy::Decode,
+            trial_by: TrialBy::Pilots,
             shear_check: false,
             model_trial: false,
             shear_trial: false,

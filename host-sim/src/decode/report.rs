@@ -118,6 +118,10 @@ pub struct TrialReport {
     pub dct_error: f64,
     /// The ensemble's.
     pub ensemble_error: f64,
+    /// With the trial by held-out decodes ([`crate::decode::options::TrialBy::Decode`]):
+    /// the DCT's and the ensemble's error estimates of the frame from them (RMS, the
+    /// output's units), which picked.
+    pub by_decode: Option<(f64, f64)>,
 }
 
 /// The disparity per lenslet (row-major, `rows x cols`) from a decode's

@@ -21,7 +21,7 @@ use slf_firmware::{
 use crate::decode::baselines::{Baseline, BaselineReport};
 use crate::decode::calibrate::{corrected, unmix, unmixing};
 use crate::decode::cs::{
-    Balance, Basis, DecodeOptions, DecodeReport, EstimateBy, NoiseSource, PatchViews, SolveSchedule, Window,
+    Balance, Basis, DecodeOptions, DecodeReport, EstimateBy, NoiseSource, PatchViews, SolveSchedule, TrialBy, Window,
     decode_into, read_blob,
 };
 use crate::decode::preset::Preset;
@@ -428,6 +428,14 @@ pub struct DecodeSettings {
     /// the eighth better decodes the region) [default: true].
     #[arg(long, value_name = "BOOL")]
     pub model_trial: Option<bool>,
+    /// How the model trial tells the DCT from the ensemble: `pilots`, pilot patches each
+    /// decoded by both from seven in eight of its measurements (about a tenth of a solve a
+    /// patch); `decode`, the frame decoded again by each, as the decode makes it, from
+    /// seven in eight samples, the one that predicts the eighth better decoding the frame
+    /// (two more decodes of the frame; with --error-map the picked one's is the map)
+    /// [default: pilots].
+    #[arg(long, value_enum, value_name = "HOW")]
+    pub trial_by: Option<TrialBy>,
     /// With half-pixel disparities: check them first on one pilot patch a tile (up to 256)
     /// against the whole disparities beside them by the held-out error estimate, and decode
     /// the frame with whole disparities only where the whole ones estimate below 0.7 x the
@@ -529,6 +537,7 @@ impl DecodeSettings {
             plausibility: self.plausible.unwrap_or(base.plausibility),
             error_estimate: self.estimate || base.error_estimate,
             estimate_by: self.estimate_by.unwrap_or(base.estimate_by),
+            trial_by: self.trial_by.unwrap_or(base.trial_by),
             shear_check: self.shear_check || base.shear_check,
             // A dictionary named is the model asked for: no trial unless asked too.
             model_trial: self.model_trial.unwrap_or(base.model_trial && self.basis.dictionary.is_none()),
