@@ -10,6 +10,8 @@
 # (slf_host::decode::held_out::LEVEL) was fitted on the test scenes: the summary gives the
 # other scenes apart.
 #
+# SLF_RESUME=1 keeps the decodes OUT_DIR holds from a run that stopped, and makes the rest.
+#
 #   bash scripts/error-map-results.sh OUT_DIR > docs/results-error-map.md
 #   SLF_SIZE=40 SLF_SCENES="canopy dim" SLF_SETTINGS=pixel:1 bash scripts/error-map-results.sh OUT_DIR
 set -euo pipefail
@@ -35,27 +37,41 @@ echo "seven in eight samples and its predictions of the eighth (the default), sc
 echo "fitted on the test scenes ($fitted), so the summary gives the other"
 echo "scenes apart; **patches**, each patch's own solve from seven in eight of its measurements."
 add_real_scenes
-echo
-echo "| scene | setting | preset | estimate | PSNR | estimated PSNR | bias | rank correlation | within 2 x | time with / without |"
-echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
-rows="$out/error-map.tsv"
-: > "$rows"
+rows="$out/error-map.tsv" lines="$out/error-map-rows.md"
+if [ -z "${SLF_RESUME:-}" ] || [ ! -f "$rows" ] || [ ! -f "$lines" ]; then
+  : > "$rows"
+  : > "$lines"
+fi
 row() {
-  local preset by t0 t1 ev p e rho w
+  local preset by t0 t1 ev p e rho w n
+  # A capture whose rows are all there (a resumed run) is kept; a part of one is made again.
+  n=$(awk -F'\t' -v s="$mask k=$k" -v c="$scene" '$1 == s && $4 == c' "$rows" | wc -l)
+  [ "$n" -eq $((2 * $(echo $methods | wc -w))) ] && return 0
+  awk -F'\t' -v s="$mask k=$k" -v c="$scene" '!($1 == s && $4 == c)' "$rows" > "$rows.tmp" && mv "$rows.tmp" "$rows"
+  grep -v -F "| $scene | $mask k=$k |" "$lines" > "$lines.tmp" || true
+  mv "$lines.tmp" "$lines"
   for preset in default preview; do
     t0=$("$slf" decode "$cap" -o "$out/plain.npy" --quiet --preset "$preset" | sed -n 's/.* in \([0-9.]*\) s; wrote.*/\1/p')
     for by in $methods; do
       t1=$("$slf" decode "$cap" -o "$out/rec.npy" --quiet --preset "$preset" --error-map "$out/map.npy" --estimate-by "$by" |
         sed -n 's/.* in \([0-9.]*\) s; wrote.*/\1/p')
-      ev=$("$slf" eval "$lf" "$out/rec.npy" --error-map "$out/map.npy")
+      # A map without a whole block of estimates (every patch interpolated) is not scored.
+      if ! ev=$("$slf" eval "$lf" "$out/rec.npy" --error-map "$out/map.npy" 2>&1); then
+        printf '| %s | %s k=%s | %s | %s | | no estimate: %s | | | | |\n' "$scene" "$mask" "$k" "$preset" "$by" "${ev#error: }" >> "$lines"
+        continue
+      fi
       read -r p e rho w < <(echo "$ev" | awk '/^estimate PSNR/ { e = $3; t = $6; r = $15; w = $16 } END { sub(/\);/, "", t); sub(/,/, "", r); print t, e, r, w }')
       printf '| %s | %s k=%s | %s | %s | %.2f | %.2f | %+.2f | %.3f | %s %% | %.2f |\n' "$scene" "$mask" "$k" "$preset" "$by" \
-        "$p" "$e" "$(echo "$e - $p" | bc -l)" "$rho" "$w" "$(echo "$t1 / $t0" | bc -l)"
+        "$p" "$e" "$(echo "$e - $p" | bc -l)" "$rho" "$w" "$(echo "$t1 / $t0" | bc -l)" >> "$lines"
       printf '%s k=%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$mask" "$k" "$preset" "$by" "$scene" "$p" "$e" "$rho" >> "$rows"
     done
   done
 }
 each_capture "$settings" 1 row
+echo
+echo "| scene | setting | preset | estimate | PSNR | estimated PSNR | bias | rank correlation | within 2 x | time with / without |"
+echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+cat "$lines"
 echo
 echo "Per setting, preset and estimate: the bias (estimated minus true PSNR) and the rank correlation over the"
 echo "scenes; \"not fitted\" leaves out the test scenes the held-out decode's level was fitted on."
