@@ -57,6 +57,7 @@ row() {
         sed -n 's/.* in \([0-9.]*\) s; wrote.*/\1/p')
       # A map without a whole block of estimates (every patch interpolated) is not scored.
       if ! ev=$("$slf" eval "$lf" "$out/rec.npy" --error-map "$out/map.npy" 2>&1); then
+        ev=$(echo "$ev" | tail -1)
         printf '| %s | %s k=%s | %s | %s | | no estimate: %s | | | | |\n' "$scene" "$mask" "$k" "$preset" "$by" "${ev#error: }" >> "$lines"
         continue
       fi

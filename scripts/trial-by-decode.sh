@@ -6,6 +6,8 @@
 # scene `slf scene` names and the real crops when present (SLF_REAL), at each setting of
 # SLF_SETTINGS (default pixel k = 1 and 3, lenslet k = 3, kronecker k = 3), `--seed 1`.
 #
+# SLF_RESUME=1 keeps the captures OUT_DIR's table already holds (a run that stopped).
+#
 #   bash scripts/trial-by-decode.sh OUT_DIR > OUT.md
 set -euo pipefail
 out=${1:?usage: trial-by-decode.sh OUT_DIR}
@@ -14,19 +16,23 @@ cd "$(dirname "$0")/.."
 table_setup
 add_real_scenes
 rows="$out/trial-by.tsv"
-: > "$rows"
+[ -n "${SLF_RESUME:-}" ] && [ -f "$rows" ] || : > "$rows"
 row() {
   local pd td pe te pp tp pq tq
+  awk -F'\t' -v s="$s" -v c="$scene" '$1 == s && $2 == c { found = 1 } END { exit !found }' "$rows" && return 0
   decode_eval "$cap" --dictionary dct; pd=$p; td=$t
   decode_eval "$cap" --model-trial false; pe=$p; te=$t
   decode_eval "$cap"; pp=$p; tp=$t
   decode_eval "$cap" --trial-by decode; pq=$p; tq=$t
   printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$s" "$scene" "$pd" "$pe" "$pp" "$pq" "$td" "$te" "$tp" "$tq" >> "$rows"
 }
-each_capture "${SLF_SETTINGS:-pixel:1 pixel:3 lenslet:3 kronecker:3}" 1 row
-python3 - "$rows" "$size" "$(git rev-parse --short HEAD)" "${RAYON_NUM_THREADS:-all}" <<'PY'
+settings=${SLF_SETTINGS:-pixel:1 pixel:3 lenslet:3 kronecker:3}
+each_capture "$settings" 1 row
+python3 - "$rows" "$size" "$(git rev-parse --short HEAD)" "${RAYON_NUM_THREADS:-all}" "$settings" <<'PY'
 import statistics, sys
+asked = sys.argv[5].split()
 rows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1]) if l.strip()]
+rows = [r for r in rows if r[0] in asked]
 print("# The model trial: by pilot patches or by held-out decodes (issue 63)")
 print()
 print(f"Made by `bash scripts/trial-by-decode.sh OUT_DIR` at {sys.argv[3]}: synthetic scenes at {sys.argv[2]} x "

@@ -322,8 +322,8 @@ pub fn run(args: Args) -> Result<()> {
         let model = if t.dct { "DCT" } else { "ensemble" };
         match t.by_decode {
             Some((dct, ensemble)) => outln!(
-                "model trial: decoded by the {model} (held-out error of the frame decoded again from 7 in 8 samples: \
-                 DCT {dct:.5}, ensemble {ensemble:.5}; over {} pilot patches: DCT {:.5}, ensemble {:.5})",
+                "model trial: decoded by the {model} (held-out error of the frame decoded again from seven samples \
+                 in eight: DCT {dct:.5}, ensemble {ensemble:.5}; over {} pilot patches: DCT {:.5}, ensemble {:.5})",
                 t.pilots,
                 t.dct_error,
                 t.ensemble_error
@@ -341,7 +341,7 @@ pub fn run(args: Args) -> Result<()> {
         let by = if r.error_lenslets.is_empty() {
             format!("{} of {} patches from held-out measurements", r.error_map.len(), r.patches.decoded)
         } else {
-            format!("the frame decoded again from 7 in 8 samples ({:.2} s)", r.estimate_seconds)
+            format!("the frame decoded again from seven samples in eight ({:.2} s)", r.estimate_seconds)
         };
         outln!("error estimate: {by}; estimated PSNR {psnr} (data range {peak:.4} = the decode's maximum)")?;
     }
