@@ -86,9 +86,10 @@ fitted = set(sys.argv[2].split())
 for key in dict.fromkeys((r[0], r[1], r[2]) for r in rows):
     sel = [r for r in rows if (r[0], r[1], r[2]) == key]
     bias = [float(r[5]) - float(r[4]) for r in sel]
-    rest = [float(r[5]) - float(r[4]) for r in sel if r[3] not in fitted] or [0.0]
+    rest = [float(r[5]) - float(r[4]) for r in sel if r[3] not in fitted]
     rho = [float(r[6]) for r in sel]
     print(f"| {key[0]} | {key[1]} | {key[2]} | {len(sel)} | {statistics.median(bias):+.2f} ({min(bias):+.2f} to {max(bias):+.2f}) | "
-          f"{sum(abs(b) <= 1 for b in bias)} | {sum(abs(b) <= 1 for b in rest)} of {len(rest)} ({min(rest):+.2f} to {max(rest):+.2f}) | "
+          f"{sum(abs(b) <= 1 for b in bias)} | "
+          f"{f'{sum(abs(b) <= 1 for b in rest)} of {len(rest)} ({min(rest):+.2f} to {max(rest):+.2f})' if rest else 'none'} | "
           f"{statistics.median(rho):.3f} ({min(rho):.3f}) | {sum(r >= 0.7 for r in rho)} |")
 PY
