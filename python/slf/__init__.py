@@ -372,6 +372,7 @@ def decode(
     shear_check: bool = False,
     model_trial: Optional[bool] = None,
     trial_by: Optional[str] = None,
+    baseline_blend: Optional[bool] = None,
     shear_trial: Optional[bool] = None,
     error_map: bool = False,
     estimate_by: Optional[str] = None,
@@ -415,7 +416,9 @@ def decode(
     the preview, False where ``dictionary`` is named: ``report["trial"]`` says which and the
     errors; ``trial_by="decode"`` tells them apart by the frame decoded again by each from
     seven in eight samples, two more decodes: ``report["trial"]["decode_dct_error"]`` and
-    ``["decode_ensemble_error"]``), ``shear_trial`` (whole disparities only for the frame where pilot patches
+    ``["decode_ensemble_error"]``), ``baseline_blend`` (on a kronecker mask, each block mixed
+    from the decode and PPID by their held-out errors; default True: ``report["baseline_blend"]``
+    gives PPID's mean weight, the lenslets mostly PPID's and its seconds), ``shear_trial`` (whole disparities only for the frame where pilot patches
     estimate them clearly better than the half-pixel ones; default True:
     ``report["shear_trial"]``), ``error_map`` (the decode's error per lenslet in
     ``report["error_map"]`` and its estimated PSNR), ``estimate_by`` decode (the frame
@@ -440,6 +443,7 @@ def decode(
     sheared_fallback = _switch("sheared_fallback", sheared_fallback)  # type: ignore[assignment]
     seeded = _switch("seeded", seeded)  # type: ignore[assignment]
     model_trial = _switch("model_trial", model_trial)  # type: ignore[assignment]
+    baseline_blend = _switch("baseline_blend", baseline_blend)  # type: ignore[assignment]
     shear_trial = _switch("shear_trial", shear_trial)  # type: ignore[assignment]
     exact = bool(_bool("exact", exact, False))
     shear_check = bool(_bool("shear_check", shear_check, False))
@@ -493,6 +497,7 @@ def decode(
         shear_check=shear_check,
         model_trial=model_trial,
         trial_by=trial_by,
+        baseline_blend=baseline_blend,
         shear_trial=shear_trial,
         estimate=True if error_map else None,
         estimate_by=estimate_by,

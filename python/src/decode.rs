@@ -142,6 +142,14 @@ pub fn decode<'py>(
                 trial.set_item("whole_error", t.whole_error)?;
                 report.set_item("shear_trial", trial)?;
             }
+            if let Some(b) = &r.blend {
+                let blend = PyDict::new(py);
+                blend.set_item("mean_weight", b.mean_weight)?;
+                blend.set_item("mostly_baseline", b.mostly_baseline)?;
+                blend.set_item("lenslets", b.lenslets)?;
+                blend.set_item("seconds", b.seconds)?;
+                report.set_item("baseline_blend", blend)?;
+            }
             if let Some(t) = &r.trial {
                 let trial = PyDict::new(py);
                 trial.set_item("model", if t.dct { "dct" } else { "ensemble" })?;

@@ -21,6 +21,7 @@ use std::time::Instant;
 use anyhow::{Result, anyhow, bail};
 use slf_firmware::{Dictionary, HoldOut, PatchModel, Pick, Picked, Sl0Config};
 
+use crate::decode::blend::{self, BaselineBlend};
 use crate::decode::held_out::HeldOutDecode;
 pub use crate::decode::options::{
     Balance, Basis, DEFAULT_STRIDE, DecodeOptions, EstimateBy, MAX_BLOB, NoiseSource, PatchViews, SolveSchedule,
@@ -29,7 +30,7 @@ pub use crate::decode::options::{
 use crate::decode::plan::{FramePlan, patch_estimates};
 pub use crate::decode::plan::{ModelPick, tile_decoder};
 pub use crate::decode::report::{
-    DecodeReport, PatchDecoder, ShearTrialReport, TrialReport, disparity_per_lenslet, error_per_lenslet, estimated_psnr,
+    BlendReport, DecodeReport, PatchDecoder, ShearTrialReport, TrialReport, disparity_per_lenslet, error_per_lenslet, estimated_psnr,
 };
 use crate::decode::strip::decode_rows;
 use crate::decode::trial::{DCT_LEAN, rms};
@@ -315,16 +316,43 @@ where
         estimated = Some((if plan.pick == Pick::First { a } else { z }, held.elapsed().as_secs_f64()));
     }
     let model = Picked { first, second, pick: plan.pick };
-    let mut report = decode_rows(&plan, &model, &raw, opts.batch_tiles, opts.progress, observer, sink)?;
+    // The baseline blend, measured before the decode whose rows it mixes as they come.
+    let blending = Instant::now();
+    let blend = match opts.baseline_blend && blend::applies(&plan) {
+        true => Some(BaselineBlend::measure(&plan, &model, capture, &raw, opts.batch_tiles)?),
+        false => None,
+    };
+    let blend_seconds = blending.elapsed().as_secs_f64();
+    let mut report = match &blend {
+        Some(b) => {
+            let mut rows = b.rows(sink, plan.shape);
+            decode_rows(&plan, &model, &raw, opts.batch_tiles, opts.progress, observer, &mut rows)?
+        }
+        None => decode_rows(&plan, &model, &raw, opts.batch_tiles, opts.progress, observer, sink)?,
+    };
     if opts.error_estimate && !patch_estimates(opts, &plan.decoder) {
         let held = Instant::now();
-        let (decode, seconds) = match estimated.take() {
-            Some(e) => e,
-            None => (HeldOutDecode::run(&plan, &model, &raw, HoldOut::DEFAULT, opts.batch_tiles)?, 0.0),
+        let (decode, seconds) = match (estimated.take(), blend.as_ref()) {
+            // The blend's held-out decodes estimate the blended output, every sample held
+            // out once: no decode more.
+            (_, Some(b)) => {
+                report.error_lenslets = b.held_out.map();
+                (None, 0.0)
+            }
+            (Some((d, s)), None) => (Some(d), s),
+            (None, None) => (Some(HeldOutDecode::run(&plan, &model, &raw, HoldOut::DEFAULT, opts.batch_tiles)?), 0.0),
         };
-        report.error_lenslets = decode.map();
+        if let Some(decode) = decode {
+            report.error_lenslets = decode.map();
+        }
         report.estimate_seconds = seconds + held.elapsed().as_secs_f64();
     }
+    report.blend = blend.as_ref().map(|b| BlendReport {
+        mean_weight: b.mean_weight(),
+        mostly_baseline: b.weights.iter().filter(|&&w| w > 0.5).count(),
+        lenslets: b.weights.len(),
+        seconds: blend_seconds,
+    });
     report.seconds = start.elapsed().as_secs_f64();
     report.gains = *plan.decoder.gains();
     report.patch_views = PatchViews::of_views(PU, PV);

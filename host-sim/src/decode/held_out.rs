@@ -40,6 +40,7 @@ use slf_firmware::{Frame, HoldOut, MaskFamily, PatchModel, RawFrame, RowSink, Ti
 
 use crate::decode::plan::FramePlan;
 use crate::decode::strip::decode_rows;
+use crate::io::lightfield::LightField;
 use crate::io::rows::{RowShape, whole_width};
 
 /// The factor the held-out decode's error estimate is scaled by to be the full decode's
@@ -108,19 +109,55 @@ impl Held {
     }
 }
 
+/// Which samples a held-out decode is not given.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Hiding {
+    /// One sample (or group, [`Held`]) in [`HoldOut::fold`], by a hash: the error estimate's.
+    Hashed(HoldOut, Held),
+    /// Fold `fold` of [`Hiding::FOLDS`]: the group `(rows, cols)` of pixels at group
+    /// `(gr, gc)` in `snapshot` when `(snapshot + gr + 2 gc) % FOLDS == fold`. The folds
+    /// together hide every sample once; at three snapshots each fold hides one of every
+    /// group's snapshots (the baseline blend's, [`crate::decode::blend`]).
+    Rotated { group: (usize, usize), fold: usize },
+}
+
+impl Hiding {
+    /// How many [`Hiding::Rotated`] folds cover the frame.
+    pub const FOLDS: usize = 3;
+
+    /// Whether sample `(row, col)` of `snapshot` (of a `rows x cols` frame) is hidden.
+    #[inline]
+    pub fn hides(self, snapshot: usize, at: (usize, usize), size: (usize, usize)) -> bool {
+        match self {
+            Self::Hashed(hold, held) => held.holds(&hold, snapshot, at, size),
+            Self::Rotated { group: (gr, gc), fold } => {
+                (snapshot + at.0 / gr.max(1) + 2 * (at.1 / gc.max(1))) % Self::FOLDS == fold
+            }
+        }
+    }
+
+    /// The lenslets either side of a lenslet whose held-out samples its map takes: as
+    /// [`Held::reach`], or a patch's reach where the folds hide every sample.
+    fn reach(self, views: (usize, usize)) -> usize {
+        match self {
+            Self::Hashed(_, held) => held.reach(views),
+            Self::Rotated { .. } => 2,
+        }
+    }
+}
+
 /// A snapshot's raw frame with its held-out samples hidden (not finite: the decode leaves
 /// them out).
 pub struct HeldOutFrame<'a> {
     frame: &'a RawFrame<'a, u16>,
     snapshot: usize,
-    hold: HoldOut,
-    held: Held,
+    hiding: Hiding,
 }
 
 impl<'a> HeldOutFrame<'a> {
-    /// `frames` (one per snapshot) with the samples `held` and `hold` name hidden.
-    pub fn of(frames: &'a [RawFrame<'a, u16>], hold: HoldOut, held: Held) -> Vec<Self> {
-        frames.iter().enumerate().map(|(snapshot, frame)| Self { frame, snapshot, hold, held }).collect()
+    /// `frames` (one per snapshot) with the samples `hiding` names hidden.
+    pub fn of(frames: &'a [RawFrame<'a, u16>], hiding: Hiding) -> Vec<Self> {
+        frames.iter().enumerate().map(|(snapshot, frame)| Self { frame, snapshot, hiding }).collect()
     }
 }
 
@@ -133,7 +170,7 @@ impl Frame for HeldOutFrame<'_> {
     fn sample(&self, i: usize) -> Option<f32> {
         let (rows, cols) = self.frame.size();
         let at = (i.checked_div(cols)?, i.checked_rem(cols)?);
-        if self.held.holds(&self.hold, self.snapshot, at, (rows, cols)) {
+        if self.hiding.hides(self.snapshot, at, (rows, cols)) {
             return Some(f32::NAN);
         }
         self.frame.sample(i)
@@ -141,13 +178,16 @@ impl Frame for HeldOutFrame<'_> {
 }
 
 /// Per lenslet: the held-out samples' squared prediction errors and noise variances
-/// summed, how many, and the valid samples in all (the light field's units).
+/// summed, how many, and the valid samples in all (the light field's units); with a second
+/// prediction (a baseline's), its squared errors and the two errors' products.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 struct Tally {
     squared: f64,
     variance: f64,
     held: u32,
     measured: f64,
+    other: f64,
+    cross: f64,
 }
 
 impl Tally {
@@ -156,6 +196,15 @@ impl Tally {
         self.variance += o.variance;
         self.held += o.held;
         self.measured += o.measured;
+        self.other += o.other;
+        self.cross += o.cross;
+    }
+
+    /// The tally of `(1 - w) x decode + w x other`: its squared errors from the two
+    /// predictions' (exact, as `w` is one number for the lenslet).
+    fn blended(&self, w: f64) -> Self {
+        let squared = (1.0 - w) * (1.0 - w) * self.squared + w * w * self.other + 2.0 * w * (1.0 - w) * self.cross;
+        Self { squared, other: 0.0, cross: 0.0, ..*self }
     }
 }
 
@@ -164,10 +213,11 @@ impl Tally {
 struct Tallies<'a, const PU: usize, const PV: usize, const N: usize> {
     decoder: &'a TileDecoder<'a, 5, 5, PU, PV, 13, N>,
     raw: &'a [RawFrame<'a, u16>],
-    hold: HoldOut,
-    held: Held,
+    hiding: Hiding,
     shape: RowShape,
     tallies: Vec<Tally>,
+    /// A second prediction of the held-out samples, from the same samples (a baseline's).
+    other: Option<&'a LightField>,
 }
 
 impl<const PU: usize, const PV: usize, const N: usize> RowSink for Tallies<'_, PU, PV, N> {
@@ -194,27 +244,26 @@ impl<const PU: usize, const PV: usize, const N: usize> RowSink for Tallies<'_, P
                         let Some(sample) = self.raw.get(j).and_then(|f| f.sample(r * frame.1 + cc)) else { continue };
                         let seen = self.decoder.light_field_value(sample, (r, cc));
                         t.measured += f64::from(u8::from(seen.is_ok()));
-                        if !self.held.holds(&self.hold, j, (r, cc), frame) {
+                        if !self.hiding.hides(j, (r, cc), frame) {
                             continue;
                         }
                         let Some(&predicted) = values.get(s.at(u, v, x, usize::from(band))) else { continue };
-                        let predicted = f64::from(predicted);
-                        match seen {
+                        let (predicted, band) = (f64::from(predicted), usize::from(band));
+                        let other = self.other.map_or(predicted, |lf| f64::from(lf.get(u, v, y, x, band)));
+                        // A saturated sample's value is at least the top of the range: a
+                        // value under it errs by the gap at least.
+                        let (d, e) = match seen {
                             Ok(seen) => {
-                                let d = predicted - f64::from(seen);
-                                t.squared += d * d;
                                 t.variance += noise * noise + shot * f64::from(seen).max(0.0);
-                                t.held += 1;
+                                (predicted - f64::from(seen), other - f64::from(seen))
                             }
-                            // A saturated sample's value is at least the top of the range:
-                            // the decode's value under it errs by the gap at least.
-                            Err(Invalid::OverRange) => {
-                                let gap = (top - predicted).max(0.0);
-                                t.squared += gap * gap;
-                                t.held += 1;
-                            }
-                            Err(_) => {}
-                        }
+                            Err(Invalid::OverRange) => ((top - predicted).max(0.0), (top - other).max(0.0)),
+                            Err(_) => continue,
+                        };
+                        t.squared += d * d;
+                        t.other += e * e;
+                        t.cross += d * e;
+                        t.held += 1;
                     }
                 }
             }
@@ -230,7 +279,7 @@ impl<const PU: usize, const PV: usize, const N: usize> RowSink for Tallies<'_, P
 pub struct HeldOutDecode {
     tallies: Vec<Tally>,
     shape: RowShape,
-    held: Held,
+    hiding: Hiding,
 }
 
 impl HeldOutDecode {
@@ -249,19 +298,67 @@ impl HeldOutDecode {
     where
         M: PatchModel<5, 5, PU, PV, 13, N> + Sync,
     {
-        let held = Held::of(&plan.decoder);
-        let hidden = HeldOutFrame::of(raw, hold, held);
+        Self::run_hiding(plan, model, raw, Hiding::Hashed(hold, Held::of(&plan.decoder)), None, batch)
+    }
+
+    /// [`Self::run`] without the samples `hiding` names, and `other` (a light field made
+    /// from the same samples, a baseline's) tallied at them too, for [`Self::blended`].
+    ///
+    /// # Errors
+    /// What the held-out decode reports, or `other` of another shape.
+    pub fn run_hiding<const PU: usize, const PV: usize, const N: usize, M>(
+        plan: &FramePlan<'_, PU, PV, N>,
+        model: &M,
+        raw: &[RawFrame<'_, u16>],
+        hiding: Hiding,
+        other: Option<&LightField>,
+        batch: usize,
+    ) -> Result<Self>
+    where
+        M: PatchModel<5, 5, PU, PV, 13, N> + Sync,
+    {
+        let hidden = HeldOutFrame::of(raw, hiding);
         let shape = plan.shape;
+        if let Some(lf) = other {
+            ensure!(
+                [lf.views.0, lf.views.1, lf.rows, lf.cols, lf.bands] == shape.shape(),
+                "the second prediction's shape differs from the decode's"
+            );
+        }
         let mut sink = Tallies {
             decoder: &plan.decoder,
             raw,
-            hold,
-            held,
+            hiding,
             shape,
             tallies: vec![Tally::default(); shape.rows * shape.cols],
+            other,
         };
         decode_rows(plan, model, &hidden, batch, false, &|_, _| {}, &mut sink)?;
-        Ok(Self { tallies: sink.tallies, shape, held })
+        Ok(Self { tallies: sink.tallies, shape, hiding })
+    }
+
+    /// Held-out decodes of the same plan added up: the folds of [`Hiding::Rotated`] into
+    /// one that held out every sample once.
+    pub fn add(&mut self, o: &Self) {
+        for (t, x) in self.tallies.iter_mut().zip(&o.tallies) {
+            // The valid samples are the frame's, the same in every fold: counted once.
+            let measured = t.measured;
+            t.add(x);
+            t.measured = measured;
+        }
+    }
+
+    /// Per lenslet, the held-out samples' summed squared errors of the decode and of the
+    /// second prediction (zero without one).
+    pub fn squared_per_lenslet(&self) -> Vec<(f64, f64)> {
+        self.tallies.iter().map(|t| (t.squared, t.other)).collect()
+    }
+
+    /// This held-out decode as the tallies of the blend `(1 - w) x decode + w x other`, `w`
+    /// per lenslet (row-major): the estimate of the blended output.
+    pub fn blended(&self, weights: &[f32]) -> Self {
+        let tallies = self.tallies.iter().zip(weights).map(|(t, &w)| t.blended(f64::from(w))).collect();
+        Self { tallies, shape: self.shape, hiding: self.hiding }
     }
 
     /// The error estimate of the frame's values nobody measured (RMS, the output's units,
@@ -281,7 +378,7 @@ impl HeldOutDecode {
     pub fn map(&self) -> Vec<f32> {
         let shape = self.shape;
         let values = (shape.views.0 * shape.views.1 * shape.bands) as f64;
-        boxed(&self.tallies, (shape.rows, shape.cols), self.held.reach(shape.views))
+        boxed(&self.tallies, (shape.rows, shape.cols), self.hiding.reach(shape.views))
             .iter()
             .map(|t| {
                 if t.held == 0 {

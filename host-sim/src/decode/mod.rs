@@ -9,7 +9,8 @@
 //!   its [`options`]: a frame's [`plan`] made once, then its rows decoded down the frame by
 //!   the [`strip`] (each tile's patches into `tile_sums`, the adaptive rule's [`seams`])
 //!   and put to a sink as they are finished; what it did in its [`report`]; the error
-//!   estimate of that decode from a second one with samples [`held_out`];
+//!   estimate of that decode from a second one with samples [`held_out`]; on a kronecker
+//!   mask, each block mixed with PPID's by their held-out errors ([`blend`]);
 //! - [`baselines`]: decode methods without compressed sensing (per-pixel interpolation, a
 //!   neighbourhood demosaic, PPID);
 //! - [`paper_1d`]: the paper's 1D method (explicit Kronecker matrices) and a 5D SL0 in f64,
@@ -24,6 +25,7 @@
 //! May use: [`crate::io`], [`crate::sim`]. Used by the train and eval layers.
 
 pub mod baselines;
+pub mod blend;
 pub mod calibrate;
 pub mod cs;
 pub mod device;

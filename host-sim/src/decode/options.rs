@@ -260,6 +260,10 @@ pub struct DecodeOptions {
     pub estimate_by: EstimateBy,
     /// How the model trial tells the models apart ([`TrialBy`]).
     pub trial_by: TrialBy,
+    /// On a kronecker mask, each block mixed from the decode and the PPID baseline by their
+    /// held-out errors ([`crate::decode::blend`]): three decodes and four PPIDs of the frame
+    /// more. Off here (the plain decode, the device's); on in the default and best presets.
+    pub baseline_blend: bool,
     /// Whether half-pixel disparities are checked against the whole ones by the held-out
     /// error estimate ([`slf_firmware::TileDecoder::with_shear_check`]). Off by default.
     pub shear_check: bool,
@@ -341,6 +345,7 @@ impl Default for DecodeOptions {
             error_estimate: false,
             estimate_by: EstimateBy::Decode,
             trial_by: TrialBy::Pilots,
+            baseline_blend: false,
             shear_check: false,
             model_trial: false,
             shear_trial: false,

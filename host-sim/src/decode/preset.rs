@@ -17,8 +17,9 @@
 //!   tapered window, the capture's disparities (half pixels at one snapshot), seeded, with
 //!   the blob's trained schedules (24 steps the DCT's cold solve, 16 a member's or a seeded
 //!   solve), the frame given to the DCT instead where the model trial's pilots say it
-//!   predicts held-out measurements better ([`crate::decode::trial`]): what `slf decode`
-//!   does unless told.
+//!   predicts held-out measurements better ([`crate::decode::trial`]), and on a kronecker
+//!   mask each block mixed with the PPID baseline's by their held-out errors
+//!   ([`crate::decode::blend`]): what `slf decode` does unless told.
 //! - [`Preset::Best`]: the default at stride 1, where every lenslet is covered by every
 //!   patch that holds it: 25 instead of 9 times the disjoint grid's patches.
 //!
@@ -75,10 +76,19 @@ impl Preset {
                 model_trial: true,
                 ..DecodeOptions::default()
             },
-            Self::Default => DecodeOptions { model_trial: true, shear_trial: true, ..DecodeOptions::default() },
-            Self::Best => {
-                DecodeOptions { stride: (1, 1), model_trial: true, shear_trial: true, ..DecodeOptions::default() }
-            }
+            Self::Default => DecodeOptions {
+                model_trial: true,
+                shear_trial: true,
+                baseline_blend: true,
+                ..DecodeOptions::default()
+            },
+            Self::Best => DecodeOptions {
+                stride: (1, 1),
+                model_trial: true,
+                shear_trial: true,
+                baseline_blend: true,
+                ..DecodeOptions::default()
+            },
         }
     }
 

@@ -82,6 +82,8 @@ pub struct DecodeReport {
     pub error_lenslets: Vec<f32>,
     /// The held-out decode's wall time, seconds (0 without it; in [`Self::seconds`] too).
     pub estimate_seconds: f64,
+    /// What the baseline blend did ([`crate::decode::blend`]; `None` without it).
+    pub blend: Option<BlendReport>,
     /// What the model trial picked ([`crate::decode::options::DecodeOptions::model_trial`]; `None` without it).
     pub trial: Option<TrialReport>,
     /// What the shear trial found ([`crate::decode::options::DecodeOptions::shear_trial`]; `None` without it or
@@ -105,6 +107,19 @@ pub struct ShearTrialReport {
     pub half_error: f64,
     /// At the better whole disparity beside each.
     pub whole_error: f64,
+}
+
+/// The baseline blend of a decode ([`crate::decode::blend`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct BlendReport {
+    /// PPID's weight averaged over the lenslets.
+    pub mean_weight: f64,
+    /// Lenslets whose values are more PPID's than the decode's (weight above one half).
+    pub mostly_baseline: usize,
+    /// Lenslets in all.
+    pub lenslets: usize,
+    /// Seconds its held-out decodes and PPIDs took (included in the decode's).
+    pub seconds: f64,
 }
 
 /// The model trial's picks in a decode ([`crate::decode::trial`]).

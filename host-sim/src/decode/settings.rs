@@ -436,6 +436,13 @@ pub struct DecodeSettings {
     /// [default: pilots].
     #[arg(long, value_enum, value_name = "HOW")]
     pub trial_by: Option<TrialBy>,
+    /// On a kronecker mask: mix each block's values from the decode and the PPID baseline by
+    /// how well each predicted the samples it was not given (three held-out decodes of the
+    /// frame and four PPIDs more; PPID's light field held whole); with --error-map their
+    /// held-out decodes are the map's. Other masks are decoded as without it [default: true;
+    /// false with --preset preview].
+    #[arg(long, value_name = "BOOL")]
+    pub baseline_blend: Option<bool>,
     /// With half-pixel disparities: check them first on one pilot patch a tile (up to 256)
     /// against the whole disparities beside them by the held-out error estimate, and decode
     /// the frame with whole disparities only where the whole ones estimate below 0.7 x the
@@ -538,6 +545,7 @@ impl DecodeSettings {
             error_estimate: self.estimate || base.error_estimate,
             estimate_by: self.estimate_by.unwrap_or(base.estimate_by),
             trial_by: self.trial_by.unwrap_or(base.trial_by),
+            baseline_blend: self.baseline_blend.unwrap_or(base.baseline_blend),
             shear_check: self.shear_check || base.shear_check,
             // A dictionary named is the model asked for: no trial unless asked too.
             model_trial: self.model_trial.unwrap_or(base.model_trial && self.basis.dictionary.is_none()),

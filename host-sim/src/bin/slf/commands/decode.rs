@@ -336,10 +336,22 @@ pub fn run(args: Args) -> Result<()> {
             )?,
         }
     }
+    if let Some(b) = &r.blend {
+        outln!(
+            "baseline blend: PPID's weight {:.2} on average, above one half at {} of {} lenslets (by the held-out \
+             errors of three decodes and PPIDs, each without one of every block's snapshots; {:.2} s)",
+            b.mean_weight,
+            b.mostly_baseline,
+            b.lenslets,
+            b.seconds
+        )?;
+    }
     if let Some(map) = &errors {
         let psnr = estimated_psnr(map, peak).map_or("none".into(), |p| format!("{p:.2} dB"));
         let by = if r.error_lenslets.is_empty() {
             format!("{} of {} patches from held-out measurements", r.error_map.len(), r.patches.decoded)
+        } else if r.blend.is_some() {
+            "the baseline blend's held-out decodes, every sample held out once".to_string()
         } else {
             format!("the frame decoded again from seven samples in eight ({:.2} s)", r.estimate_seconds)
         };
