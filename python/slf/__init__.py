@@ -418,7 +418,8 @@ def decode(
     seven in eight samples, two more decodes: ``report["trial"]["decode_dct_error"]`` and
     ``["decode_ensemble_error"]``), ``baseline_blend`` (on a kronecker mask, each block mixed
     from the decode and PPID by their held-out errors; default True: ``report["baseline_blend"]``
-    gives PPID's mean weight, the lenslets mostly PPID's and its seconds), ``shear_trial`` (whole disparities only for the frame where pilot patches
+    gives PPID's mean weight, its weight per lenslet (``"weights"``), the lenslets mostly PPID's
+    and its seconds), ``shear_trial`` (whole disparities only for the frame where pilot patches
     estimate them clearly better than the half-pixel ones; default True:
     ``report["shear_trial"]``), ``error_map`` (the decode's error per lenslet in
     ``report["error_map"]`` and its estimated PSNR), ``estimate_by`` decode (the frame

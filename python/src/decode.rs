@@ -148,6 +148,8 @@ pub fn decode<'py>(
                 blend.set_item("mostly_baseline", b.mostly_baseline)?;
                 blend.set_item("lenslets", b.lenslets)?;
                 blend.set_item("seconds", b.seconds)?;
+                let (rows, cols) = (d.lenslets[0], d.lenslets[1]);
+                blend.set_item("weights", plane(py, b.weights.clone(), rows, cols)?)?;
                 report.set_item("baseline_blend", blend)?;
             }
             if let Some(t) = &r.trial {

@@ -245,3 +245,27 @@ def test_an_hdf5_soft_link_is_named_as_one(tmp_path, slf_bin):
     assert p.returncode == 1
     assert "is a soft link or another object" in p.stderr and "18446744073709551615" not in p.stderr
     run(base + ["--dataset", "real"])
+
+
+def test_baseline_blend_equals_cli(tmp_path, slf_bin, depth):
+    """On a kronecker mask the default blends each block with PPID's (issue 63): the same
+    output and weights as the command's; off, the decode alone; on a pixel mask, nothing."""
+    cap = slf.simulate(depth, mask="kronecker", k=3, seed=1)
+    cap.save(tmp_path / "cap")
+    out = run([slf_bin, "decode", tmp_path / "cap", "-o", tmp_path / "o.npy", "-q"]).stdout
+    lf, report = slf.decode(cap, report=True)
+    assert np.array_equal(lf, np.load(tmp_path / "o.npy"))
+    b = report["baseline_blend"]
+    w = b["weights"]
+    assert w.shape == (20, 20) and w.dtype == np.float32 and ((w >= 0) & (w <= 1)).all()
+    assert b["mean_weight"] == pytest.approx(float(w.mean()), abs=1e-6)
+    assert b["mostly_baseline"] == int((w > 0.5).sum()) and b["lenslets"] == 400
+    assert f"baseline blend: PPID's weight {b['mean_weight']:.2f} on average, above one half at {b['mostly_baseline']} of 400" in out
+    # Each value between the decode's alone and PPID's, at the lenslet's weight.
+    alone, off = slf.decode(cap, baseline_blend=False, report=True)
+    assert "baseline_blend" not in off
+    baseline = slf.decode(cap, method="ppid")
+    want = alone + w[None, None, :, :, None] * (baseline - alone)
+    assert np.abs(lf - want).max() < 1e-5
+    _, pixel = slf.decode(slf.simulate(depth, k=3, seed=1), report=True)
+    assert "baseline_blend" not in pixel

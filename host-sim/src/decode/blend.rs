@@ -136,7 +136,8 @@ pub fn weights(squared: &[(f64, f64)], shape: RowShape, (br, bc): (usize, usize)
     let mut blocks = vec![(0.0f64, 0.0f64); nr * nc];
     for y in 0..shape.rows {
         for x in 0..shape.cols {
-            if let (Some(b), Some(&(c, p))) = (blocks.get_mut((y / br) * nc + x / bc), squared.get(y * shape.cols + x)) {
+            if let (Some(b), Some(&(c, p))) = (blocks.get_mut((y / br) * nc + x / bc), squared.get(y * shape.cols + x))
+            {
                 b.0 += c;
                 b.1 += p;
             }

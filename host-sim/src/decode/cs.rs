@@ -30,7 +30,8 @@ pub use crate::decode::options::{
 use crate::decode::plan::{FramePlan, patch_estimates};
 pub use crate::decode::plan::{ModelPick, tile_decoder};
 pub use crate::decode::report::{
-    BlendReport, DecodeReport, PatchDecoder, ShearTrialReport, TrialReport, disparity_per_lenslet, error_per_lenslet, estimated_psnr,
+    BlendReport, DecodeReport, PatchDecoder, ShearTrialReport, TrialReport, disparity_per_lenslet, error_per_lenslet,
+    estimated_psnr,
 };
 use crate::decode::strip::decode_rows;
 use crate::decode::trial::{DCT_LEAN, rms};
@@ -352,6 +353,7 @@ where
         mostly_baseline: b.weights.iter().filter(|&&w| w > 0.5).count(),
         lenslets: b.weights.len(),
         seconds: blend_seconds,
+        weights: b.weights.clone(),
     });
     report.seconds = start.elapsed().as_secs_f64();
     report.gains = *plan.decoder.gains();

@@ -448,7 +448,7 @@ mod tests {
 
     #[test]
     fn a_box_sums_its_neighbours_and_clips_at_the_edges() {
-        let one = Tally { squared: 1.0, variance: 0.5, held: 1, measured: 2.0 };
+        let one = Tally { squared: 1.0, variance: 0.5, held: 1, measured: 2.0, ..Tally::default() };
         let b = boxed(&vec![one; 36], (6, 6), 2);
         // A corner's box holds 3 x 3 lenslets, the middle's 5 x 5.
         assert_eq!(b[0].held, 9);

@@ -76,12 +76,9 @@ impl Preset {
                 model_trial: true,
                 ..DecodeOptions::default()
             },
-            Self::Default => DecodeOptions {
-                model_trial: true,
-                shear_trial: true,
-                baseline_blend: true,
-                ..DecodeOptions::default()
-            },
+            Self::Default => {
+                DecodeOptions { model_trial: true, shear_trial: true, baseline_blend: true, ..DecodeOptions::default() }
+            }
             Self::Best => DecodeOptions {
                 stride: (1, 1),
                 model_trial: true,

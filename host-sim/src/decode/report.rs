@@ -120,6 +120,8 @@ pub struct BlendReport {
     pub lenslets: usize,
     /// Seconds its held-out decodes and PPIDs took (included in the decode's).
     pub seconds: f64,
+    /// PPID's weight per lenslet, row-major (the decode's is one less).
+    pub weights: Vec<f32>,
 }
 
 /// The model trial's picks in a decode ([`crate::decode::trial`]).
