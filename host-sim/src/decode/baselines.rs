@@ -422,14 +422,35 @@ pub fn ppid(capture: &Capture, cfg: &PpidConfig) -> Result<(LightField, Baseline
     let coarse: Vec<f32> = estimate.iter().map(|e| e.iter().sum::<f32>() / nb as f32).collect();
     // Every position's lenslet and measurements, and the positions of each lenslet.
     let positions: Vec<Position> = samples.positions().map(|(_, st, own)| (st, own)).collect();
-    let mut by_lenslet: Vec<Vec<usize>> = vec![Vec::new(); ls * lt];
-    for (i, ((s, t), _)) in positions.iter().enumerate() {
-        by_lenslet[s * lt + t].push(i);
+    // The same, laid out lenslet by lenslet (each lenslet's positions in position order,
+    // each position's measurements after another): the walk over a neighbourhood reads
+    // memory in order. Read through each position's own allocation, a 128 x 128-lenslet
+    // frame's PPID took 43 s on one thread, 2.4 times the CS decode.
+    let mut slots: Vec<usize> = Vec::with_capacity(positions.len());
+    let mut lenslet_start = vec![0usize; ls * lt + 1];
+    {
+        let mut by_lenslet: Vec<Vec<usize>> = vec![Vec::new(); ls * lt];
+        for (i, ((s, t), _)) in positions.iter().enumerate() {
+            by_lenslet[s * lt + t].push(i);
+        }
+        for (l, members) in by_lenslet.iter().enumerate() {
+            slots.extend_from_slice(members);
+            lenslet_start[l + 1] = slots.len();
+        }
     }
+    let mut taken: Vec<(u8, f32)> = Vec::new();
+    let mut taken_start = Vec::with_capacity(slots.len() + 1);
+    taken_start.push(0usize);
+    for &q in &slots {
+        taken.extend_from_slice(&positions[q].1);
+        taken_start.push(taken.len());
+    }
+    let theirs = |j: usize| &taken[taken_start[j]..taken_start[j + 1]];
     let r = cfg.radius as isize;
     let gauss = |ds: isize, dt: isize| (-((ds * ds + dt * dt) as f32) / (2.0 * cfg.sigma * cfg.sigma)).exp();
-    // Calls f(weight, neighbour position) for every position of the lenslets around (s, t).
-    let around = |s: usize, t: usize, f: &mut dyn FnMut(f32, usize)| {
+    // Calls f(weight, neighbour's lenslet, neighbour's slot) for every position of the
+    // lenslets around (s, t).
+    let around = |s: usize, t: usize, f: &mut dyn FnMut(f32, usize, usize)| {
         for ds in -r..=r {
             for dt in -r..=r {
                 let (ss, tt) = (s as isize + ds, t as isize + dt);
@@ -437,8 +458,9 @@ pub fn ppid(capture: &Capture, cfg: &PpidConfig) -> Result<(LightField, Baseline
                     continue;
                 }
                 let g = gauss(ds, dt);
-                for &q in &by_lenslet[ss as usize * lt + tt as usize] {
-                    f(g, q);
+                let l = ss as usize * lt + tt as usize;
+                for j in lenslet_start[l]..lenslet_start[l + 1] {
+                    f(g, l, j);
                 }
             }
         }
@@ -453,12 +475,11 @@ pub fn ppid(capture: &Capture, cfg: &PpidConfig) -> Result<(LightField, Baseline
                 return coarse[s * lt + t];
             }
             let (mut num, mut den) = (vec![0.0f32; nb], vec![0.0f32; nb]);
-            around(*s, *t, &mut |g, q| {
-                let ((qs, qt), theirs) = &positions[q];
-                for &(b, x) in theirs {
+            around(*s, *t, &mut |g, l, j| {
+                for &(b, x) in theirs(j) {
                     let b = usize::from(b);
                     if own.iter().any(|&(ob, _)| usize::from(ob) == b) {
-                        num[b] += g * (coarse[qs * lt + qt] - x);
+                        num[b] += g * (coarse[l] - x);
                         den[b] += g;
                     }
                 }
@@ -473,16 +494,18 @@ pub fn ppid(capture: &Capture, cfg: &PpidConfig) -> Result<(LightField, Baseline
             sum / own.len() as f32
         })
         .collect();
+    let ppi_of_slot: Vec<f32> = slots.iter().map(|&q| ppi[q]).collect();
     // Step 2: each band is the PPI plus the band's difference to it, interpolated with
     // edge-sensing weights.
     let mut lf = samples.empty_field();
     lf.data.par_chunks_mut(nb).enumerate().for_each(|(p, out)| {
         let ((s, t), own) = &positions[p];
         let (mut num, mut den) = (vec![0.0f32; nb], vec![0.0f32; nb]);
-        around(*s, *t, &mut |g, q| {
-            let w = g / (cfg.epsilon + (ppi[p] - ppi[q]).abs());
-            for &(b, x) in &positions[q].1 {
-                num[usize::from(b)] += w * (x - ppi[q]);
+        around(*s, *t, &mut |g, _, j| {
+            let pq = ppi_of_slot[j];
+            let w = g / (cfg.epsilon + (ppi[p] - pq).abs());
+            for &(b, x) in theirs(j) {
+                num[usize::from(b)] += w * (x - pq);
                 den[usize::from(b)] += w;
             }
         });
