@@ -79,6 +79,15 @@ impl BaselineBlend {
         let Held::Group(group) = Held::of(&plan.decoder) else {
             anyhow::bail!("a kronecker mask holds out whole blocks");
         };
+        // Two PPID light fields at once (the whole capture's, kept, and a fold's) and PPID's
+        // own tables (about 150 bytes a sensor position): checked before any is made.
+        let s = plan.shape;
+        let positions = (s.views.0 * s.views.1 * s.rows * s.cols) as u64;
+        crate::io::budget::check(
+            positions * (2 * 4 * s.bands as u64 + 150),
+            "the baseline blend (two PPID light fields held whole)",
+            "--baseline-blend false, which decodes in a band of rows",
+        )?;
         let cfg = PpidConfig::default();
         let mut total: Option<HeldOutDecode> = None;
         for fold in 0..Hiding::FOLDS {
