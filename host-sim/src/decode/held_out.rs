@@ -33,6 +33,11 @@
 //! It is taken where the light field holds each sample's own value
 //! ([`slf_firmware::TileDecoder::samples_are_values`]); elsewhere the patches' estimates
 //! stand in. It costs a second decode of the frame.
+//!
+//! A held-out decode can hide folds that together cover the frame instead
+//! ([`Hiding::Rotated`]), and tally a second prediction of the same samples beside its own
+//! (a baseline's from the same samples, with the two errors' products): the baseline
+//! blend's ([`crate::decode::blend`]), whose tallies then estimate the blended output.
 
 use anyhow::{Result, ensure};
 use slf_firmware::raw::Invalid;
