@@ -5,8 +5,8 @@
 # --error-map), the default without the blend, the PPID and demosaic baselines, the preview
 # and the preview with the blend; PSNR / SSIM / SA against the truth, the blended output's
 # estimated PSNR and rank correlation (`slf eval --error-map`), and each decode's seconds.
-# The blend's weights were chosen on the 18 synthetic scenes at kronecker k = 3; the real
-# crops and k = 1 were not looked at before.
+# The blend's rule was chosen on the 18 synthetic scenes at kronecker k = 3 (the real crops'
+# figures were printed beside them then); k = 1 was not looked at before.
 #
 # SLF_RESUME=1 keeps the captures OUT_DIR's table already holds (a run that stopped).
 #
@@ -52,7 +52,8 @@ print(f"Made by `bash scripts/baseline-blend.sh OUT_DIR` at {sys.argv[3]}: synth
       "is `--preset preview --baseline-blend true`. The estimate is the blended output's (`--error-map`, "
       "`slf eval --error-map`): its PSNR less the true one, and the rank correlation of the estimated and true RMS "
       "errors of blocks of 5 x 5 lenslets. Times: seconds of one decode each. The blend's rule was chosen on the "
-      "synthetic scenes at kronecker k = 3; the real crops (\\*) and k = 1 were not looked at before.")
+      "synthetic scenes at kronecker k = 3, with the real crops' (\\*) figures printed beside them; k = 1 was not "
+      "looked at before.")
 for s in asked:
     sel = [r for r in rows if r[0] == s]
     if not sel:

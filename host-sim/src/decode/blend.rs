@@ -19,8 +19,9 @@
 //! lost up to 1.9 dB), and PPID's weight `c^2 / (c^2 + p^2)` for the decode's error `c` and
 //! PPID's `p`: about one half where they tie, the better one's where they do not (the
 //! aggregation of estimators by their errors; picking the better one lost up to 0.9 dB where
-//! the weights lost 0.34, `docs/results-baseline-blend.md`). The weights were chosen on the
-//! 18 synthetic scenes; the real crops were not looked at before.
+//! the weights lost 0.34, `docs/results-baseline-blend.md`). The rule was chosen on the 18
+//! synthetic scenes at kronecker k = 3 (the real crops' figures printed beside them);
+//! kronecker k = 1 was not looked at before.
 //!
 //! The held-out decodes give the error estimate of the blended output too, exactly (the
 //! weight is one number per lenslet): [`HeldOutDecode::blended`].
