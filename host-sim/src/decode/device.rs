@@ -564,9 +564,11 @@ fn check_rows(
     model: &EnsembleModel<'_, 5, 5, 5, 5, 13>,
     pick: Pick,
 ) -> Result<()> {
-    // The host's default, full-view patches (the device's), no flags.
+    // The host's default, full-view patches (the device's), no flags; without the baseline
+    // blend, which the device does not make (it has no PPID).
     let opts = crate::decode::cs::DecodeOptions {
         patch_views: Some(crate::decode::cs::PatchViews::Five),
+        baseline_blend: false,
         ..crate::decode::preset::Preset::Default.options()
     };
     // With the model the trial picked (the device's, checked above).
