@@ -8,7 +8,9 @@
 # The blend's rule was chosen on the 18 synthetic scenes at kronecker k = 3 (the real crops'
 # figures were printed beside them then); k = 1 was not looked at before.
 #
-# SLF_RESUME=1 keeps the captures OUT_DIR's table already holds (a run that stopped).
+# SLF_RESUME=1 keeps the captures OUT_DIR's table already holds (a run that stopped); the page
+# names the commits whose binaries made its rows (OUT_DIR/made-at; SLF_MADE_AT names the
+# commit of an SLF_BIN built earlier).
 #
 #   RAYON_NUM_THREADS=1 bash scripts/baseline-blend.sh OUT_DIR > docs/results-baseline-blend.md
 set -euo pipefail
@@ -33,10 +35,13 @@ row() {
   decode_eval "$cap" --preset preview; cols+=("$p" "$t")
   decode_eval "$cap" --preset preview --baseline-blend true; cols+=("$p" "$t")
   (IFS=$'\t'; echo "$s	$scene	${cols[*]}") >> "$rows"
+  # The commit whose binary made the rows (a resumed run adds its own).
+  grep -qx "$made" "$out/made-at" 2>/dev/null || echo "$made" >> "$out/made-at"
 }
+made=${SLF_MADE_AT:-$(git rev-parse --short HEAD)}
 settings=${SLF_SETTINGS:-kronecker:3 kronecker:1}
 each_capture "$settings" 1 row
-python3 - "$rows" "$size" "$(git rev-parse --short HEAD)" "${RAYON_NUM_THREADS:-all}" "$settings" <<'PY'
+python3 - "$rows" "$size" "$(paste -sd, "$out/made-at" 2>/dev/null || git rev-parse --short HEAD)" "${RAYON_NUM_THREADS:-all}" "$settings" <<'PY'
 import statistics, sys
 asked = sys.argv[5].split()
 rows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1]) if l.strip()]
