@@ -748,6 +748,29 @@ fn interpolated_patches_are_counted_and_mapped_apart() {
     }
 }
 
+/// On a kronecker mask the default blends with PPID (issue 63); a blend that cannot be made
+/// (here: the memory cap, 0.01 GiB, below its two PPID light fields, about 12 MB at 44 x 44
+/// lenslets) leaves the decode alone, said in
+/// one line, exit 0, the same output as `--baseline-blend false`.
+#[test]
+fn a_blend_that_cannot_be_made_leaves_the_decode_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    stdout(slf().args(["scene", "smooth", "--size", "44", "-o"]).arg(p("s.npy")));
+    stdout(slf().arg("simulate").arg(p("s.npy")).args(["--mask", "kronecker", "-s", "3", "-o"]).arg(p("cap")));
+    let blended = stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("b.npy")));
+    assert!(blended.contains("baseline blend: PPID's weight"), "{blended}");
+    let capped = stdout(slf().args(["--max-memory", "0.01", "decode"]).arg(p("cap")).arg("-o").arg(p("c.npy")));
+    let line = capped.lines().find(|l| l.starts_with("baseline blend:")).unwrap_or_default();
+    assert!(
+        line.starts_with("baseline blend: not made (") && line.contains("cap") && line.ends_with("the decode alone"),
+        "{capped}"
+    );
+    stdout(slf().arg("decode").arg(p("cap")).args(["--baseline-blend", "false", "-o"]).arg(p("d.npy")));
+    assert_eq!(std::fs::read(p("c.npy")).unwrap(), std::fs::read(p("d.npy")).unwrap());
+    assert_ne!(std::fs::read(p("b.npy")).unwrap(), std::fs::read(p("d.npy")).unwrap());
+}
+
 /// `slf bench --from CSV --device CSV` draws a sweep's table again with the device's frame
 /// figure after it (seconds = solves x instructions / clock), without sweeping; a bad
 /// device file is one error line naming its line, and nothing is written.

@@ -142,6 +142,9 @@ pub fn decode<'py>(
                 trial.set_item("whole_error", t.whole_error)?;
                 report.set_item("shear_trial", trial)?;
             }
+            if let Some(why) = &r.blend_skipped {
+                report.set_item("baseline_blend_skipped", why)?;
+            }
             if let Some(b) = &r.blend {
                 let blend = PyDict::new(py);
                 blend.set_item("mean_weight", b.mean_weight)?;

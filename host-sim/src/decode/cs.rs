@@ -319,8 +319,13 @@ where
     let model = Picked { first, second, pick: plan.pick };
     // The baseline blend, measured before the decode whose rows it mixes as they come.
     let blending = Instant::now();
+    // A blend that cannot be made (a fold that leaves PPID no measurement, the memory cap)
+    // leaves the decode alone, and the report says why.
+    let mut blend_skipped = None;
     let blend = match opts.baseline_blend && blend::applies(&plan) {
-        true => Some(BaselineBlend::measure(&plan, &model, capture, &raw, opts.batch_tiles)?),
+        true => BaselineBlend::measure(&plan, &model, capture, &raw, opts.batch_tiles)
+            .map_err(|e| blend_skipped = Some(crate::io::message::one_line(&e)))
+            .ok(),
         false => None,
     };
     let blend_seconds = blending.elapsed().as_secs_f64();
@@ -348,6 +353,7 @@ where
         }
         report.estimate_seconds = seconds + held.elapsed().as_secs_f64();
     }
+    report.blend_skipped = blend_skipped;
     report.blend = blend.as_ref().map(|b| BlendReport {
         mean_weight: b.mean_weight(),
         mostly_baseline: b.weights.iter().filter(|&&w| w > 0.5).count(),

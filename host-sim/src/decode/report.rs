@@ -84,6 +84,8 @@ pub struct DecodeReport {
     pub estimate_seconds: f64,
     /// What the baseline blend did ([`crate::decode::blend`]; `None` without it).
     pub blend: Option<BlendReport>,
+    /// Why the baseline blend was asked for and not made (the decode alone was put out).
+    pub blend_skipped: Option<String>,
     /// What the model trial picked ([`crate::decode::options::DecodeOptions::model_trial`]; `None` without it).
     pub trial: Option<TrialReport>,
     /// What the shear trial found ([`crate::decode::options::DecodeOptions::shear_trial`]; `None` without it or

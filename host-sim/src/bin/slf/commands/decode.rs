@@ -336,6 +336,9 @@ pub fn run(args: Args) -> Result<()> {
             )?,
         }
     }
+    if let Some(why) = &r.blend_skipped {
+        outln!("baseline blend: not made ({why}); the decode alone")?;
+    }
     if let Some(b) = &r.blend {
         outln!(
             "baseline blend: PPID's weight {:.2} on average, above one half at {} of {} lenslets (by the held-out \
