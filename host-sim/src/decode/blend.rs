@@ -28,6 +28,8 @@
 //!
 //! Cost: three decodes and four PPIDs of the frame more, and PPID's light field held whole
 //! (13 values a pixel) while the decode writes: not the band of rows the decode alone holds.
+//! Checked against the memory cap before it starts; the decode goes on without a blend that
+//! cannot be made ([`crate::decode::report::DecodeReport::blend_skipped`]).
 
 use anyhow::{Result, ensure};
 use slf_firmware::{MaskFamily, PatchModel, RawFrame, RowSink};
