@@ -147,9 +147,9 @@ pub fn decode<'py>(
             }
             if let Some(b) = &r.blend {
                 let blend = PyDict::new(py);
-                blend.set_item("mean_weight", b.mean_weight)?;
-                blend.set_item("mostly_baseline", b.mostly_baseline)?;
-                blend.set_item("lenslets", b.lenslets)?;
+                blend.set_item("mean_weight", b.mean_weight())?;
+                blend.set_item("mostly_baseline", b.mostly_baseline())?;
+                blend.set_item("lenslets", b.weights.len())?;
                 blend.set_item("seconds", b.seconds)?;
                 let (rows, cols) = (d.lenslets[0], d.lenslets[1]);
                 blend.set_item("weights", plane(py, b.weights.clone(), rows, cols)?)?;

@@ -110,11 +110,6 @@ impl BaselineBlend {
         Ok(Self { baseline, weights, held_out })
     }
 
-    /// PPID's weight averaged over the frame's lenslets.
-    pub fn mean_weight(&self) -> f64 {
-        self.weights.iter().map(|&w| f64::from(w)).sum::<f64>() / self.weights.len().max(1) as f64
-    }
-
     /// A sink that blends each row the decode puts with PPID's and passes it to `inner`.
     pub fn rows<'a>(&'a self, inner: &'a mut Rows<'a>, shape: RowShape) -> BlendRows<'a> {
         BlendRows { inner, blend: self, shape, row: Vec::new() }

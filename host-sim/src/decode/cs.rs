@@ -338,29 +338,18 @@ where
     };
     if opts.error_estimate && !patch_estimates(opts, &plan.decoder) {
         let held = Instant::now();
-        let (decode, seconds) = match (estimated.take(), blend.as_ref()) {
+        let (map, seconds) = match (blend.as_ref(), estimated.take()) {
             // The blend's held-out decodes estimate the blended output, every sample held
             // out once: no decode more.
-            (_, Some(b)) => {
-                report.error_lenslets = b.held_out.map();
-                (None, 0.0)
-            }
-            (Some((d, s)), None) => (Some(d), s),
-            (None, None) => (Some(HeldOutDecode::run(&plan, &model, &raw, HoldOut::DEFAULT, opts.batch_tiles)?), 0.0),
+            (Some(b), _) => (b.held_out.map(), 0.0),
+            (None, Some((d, s))) => (d.map(), s),
+            (None, None) => (HeldOutDecode::run(&plan, &model, &raw, HoldOut::DEFAULT, opts.batch_tiles)?.map(), 0.0),
         };
-        if let Some(decode) = decode {
-            report.error_lenslets = decode.map();
-        }
+        report.error_lenslets = map;
         report.estimate_seconds = seconds + held.elapsed().as_secs_f64();
     }
     report.blend_skipped = blend_skipped;
-    report.blend = blend.as_ref().map(|b| BlendReport {
-        mean_weight: b.mean_weight(),
-        mostly_baseline: b.weights.iter().filter(|&&w| w > 0.5).count(),
-        lenslets: b.weights.len(),
-        seconds: blend_seconds,
-        weights: b.weights.clone(),
-    });
+    report.blend = blend.map(|b| BlendReport { seconds: blend_seconds, weights: b.weights });
     report.seconds = start.elapsed().as_secs_f64();
     report.gains = *plan.decoder.gains();
     report.patch_views = PatchViews::of_views(PU, PV);

@@ -114,16 +114,22 @@ pub struct ShearTrialReport {
 /// The baseline blend of a decode ([`crate::decode::blend`]).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct BlendReport {
-    /// PPID's weight averaged over the lenslets.
-    pub mean_weight: f64,
-    /// Lenslets whose values are more PPID's than the decode's (weight above one half).
-    pub mostly_baseline: usize,
-    /// Lenslets in all.
-    pub lenslets: usize,
     /// Seconds its held-out decodes and PPIDs took (included in the decode's).
     pub seconds: f64,
     /// PPID's weight per lenslet, row-major (the decode's is one less).
     pub weights: Vec<f32>,
+}
+
+impl BlendReport {
+    /// PPID's weight averaged over the lenslets.
+    pub fn mean_weight(&self) -> f64 {
+        self.weights.iter().map(|&w| f64::from(w)).sum::<f64>() / self.weights.len().max(1) as f64
+    }
+
+    /// Lenslets whose values are more PPID's than the decode's (weight above one half).
+    pub fn mostly_baseline(&self) -> usize {
+        self.weights.iter().filter(|&&w| w > 0.5).count()
+    }
 }
 
 /// The model trial's picks in a decode ([`crate::decode::trial`]).

@@ -343,9 +343,9 @@ pub fn run(args: Args) -> Result<()> {
         outln!(
             "baseline blend: PPID's weight {:.2} on average, above one half at {} of {} lenslets (by the held-out \
              errors of three decodes and PPIDs, each without one of every block's snapshots; {:.2} s)",
-            b.mean_weight,
-            b.mostly_baseline,
-            b.lenslets,
+            b.mean_weight(),
+            b.mostly_baseline(),
+            b.weights.len(),
             b.seconds
         )?;
     }
