@@ -122,14 +122,14 @@ fn the_picked_model_decodes_as_it_does_alone() {
 #[test]
 fn the_pick_is_the_smaller_sum_and_the_second_without_pilots_or_on_a_tie() {
     assert_eq!(TrialErrors::default().pick(), Pick::Second);
-    let mut t = TrialErrors { first: 1.0, second: 2.0, pilots: 1 };
+    let mut t = TrialErrors::one(1.0, 2.0);
     assert_eq!(t.pick(), Pick::First);
-    t.add(&TrialErrors { first: 3.0, second: 1.0, pilots: 1 });
-    assert_eq!(t, TrialErrors { first: 4.0, second: 3.0, pilots: 2 });
+    t.add(&TrialErrors::one(3.0, 1.0));
+    assert_eq!(t, TrialErrors { first: 4.0, second: 3.0, spread: 5.0, pilots: 2 });
     assert_eq!(t.pick(), Pick::Second);
-    assert_eq!(TrialErrors { first: 2.0, second: 2.0, pilots: 3 }.pick(), Pick::Second);
+    assert_eq!(TrialErrors { first: 2.0, second: 2.0, spread: 0.0, pilots: 3 }.pick(), Pick::Second);
     // No pilot: the sums say nothing.
-    assert_eq!(TrialErrors { first: 0.0, second: 5.0, pilots: 0 }.pick(), Pick::Second);
+    assert_eq!(TrialErrors { first: 0.0, second: 5.0, spread: 0.0, pilots: 0 }.pick(), Pick::Second);
 }
 
 #[test]
@@ -153,17 +153,91 @@ fn a_leaning_pick_leaves_its_model_only_below_the_margin() {
         (state >> 40) as f32 / (1u64 << 24) as f32
     };
     for i in 0..2000 {
-        let t = TrialErrors { first: next(), second: next(), pilots: (i % 3) as u32 };
+        let t = TrialErrors { first: next(), second: next(), spread: 0.0, pilots: (i % 3) as u32 };
         for (towards, margin) in [(Pick::First, 0.8), (Pick::Second, 0.8), (Pick::Second, 1.0), (Pick::First, 1.0)] {
             assert_eq!(t.pick_leaning(towards, margin), reference(&t, towards, margin), "{t:?} {towards:?} {margin}");
         }
         assert_eq!(t.pick_leaning(Pick::Second, 1.0), t.pick(), "{t:?}");
     }
     // At the margin's edges: 0.64 x is not below 0.8^2 x, just under it is.
-    let t = |second: f32| TrialErrors { first: 1.0, second, pilots: 4 };
+    let t = |second: f32| TrialErrors { first: 1.0, second, spread: 0.0, pilots: 4 };
     assert_eq!(t(0.7).pick_leaning(Pick::First, 0.8), Pick::First);
     assert_eq!(t(0.6).pick_leaning(Pick::First, 0.8), Pick::Second);
-    assert_eq!(TrialErrors { first: 1.0, second: 0.0, pilots: 0 }.pick_leaning(Pick::First, 0.8), Pick::First);
+    assert_eq!(
+        TrialErrors { first: 1.0, second: 0.0, spread: 0.0, pilots: 0 }.pick_leaning(Pick::First, 0.8),
+        Pick::First
+    );
+}
+
+#[test]
+fn a_tie_is_a_difference_within_two_standard_errors_of_the_pilots_and_takes_the_prior() {
+    // The reference, in f64 from the pilots' pairs: the paired differences' sample
+    // variance s^2, the sum's standard error sqrt(n s^2); tied when the sum of the
+    // differences is within two of them, or with fewer than two pilots.
+    let reference = |pairs: &[(f32, f32)]| {
+        let n = pairs.len() as f64;
+        if pairs.len() < 2 {
+            return true;
+        }
+        let d: Vec<f64> = pairs.iter().map(|&(a, b)| f64::from(a) - f64::from(b)).collect();
+        let mean = d.iter().sum::<f64>() / n;
+        let s2 = d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
+        (mean * n).abs() <= 2.0 * (n * s2).sqrt()
+    };
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let (mut tied, mut apart) = (0, 0);
+    for case in 0..3000 {
+        let n = case % 40;
+        // A shift between the models, from none to about the pilots' own spread.
+        let shift = (case % 7) as f32 * 0.05;
+        let pairs: Vec<(f32, f32)> = (0..n).map(|_| (next(), next() * 0.8 + shift)).collect();
+        let mut t = TrialErrors::default();
+        for &(a, b) in &pairs {
+            t.add(&TrialErrors::one(a, b));
+        }
+        let want = reference(&pairs);
+        // Away from the edge (f32 sums against f64), the two must agree.
+        let d: f64 = pairs.iter().map(|&(a, b)| f64::from(a) - f64::from(b)).sum();
+        let ratio = if n >= 2 {
+            let mean = d / n as f64;
+            let s2 = pairs.iter().map(|&(a, b)| (f64::from(a) - f64::from(b) - mean).powi(2)).sum::<f64>()
+                / (n as f64 - 1.0);
+            d.abs() / (2.0 * (n as f64 * s2).sqrt())
+        } else {
+            0.0
+        };
+        if (ratio - 1.0).abs() > 1e-3 {
+            assert_eq!(t.tied(), want, "{pairs:?}");
+        }
+        let lower = if t.first < t.second { Pick::First } else { Pick::Second };
+        for prior in [Pick::First, Pick::Second] {
+            assert_eq!(t.pick_unless_tied(Some(prior)), if t.tied() { prior } else { lower }, "{t:?}");
+        }
+        // Without a prior, the lower sum however close.
+        assert_eq!(t.pick_unless_tied(None), if n == 0 { Pick::Second } else { lower }, "{t:?}");
+        if t.tied() { tied += 1 } else { apart += 1 }
+    }
+    // Both sides of the test were reached.
+    assert!(tied > 300 && apart > 300, "{tied} tied, {apart} apart");
+    // Pilots that all differ by the same amount are apart however small it is; two
+    // pilots of opposite differences are tied.
+    let mut same = TrialErrors::default();
+    for _ in 0..4 {
+        same.add(&TrialErrors::one(1.0, 1.01));
+    }
+    assert!(!same.tied());
+    assert_eq!(same.pick_unless_tied(Some(Pick::Second)), Pick::First);
+    let mut opposite = TrialErrors::one(1.0, 2.0);
+    opposite.add(&TrialErrors::one(2.0, 0.9));
+    assert!(opposite.tied());
+    assert_eq!(opposite.pick_unless_tied(Some(Pick::First)), Pick::First);
+    assert_eq!(opposite.pick_unless_tied(None), Pick::Second);
 }
 
 /// A scene at half a pixel of disparity (each view of lenslet `(s, t)` sees the point

@@ -161,6 +161,7 @@ pub fn decode<'py>(
                 trial.set_item("pilots", t.pilots)?;
                 trial.set_item("dct_error", t.dct_error)?;
                 trial.set_item("ensemble_error", t.ensemble_error)?;
+                trial.set_item("tied", t.tied)?;
                 if let Some((dct, ensemble)) = t.by_decode {
                     trial.set_item("decode_dct_error", dct)?;
                     trial.set_item("decode_ensemble_error", ensemble)?;

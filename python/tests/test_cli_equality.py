@@ -153,8 +153,12 @@ def test_model_trial_report_equals_cli(tmp_path, slf_bin, capture):
     lf, report = slf.decode(capture, report=True)
     t = report["trial"]
     assert t["model"] in ("dct", "ensemble") and t["pilots"] > 0
-    # The model with the smaller held-out error decodes (the ensemble on a tie).
-    assert (t["model"] == "dct") == (t["dct_error"] < t["ensemble_error"]), t
+    # The model with the smaller held-out error decodes, unless the two are within their
+    # spread: then the model the pixel mask at k = 1 favours, the ensemble.
+    if t["tied"]:
+        assert t["model"] == "ensemble", t
+    else:
+        assert (t["model"] == "dct") == (t["dct_error"] < t["ensemble_error"]), t
     name = "DCT" if t["model"] == "dct" else "ensemble"
     assert f"model trial: decoded by the {name} (held-out error over {t['pilots']} pilot patches" in out
     # The frame is the picked model's decode without the trial.

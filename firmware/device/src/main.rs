@@ -52,7 +52,7 @@ mod device {
         Ensemble, EnsembleModel, FrameSource, FullViewShape, FullViewWorkspace, HoldOut, LeU16Frame, LensletGrid,
         LensletSize, Mask, MemberChoice, Overlap, OverlapDecoder, PatchModel, PatchOrigin, PatchReport, PatchSink,
         Pick, Picked, Pixel, RawFormat, Response, ResponseModel, RowSink, ScheduledDictionary, SensorGeometry,
-        Sl0Config, TileDecoder, TrialErrors,
+        Sl0Config, TileDecoder, TrialErrors, dct_where_tied,
     };
 
     use super::{bench_begin, bench_end};
@@ -368,7 +368,11 @@ mod device {
                 Err(_) => failed += 1,
             }
         }
-        let pick = trial.pick();
+        // Where the pilots tie, the model the mask and snapshot count favour, as the host's
+        // default picks.
+        let prior = dct_where_tied(config.mask.family(), SNAPSHOTS.into())
+            .map(|dct| if dct { Pick::First } else { Pick::Second });
+        let pick = trial.pick_unless_tied(prior);
         hprintln!(
             "trial pilots {} dct {:08x} ensemble {:08x} pick {}",
             trial.pilots,

@@ -12,6 +12,7 @@
 //! decoded once, by the picked model ([`crate::solver::picked::Picked`]).
 
 use crate::decode::tile::{PatchOrigin, TileDecoder, TileSource};
+use crate::sensor::mask::MaskFamily;
 use crate::solver::choice::PatchModel;
 use crate::solver::holdout::HoldOut;
 use crate::solver::interpolate::bands_measured;
@@ -19,7 +20,8 @@ use crate::solver::picked::Pick;
 use crate::solver::workspace::Workspace;
 
 /// What pilot patches measured of two models: the sums of their squared held-out error
-/// estimates (sensor units), over the pilots both estimated.
+/// estimates (sensor units), over the pilots both estimated, and the sum of the squares of
+/// their differences pilot by pilot (the spread that says when the sums tie, [`Self::tied`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct TrialErrors {
@@ -27,16 +29,77 @@ pub struct TrialErrors {
     pub first: f32,
     /// The second model's.
     pub second: f32,
+    /// The squared differences of the two, pilot by pilot, summed.
+    pub spread: f32,
     /// Pilot patches counted.
     pub pilots: u32,
 }
 
+/// How many standard errors apart the two sums of a trial must be for it to tell the
+/// models apart ([`TrialErrors::tied`]): about the 95 % level of a two-sided test on the
+/// pilots' paired differences.
+pub const TIE_SPREAD: f32 = 2.0;
+
+/// Whether a frame of `family` at `snapshots` is better decoded by the DCT than by the
+/// screened ensemble where the model trial's pilots cannot tell them apart
+/// ([`TrialErrors::tied`]); `None` where the sets favour neither, and the lower sum
+/// decides as before.
+///
+/// From the decodes by each model alone of 21 scenes (18 synthetic at 48 x 48 lenslets
+/// and 3 real crops, `docs/results-trial-by-decode.md`): at pixel k = 1 the ensemble was
+/// within 0.1 dB of the better on all but 4, the DCT on all but 9; at pixel k = 3 the DCT
+/// on all but 5, the ensemble on all but 13; at lenslet k = 3 the ensemble on all but 3,
+/// the DCT on all but 17. The more a block measures, the less the learned members' prior
+/// helps; snapshot counts not measured take the nearest measured one's side. At kronecker
+/// k = 3 the DCT was within 0.1 dB on all but 4 there, but on a second set (the synthetic
+/// scenes at 60 x 60, seed 2, `docs/results-model-tie.md`) the DCT on ties lost 0.1 dB or
+/// more on 7 of 16 where the lower sum lost on 3: no prior there.
+pub fn dct_where_tied(family: MaskFamily, snapshots: usize) -> Option<bool> {
+    match family {
+        MaskFamily::Pixel => Some(snapshots > 1),
+        MaskFamily::Lenslet => Some(false),
+        MaskFamily::Kronecker => None,
+    }
+}
+
 impl TrialErrors {
+    /// One pilot's errors: `first` and `second` are the two models' squared estimates.
+    pub fn one(first: f32, second: f32) -> Self {
+        let d = first - second;
+        Self { first, second, spread: d * d, pilots: 1 }
+    }
+
     /// These errors and `other`'s, summed (a region's pilots together).
     pub fn add(&mut self, other: &Self) {
         self.first += other.first;
         self.second += other.second;
+        self.spread += other.spread;
         self.pilots += other.pilots;
+    }
+
+    /// Whether the two sums are within [`TIE_SPREAD`] standard errors of their difference,
+    /// taken from the pilots' paired differences (`n` pilots, differences `d_i`, sum `D`:
+    /// the sum's variance is `n (sum d_i^2 - D^2 / n) / (n - 1)`). Fewer than two pilots
+    /// cannot tell: tied.
+    pub fn tied(&self) -> bool {
+        if self.pilots < 2 {
+            return true;
+        }
+        let n = self.pilots as f32;
+        let d = self.first - self.second;
+        let var = (self.spread - d * d / n).max(0.0) * n / (n - 1.0);
+        d * d <= TIE_SPREAD * TIE_SPREAD * var
+    }
+
+    /// The model whose pilots erred less, unless the two tie ([`Self::tied`]) and there is
+    /// a `prior`, the one a frame of this mask and snapshot count is better decoded by
+    /// where the pilots cannot tell ([`dct_where_tied`]); without one, the lower sum (the
+    /// second on an equal one, as [`Self::pick`]).
+    pub fn pick_unless_tied(&self, prior: Option<Pick>) -> Pick {
+        match prior {
+            Some(p) if self.tied() => p,
+            _ => self.pick(),
+        }
     }
 
     /// The model whose pilots erred less; the second (the decode's default) without pilots
@@ -98,7 +161,7 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
         // The estimate read the patch again: the same held-out measurements for the second.
         let (z, _) = self.estimate_error(second, &HoldOut::DEFAULT, origin, source, ws, true)?;
         Ok(match (a, z) {
-            (Some(a), Some(z)) => TrialErrors { first: a * a, second: z * z, pilots: 1 },
+            (Some(a), Some(z)) => TrialErrors::one(a * a, z * z),
             _ => none,
         })
     }
@@ -129,7 +192,7 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
             (b, a) => b.or(a),
         };
         Ok(match (at_half, whole) {
-            (Some(h), Some(w)) => TrialErrors { first: h * h, second: w * w, pilots: 1 },
+            (Some(h), Some(w)) => TrialErrors::one(h * h, w * w),
             _ => TrialErrors::default(),
         })
     }

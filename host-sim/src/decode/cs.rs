@@ -122,9 +122,15 @@ fn decode_basis<const PU: usize, const PV: usize, const N: usize>(
                 None => decode_observed_into::<PU, PV, N, _>(capture, &dictionary, opts, observer, sink),
             }
         }
+        // The screened ensemble with the model trial: the model whose pilots err less, or
+        // where they tie, the one the mask and snapshot count favour
+        // ([`slf_firmware::dct_where_tied`]).
         Basis::Ensemble { blob, choice } if opts.model_trial => {
-            let even = ModelPick::Trial { towards: Pick::Second, margin: 1.0 };
-            trial_decode::<PU, PV, N>(capture, blob.as_deref(), *choice, even, opts, observer, sink)
+            let mask = capture.mask()?;
+            let prior = slf_firmware::dct_where_tied(mask.family(), mask.snapshots())
+                .map(|dct| if dct { Pick::First } else { Pick::Second });
+            let prior = ModelPick::UnlessTied { prior };
+            trial_decode::<PU, PV, N>(capture, blob.as_deref(), *choice, prior, opts, observer, sink)
         }
         Basis::Ensemble { blob, choice } => {
             let ensemble = ensemble::<PU, PV>(blob.as_deref())?;
@@ -302,15 +308,21 @@ where
     // pilots' trial leans); the picked one's tallies are the error map's too.
     let mut estimated = None;
     let mut by_decode = None;
-    if let (Some(_), TrialBy::Decode, true, ModelPick::Trial { towards, margin }) =
-        (plan.model_trial, opts.trial_by, plan.decoder.samples_are_values(), pick)
+    // By decode, the frame's two errors alone have no spread: a tie is an equal pair.
+    let lean = match pick {
+        ModelPick::Trial { towards, margin } => Some((towards, margin)),
+        ModelPick::UnlessTied { prior } => Some((prior.unwrap_or(Pick::Second), 1.0)),
+        ModelPick::Given(_) => None,
+    };
+    if let (Some(_), TrialBy::Decode, true, Some((towards, margin))) =
+        (plan.model_trial, opts.trial_by, plan.decoder.samples_are_values(), lean)
     {
         let held = Instant::now();
         let run =
             |pick| HeldOutDecode::run(&plan, &Picked { first, second, pick }, &raw, HoldOut::DEFAULT, opts.batch_tiles);
         let (a, z) = (run(Pick::First)?, run(Pick::Second)?);
         if let (Some(ea), Some(ez)) = (a.frame_error(), z.frame_error()) {
-            let t = slf_firmware::TrialErrors { first: (ea * ea) as f32, second: (ez * ez) as f32, pilots: 1 };
+            let t = slf_firmware::TrialErrors::one((ea * ea) as f32, (ez * ez) as f32);
             plan.pick = t.pick_leaning(towards, margin);
             by_decode = Some((ea, ez));
         }
@@ -365,7 +377,8 @@ where
     });
     report.trial = plan.model_trial.map(|t| {
         let (dct_error, ensemble_error) = rms(&t);
-        TrialReport { pilots: t.pilots, dct: plan.pick == Pick::First, dct_error, ensemble_error, by_decode }
+        let tied = matches!(pick, ModelPick::UnlessTied { prior: Some(_) }) && by_decode.is_none() && t.tied();
+        TrialReport { pilots: t.pilots, dct: plan.pick == Pick::First, dct_error, ensemble_error, tied, by_decode }
     });
     Ok(report)
 }

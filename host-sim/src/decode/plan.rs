@@ -106,6 +106,10 @@ impl<'a, const PU: usize, const PV: usize, const N: usize> FramePlan<'a, PU, PV,
                 let t = frame_trial(&decoder, first, second, raw, &base, budget);
                 (t.pick_leaning(towards, margin), Some(t))
             }
+            ModelPick::UnlessTied { prior } => {
+                let t = frame_trial(&decoder, first, second, raw, &base, budget);
+                (t.pick_unless_tied(prior), Some(t))
+            }
         };
         let halo = decoder.disparities().halo(views.0.max(views.1));
         // The shifted grids: every tile, or with the adaptive rule every single patch (the
@@ -145,6 +149,12 @@ pub enum ModelPick {
         towards: Pick,
         /// How far below (RMS) the other's error must be.
         margin: f32,
+    },
+    /// The one whose pilots err less, unless the two tie within the pilots' spread
+    /// ([`slf_firmware::TrialErrors::pick_unless_tied`]); then `prior`, where there is one.
+    UnlessTied {
+        /// The model kept on a tie or without pilots.
+        prior: Option<Pick>,
     },
 }
 

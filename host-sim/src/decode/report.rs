@@ -143,6 +143,11 @@ pub struct TrialReport {
     pub dct_error: f64,
     /// The ensemble's.
     pub ensemble_error: f64,
+    /// Whether the pilots tied (their difference within [`slf_firmware::TIE_SPREAD`] of its
+    /// standard error), so the mask's and snapshot count's prior model decoded the frame
+    /// ([`slf_firmware::dct_where_tied`]); false for a trial that leans by a margin (the
+    /// preview's).
+    pub tied: bool,
     /// With the trial by held-out decodes ([`crate::decode::options::TrialBy::Decode`]):
     /// the DCT's and the ensemble's error estimates of the frame from them (RMS, the
     /// output's units), which picked.

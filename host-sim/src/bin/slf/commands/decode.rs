@@ -329,10 +329,11 @@ pub fn run(args: Args) -> Result<()> {
                 t.ensemble_error
             )?,
             None => outln!(
-                "model trial: decoded by the {model} (held-out error over {} pilot patches: DCT {:.5}, ensemble {:.5})",
+                "model trial: decoded by the {model} (held-out error over {} pilot patches: DCT {:.5}, ensemble {:.5}{})",
                 t.pilots,
                 t.dct_error,
-                t.ensemble_error
+                t.ensemble_error,
+                if t.tied { "; within their spread, so the mask's usual model" } else { "" }
             )?,
         }
     }
