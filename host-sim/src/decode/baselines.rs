@@ -466,7 +466,24 @@ pub fn ppid(capture: &Capture, cfg: &PpidConfig) -> Result<(LightField, Baseline
         }
     };
     // Step 1: the PPI at each position: its own values plus the local difference between
-    // the coarse PPI and the raw values of the same band.
+    // the coarse PPI and the raw values of the same band. That difference's sums depend on
+    // the lenslet and the band alone (the neighbourhood is the lenslets around), so they
+    // are summed once a lenslet for every band, in the order a position's walk adds them:
+    // the same values, bit for bit, as summing them for each of a lenslet's 25 positions
+    // (which took half of PPID's time).
+    let differences: Vec<(Vec<f32>, Vec<f32>)> = (0..ls * lt)
+        .into_par_iter()
+        .map(|st| {
+            let (mut num, mut den) = (vec![0.0f32; nb], vec![0.0f32; nb]);
+            around(st / lt, st % lt, &mut |g, l, j| {
+                for &(b, x) in theirs(j) {
+                    num[usize::from(b)] += g * (coarse[l] - x);
+                    den[usize::from(b)] += g;
+                }
+            });
+            (num, den)
+        })
+        .collect();
     let ppi: Vec<f32> = (0..positions.len())
         .into_par_iter()
         .map(|p| {
@@ -474,16 +491,7 @@ pub fn ppid(capture: &Capture, cfg: &PpidConfig) -> Result<(LightField, Baseline
             if own.is_empty() {
                 return coarse[s * lt + t];
             }
-            let (mut num, mut den) = (vec![0.0f32; nb], vec![0.0f32; nb]);
-            around(*s, *t, &mut |g, l, j| {
-                for &(b, x) in theirs(j) {
-                    let b = usize::from(b);
-                    if own.iter().any(|&(ob, _)| usize::from(ob) == b) {
-                        num[b] += g * (coarse[l] - x);
-                        den[b] += g;
-                    }
-                }
-            });
+            let (num, den) = &differences[s * lt + t];
             let sum: f32 = own
                 .iter()
                 .map(|&(b, x)| {
