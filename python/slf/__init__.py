@@ -413,8 +413,9 @@ def decode(
     ``adaptive`` and the solver's ``sigma_f`` ... ``min_bands``, ``plausible``,
     ``shear_check``, ``model_trial`` (the ensemble or the DCT for the frame by their
     held-out errors on pilot patches; default True in every preset, leaning to the DCT in
-    the preview, False where ``dictionary`` is named: ``report["trial"]`` says which and the
-    errors; ``trial_by="decode"`` tells them apart by the frame decoded again by each from
+    the preview, False where ``dictionary`` is named: ``report["trial"]`` says which, the
+    errors and ``tied`` (the two within their spread, so the mask's favoured model decoded);
+    ``trial_by="decode"`` tells them apart by the frame decoded again by each from
     seven in eight samples, two more decodes: ``report["trial"]["decode_dct_error"]`` and
     ``["decode_ensemble_error"]``), ``baseline_blend`` (on a kronecker mask, each block mixed
     from the decode and PPID by their held-out errors; default True: ``report["baseline_blend"]``
