@@ -273,7 +273,7 @@ fn a_grid_half_a_pixel_off_decodes_every_patch() {
     let cap = simulate(&lf, &cam).unwrap();
     let s = DecodeSettings::from_flags(["--disparities", "0:0", "--stride", "5"]).unwrap();
     let run = s.run(&cap, false, &|_, _| {}).unwrap();
-    let slf_host::decode::settings::Outcome::Cs { report, .. } = &run.outcome else { panic!("not a CS decode") };
+    let slf_host::decode::pipeline::Outcome::Cs { report, .. } = &run.outcome else { panic!("not a CS decode") };
     assert!(report.patches.decoded > 0 && report.patches.failed == 0, "{:?}", report.patches);
     let m = evaluate(&lf, &run.light_field).unwrap();
     let aligned = simulate(&lf, &CameraConfig::pixel(5, 3).noiseless()).unwrap();
@@ -294,13 +294,13 @@ fn the_decode_counts_the_views_off_the_sensor() {
     let cap = simulate(&lf, &cam).unwrap();
     let s = DecodeSettings::from_flags(["--disparities", "0:0", "--stride", "5"]).unwrap();
     let run = s.run(&cap, false, &|_, _| {}).unwrap();
-    let slf_host::decode::settings::Outcome::Cs { report, .. } = &run.outcome else { panic!("not a CS decode") };
+    let slf_host::decode::pipeline::Outcome::Cs { report, .. } = &run.outcome else { panic!("not a CS decode") };
     assert_eq!((report.off_sensor.lenslets, report.off_sensor.views), (30, 30 * 25));
     assert!(report.patches.decoded > 0, "{:?}", report.patches);
     // On a grid that keeps every view on the sensor: none.
     cam.grid = Some(GridSettings { rotation_deg: 0.0, pitch: Some([5.02, 5.02]), offset: None });
     let run = s.run(&simulate(&lf, &cam).unwrap(), false, &|_, _| {}).unwrap();
-    let slf_host::decode::settings::Outcome::Cs { report, .. } = &run.outcome else { panic!("not a CS decode") };
+    let slf_host::decode::pipeline::Outcome::Cs { report, .. } = &run.outcome else { panic!("not a CS decode") };
     assert_eq!(report.off_sensor.lenslets, 0);
 }
 
@@ -309,7 +309,8 @@ fn the_decode_counts_the_views_off_the_sensor() {
 /// cells' centres, not their shares); asked for, halves are searched there too.
 #[test]
 fn behind_a_grid_the_default_disparities_are_whole() {
-    use slf_host::decode::settings::{DecodeSettings, Outcome};
+    use slf_host::decode::pipeline::Outcome;
+    use slf_host::decode::settings::DecodeSettings;
     use slf_host::sim::scene::SceneSize;
     let lf = slf_host::sim::realistic::named("office").unwrap().render(SceneSize { views: (5, 5), rows: 30, cols: 30 });
     let halves = |cap: &slf_host::io::capture::Capture, flags: &[&str]| {

@@ -8,7 +8,8 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use slf_host::decode::cs::{PatchViews, disparity_per_lenslet, estimated_psnr};
-use slf_host::decode::settings::{DecodeSettings, Outcome, output_shape};
+use slf_host::decode::pipeline::{Outcome, output_shape};
+use slf_host::decode::settings::DecodeSettings;
 use slf_host::io::lightfield::Dtype;
 use slf_host::io::npy_rows::NpyRows;
 

@@ -20,7 +20,9 @@
 //! - [`trial`]: the model trial, the DCT or the ensemble per region of the frame by
 //!   their held-out errors on pilot patches;
 //! - [`settings`]: what a user asks of a decode (`slf decode`'s flags, `slf.decode`'s
-//!   keywords), parsed once and resolved to a basis and options.
+//!   keywords), parsed once and resolved to a basis and options;
+//! - [`pipeline`]: those settings run on a capture: the checks that they fit it, the
+//!   calibration's correction, then compressed sensing or a baseline into a sink.
 //!
 //! May use: [`crate::io`], [`crate::sim`]. Used by the train and eval layers.
 
@@ -33,6 +35,7 @@ pub mod grid_fit;
 pub mod held_out;
 pub mod options;
 pub mod paper_1d;
+pub mod pipeline;
 pub mod plan;
 pub mod preset;
 pub mod report;

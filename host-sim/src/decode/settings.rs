@@ -6,8 +6,8 @@
 //! [`DecodeSettings::from_flags`] parses the same flags from a list of strings (the Python
 //! package turns its keywords into them), so there is one parser, not two. An unset flag is
 //! the preset's value ([`Preset`]) or the solver's default ([`Sl0Config::DEFAULT`]).
-//! [`DecodeSettings::run`] resolves them ([`DecodeSettings::resolve`]), refuses what does
-//! not fit together, and decodes by compressed sensing or by a baseline.
+//! [`DecodeSettings::resolve`] turns them into a basis and options and refuses what does not
+//! fit together; [`crate::decode::pipeline`] runs them on a capture.
 
 use std::path::PathBuf;
 
@@ -15,21 +15,15 @@ use anyhow::{Result, anyhow, bail, ensure};
 use clap::{Args, ValueEnum};
 use slf_firmware::disparity::MAX_DISPARITY;
 use slf_firmware::{
-    ChoiceRule, DisparityRange, MemberChoice, Plausibility, Response, ResponseModel, Sl0Config, SolveError, gains,
+    ChoiceRule, DisparityRange, MemberChoice, Plausibility, ResponseModel, Sl0Config, SolveError, gains,
 };
 
-use crate::decode::baselines::{Baseline, BaselineReport};
-use crate::decode::calibrate::{corrected, unmix, unmixing};
+use crate::decode::baselines::Baseline;
 use crate::decode::cs::{
-    Balance, Basis, DecodeOptions, DecodeReport, EstimateBy, NoiseSource, PatchViews, SolveSchedule, TrialBy, Window,
-    decode_into, read_blob,
+    Balance, Basis, DecodeOptions, EstimateBy, NoiseSource, PatchViews, SolveSchedule, TrialBy, Window, read_blob,
 };
 use crate::decode::preset::Preset;
-use crate::io::calibration::Calibration;
-use crate::io::capture::Capture;
-use crate::io::lightfield::LightField;
 use crate::io::message::number as show;
-use crate::io::rows::{MapRows, RowShape, Rows, put_light_field};
 use crate::sim::flags::parse;
 
 /// Decode method: compressed sensing, or a baseline without it.
@@ -470,25 +464,6 @@ pub fn plausibility(s: &str) -> Result<Plausibility, String> {
     Ok(Plausibility { factor, margin })
 }
 
-/// A decode's light field and what it reports.
-#[derive(Clone, Debug)]
-pub struct Decoded {
-    /// `(U, V, H, W, 13)`.
-    pub light_field: LightField,
-    /// What the method reports.
-    pub outcome: Outcome,
-}
-
-/// What a decode reports, by method.
-#[derive(Clone, Debug)]
-pub enum Outcome {
-    /// Compressed sensing: the options it ran with (presets and flags resolved) and its
-    /// report.
-    Cs { options: Box<DecodeOptions>, report: Box<DecodeReport> },
-    /// A baseline's report.
-    Baseline { method: Method, report: BaselineReport },
-}
-
 impl DecodeSettings {
     /// The settings from `slf decode`'s flags (without the capture, `-o` and the output
     /// flags), e.g. `["--preset", "preview", "--stride=3"]`.
@@ -646,208 +621,10 @@ impl DecodeSettings {
         .filter_map(|(same, name)| (!same).then_some(name))
         .collect()
     }
-
-    /// Decodes `capture`. `progress` shows a bar on stderr once the decode has taken a
-    /// second; `observer` is called after each tile with (tiles done, tiles in all).
-    ///
-    /// # Errors
-    /// What [`Self::resolve`] refuses; a capture the method cannot take; a decode where no
-    /// patch decoded (every patch saturated, defective or unreadable).
-    pub fn run(&self, capture: &Capture, progress: bool, observer: &(dyn Fn(usize, usize) + Sync)) -> Result<Decoded> {
-        let mut light_field = output_shape(capture).zeros()?;
-        let outcome = self.run_into(capture, progress, observer, &mut light_field)?;
-        Ok(Decoded { light_field, outcome })
-    }
-
-    /// [`Self::run`], each finished lenslet row of the light field ([`output_shape`]) put
-    /// into `sink` in order: a compressed-sensing decode holds a band of rows, not the
-    /// frame (a baseline decodes the frame, then puts its rows).
-    ///
-    /// # Errors
-    /// As [`Self::run`], or what the sink returns. On an error the sink may hold some rows
-    /// (a file sink is then dropped unfinished: nothing is written).
-    pub fn run_into(
-        &self,
-        capture: &Capture,
-        progress: bool,
-        observer: &(dyn Fn(usize, usize) + Sync),
-        sink: &mut Rows<'_>,
-    ) -> Result<Outcome> {
-        // Values that would be accepted and ignored: the projection needs a calibration's
-        // response, and turns half-pixel shears off (`-1:1:0.5` once gave `-1:1`'s bytes).
-        if self.response_model == ResponseChoice::Projection {
-            ensure!(
-                self.calibration.is_some(),
-                "--response-model projection given without --calibration: the response it projects is a \
-                 calibration's"
-            );
-            ensure!(
-                self.method.baseline().is_none(),
-                "--response-model projection given with a baseline method, which unmixes its spectra: drop it, or \
-                 use --method cs"
-            );
-            ensure!(
-                !self.disparities.is_some_and(|d| d.has_halves()),
-                "--disparities with half-pixel steps given with --response-model projection, which turns them off: \
-                 give whole steps (e.g. -1:1) or --response-model unmix"
-            );
-        }
-        // A calibration capture is no scene: decoding it once went without a word.
-        ensure!(
-            capture.description.light.is_scene(),
-            "{}: a calibration capture (its light is dark, flat or a band), not a scene's: slf calibrate reads it",
-            capture.source()
-        );
-        // A frame with no pixel above the black level recorded no light (a lens cap, an
-        // exposure of zero): every method would decode zeros.
-        let black = capture.description.black_level;
-        ensure!(
-            capture.frames.iter().flatten().any(|&x| f32::from(x) > black),
-            "every pixel of every frame is at or below the black level ({black} DN): no light was recorded"
-        );
-        // The output contract, on the capture as recorded: a corrected capture's saturation
-        // is the top of 16 bits.
-        let (lo, hi) = capture.raw_format().range();
-        let stated = capture.description.lenslet_grid;
-        let calibrated;
-        let (capture, inverse, response) = match &self.calibration {
-            Some(dir) => {
-                let cal = Calibration::load(dir)?;
-                calibrated = corrected(capture, &cal)?;
-                // The same check on the corrected frames: a dark level at or above the raw
-                // values once decoded to all zeros with "0 flagged".
-                ensure!(
-                    calibrated.frames.iter().flatten().any(|&x| f32::from(x) > black && x != u16::MAX),
-                    "{}: with its dark levels subtracted every pixel is at or below the black level ({black} DN): no \
-                     light above the dark was recorded (is it this sensor's calibration?)",
-                    dir.display()
-                );
-                let inverse = unmixing(&cal).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
-                (&calibrated, Some(inverse), Some(cal.description.response))
-            }
-            None => (capture, None, None),
-        };
-        let regridded;
-        let capture = match self.grid {
-            GridChoice::Auto => capture,
-            GridChoice::Capture => {
-                let mut c = capture.clone();
-                c.description.lenslet_grid = stated;
-                regridded = c;
-                &regridded
-            }
-            GridChoice::Aligned => {
-                regridded = capture.aligned()?;
-                &regridded
-            }
-        };
-        // The baselines interpolate the aligned mosaic: behind a grid its pixels are not
-        // where they assume.
-        ensure!(
-            self.method.baseline().is_none() || capture.description.lenslet_grid.is_none(),
-            "{}: the baseline methods read the aligned grid, and this capture has a lenslet_grid: give --grid \
-             aligned to decode it as aligned, or --method cs",
-            capture.source()
-        );
-        // Compressed sensing puts the response in the firmware's decode; baselines unmix
-        // their spectra here.
-        let rows: Option<Vec<[f32; PATCH_BANDS]>> =
-            response.map(|r| r.iter().filter_map(|row| row.as_slice().try_into().ok()).collect());
-        let modelled = match rows.and_then(|rows| <[[f32; PATCH_BANDS]; PATCH_BANDS]>::try_from(rows).ok()) {
-            Some(r) if self.method.baseline().is_none() => Some((
-                Response::new(&r).map_err(|e| anyhow::anyhow!("the calibration's response matrix: {e}"))?,
-                self.response_model.model(),
-            )),
-            _ => None,
-        };
-        match (&inverse, modelled) {
-            (Some(inverse), None) => {
-                let bands = output_shape(capture).bands;
-                // Unmixing can take a value below 0 or past the sensor's top (PPID's wrote
-                // 20,531 of 83,200 values below 0): clamped again, as every method's output.
-                let mut unmixed = MapRows::new(sink, |row: &mut [f32]| {
-                    unmix(row, bands, inverse);
-                    row.iter_mut().for_each(|v| *v = v.clamp(lo, hi));
-                });
-                self.run_corrected(capture, modelled, progress, observer, &mut unmixed)
-            }
-            _ => self.run_corrected(capture, modelled, progress, observer, sink),
-        }
-    }
-
-    /// [`Self::run_into`] on a capture as it is (corrected already, or needing no
-    /// correction).
-    fn run_corrected(
-        &self,
-        capture: &Capture,
-        response: Option<(Response<PATCH_BANDS>, ResponseModel)>,
-        progress: bool,
-        observer: &(dyn Fn(usize, usize) + Sync),
-        sink: &mut Rows<'_>,
-    ) -> Result<Outcome> {
-        if let Some(baseline) = self.method.baseline() {
-            let given = self.compressed_sensing_flags();
-            ensure!(
-                given.is_empty(),
-                "{} given with --method {}, which uses none of the compressed-sensing flags: drop them, or use \
-                 --method cs",
-                given.join(", "),
-                self.method.to_possible_value().map_or_else(String::new, |v| v.get_name().to_string())
-            );
-            let (light_field, report) = baseline.run(capture)?;
-            put_light_field(&light_field, sink)?;
-            return Ok(Outcome::Baseline { method: self.method, report });
-        }
-        let (basis, options) = self.resolve()?;
-        let options = DecodeOptions { progress, response, ..options };
-        let report = decode_into(capture, &basis, &options, observer, sink)?;
-        let p = &report.patches;
-        if p.decoded == 0 {
-            bail!(
-                "no patch decoded ({} failed, {} of {} tiles failed): every patch saturated, defective or \
-                 unreadable",
-                p.failed,
-                report.failed_tiles,
-                report.tiles
-            );
-        }
-        Ok(Outcome::Cs { options: Box::new(options), report: Box::new(report) })
-    }
-}
-
-/// The shape of the light field a decode of `capture` makes: its views and lenslets, a band
-/// per filter type.
-pub fn output_shape(capture: &Capture) -> RowShape {
-    let d = &capture.description;
-    RowShape { views: (d.views[0], d.views[1]), rows: d.lenslets[0], cols: d.lenslets[1], bands: d.bands_nm.len() }
-}
-
-impl Decoded {
-    /// A warning when more than [`WARN_FRACTION`] of the patches failed or were flagged, or
-    /// a tile failed ([`Outcome::warning`]).
-    pub fn warning(&self) -> Option<String> {
-        self.outcome.warning()
-    }
-}
-
-impl Outcome {
-    /// A warning when more than [`WARN_FRACTION`] of the patches failed or were flagged, or
-    /// a tile failed.
-    pub fn warning(&self) -> Option<String> {
-        let Outcome::Cs { report: r, .. } = self else { return None };
-        let p = &r.patches;
-        let all = p.decoded + p.failed;
-        ((p.failed + p.flagged) as f64 > WARN_FRACTION * f64::from(all) || r.failed_tiles > 0).then(|| {
-            format!(
-                "{} of {all} patches failed and {} were flagged (pixels left out), {} tiles failed",
-                p.failed, p.flagged, r.failed_tiles
-            )
-        })
-    }
 }
 
 /// Bands of the decoder's patch (the camera's 13).
-const PATCH_BANDS: usize = 13;
+pub(crate) const PATCH_BANDS: usize = 13;
 
 /// `--grid`: which lenslet grid a decode reads the frames through.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
@@ -885,9 +662,6 @@ impl ResponseChoice {
     }
 }
 
-/// A decode warns when more than this fraction of patches failed or were flagged.
-pub const WARN_FRACTION: f64 = 0.01;
-
 /// `MIN:MAX[:STEP]`, integer disparities around 0 (e.g. `-1:1`) within the decoder's
 /// limit, in steps of 1 (the default) or 0.5.
 ///
@@ -911,126 +685,4 @@ pub fn disparity_range(s: &str) -> Result<DisparityRange, String> {
         Some(_) => return Err(bad()),
     };
     DisparityRange::new(a, b).map(|r| r.with_halves(halves)).ok_or_else(bad)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn resolved(flags: &[&str]) -> (Basis, DecodeOptions) {
-        DecodeSettings::from_flags(flags).and_then(|s| s.resolve().map_err(|e| e.to_string())).unwrap()
-    }
-
-    #[test]
-    fn no_flags_is_the_default_preset() {
-        let (basis, o) = resolved(&[]);
-        let d = Preset::Default.options();
-        assert_eq!(basis.name(), Preset::Default.basis().name());
-        assert_eq!(
-            (o.stride, o.window, o.disparities, o.edge_fallback, o.sheared_fallback),
-            (d.stride, d.window, d.disparities, d.edge_fallback, d.sheared_fallback)
-        );
-        assert_eq!(o.sl0, Sl0Config::DEFAULT);
-        assert_eq!((o.noise, o.balance), (NoiseSource::Capture, Balance::GreyWorld));
-    }
-
-    #[test]
-    fn a_preset_then_flags_over_it() {
-        let p = Preset::Preview.options();
-        let (basis, o) = resolved(&["--preset", "preview"]);
-        assert!(matches!(basis, Basis::Dct));
-        assert_eq!(
-            (o.stride, o.window, o.disparities, o.edge_fallback, o.sheared_fallback),
-            (p.stride, p.window, p.disparities, p.edge_fallback, p.sheared_fallback)
-        );
-        assert_eq!((o.sl0.sigma_min, o.sl0.cold_start), (p.sl0.sigma_min, p.sl0.cold_start));
-        let (basis, o) = resolved(&[
-            "--preset=preview",
-            "--stride=2",
-            "--dictionary=ensemble",
-            "--sigma-min=0.002",
-            "--disparities=-2:2:0.5",
-        ]);
-        assert!(matches!(basis, Basis::Ensemble { .. }));
-        assert_eq!(
-            (o.stride, o.window, o.sl0.sigma_min, o.sl0.cold_start),
-            ((2, 2), p.window, 0.002, p.sl0.cold_start)
-        );
-        assert_eq!(o.disparities, DisparityRange::new(-2, 2).map(|r| r.with_halves(true)));
-        let (_, o) = resolved(&["--exact", "--balance", "off", "--edge-fallback", "false", "--seeded", "false"]);
-        assert_eq!((o.noise, o.balance, o.edge_fallback, o.seeded), (NoiseSource::Config, Balance::Off, false, false));
-        assert!(resolved(&[]).1.seeded);
-    }
-
-    #[test]
-    fn errors_are_one_line_and_name_the_flag() {
-        for (flags, says) in [
-            (&["--stride", "9"][..], "--stride"),
-            (&["--preset", "fast"][..], "--preset"),
-            (&["--disparities", "3:1"][..], "MIN:MAX"),
-            (&["--exact", "--noise", "0.1"][..], "--noise"),
-            (&["--bogus"][..], "--bogus"),
-        ] {
-            let e = DecodeSettings::from_flags(flags).unwrap_err();
-            assert!(e.contains(says) && !e.contains('\n') && !e.starts_with("error"), "{flags:?}: {e}");
-        }
-        let s = DecodeSettings::from_flags(["--gains", "1,2"]).unwrap();
-        assert_eq!(s.resolve().unwrap_err().to_string(), "--gains: 13 values, got 2");
-        // A solver value out of its range: the flag, the value and the range.
-        let s = DecodeSettings::from_flags(["--sigma-f", "1.5"]).unwrap();
-        assert_eq!(s.resolve().unwrap_err().to_string(), "--sigma-f 1.5: must be in (0, 1)");
-        let s = DecodeSettings::from_flags(["--cold-start=0"]).unwrap();
-        assert_eq!(s.resolve().unwrap_err().to_string(), "--cold-start 0: must be in (0, 1]");
-        let s = DecodeSettings::from_flags(["--mu=-1"]).unwrap();
-        assert!(s.resolve().unwrap_err().to_string().starts_with("--mu -1: must be in (0, 2]"));
-        // Absurd values of every solver and noise flag (issue 32, item 4), each named with
-        // its range; the range's ends are taken.
-        for (flag, bad, good, range) in [
-            ("--mu", ["5", "10", "100", "1e30"], "2", "in (0, 2]"),
-            ("--sigma-min", ["1.5", "1e30", "0", "inf"], "1", "in (0, 1]"),
-            ("--tolerance", ["1.5", "1e30", "-1", "NaN"], "1", "in [0, 1]"),
-            ("--noise", ["1.5", "1e30", "-1", "inf"], "1", "in [0, 1]"),
-            ("--shot", ["1.5", "1e30", "-1", "inf"], "1", "in [0, 1]"),
-            ("--flat", ["1.5", "1e30", "-1", "inf"], "1", "in [0, 1]"),
-            ("--seed-sigma-f", ["1", "0", "1e30", "NaN"], "0.5", "in (0, 1)"),
-        ] {
-            for v in bad {
-                let arg = format!("{flag}={v}");
-                let e = DecodeSettings::from_flags([arg.as_str()]).unwrap().resolve().unwrap_err().to_string();
-                assert!(e.starts_with(&format!("{flag} ")) && e.contains(range) && !e.contains('\n'), "{arg}: {e}");
-            }
-            // (The hand-set schedule's flags are taken with it.)
-            resolved(&[&format!("{flag}={good}"), "--schedule", "annealed"]);
-        }
-        let e = DecodeSettings::from_flags(["--tolerance=1"]).unwrap().resolve().unwrap_err().to_string();
-        assert_eq!(
-            e,
-            "--tolerance sets the hand-set schedule, which the trained one replaces: add --schedule annealed"
-        );
-        for g in ["1e30", "0", "0.01", "65", "nan"] {
-            let arg = format!("--gains=1,1,1,{g},1,1,1,1,1,1,1,1,1");
-            let e = DecodeSettings::from_flags([arg.as_str()]).unwrap().resolve().unwrap_err().to_string();
-            assert!(e.starts_with("--gains: gain 4 is ") && e.contains("[1/64, 64]"), "{arg}: {e}");
-        }
-        resolved(&["--gains=64,0.015625,1,1,1,1,1,1,1,1,1,1,1"]);
-        // Flags that would be ignored are refused (issue 32, items 5 and 9).
-        for (flags, says) in [
-            (&["--min-bands", "14"][..], "--min-bands 14: at most 13"),
-            (&["--adaptive", "2", "--stride", "5"][..], "--adaptive needs a stride below 5"),
-            (&["--adaptive", "2", "--preset", "preview"][..], "--adaptive needs a stride below 5"),
-            (&["--seeded", "true", "--preset", "preview"][..], "--seeded true needs a stride below 5"),
-            (
-                &["--blob", "e.slfd", "--dictionary", "dct"][..],
-                "--blob names an ensemble, but this decode uses the DCT (--dictionary dct)",
-            ),
-            (&["--blob", "e.slfd", "--preset", "preview"][..], "(--preset preview)"),
-        ] {
-            let e = DecodeSettings::from_flags(flags).unwrap().resolve().unwrap_err().to_string();
-            assert!(e.contains(says), "{flags:?}: {e}");
-        }
-        resolved(&["--min-bands", "13"]);
-        resolved(&["--adaptive", "2"]);
-        let s = DecodeSettings::from_flags(["--adaptive=-1"]).unwrap();
-        assert!(s.resolve().unwrap_err().to_string().starts_with("--adaptive -1"));
-    }
 }

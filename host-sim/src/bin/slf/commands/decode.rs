@@ -8,7 +8,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::{Context, Result};
 use slf_host::decode::cs::{Balance, NoiseSource, PatchDecoder, disparity_per_lenslet, estimated_psnr};
-use slf_host::decode::settings::{DecodeSettings, Outcome, output_shape};
+use slf_host::decode::pipeline::{Outcome, output_shape};
+use slf_host::decode::settings::DecodeSettings;
 use slf_host::firmware::disparity::Disparity;
 use slf_host::io::calibration::Calibration;
 use slf_host::io::capture::Capture;
