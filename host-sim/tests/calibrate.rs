@@ -320,8 +320,13 @@ fn the_decode_unmixes_as_the_inverse_does() {
     let rms = (diffs.iter().map(|d| f64::from(d * d)).sum::<f64>() / diffs.len() as f64).sqrt();
     eprintln!("values off by more than 1e-4: {:.3} %, RMS difference {rms:.2e}", 100.0 * off);
     assert!(off < 0.01 && rms < 1e-4, "in-tile unmixing: {off} of the values differ, RMS {rms}");
-    let projected = run(&real, &["--calibration", &at, "--response-model", "projection"]);
-    let (u, p) = (evaluate(&lf, &fast).unwrap(), evaluate(&lf, &projected).unwrap());
+    // The projection against unmixing by the same model: the model trial has no pilot with
+    // the response in the projection (the ensemble decodes), and on this frame its pilots
+    // tie with unmixing, where the pixel mask at k = 3 takes the DCT (1.2 dB better here).
+    let same = ["--calibration", &at, "--model-trial", "false"];
+    let unmixed = run(&real, &same);
+    let projected = run(&real, &[&same[..], &["--response-model", "projection"]].concat());
+    let (u, p) = (evaluate(&lf, &unmixed).unwrap(), evaluate(&lf, &projected).unwrap());
     eprintln!("unmixed {u:?}\nprojected {p:?}");
     assert!(p.psnr > u.psnr - 1.0 && p.psnr.is_finite(), "projection {} dB against unmixing {}", p.psnr, u.psnr);
 }

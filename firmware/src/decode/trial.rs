@@ -94,10 +94,12 @@ impl TrialErrors {
     /// The model whose pilots erred less, unless the two tie ([`Self::tied`]) and there is
     /// a `prior`, the one a frame of this mask and snapshot count is better decoded by
     /// where the pilots cannot tell ([`dct_where_tied`]); without one, the lower sum (the
-    /// second on an equal one, as [`Self::pick`]).
+    /// second on an equal one, as [`Self::pick`]). Without a pilot (a response in the
+    /// projection, too few bands) nothing was measured and the second decodes, as
+    /// [`Self::pick`] has it: the prior was read from frames the pilots could estimate.
     pub fn pick_unless_tied(&self, prior: Option<Pick>) -> Pick {
         match prior {
-            Some(p) if self.tied() => p,
+            Some(p) if self.pilots > 0 && self.tied() => p,
             _ => self.pick(),
         }
     }

@@ -195,8 +195,8 @@ fn points_of<R: std::io::Read>(mut r: csv::Reader<R>) -> Result<Vec<Point>> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::run::{BenchOptions, run};
     use super::*;
+    use crate::eval::bench::run::{BenchOptions, run};
 
     #[test]
     fn csv_keeps_settings_with_commas_in_one_field() {
