@@ -1,8 +1,10 @@
 //! The decode layer: whole frames, tile by tile and patch by patch.
 //!
 //! - [`tile`]: the [`TileDecoder`](tile::TileDecoder), a rectangle of the raw frame patch
-//!   by patch from a source to a [`PatchSink`](tile::PatchSink), with its configuration,
-//!   the depth search per block and the reports per patch, tile and frame;
+//!   by patch from a source to a [`PatchSink`](tile::PatchSink) (`tile/sink.rs`), with its
+//!   configuration and decode loop (`tile/mod.rs`), the sensor read (`tile/read.rs`), the
+//!   checks on a decoded patch and the depth search per block (`tile/checks.rs`) and the
+//!   reports per patch, tile and frame (`tile/report.rs`);
 //! - [`engine`]: the overlapped decode, once for the host and the device: patches at a
 //!   stride below the patch size, seeded from the disjoint grid's decode, averaged with a
 //!   window into a caller-owned strip of lenslet rows, finished rows to a

@@ -1,0 +1,141 @@
+//! The checks on a decoded patch (the shear check, plausibility, the held-out error
+//! estimate) and the disparity a block is sheared to.
+
+use super::*;
+
+impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
+    TileDecoder<'a, PS, PT, PU, PV, B, N>
+{
+    /// [`Self::with_shear_check`]: `half`, or the whole disparity next to it whose first
+    /// window's patch at block `(row, col)` estimates a held-out error below
+    /// [`SHEAR_MARGIN`] times `half`'s (the smaller of the two).
+    ///
+    /// # Errors
+    /// The source's error.
+    #[inline(never)]
+    pub(super) fn check_shear<M: PatchModel<PS, PT, PU, PV, B, N>, S: TileSource>(
+        &self,
+        model: &M,
+        row: u16,
+        col: u16,
+        half: Disparity,
+        source: &mut S,
+        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ) -> Result<Disparity, S::Error> {
+        let mut best = (f32::INFINITY, half);
+        for (d, error) in self.shear_errors(model, (row, col), half, source, ws)? {
+            // A whole disparity must estimate clearly better than the half one.
+            let error = if d == half { error } else { error.map(|e| e / SHEAR_MARGIN) };
+            if let Some(e) = error.filter(|e| *e < best.0) {
+                best = (e, d);
+            }
+        }
+        Ok(best.1)
+    }
+
+    /// The held-out measurements the error estimate takes, if the decoder estimates.
+    pub fn error_estimate(&self) -> Option<HoldOut> {
+        self.holdout
+    }
+
+    /// The plausibility check on the solved patch in `ws` (the solve's units and frame):
+    /// within the bounds it is left as it is; otherwise decoded again by the safe path, and
+    /// clipped to the bounds if that breaks them too (or fails). `done` counts the solve.
+    /// Out of line: the safe path's DCT (2 KB) stays off the decode's stack.
+    #[inline(never)]
+    pub(super) fn check_plausible(
+        &self,
+        cfg: &Sl0Config,
+        flags: PatchFlags,
+        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+        done: &mut ModelOutcome,
+    ) -> Checked {
+        // A patch with saturated samples left out is brighter than it measured: no bound.
+        if self.plausibility.is_off()
+            || flags.contains(PatchFlags::OVER_RANGE)
+            || matches!(done.outcome.ended, Ended::Interpolated | Ended::Flat)
+        {
+            return Checked::Plausible;
+        }
+        let bounds = self.plausibility.bounds::<PS, PT, PU, PV, B, N>(ws.measurements());
+        if implausible::<PS, PT, PU, PV, B, N>(&bounds, ws.patch()) == 0 {
+            return Checked::Plausible;
+        }
+        let safe = Sl0Config { cold_start: 1.0, ..*cfg };
+        done.solves = done.solves.saturating_add(1);
+        match solve(&crate::operators::dictionary::Dictionary::dct(), &safe, ws) {
+            Ok(outcome) => {
+                done.outcome = outcome;
+                if implausible::<PS, PT, PU, PV, B, N>(&bounds, ws.patch()) == 0 {
+                    return Checked::Redecoded;
+                }
+            }
+            Err(_) => {
+                // Nothing finite to keep: the band-gain fill holds the measurements.
+                let Workspace { signal, measurements, .. } = ws;
+                crate::solver::fill::fill_bands::<B, N>(measurements, signal);
+            }
+        }
+        clip::<PS, PT, PU, PV, B, N>(&bounds, &mut ws.signal);
+        Checked::Clipped
+    }
+
+    /// The disparity of `range` whose shear best aligns the views of the `PS x PT` block
+    /// at lenslet `(row, col)`: every view of each of its lenslets (not only a window's),
+    /// scored by [`Consistency`]. 0 when the range is off (nothing is read).
+    ///
+    /// # Errors
+    /// The source's error.
+    pub fn choose_disparity<S: TileSource>(
+        &self,
+        row: usize,
+        col: usize,
+        source: &mut S,
+    ) -> Result<Disparity, S::Error> {
+        if self.disparities.is_off() {
+            return Ok(Disparity::ZERO);
+        }
+        let c = &self.config;
+        let (lu, lv) = (c.sensor.lenslet.rows as usize, c.sensor.lenslet.cols as usize);
+        let k = c.mask.snapshots();
+        let mut best = Best::default();
+        let mut one = [[0.0f32; 1]; B];
+        for d in self.disparities.candidates() {
+            let mut score = Consistency::new();
+            for s in 0..PS {
+                for t in 0..PT {
+                    for u in 0..lu {
+                        let lr = (row + s) as isize + rounded_shift(d, u, lu);
+                        for v in 0..lv {
+                            let lc = (col + t) as isize + rounded_shift(d, v, lv);
+                            let Some((r, cc)) = self.sensor_pixel((lr, lc), u, v) else { continue };
+                            if c.defects.contains(r, cc) {
+                                continue;
+                            }
+                            for (j, o) in one.iter_mut().enumerate().take(k) {
+                                source.read(j, r, cc, o)?;
+                            }
+                            for (band, o) in c.mask.bands_at(r, cc).iter().zip(&one) {
+                                if let Ok(y) = self.balanced(*band, o[0], (r, cc)) {
+                                    score.add(*band as usize, y);
+                                }
+                            }
+                        }
+                    }
+                    score.end_point();
+                }
+            }
+            best.offer(d, &score);
+        }
+        Ok(best.disparity())
+    }
+
+    /// Whether a block at lenslet `(row, col)` sheared to `d` reaches past the sensor's edge.
+    pub(super) fn near_edge(&self, row: usize, col: usize, d: Disparity) -> bool {
+        let c = &self.config;
+        let (lu, lv) = (c.sensor.lenslet.rows as usize, c.sensor.lenslet.cols as usize);
+        let (rows, cols) = (c.sensor.lenslets.0 as usize, c.sensor.lenslets.1 as usize);
+        let (hr, hc) = (reach(d, lu), reach(d, lv));
+        row < hr || col < hc || row + PS + hr > rows || col + PT + hc > cols
+    }
+}

@@ -1,0 +1,293 @@
+//! The sensor read: a patch's samples from the source, balanced, placed in its views (or
+//! in the view cells of a turned grid), and the white balance estimated from the frame.
+
+use super::*;
+
+impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
+    TileDecoder<'a, PS, PT, PU, PV, B, N>
+{
+    /// Grey-world band gains of a frame: every valid sample of the sensor (defects and
+    /// invalid samples left out) summed per band ([`crate::sensor::gains::gains_from_sums`]).
+    /// Reads the frame once, one sensor row at a time in runs of up to 16 samples per
+    /// snapshot.
+    ///
+    /// # Errors
+    /// The source's error; nothing is estimated then.
+    pub fn estimate_gains<S: TileSource>(&self, source: &mut S) -> Result<[f32; B], S::Error> {
+        const RUN: usize = 16;
+        let c = &self.config;
+        let (rows, cols) = self.frame_size();
+        let k = c.mask.snapshots();
+        let mut sums = [0.0f32; B];
+        let mut counts = [0u32; B];
+        // A pixel measures at most `B` distinct bands, so `k <= B` (checked by the mask).
+        let mut runs = [[0.0f32; RUN]; B];
+        for row in 0..rows {
+            // Per row in f32, then added to the totals: a frame's sum in one f32 would lose
+            // the small bands' low digits.
+            let mut row_sums = [0.0f32; B];
+            for col0 in (0..cols).step_by(RUN) {
+                let len = RUN.min(cols - col0);
+                for (j, run) in runs.iter_mut().enumerate().take(k) {
+                    let Some(out) = run.get_mut(..len) else { break };
+                    source.read(j, row, col0, out)?;
+                }
+                for dc in 0..len {
+                    let col = col0 + dc;
+                    if c.defects.contains(row, col) {
+                        continue;
+                    }
+                    // One band list per pixel, every snapshot's sample against it.
+                    for (band, run) in c.mask.bands_at(row, col).iter().zip(&runs) {
+                        let Ok(y) = c.raw.classify(run.get(dc).copied().unwrap_or(f32::NAN)) else { continue };
+                        let y = y / self.view_gain(row, col);
+                        if let (Some(s), Some(n)) = (row_sums.get_mut(*band as usize), counts.get_mut(*band as usize)) {
+                            *s += y;
+                            *n += 1;
+                        }
+                    }
+                }
+            }
+            for (t, r) in sums.iter_mut().zip(&row_sums) {
+                *t += r;
+            }
+        }
+        if !self.solved_response().is_identity() {
+            // The filters' means are `R` of the frame's mean spectrum: the gains are of the
+            // spectrum (leaked light from a bright band would otherwise inflate a dark
+            // band's gain and tilt the balanced spectra: measured on the office scene at 10 %
+            // leakage, 2.6 dB lost with the DCT).
+            let (mut means, mut ones) = ([0.0f32; B], [0u32; B]);
+            for (((m, o), &s), &n) in means.iter_mut().zip(&mut ones).zip(&sums).zip(&counts) {
+                (*m, *o) = (s / n.max(1) as f32, u32::from(n > 0));
+            }
+            self.response.unmix(&mut means);
+            return Ok(crate::sensor::gains::gains_from_sums(&means, &ones));
+        }
+        Ok(crate::sensor::gains::gains_from_sums(&sums, &counts))
+    }
+
+    /// Reads the patch at `origin` into the workspace's measurements (each divided by its
+    /// band's gain), as a decode does before it solves; returns the flags and the number of
+    /// samples left out. A sheared patch (`origin.disparity != 0`) reads each view from its
+    /// shifted lenslet ([`PatchOrigin::lenslet`]), one sample at a time; pixels the shear
+    /// puts outside the sensor are not measurements. `origin` is not checked against the
+    /// sensor: a pixel outside it is a read the source refuses.
+    ///
+    /// # Errors
+    /// The source's error.
+    pub fn read_patch<S: TileSource>(
+        &self,
+        origin: PatchOrigin,
+        source: &mut S,
+        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ) -> Result<(PatchFlags, u16), S::Error> {
+        let c = &self.config;
+        let (lu, lv) = (c.sensor.lenslet.rows as usize, c.sensor.lenslet.cols as usize);
+        let k = c.mask.snapshots();
+        let m = ws.measurements_mut();
+        m.clear();
+        // Checked within [1/64, 64] by `with_gains`; `B <= MAX_BANDS` by `PatchShape`.
+        let _ = m.set_gains(&self.gains);
+        ws.set_response(self.solved_response());
+        let m = ws.measurements_mut();
+        let mut flags = PatchFlags::default();
+        let mut excluded = 0u16;
+        let mut run = [[0.0f32; PV]; B];
+        let half = HalfViews::of(origin.disparity, (origin.view_row as usize, origin.view_col as usize), (lu, lv));
+        m.set_half_views(half);
+        // Behind a lenslet grid each pixel is the shares of the cells it covers; with a
+        // half-pixel shear or a response that mixes bands, the cell under its centre.
+        let shares = self.cell_shares(origin, half);
+        if m.set_shares(shares).is_err() {
+            let _ = m.set_shares(None);
+        }
+        let shared = m.shares().is_some();
+        for s in 0..PS {
+            for u in 0..PU {
+                for t in 0..PT {
+                    if origin.disparity == Disparity::ZERO && self.grid.is_none() {
+                        // One run of the lenslet's view row per snapshot.
+                        let row = (origin.lenslet_row as usize + s) * lu + origin.view_row as usize + u;
+                        let col0 = (origin.lenslet_col as usize + t) * lv + origin.view_col as usize;
+                        for (j, r) in run.iter_mut().enumerate().take(k) {
+                            source.read(j, row, col0, r)?;
+                        }
+                        for v in 0..PV {
+                            let at = PatchShape::<PS, PT, PU, PV, B, N>::pixel_index(s, t, u, v);
+                            self.put_pixel(
+                                m,
+                                at,
+                                row,
+                                col0 + v,
+                                |j| run.get(j).map(|r| r[v]),
+                                &mut flags,
+                                &mut excluded,
+                            );
+                        }
+                    } else {
+                        for v in 0..PV {
+                            let (vr, vc) = (origin.view_row as usize + u, origin.view_col as usize + v);
+                            let Some(lenslet) = origin.lenslet::<PS, PT>(s, t, u, v, (lu, lv)) else { continue };
+                            let Some((row, col)) = self.sensor_pixel(lenslet, vr, vc) else { continue };
+                            let at = PatchShape::<PS, PT, PU, PV, B, N>::pixel_index(s, t, u, v);
+                            if shared {
+                                // The pixel's place in its cell; a pixel whose centre lies
+                                // in another cell is that cell's measurement, not this one's.
+                                let Some(place) = self.place_in_cell(lenslet, (vr, vc), (row, col)) else { continue };
+                                let _ = m.set_place(at / B, place);
+                            }
+                            for (j, r) in run.iter_mut().enumerate().take(k) {
+                                source.read(j, row, col, &mut r[..1])?;
+                            }
+                            self.put_pixel(m, at, row, col, |j| run.get(j).map(|r| r[0]), &mut flags, &mut excluded);
+                        }
+                    }
+                }
+            }
+        }
+        Ok((flags, excluded))
+    }
+
+    /// How the pixels of a patch at `origin` share view cells behind the lenslet grid:
+    /// `None` on the aligned sensor (each pixel its cell, the selection's bits), for a
+    /// half-pixel shear (its own interpolation) and for a solved response that mixes bands
+    /// (neither projection is built with shares).
+    pub(super) fn cell_shares(&self, origin: PatchOrigin, half: HalfViews) -> Option<CellShares> {
+        let g = self.grid.as_ref().filter(|g| !g.is_aligned())?;
+        let fits = PU <= MAX_SHARE_VIEWS && PV <= MAX_SHARE_VIEWS && PS * PT * PU * PV <= MAX_PLACES;
+        if !half.is_none() || !self.solved_response().is_identity() || !fits {
+            return None;
+        }
+        let (lu, lv) = (usize::from(self.config.sensor.lenslet.rows), usize::from(self.config.sensor.lenslet.cols));
+        let mut shares = CellShares::unsheared(g.pixel_width());
+        let d = origin.disparity;
+        for (u, o) in shares.shift.0.iter_mut().enumerate().take(PU) {
+            *o = i8::try_from(shift(d, origin.view_row as usize + u, lu)).ok()?;
+        }
+        for (v, o) in shares.shift.1.iter_mut().enumerate().take(PV) {
+            *o = i8::try_from(shift(d, origin.view_col as usize + v, lv)).ok()?;
+        }
+        Some(shares)
+    }
+
+    /// Where pixel `(row, col)`'s centre lies in the view cell of view `(u, v)` of lenslet
+    /// `(lr, lc)`: cells off the cell's centre (rows, cols), `None` if outside that cell (so
+    /// no pixel is two cells' measurement).
+    pub(super) fn place_in_cell(
+        &self,
+        (lr, lc): (isize, isize),
+        (u, v): (usize, usize),
+        (row, col): (usize, usize),
+    ) -> Option<(f32, f32)> {
+        let g = self.grid.as_ref()?;
+        let (a, b) = g.cell_position(row, col)?;
+        let (nu, nv) = g.views();
+        let centre = |l: isize, n: u8, w: usize| l as f32 * f32::from(n) + w as f32 + 0.5;
+        let (dr, dc) = (a - centre(lr, nu, u), b - centre(lc, nv, v));
+        // Cells at least a pixel apart (pitch at least the views) never share the pixel under
+        // their centres, which may sit on the cell's border (a grid offset by half a pixel);
+        // smaller cells may, and the border then goes to the cell after it.
+        let within = |d: f32, wide: bool| if wide { (-0.5..=0.5).contains(&d) } else { (-0.5..0.5).contains(&d) };
+        let (wr, wc) = g.pixel_width();
+        (within(dr, wr <= 1.0) && within(dc, wc <= 1.0)).then_some((dr, dc))
+    }
+
+    /// The sensor pixel `(row, col)` of view `(u, v)` of lenslet `(lr, lc)` (a shear can
+    /// put the lenslet outside the sensor: then `None`).
+    #[inline(always)]
+    pub(super) fn sensor_pixel(&self, (lr, lc): (isize, isize), u: usize, v: usize) -> Option<(usize, usize)> {
+        let c = &self.config;
+        let lr = usize::try_from(lr).ok().filter(|&r| r < usize::from(c.sensor.lenslets.0))?;
+        let lc = usize::try_from(lc).ok().filter(|&c0| c0 < usize::from(c.sensor.lenslets.1))?;
+        if let Some(g) = &self.grid {
+            return g.pixel((lr as isize, lc as isize), (u, v));
+        }
+        Some((lr * usize::from(c.sensor.lenslet.rows) + u, lc * usize::from(c.sensor.lenslet.cols) + v))
+    }
+
+    /// A raw sample of sensor pixel `(row, col)` through `band` as a measurement:
+    /// normalised and divided by its view's gain and the band's, or why it is not one.
+    #[inline(always)]
+    pub(super) fn balanced(&self, band: u8, raw: f32, (row, col): (usize, usize)) -> Result<f32, Invalid> {
+        let gain = self.gains.get(band as usize).copied().unwrap_or(1.0) * self.view_gain(row, col);
+        self.config.raw.classify(raw).map(|y| y / gain)
+    }
+
+    /// A raw sample of sensor pixel `(row, col)` in the decoded light field's units:
+    /// normalised and divided by its view's flat field (the band gains are divided out
+    /// before the solve and multiplied back into its output), or why it is not a
+    /// measurement. On the aligned grid with the identity response it is the light field's
+    /// value at the pixel's lenslet, view and band: what a held-out sample is compared with.
+    #[inline]
+    pub fn light_field_value(&self, raw: f32, (row, col): (usize, usize)) -> Result<f32, Invalid> {
+        let gain = self.view_gain(row, col);
+        self.config.raw.classify(raw).map(|y| y / gain)
+    }
+
+    /// Whether the decode's light field holds each sample's own value: no lenslet grid
+    /// (every pixel under one lenslet's view) and the identity response (a pixel measures
+    /// one band). Then a sample the decode was not given can be compared with the output
+    /// ([`Self::light_field_value`]).
+    pub fn samples_are_values(&self) -> bool {
+        self.grid.is_none() && self.solved_response().is_identity()
+    }
+
+    /// The flat field of sensor pixel `(row, col)`'s view ([`Self::with_view_gains`]); 1
+    /// without one.
+    #[inline(always)]
+    pub(super) fn view_gain(&self, row: usize, col: usize) -> f32 {
+        let Some((table, (rr, rc))) = self.view_gains else { return 1.0 };
+        let (lenslet, lenslets) = (self.config.sensor.lenslet, self.config.sensor.lenslets);
+        let (lu, lv) = (usize::from(lenslet.rows), usize::from(lenslet.cols));
+        // The pixel's lenslet and view: on the grid, the cell its centre lies in.
+        let ((s, t), (u, v)) = match &self.grid {
+            Some(g) => g.view_of(row, col).unwrap_or(((0, 0), (0, 0))),
+            None => (
+                (row.checked_div(lu).unwrap_or(0), col.checked_div(lv).unwrap_or(0)),
+                (row.checked_rem(lu).unwrap_or(0), col.checked_rem(lv).unwrap_or(0)),
+            ),
+        };
+        let region = |l: usize, count: u16, regions: u16| {
+            (l * usize::from(regions))
+                .checked_div(usize::from(count))
+                .unwrap_or(0)
+                .min(usize::from(regions).saturating_sub(1))
+        };
+        let (i, j) = (region(s, lenslets.0, rr), region(t, lenslets.1, rc));
+        table.get(((i * usize::from(rc) + j) * lu + u) * lv + v).copied().unwrap_or(1.0)
+    }
+
+    /// Sensor pixel `(row, col)`'s samples (`sample(j)` of snapshot `j`) as measurements
+    /// of the patch's pixel whose first band is at `at`, each divided by its band's gain;
+    /// a defective pixel or an invalid sample is left out and flagged.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn put_pixel(
+        &self,
+        m: &mut crate::solver::workspace::Measurements<N>,
+        at: usize,
+        row: usize,
+        col: usize,
+        sample: impl Fn(usize) -> Option<f32>,
+        flags: &mut PatchFlags,
+        excluded: &mut u16,
+    ) {
+        let c = &self.config;
+        if c.defects.contains(row, col) {
+            flags.insert(PatchFlags::DEFECTIVE);
+            *excluded += c.mask.snapshots() as u16;
+            return;
+        }
+        for (j, band) in c.mask.bands_at(row, col).iter().enumerate() {
+            let ok = match self.balanced(*band, sample(j).unwrap_or(f32::NAN), (row, col)) {
+                Ok(y) => m.set(at + *band as usize, y).map_err(|_| Invalid::NonFinite),
+                Err(e) => Err(e),
+            };
+            if let Err(e) = ok {
+                flags.insert(e.into());
+                *excluded += 1;
+            }
+        }
+    }
+}
