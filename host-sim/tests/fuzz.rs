@@ -426,7 +426,7 @@ static FRAMES: AtomicU32 = AtomicU32::new(0);
 /// a small PNG claiming 15000 x 15000).
 #[test]
 fn fuzz_frame_headers() {
-    use slf_host::io::capture::read_frame;
+    use slf_host::io::frame_file::read_frame;
     let dir = tempfile::tempdir().unwrap();
     let expect = (10usize, 15usize);
     let size = |right: u32| prop_oneof![3 => Just(right), 4 => 0u32..20, 2 => 0u32..70_000, 1 => any::<u32>()];

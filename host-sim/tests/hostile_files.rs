@@ -9,7 +9,8 @@ use std::path::{Path, PathBuf};
 use std::sync::mpsc;
 use std::time::Duration;
 
-use slf_host::io::capture::{Capture, read_frame, write_frame};
+use slf_host::io::capture::Capture;
+use slf_host::io::frame_file::{read_frame, write_frame};
 use slf_host::io::lightfield::{LightField, read_npy, read_npy_with_notes};
 use slf_host::io::npy::{self, NpyErrorKind, Values};
 use slf_host::sim::camera::{CameraConfig, simulate};

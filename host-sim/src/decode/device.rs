@@ -403,7 +403,7 @@ fn within(worst: f64) -> bool {
 pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
     // A log is read whole only if it is a regular file of a log's size: a FIFO would block,
     // /dev/zero never end.
-    let text = crate::io::capture::read_small_file(log, MAX_LOG)?;
+    let text = crate::io::file_checks::read_small_file(log, MAX_LOG)?;
     let DeviceLog { patches: device, rows, count, gains, calibrated, calibrated_gains, trial } = parse(&text)?;
     let capture = Capture::load(capture_dir)?;
     // The device decodes full-view patches with the shipped full-view ensemble.

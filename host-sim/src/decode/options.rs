@@ -131,7 +131,7 @@ pub const MAX_BLOB: usize = slf_firmware::blob::blob_len([5, 5, 5, 5, 13], u16::
 /// # Errors
 /// A message with the file and what is wrong.
 pub fn read_blob(path: &std::path::Path) -> Result<Vec<u8>> {
-    crate::io::capture::regular_file(
+    crate::io::file_checks::regular_file(
         path,
         MAX_BLOB as u64,
         "of the largest dictionary blob of a decoder's patch (65,535 members)",

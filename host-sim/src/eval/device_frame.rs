@@ -8,7 +8,7 @@
 //! frame figure (`bench.md`), so one page shows both: the host's seconds measured, the
 //! device's projected from counts (one instruction a cycle; a Cortex-M7 issues up to two).
 //!
-//! The file is checked before anything is kept: a regular file (`io::capture::regular_file`)
+//! The file is checked before anything is kept: a regular file (`io::file_checks::regular_file`)
 //! of at most [`MAX_BYTES`], at most [`MAX_ROWS`] rows,
 //! every number finite and positive, each fault named with its line.
 
@@ -16,7 +16,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 
-use crate::io::capture::regular_file;
+use crate::io::file_checks::regular_file;
 
 /// The largest device-frame file read: a few rows of text.
 pub const MAX_BYTES: u64 = 64 * 1024;

@@ -12,7 +12,8 @@ use anyhow::{Result, anyhow, bail, ensure};
 use crate::io::folder::{FileRecord, Kind, WholeFolder, record, verify};
 use serde::{Deserialize, Serialize};
 
-use crate::io::capture::{MAX_DESCRIPTION, read_small_file};
+use crate::io::capture::MAX_DESCRIPTION;
+use crate::io::file_checks::read_small_file;
 use crate::io::grid::GridDescription;
 use crate::io::lightfield::write_npy_f32_2d;
 use crate::io::message::number;

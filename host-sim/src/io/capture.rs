@@ -13,11 +13,12 @@ use slf_firmware::{
     Sl0Config, TileDecoder,
 };
 
+use crate::io::file_checks::read_small_file;
 use crate::io::folder::{FileRecord, Kind, WholeFolder, record, verify};
+use crate::io::frame_file::{extension, read_frame, write_frame};
 use crate::io::grid::GridDescription;
-use crate::io::lightfield::{read_npy_u16_2d, write_npy_u16_2d};
 use crate::io::message::one_line;
-use crate::io::output::{write_bytes, write_whole};
+use crate::io::output::write_bytes;
 use crate::io::sensor::SensorDescription;
 
 /// The largest `capture.json` read (a long defect list fits many times over).
@@ -544,195 +545,9 @@ impl Capture {
     }
 }
 
-/// A raw frame as read from a file.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct FrameFile {
-    /// Values as stored (DN), row-major.
-    pub data: Vec<u16>,
-    pub rows: usize,
-    pub cols: usize,
-    /// The largest value the file can hold: a PGM's MAXVAL, 255 or 65535 for PNG and `.npy`.
-    pub top: u32,
-}
-
-/// Reads a 16-bit raw frame: binary PGM (P5), 8- or 16-bit grey PNG, or `.npy` (uint16, 2
-/// axes). Values are DN as stored, whatever a PGM's MAXVAL says (image libraries rescale
-/// a MAXVAL of 4095 to 65535 for display; a decoder must not). With `expect` (rows, cols),
-/// a file whose header states another size is refused before its pixels are read.
-///
-/// # Errors
-/// A message with the file and what is wrong.
-pub fn read_frame(path: &Path, expect: Option<(usize, usize)>) -> Result<FrameFile> {
-    let len = regular_file(path, u64::MAX, "")?;
-    // A header that claims another size is refused before its pixels are read: a sparse
-    // file or a small PNG can claim gigabytes.
-    let sized = |rows: u64, cols: u64| match expect {
-        Some((r, c)) if (rows, cols) != (r as u64, c as u64) => {
-            Err(anyhow!("{}: frame is {rows} x {cols}, the capture's frames are {r} x {c}", path.display()))
-        }
-        _ => Ok(()),
-    };
-    match extension(path).as_str() {
-        "npy" => {
-            let (data, rows, cols) = read_npy_u16_2d(path, expect)?;
-            Ok(FrameFile { data, rows, cols, top: u32::from(u16::MAX) })
-        }
-        "pgm" => read_pgm(path, len, &sized),
-        "png" => {
-            use image::ImageDecoder;
-            let undecodable = || format!("{}: cannot decode image", path.display());
-            let decoder = image::ImageReader::open(path)
-                .and_then(image::ImageReader::with_guessed_format)
-                .with_context(|| format!("cannot read {}", path.display()))?
-                .into_decoder()
-                .with_context(undecodable)?;
-            let (w, h) = decoder.dimensions();
-            sized(u64::from(h), u64::from(w))?;
-            let img = image::DynamicImage::from_decoder(decoder).with_context(undecodable)?;
-            let color = img.color();
-            let top = match color {
-                image::ColorType::L8 => 255,
-                image::ColorType::L16 => 65535,
-                _ => bail!("{}: raw frame must be single-channel grey, found {color:?}", path.display()),
-            };
-            let g = img.into_luma16();
-            let (w, h) = g.dimensions();
-            let data = if top == 255 { g.into_raw().iter().map(|&x| x / 257).collect() } else { g.into_raw() };
-            Ok(FrameFile { data, rows: h as usize, cols: w as usize, top })
-        }
-        other => bail!("{}: unknown frame format {other:?} (use .pgm, .png or .npy)", path.display()),
-    }
-}
-
-/// A binary PGM: the header through the image library, the samples as stored.
-fn read_pgm(path: &Path, file_len: u64, sized: &dyn Fn(u64, u64) -> Result<()>) -> Result<FrameFile> {
-    use image::codecs::pnm::{PnmDecoder, PnmSubtype, SampleEncoding};
-    let file = fs::File::open(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let decoder = PnmDecoder::new(std::io::BufReader::new(file))
-        .map_err(|e| anyhow!("{}: not a PGM file: {e}", path.display()))?;
-    let (mut reader, header) = decoder.into_inner();
-    ensure!(
-        header.subtype() == PnmSubtype::Graymap(SampleEncoding::Binary),
-        "{}: a raw frame is a binary PGM (P5), this file is {:?}",
-        path.display(),
-        header.subtype()
-    );
-    let (w, h, top) = (header.width(), header.height(), header.maximal_sample());
-    ensure!((1..=65535).contains(&top), "{}: MAXVAL {top} out of 1..=65535", path.display());
-    sized(u64::from(h), u64::from(w))?;
-    let bytes_per = if top > 255 { 2u64 } else { 1 };
-    let count = u64::from(w) * u64::from(h);
-    ensure!(
-        count * bytes_per <= file_len,
-        "{}: {w} x {h} pixels need {} bytes, the file has {file_len}",
-        path.display(),
-        count * bytes_per
-    );
-    let mut raw = vec![0u8; (count * bytes_per) as usize];
-    std::io::Read::read_exact(&mut reader, &mut raw)
-        .with_context(|| format!("{}: truncated: {w} x {h} pixels promised", path.display()))?;
-    // A frame file holds one image: bytes after it mean a writer that disagrees with the
-    // header (a wrong size, a second image), so the file is refused, not half read.
-    let mut rest = [0u8; 1];
-    let extra =
-        std::io::Read::read(&mut reader, &mut rest).with_context(|| format!("cannot read {}", path.display()))?;
-    ensure!(
-        extra == 0,
-        "{}: bytes after the {w} x {h} pixels the header promises (the file is longer than its image)",
-        path.display()
-    );
-    let data: Vec<u16> = if bytes_per == 2 {
-        raw.chunks_exact(2).map(|c| u16::from_be_bytes([c[0], c[1]])).collect()
-    } else {
-        raw.iter().map(|&x| u16::from(x)).collect()
-    };
-    if let Some(i) = data.iter().position(|&x| u32::from(x) > top) {
-        bail!("{}: pixel ({}, {}) is {}, above MAXVAL {top}", path.display(), i / w as usize, i % w as usize, data[i]);
-    }
-    Ok(FrameFile { data, rows: h as usize, cols: w as usize, top })
-}
-
-/// Writes a 16-bit raw frame; the extension picks PGM, PNG or `.npy`.
-///
-/// # Errors
-/// I/O and encoding errors, with the file.
-pub fn write_frame(path: &Path, data: &[u16], rows: usize, cols: usize) -> Result<()> {
-    match extension(path).as_str() {
-        "npy" => write_npy_u16_2d(path, data, rows, cols),
-        "pgm" => {
-            // P5 with MAXVAL 65535, as docs/capture-format.md says: values as stored.
-            use image::codecs::pnm::{GraymapHeader, PnmEncoder, SampleEncoding};
-            ensure!(data.len() == rows * cols, "frame size does not match its data");
-            let header = GraymapHeader {
-                encoding: SampleEncoding::Binary,
-                height: rows as u32,
-                width: cols as u32,
-                maxwhite: u32::from(u16::MAX),
-            };
-            let bytes: Vec<u8> = data.iter().flat_map(|x| x.to_ne_bytes()).collect();
-            write_whole(path, |out| {
-                PnmEncoder::new(out).with_header(header.into()).encode(
-                    &bytes[..],
-                    cols as u32,
-                    rows as u32,
-                    image::ExtendedColorType::L16,
-                )?;
-                Ok(())
-            })
-        }
-        "png" => {
-            use image::ImageEncoder;
-            ensure!(data.len() == rows * cols, "frame size does not match its data");
-            let bytes: Vec<u8> = data.iter().flat_map(|x| x.to_ne_bytes()).collect();
-            write_whole(path, |out| {
-                image::codecs::png::PngEncoder::new(out).write_image(
-                    &bytes,
-                    cols as u32,
-                    rows as u32,
-                    image::ExtendedColorType::L16,
-                )?;
-                Ok(())
-            })
-        }
-        other => bail!("{}: unknown frame format {other:?} (use .pgm, .png or .npy)", path.display()),
-    }
-}
-
-fn extension(path: &Path) -> String {
-    path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
-}
-
-/// Frame file names for `k` snapshots with extension `ext`.
-pub fn frame_names(k: usize, ext: &str) -> Vec<String> {
-    (0..k).map(|j| format!("snapshot_{j}.{ext}")).collect()
-}
-
 /// The folder path's description file.
 pub fn description_path(dir: &Path) -> PathBuf {
     dir.join(DESCRIPTION)
-}
-
-/// Reads a regular file of at most `max` bytes as text; larger files, FIFOs and devices are
-/// refused before reading.
-///
-/// # Errors
-/// A message with the file and what is wrong.
-pub fn read_small_file(path: &Path, max: u64) -> Result<String> {
-    regular_file(path, max, "this file can need")?;
-    fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))
-}
-
-/// The size of `path`, checked before anything opens it: a regular file (opening a FIFO
-/// blocks until a writer comes, a device may never end) of at most `max` bytes (`why` says
-/// where the limit comes from).
-///
-/// # Errors
-/// A message with the file and what is wrong.
-pub fn regular_file(path: &Path, max: u64, why: &str) -> Result<u64> {
-    let meta = fs::metadata(path).with_context(|| format!("cannot read {}", path.display()))?;
-    ensure!(meta.is_file(), "{}: not a regular file (a FIFO, device or folder is not read)", path.display());
-    ensure!(meta.len() <= max, "{}: {} bytes, more than the {max} {why}", path.display(), meta.len());
-    Ok(meta.len())
 }
 
 /// A frame's path: `name` must be a relative path inside the capture folder.

@@ -9,6 +9,8 @@
 //! - [`calibration`]: the calibration folder `slf calibrate` writes and a calibrated
 //!   decode reads;
 //! - [`capture`]: the capture folder (frames and `capture.json`), loaded and saved;
+//! - [`frame_file`]: a raw frame's file (PGM, PNG, `.npy`), read and written;
+//! - [`file_checks`]: a file checked before it is opened (regular, not too large);
 //! - [`hdf5_rows`]: a light field's HDF5 file, from its rows;
 //! - [`folder`]: folders written whole, and the checksums their descriptions record;
 //! - [`grid`]: the lenslet grid, where a real lenslet array sits on the sensor;
@@ -25,7 +27,9 @@
 pub mod budget;
 pub mod calibration;
 pub mod capture;
+pub mod file_checks;
 pub mod folder;
+pub mod frame_file;
 pub mod grid;
 pub mod hdf5_rows;
 pub mod import;

@@ -27,8 +27,8 @@ use rand_distr::{Distribution, Normal, Poisson};
 
 use crate::io::capture::{
     Capture, CaptureDescription, FORMAT, Light, MaskDescription, MaskSource, NoiseDescription, VERSION, VERSION_SENSOR,
-    frame_names,
 };
+use crate::io::frame_file::frame_names;
 use crate::io::grid::{GridDescription, lenslet_view};
 use crate::io::lightfield::LightField;
 use crate::io::sensor::SensorDescription;

@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use super::plot::plot;
 use super::{PSNR_DB, Point, TIME_MS};
 use crate::eval::device_frame::{self, DeviceFrame};
-use crate::io::capture::regular_file;
+use crate::io::file_checks::regular_file;
 use crate::io::output::write_bytes;
 
 /// Marks, per mask family and k, the points no other point beats in both time (one
