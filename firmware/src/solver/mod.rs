@@ -19,7 +19,8 @@
 //! - [`holdout`]: held-out measurements, a patch's estimate of its own decode's error;
 //! - [`plausible`]: the plausibility check, a decoded patch against the brightest
 //!   measurements of its lenslets' neighbourhoods;
-//! - [`sl0`]: Algorithm 1, its configuration and how a solve ended;
+//! - [`sl0`]: Algorithm 1;
+//! - [`sl0_config`]: its configuration and how a solve ended;
 //! - [`choice`]: the ensemble's member choice per patch (exhaustive or screened);
 //! - [`picked`]: two models, one of which decodes (the model trial's pick);
 //! - [`interpolate`]: per-pixel spectral interpolation, for a patch that measures too few
@@ -42,4 +43,5 @@ pub mod plausible;
 pub mod projection;
 pub mod shares;
 pub mod sl0;
+pub mod sl0_config;
 pub mod workspace;
