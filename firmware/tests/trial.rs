@@ -145,13 +145,7 @@ fn a_leaning_pick_leaves_its_model_only_below_the_margin() {
             towards
         }
     };
-    let mut state = 0x2545_f491_4f6c_dd1du64;
-    let mut next = || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 40) as f32 / (1u64 << 24) as f32
-    };
+    let mut next = uniform(0x2545_f491_4f6c_dd1d);
     for i in 0..2000 {
         let t = TrialErrors { first: next(), second: next(), spread: 0.0, pilots: (i % 3) as u32 };
         for (towards, margin) in [(Pick::First, 0.8), (Pick::Second, 0.8), (Pick::Second, 1.0), (Pick::First, 1.0)] {
@@ -184,13 +178,7 @@ fn a_tie_is_a_difference_within_two_standard_errors_of_the_pilots_and_takes_the_
         let s2 = d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
         (mean * n).abs() <= 2.0 * (n * s2).sqrt()
     };
-    let mut state = 0x9e37_79b9_7f4a_7c15u64;
-    let mut next = || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 40) as f32 / (1u64 << 24) as f32
-    };
+    let mut next = uniform(0x9e37_79b9_7f4a_7c15);
     let (mut tied, mut apart) = (0, 0);
     for case in 0..3000 {
         let n = case % 40;
@@ -287,4 +275,14 @@ fn the_shear_trial_pilots_half_pixel_blocks_and_finds_a_true_half_disparity_bett
     }
     assert!(sum.pilots >= 2, "{sum:?}");
     assert!(sum.first < sum.second, "half {} against whole {}", sum.first.sqrt(), sum.second.sqrt());
+}
+
+/// A xorshift stream of values in [0, 1) from `seed` (fixed seeds: the tests repeat).
+fn uniform(mut state: u64) -> impl FnMut() -> f32 {
+    move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 40) as f32 / (1u64 << 24) as f32
+    }
 }
