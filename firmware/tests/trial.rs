@@ -213,6 +213,9 @@ fn a_tie_is_a_difference_within_two_standard_errors_of_the_pilots_and_takes_the_
             };
             assert_eq!(t.pick_unless_tied(Some(prior)), want, "{t:?}");
         }
+        // The prior is taken where a pilot was measured and the sums tie, never without one.
+        assert_eq!(t.takes_prior(Some(Pick::First)), n > 0 && t.tied(), "{t:?}");
+        assert!(!t.takes_prior(None), "{t:?}");
         // Without a prior, the lower sum however close.
         assert_eq!(t.pick_unless_tied(None), if n == 0 { Pick::Second } else { lower }, "{t:?}");
         if t.tied() { tied += 1 } else { apart += 1 }

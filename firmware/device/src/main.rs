@@ -52,7 +52,7 @@ mod device {
         Ensemble, EnsembleModel, FrameSource, FullViewShape, FullViewWorkspace, HoldOut, LeU16Frame, LensletGrid,
         LensletSize, Mask, MemberChoice, Overlap, OverlapDecoder, PatchModel, PatchOrigin, PatchReport, PatchSink,
         Pick, Picked, Pixel, RawFormat, Response, ResponseModel, RowSink, ScheduledDictionary, SensorGeometry,
-        Sl0Config, TileDecoder, TrialErrors, dct_where_tied,
+        Sl0Config, TileDecoder, TrialErrors, tie_prior,
     };
 
     use super::{bench_begin, bench_end};
@@ -370,9 +370,7 @@ mod device {
         }
         // Where the pilots tie, the model the mask and snapshot count favour, as the host's
         // default picks.
-        let prior = dct_where_tied(config.mask.family(), SNAPSHOTS.into())
-            .map(|dct| if dct { Pick::First } else { Pick::Second });
-        let pick = trial.pick_unless_tied(prior);
+        let pick = trial.pick_unless_tied(tie_prior(config.mask.family(), SNAPSHOTS.into()));
         hprintln!(
             "trial pilots {} dct {:08x} ensemble {:08x} pick {}",
             trial.pilots,

@@ -62,6 +62,12 @@ pub fn dct_where_tied(family: MaskFamily, snapshots: usize) -> Option<bool> {
     }
 }
 
+/// [`dct_where_tied`] as the trial's pick: the DCT is the first model of the model trial
+/// and the ensemble its second, as every caller of [`TileDecoder::trial`] orders them.
+pub fn tie_prior(family: MaskFamily, snapshots: usize) -> Option<Pick> {
+    dct_where_tied(family, snapshots).map(|dct| if dct { Pick::First } else { Pick::Second })
+}
+
 impl TrialErrors {
     /// One pilot's errors: `first` and `second` are the two models' squared estimates.
     pub fn one(first: f32, second: f32) -> Self {
@@ -99,9 +105,15 @@ impl TrialErrors {
     /// [`Self::pick`] has it: the prior was read from frames the pilots could estimate.
     pub fn pick_unless_tied(&self, prior: Option<Pick>) -> Pick {
         match prior {
-            Some(p) if self.pilots > 0 && self.tied() => p,
+            Some(p) if self.takes_prior(prior) => p,
             _ => self.pick(),
         }
+    }
+
+    /// Whether [`Self::pick_unless_tied`] with `prior` takes the prior: there is one, a
+    /// pilot was measured, and the sums tie.
+    pub fn takes_prior(&self, prior: Option<Pick>) -> bool {
+        prior.is_some() && self.pilots > 0 && self.tied()
     }
 
     /// The model whose pilots erred less; the second (the decode's default) without pilots

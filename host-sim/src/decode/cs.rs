@@ -124,12 +124,10 @@ fn decode_basis<const PU: usize, const PV: usize, const N: usize>(
         }
         // The screened ensemble with the model trial: the model whose pilots err less, or
         // where they tie, the one the mask and snapshot count favour
-        // ([`slf_firmware::dct_where_tied`]).
+        // ([`slf_firmware::tie_prior`]).
         Basis::Ensemble { blob, choice } if opts.model_trial => {
             let mask = capture.mask()?;
-            let prior = slf_firmware::dct_where_tied(mask.family(), mask.snapshots())
-                .map(|dct| if dct { Pick::First } else { Pick::Second });
-            let prior = ModelPick::UnlessTied { prior };
+            let prior = ModelPick::UnlessTied { prior: slf_firmware::tie_prior(mask.family(), mask.snapshots()) };
             trial_decode::<PU, PV, N>(capture, blob.as_deref(), *choice, prior, opts, observer, sink)
         }
         Basis::Ensemble { blob, choice } => {
@@ -333,12 +331,12 @@ where
     let blending = Instant::now();
     // A blend that cannot be made (a fold that leaves PPID no measurement, the memory cap)
     // leaves the decode alone, and the report says why.
-    let mut blend_skipped = None;
-    let blend = match opts.baseline_blend && blend::applies(&plan) {
-        true => BaselineBlend::measure(&plan, &model, capture, &raw, opts.batch_tiles)
-            .map_err(|e| blend_skipped = Some(crate::io::message::one_line(&e)))
-            .ok(),
-        false => None,
+    let (blend, blend_skipped) = match opts.baseline_blend && blend::applies(&plan) {
+        true => match BaselineBlend::measure(&plan, &model, capture, &raw, opts.batch_tiles) {
+            Ok(b) => (Some(b), None),
+            Err(e) => (None, Some(crate::io::message::one_line(&e))),
+        },
+        false => (None, None),
     };
     let blend_seconds = blending.elapsed().as_secs_f64();
     let mut report = match &blend {
@@ -377,7 +375,10 @@ where
     });
     report.trial = plan.model_trial.map(|t| {
         let (dct_error, ensemble_error) = rms(&t);
-        let tied = matches!(pick, ModelPick::UnlessTied { prior: Some(_) }) && by_decode.is_none() && t.tied();
+        let tied = match pick {
+            ModelPick::UnlessTied { prior } => by_decode.is_none() && t.takes_prior(prior),
+            _ => false,
+        };
         TrialReport { pilots: t.pilots, dct: plan.pick == Pick::First, dct_error, ensemble_error, tied, by_decode }
     });
     Ok(report)

@@ -459,9 +459,7 @@ pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
         host_trial.add(&t);
     }
     let mask = capture.mask()?;
-    let prior = slf_firmware::dct_where_tied(mask.family(), mask.snapshots())
-        .map(|dct| if dct { Pick::First } else { Pick::Second });
-    let pick = host_trial.pick_unless_tied(prior);
+    let pick = host_trial.pick_unless_tied(slf_firmware::tie_prior(mask.family(), mask.snapshots()));
     let name = if pick == Pick::First { "dct" } else { "ensemble" };
     let (pilots, first, second, device_pick) = trial.context("the device log has no `trial` line")?;
     let rel = |a: f32, b: f32| f64::from((a - b).abs() / b.abs().max(f32::MIN_POSITIVE));

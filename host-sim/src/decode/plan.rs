@@ -102,13 +102,9 @@ impl<'a, const PU: usize, const PV: usize, const N: usize> FramePlan<'a, PU, PV,
         let decoder = if alias { decoder.with_disparities(decoder.disparities().with_halves(false)) } else { decoder };
         let (pick, model_trial) = match pick {
             ModelPick::Given(p) => (p, None),
-            ModelPick::Trial { towards, margin } => {
+            trial => {
                 let t = frame_trial(&decoder, first, second, raw, &base, budget);
-                (t.pick_leaning(towards, margin), Some(t))
-            }
-            ModelPick::UnlessTied { prior } => {
-                let t = frame_trial(&decoder, first, second, raw, &base, budget);
-                (t.pick_unless_tied(prior), Some(t))
+                (trial.of(&t), Some(t))
             }
         };
         let halo = decoder.disparities().halo(views.0.max(views.1));
@@ -156,6 +152,17 @@ pub enum ModelPick {
         /// The model kept on a tie or without pilots.
         prior: Option<Pick>,
     },
+}
+
+impl ModelPick {
+    /// The model this rule picks from the trial's errors `t` (the named one, whatever `t`).
+    pub fn of(self, t: &TrialErrors) -> Pick {
+        match self {
+            Self::Given(p) => p,
+            Self::Trial { towards, margin } => t.pick_leaning(towards, margin),
+            Self::UnlessTied { prior } => t.pick_unless_tied(prior),
+        }
+    }
 }
 
 /// The firmware's tile decoder for `capture` as a decode runs it: the solver config of
