@@ -19,8 +19,8 @@
 # (or $SLF_DEVICE_FRAME): patch solves, instructions a solve and clock per kind of decode.
 #
 #   bash scripts/budgets.sh            # measure and print the table
-#   bash scripts/budgets.sh --write    # and put it in the README, between its budgets.sh marks
-#   bash scripts/budgets.sh --check    # and fail when the README's table is not the one measured
+#   bash scripts/budgets.sh --write    # and put it in docs/device.md, between its budgets.sh marks
+#   bash scripts/budgets.sh --check    # and fail when docs/device.md's table is not the one measured
 #                                      # (each number within 3 %: another compiler moves the
 #                                      # instruction counts a little; CI runs this)
 set -euo pipefail
@@ -39,7 +39,7 @@ import os, re, sys
 table = []
 _print = print
 def print(line):
-    """A line of the table: printed, and kept for the README."""
+    """A line of the table: printed, and kept for docs/device.md."""
     table.append(line)
     _print(line)
 text, rodata, data, bss = (int(x or 0) for x in sys.argv[1:5])
@@ -51,8 +51,8 @@ stack = int(re.search(r"^stack peak bytes (\d+)", log, re.M).group(1))
 disjoint_stack = int(re.search(r"^disjoint stack peak bytes (\d+)", log, re.M).group(1))
 ws = int(re.search(r"workspace bytes (\d+)", log).group(1))
 # The device's workspace (the full-view patch's) is the size firmware/tests/solver.rs pins on
-# the host and the README and crate docs give.
-assert ws == 140_900, f"the device's Workspace is {ws} B; firmware/tests/solver.rs, the README and lib.rs say 140,900"
+# the host, docs/decoder.md and the crate docs give.
+assert ws == 140_900, f"the device's Workspace is {ws} B; firmware/tests/solver.rs, docs/decoder.md and lib.rs say 140,900"
 cameras = {
     int(m[0]): [int(x) for x in m[1:]]
     for m in re.findall(
@@ -139,19 +139,19 @@ with open(sys.argv[5], "w") as f:
 ok = flash <= 320 * 1024 and ram <= 512 * 1024 and stack <= 128 * 1024
 _print("within budget" if ok else "OVER BUDGET")
 
-# The README's table is this one: written there with --write, compared with --check.
+# docs/device.md's table is this one: written there with --write, compared with --check.
 BEGIN, END = "<!-- budgets.sh: made by `bash scripts/budgets.sh --write` -->", "<!-- /budgets.sh -->"
-readme = open("README.md").read()
+readme = open("docs/device.md").read()
 mode = os.environ.get("SLF_BUDGETS_MODE", "")
 block = "\n".join(t for line in table for t in line.split("\n"))
 if mode:
     if BEGIN not in readme or END not in readme:
-        sys.exit(f"README.md has no {BEGIN} ... {END} block")
+        sys.exit(f"docs/device.md has no {BEGIN} ... {END} block")
     head, rest = readme.split(BEGIN, 1)
     old, tail = rest.split(END, 1)
 if mode == "--write":
-    open("README.md", "w").write(head + BEGIN + "\n" + block + "\n" + END + tail)
-    _print("wrote the table into README.md")
+    open("docs/device.md", "w").write(head + BEGIN + "\n" + block + "\n" + END + tail)
+    _print("wrote the table into docs/device.md")
 elif mode == "--check":
     number = re.compile(r"\d[\d,]*(?:\.\d+)?")
     def parts(text):
@@ -161,15 +161,15 @@ elif mode == "--check":
     stale = len(have) != len(want)
     for (hs, hn), (ws_, wn) in zip(have, want):
         if hs != ws_ or len(hn) != len(wn):
-            _print(f"README row differs: {hs!r}\n  measured:         {ws_!r}")
+            _print(f"docs/device.md row differs: {hs!r}\n  measured:         {ws_!r}")
             stale = True
             continue
         for h, w in zip(hn, wn):
             if abs(h - w) > 0.03 * max(abs(w), 1.0):
-                _print(f"README says {h:g}, measured {w:g}: {ws_}")
+                _print(f"docs/device.md says {h:g}, measured {w:g}: {ws_}")
                 stale = True
     if stale:
-        sys.exit("README.md's budget table is not the one measured: run bash scripts/budgets.sh --write")
-    _print("README.md's budget table is the one measured (each number within 3 %)")
+        sys.exit("docs/device.md's budget table is not the one measured: run bash scripts/budgets.sh --write")
+    _print("docs/device.md's budget table is the one measured (each number within 3 %)")
 sys.exit(0 if ok else 1)
 PY

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Captures per second of `python/examples/decode_folder.py` on a Dask LocalCluster of 1 and
 # of 2 worker processes (one thread each, loopback), on the same captures in one run; writes
-# the table into README.md between the dask-throughput markers.
+# the table into docs/python.md between the dask-throughput markers.
 #
 #   pip install "./python[dask]"; bash scripts/dask-throughput.sh
 #
@@ -61,9 +61,9 @@ on a LocalCluster of this machine ($(nproc) cores, shared), $(date -u +%Y-%m-%d)
 includes the cluster's task overhead but not its start."
 "$py" - "$table" <<'PY'
 import re, sys
-text = open("README.md").read()
+text = open("docs/python.md").read()
 begin, end = "<!-- dask-throughput:begin -->", "<!-- dask-throughput:end -->"
 new = re.sub(re.escape(begin) + ".*?" + re.escape(end), lambda m: f"{begin}\n{sys.argv[1]}\n{end}", text, flags=re.S)
-open("README.md", "w").write(new)
+open("docs/python.md", "w").write(new)
 PY
-echo "README.md: table written"
+echo "docs/python.md: table written"

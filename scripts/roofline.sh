@@ -12,7 +12,7 @@
 #    `perf record --call-graph dwarf`: seconds a patch, solves and steps a patch, the
 #    multiply-adds those steps stand for, and the share of the samples by kind of work
 #    (scripts/roofline-kinds.py), with the demosaic's time beside.
-# 3. The device: instructions a transform multiply-add and a patch, from the README's budget
+# 3. The device: instructions a transform multiply-add and a patch, from docs/device.md's budget
 #    table (written by `bash scripts/budgets.sh --write`; CI checks it within 3 %), and where a
 #    patch's instructions go (scripts/device-profile.sh, where qemu-system-arm is installed).
 #
@@ -139,13 +139,13 @@ for preset in ("default", "preview"):
 PY
 echo "## The device"
 echo
-echo "From the README's budget table (\`bash scripts/budgets.sh --write\`, qemu's Cortex-M7 counting"
+echo "From docs/device.md's budget table (\`bash scripts/budgets.sh --write\`, qemu's Cortex-M7 counting"
 echo "instructions; CI checks it within 3 %). At one instruction a cycle (the M7 dual-issues, so a"
 echo "cycle can hold more), an instruction a multiply-add is the device's peak:"
 echo
 echo "| measure | instructions | a multiply-add | at 480 MHz |"
 echo "| --- | --- | --- | --- |"
-python3 - README.md "$tmacs" <<'PY'
+python3 - docs/device.md "$tmacs" <<'PY'
 import re, sys
 text = open(sys.argv[1]).read()
 tmacs = float(sys.argv[2])
@@ -173,7 +173,7 @@ if command -v qemu-system-arm > /dev/null; then
 fi
 echo "## Against issue 62's targets"
 echo
-python3 - "$shares" README.md "$kernel_peak" <<'PY'
+python3 - "$shares" docs/device.md "$kernel_peak" <<'PY'
 import re, statistics, sys
 KERNEL_PEAK = float(sys.argv[3])
 rows = [l[4:].strip().strip("|").split("|") for l in open(sys.argv[1]) if l.startswith("ROW ")]
@@ -214,7 +214,7 @@ if solves and rows:
     per_solve = statistics.median(float(r[6]) / float(r[5].split("/")[0]) for r in rows if r[2] == "default")
     n = int(solves.group(1).replace(",", ""))
     secs = n * per_solve * 1e6 / 480e6
-    print(f"- **device frame**: the 100 x 100-lenslet frame's {n:,} patch solves (README's budget table) at "
+    print(f"- **device frame**: the 100 x 100-lenslet frame's {n:,} patch solves (docs/device.md's budget table) at "
           f"{per_solve:.1f} M multiply-adds a solve (the median default's, at least) take {secs:.0f} s at one "
           f"multiply-add a cycle at 480 MHz: the target of 60 s needs {100 * secs / 60:.0f} % of that peak"
           + (", more than the core has." if secs > 60 else "."))

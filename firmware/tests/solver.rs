@@ -29,14 +29,14 @@ fn workspace_fits_the_ram_budget() {
     let response = 2 * 4 * 13 * 13 + 8;
     let grid = 2 * slf_firmware::workspace::MAX_PLACES + 8 + 2 * slf_firmware::workspace::MAX_SHARE_VIEWS + 4;
     assert!(size <= 4 * 4 * 5200 + 5200 + 4 * 32 + 16 + response + grid, "workspace is {size} bytes");
-    // The exact figure the README, the crate docs and the device's log give: a change to the
+    // The exact figure docs/decoder.md, the crate docs and the device's log give: a change to the
     // workspace shows here first.
-    assert_eq!(size, 91_176, "the README and firmware/src/lib.rs say 91,176 B");
+    assert_eq!(size, 91_176, "docs/decoder.md and firmware/src/lib.rs say 91,176 B");
     // The full-view patch's, the device's (`scripts/budgets.sh` checks its log against it):
     // the same parts for 8,125 values, in the part's 512 KiB of RAM.
     let full = core::mem::size_of::<FullViewWorkspace>();
     assert!(full <= 4 * 4 * 8125 + 8125 + 4 * 32 + 16 + response + grid, "full-view workspace is {full} bytes");
-    assert_eq!(full, 140_900, "the README, firmware/src/lib.rs and scripts/budgets.sh say 140,900 B");
+    assert_eq!(full, 140_900, "docs/decoder.md, firmware/src/lib.rs and scripts/budgets.sh say 140,900 B");
 }
 
 fn masks(k: u8) -> [Mask<'static>; 3] {

@@ -1,0 +1,136 @@
+//! The house rules a newcomer relies on, checked from the tree (issue 64):
+//!
+//! 1. no source file holds more than [`MAX_LINES`] lines, generated data tables aside
+//!    ([`DATA_TABLES`]): a file that grows past it holds more than one idea;
+//! 2. the README stays a five-minute read ([`MAX_README_LINES`]), the details in `docs/`;
+//! 3. every relative link of the README and the docs pages reaches a file, and every
+//!    `#anchor` a heading of it.
+
+use std::path::{Path, PathBuf};
+
+/// The most lines a source file may hold.
+const MAX_LINES: usize = 800;
+/// The most lines of the README.
+const MAX_README_LINES: usize = 300;
+/// Files that are data, written by a generator, not code to read.
+const DATA_TABLES: &[&str] = &["host-sim/src/sim/spectra_data.rs"];
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Every file below `dir` whose name ends in one of `exts`, `target/` and hidden folders aside.
+fn files(dir: &Path, exts: &[&str], out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for entry in entries.flatten() {
+        let path = entry.path();
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if path.is_dir() {
+            if !name.starts_with('.') && name != "target" {
+                files(&path, exts, out);
+            }
+        } else if exts.iter().any(|e| name.ends_with(e)) {
+            out.push(path);
+        }
+    }
+}
+
+fn relative(path: &Path) -> String {
+    path.strip_prefix(root()).unwrap_or(path).to_string_lossy().replace('\\', "/")
+}
+
+#[test]
+fn no_source_file_holds_more_than_one_idea_by_size() {
+    let mut sources = Vec::new();
+    for dir in ["firmware/src", "firmware/device/src", "host-sim/src", "python/src"] {
+        files(&root().join(dir), &[".rs"], &mut sources);
+    }
+    files(&root().join("python/slf"), &[".py"], &mut sources);
+    assert!(sources.len() > 100, "the walk found {} sources: wrong root?", sources.len());
+    let mut long: Vec<String> = sources
+        .iter()
+        .filter(|p| !DATA_TABLES.contains(&relative(p).as_str()))
+        .filter_map(|p| {
+            let lines = std::fs::read_to_string(p).ok()?.lines().count();
+            (lines > MAX_LINES).then(|| format!("{} ({lines} lines)", relative(p)))
+        })
+        .collect();
+    long.sort();
+    assert!(long.is_empty(), "over {MAX_LINES} lines: {}", long.join(", "));
+}
+
+#[test]
+fn the_readme_is_short() {
+    let readme = std::fs::read_to_string(root().join("README.md")).expect("README.md");
+    let lines = readme.lines().count();
+    assert!(
+        lines <= MAX_README_LINES,
+        "README.md has {lines} lines; at most {MAX_README_LINES}: move details to docs/"
+    );
+    for command in ["cargo run --release -p slf-host -- demo", "cargo test"] {
+        assert!(readme.contains(&format!("    {command}\n")), "the README does not give `{command}`");
+    }
+}
+
+/// GitHub's anchor of a heading: lower case, punctuation but `-` and `_` dropped, spaces as `-`.
+fn anchor(heading: &str) -> String {
+    heading
+        .trim()
+        .to_lowercase()
+        .chars()
+        .filter(|c| c.is_alphanumeric() || matches!(c, '-' | '_' | ' '))
+        .map(|c| if c == ' ' { '-' } else { c })
+        .collect()
+}
+
+/// The text outside fenced code blocks.
+fn prose(text: &str) -> String {
+    let mut fenced = false;
+    let mut out = String::new();
+    for line in text.lines() {
+        if line.trim_start().starts_with("```") {
+            fenced = !fenced;
+        } else if !fenced {
+            out.push_str(line);
+            out.push('\n');
+        }
+    }
+    out
+}
+
+#[test]
+fn every_link_of_the_docs_reaches_its_target() {
+    let mut pages = vec![root().join("README.md")];
+    files(&root().join("docs"), &[".md"], &mut pages);
+    let mut broken = Vec::new();
+    for page in &pages {
+        let text = prose(&std::fs::read_to_string(page).expect("a page"));
+        let mut rest = text.as_str();
+        while let Some(at) = rest.find("](") {
+            rest = &rest[at + 2..];
+            let Some(end) = rest.find(')') else { break };
+            let link = &rest[..end];
+            if link.contains("://") || link.starts_with("mailto:") || link.contains(' ') {
+                continue;
+            }
+            let (file, hash) = link.split_once('#').unwrap_or((link, ""));
+            let target = if file.is_empty() { page.clone() } else { page.parent().expect("a folder").join(file) };
+            if !target.exists() {
+                broken.push(format!("{}: {link} (no such file)", relative(page)));
+                continue;
+            }
+            if !hash.is_empty() && target.extension().is_some_and(|e| e == "md") {
+                let headings = std::fs::read_to_string(&target).unwrap_or_default();
+                let found = prose(&headings)
+                    .lines()
+                    .filter_map(|l| l.strip_prefix('#'))
+                    .any(|h| anchor(h.trim_start_matches('#')) == hash);
+                if !found {
+                    broken.push(format!("{}: {link} (no such heading)", relative(page)));
+                }
+            }
+        }
+    }
+    assert!(pages.len() > 20, "found {} pages: wrong root?", pages.len());
+    assert!(broken.is_empty(), "broken links:\n{}", broken.join("\n"));
+}
