@@ -16,6 +16,7 @@
 set -euo pipefail
 out=${1:?usage: baseline-blend.sh OUT_DIR}
 cd "$(dirname "$0")/.."
+. scripts/stamp.sh
 . scripts/scene-tables.sh
 table_setup
 add_real_scenes
@@ -41,6 +42,7 @@ row() {
 made=${SLF_MADE_AT:-$(git rev-parse --short HEAD)}
 settings=${SLF_SETTINGS:-kronecker:3 kronecker:1}
 each_capture "$settings" 1 row
+STAMP_LINE=$(stamp "bash scripts/baseline-blend.sh OUT_DIR") && export STAMP_LINE
 python3 - "$rows" "$size" "$(paste -sd, "$out/made-at" 2>/dev/null || git rev-parse --short HEAD)" "${RAYON_NUM_THREADS:-all}" "$settings" <<'PY'
 import statistics, sys
 asked = sys.argv[5].split()
@@ -48,6 +50,8 @@ rows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1]) if l.strip()]
 rows = [r for r in rows if r[0] in asked]
 real = lambda scene: scene.endswith("_128")
 print("# The baseline blend on kronecker masks (issue 63)")
+print()
+print(__import__("os").environ["STAMP_LINE"])
 print()
 print(f"Made by `bash scripts/baseline-blend.sh OUT_DIR` at {sys.argv[3]}: synthetic scenes at {sys.argv[2]} x "
       f"{sys.argv[2]} lenslets and the real crops, 5 x 5 views, `slf simulate --seed 1`, "

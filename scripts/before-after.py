@@ -30,6 +30,8 @@ def main():
     rows, scenes, settings = read(path)
     print("# Speed before and after issue 62, every scene")
     print()
+    print(__import__("os").environ.get("STAMP_LINE", "> Made by `before-after.py` outside its script."))
+    print()
     print(f"Made by `SLF_BEFORE={before} bash scripts/before-after.sh OUT` at commit {after}")
     print(f"(`RAYON_NUM_THREADS={threads}`); the binary before is built as the script's header says, from")
     print("e25a905, the commit before issue 62's first change.")

@@ -17,6 +17,7 @@ set -euo pipefail
 out=${1:?usage: before-after.sh OUT_DIR}
 before=${SLF_BEFORE:?SLF_BEFORE: the binary to compare with}
 cd "$(dirname "$0")/.."
+. scripts/stamp.sh
 . scripts/scene-tables.sh
 table_setup
 add_real_scenes
@@ -42,4 +43,5 @@ for token in $scenes; do
     done
   done
 done
+STAMP_LINE=$(stamp "SLF_BEFORE=BINARY bash scripts/before-after.sh OUT") && export STAMP_LINE
 python3 scripts/before-after.py "$rows" "${RAYON_NUM_THREADS:-all}" "$before" "$size" "$(git rev-parse --short HEAD)"

@@ -11,6 +11,7 @@
 set -euo pipefail
 out=${1:?usage: halves-check.sh OUT_DIR}
 cd "$(dirname "$0")/.."
+. scripts/stamp.sh
 . scripts/scene-tables.sh
 SLF_SIZE=${SLF_SIZE:-64} table_setup
 add_real_scenes
@@ -24,9 +25,12 @@ row() {
   printf '%s\t%s\t%s\t%s\t%s\t%s\n' "$s" "$scene" "$pw" "$tw" "$p" "$t" >> "$rows"
 }
 each_capture "${SLF_SETTINGS:-lenslet:2 lenslet:3 lenslet:5}" 2 row
+STAMP_LINE=$(stamp "bash scripts/halves-check.sh OUT_DIR") && export STAMP_LINE
 python3 - "$rows" "$size" "$(git rev-parse --short HEAD)" <<'PY'
 import statistics, sys
 rows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1]) if l.strip()]
+print(__import__("os").environ["STAMP_LINE"])
+print()
 print(f"Made by `bash scripts/halves-check.sh OUT_DIR` at {sys.argv[3]}: synthetic scenes at {sys.argv[2]} x "
       f"{sys.argv[2]} lenslets and the real crops, `slf simulate --seed 2`, one thread; PSNR in dB, "
       "times as halves' over whole disparities' in the same row.")

@@ -14,6 +14,7 @@
 set -euo pipefail
 out=${1:?usage: hard-cases.sh OUT_DIR}
 cd "$(dirname "$0")/.."
+. scripts/stamp.sh
 . scripts/scene-tables.sh
 cargo build --release -q -p slf-host
 slf=${SLF_BIN:-./target/release/slf}
@@ -22,6 +23,8 @@ scenes=${SLF_SCENES:-mosaic mosaic-2 field print speculars narrow dim canopy can
 methods="demosaic=--method,demosaic ppid=--method,ppid preview=--preset,preview default=--preset,default best=--preset,best"
 mkdir -p "$out"
 echo "# The hard-case set"
+echo
+stamp "bash scripts/hard-cases.sh OUT_DIR"
 echo
 echo "Made by \`bash scripts/hard-cases.sh OUT_DIR\` (scenes of ${size} x ${size} lenslets, 5 x 5 views;"
 echo "\`RAYON_NUM_THREADS=${RAYON_NUM_THREADS:-all}\`). Each scene is described in"

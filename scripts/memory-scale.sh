@@ -15,6 +15,7 @@
 set -euo pipefail
 out=${1:?usage: memory-scale.sh OUT_DIR}
 cd "$(dirname "$0")/.."
+. scripts/stamp.sh
 cargo build --release -q -p slf-host
 slf=${SLF_BIN:-./target/release/slf}
 sizes=${SLF_SIZES:-100 200 300 500 500x1000 1000}
@@ -25,6 +26,8 @@ label=${SLF_BEFORE_LABEL:-$before}
 export RAYON_NUM_THREADS=${RAYON_NUM_THREADS:-2}
 mkdir -p "$out"
 echo "# Peak memory against frame size"
+echo
+stamp "bash scripts/memory-scale.sh OUT_DIR"
 echo
 echo "Made by \`bash scripts/memory-scale.sh OUT_DIR > docs/results-memory.md\` (texture scene, pixel k = 1,"
 echo "\`slf simulate --seed 1\`; \`RAYON_NUM_THREADS=$RAYON_NUM_THREADS\`; $(nproc) cores). Peak resident memory of"

@@ -12,6 +12,7 @@ set -euo pipefail
 out=${1:?usage: model-blend.sh OUT_DIR}
 py=${SLF_PYTHON:-python3}
 cd "$(dirname "$0")/.."
+. scripts/stamp.sh
 . scripts/scene-tables.sh
 table_setup
 add_real_scenes
@@ -26,10 +27,13 @@ row() {
   printf '%s\t%s\t%s\t%s\n' "$s" "$scene" "${pick:-none}" "$("$py" scripts/model-blend.py "$lf" "$out/dct.npy" "$out/ens.npy")" >> "$rows"
 }
 each_capture "${SLF_SETTINGS:-pixel:1 pixel:3 lenslet:3}" 1 row
+STAMP_LINE=$(stamp "bash scripts/model-blend.sh OUT_DIR") && export STAMP_LINE
 "$py" - "$rows" "$size" "$(git rev-parse --short HEAD)" <<'PY'
 import statistics, sys
 rows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1]) if l.strip()]
 print("# A choice per block, or the mean, against the frame's better model (issue 63)")
+print()
+print(__import__("os").environ["STAMP_LINE"])
 print()
 print(f"Made by `bash scripts/model-blend.sh OUT_DIR` at {sys.argv[3]}: synthetic scenes at {sys.argv[2]} x "
       f"{sys.argv[2]} lenslets and the real crops, `slf simulate --seed 1`, one thread. PSNR in dB; \"best\" is "

@@ -17,6 +17,7 @@
 set -euo pipefail
 root=${1:?usage: model-tie.sh OUT_DIR}
 cd "$(dirname "$0")/.."
+. scripts/stamp.sh
 . scripts/scene-tables.sh
 out=$root
 table_setup
@@ -46,10 +47,13 @@ for pair in depth:60 texture:300; do
   scenes=${pair%:*}; size=${pair#*:}; out="$root/issue/$size"; mkdir -p "$out"
   each_capture "pixel:1" 1 row
 done
+STAMP_LINE=$(stamp "bash scripts/model-tie.sh OUT_DIR") && export STAMP_LINE
 python3 - "$rows" "$(git rev-parse --short HEAD)" "${RAYON_NUM_THREADS:-all}" <<'PY'
 import re, statistics, sys
 rows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1]) if l.strip()]
 print("# The model trial's tie rule (issue 63)")
+print()
+print(__import__("os").environ["STAMP_LINE"])
 print()
 print(f"Made by `bash scripts/model-tie.sh OUT_DIR` at {sys.argv[2]}, `RAYON_NUM_THREADS={sys.argv[3]}`. PSNR in dB "
       "against the better of the DCT alone and the screened ensemble alone (\"best\"), all without the baseline "

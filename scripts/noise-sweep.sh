@@ -12,6 +12,7 @@ set -euo pipefail
 out=$1
 shift
 root=$(cd "$(dirname "$0")/.." && pwd)
+. "$root/scripts/stamp.sh"
 slf="$root/target/release/slf"
 cargo build --release -q -p slf-host --manifest-path "$root/Cargo.toml"
 work=$(mktemp -d)
@@ -19,6 +20,8 @@ trap 'rm -rf "$work"' EXIT
 # metric RECON TRUTH
 metric() { "$slf" eval "$2" "$1" | awk '/^PSNR/ { p = $2 } /^SA/ { s = $2 } END { printf "%.2f / %.2f", p, s }'; }
 {
+  stamp "bash scripts/noise-sweep.sh OUT_DIR ..."
+  echo
   echo "| scene | electrons at white / read noise DN | k | exact | capture's noise (default) | demosaic |"
   echo "| --- | --- | --- | --- | --- | --- |"
   for lf in "$@"; do

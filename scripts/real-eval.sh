@@ -19,6 +19,7 @@ set -euo pipefail
 hci=${1:?usage: real-eval.sh HCI_DATASET_DIR OUT_DIR}
 out=${2:?usage: real-eval.sh HCI_DATASET_DIR OUT_DIR}
 cd "$(dirname "$0")/.."
+. scripts/stamp.sh
 cargo build --release -q -p slf-host
 slf=./target/release/slf
 mkdir -p "$out"
@@ -27,3 +28,5 @@ for scene in additional/antinous training/dino training/cotton; do
   "$slf" import views "$hci/$scene" -o "$out/$name.npy" --crop 128,128,256,256 --fill warp 2>&1 | grep -v '^note: .*view ('
 done
 "$slf" evaluate "$out/antinous.npy" "$out/dino.npy" "$out/cotton.npy" -o "$out"
+# The page's stamp, for docs/results-real.md above the table slf evaluate wrote.
+stamp "bash scripts/real-eval.sh HCI_DATASET_DIR OUT_DIR" | tee "$out/stamp.md"

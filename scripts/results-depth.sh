@@ -25,6 +25,7 @@
 set -euo pipefail
 out=${1:?usage: results-depth.sh OUT_DIR}
 cd "$(dirname "$0")/.."
+. scripts/stamp.sh
 cargo build --release -q -p slf-host
 slf=${SLF_BIN:-./target/release/slf}
 hci=${SLF_REAL:-/tmp/hci/real}
@@ -84,6 +85,8 @@ table() {
     done
   done
 }
+stamp "bash scripts/results-depth.sh OUT_DIR"
+echo
 echo "## Realistic set"
 echo
 table "$out/real" "$hci/antinous_128.npy" "$hci/dino_128.npy" "$hci/cotton_128.npy" "$out/lf/outdoor.npy" \

@@ -15,6 +15,7 @@ out=${1:?usage: results-ensemble.sh OUT_DIR OLD.slfd REAL.slfd}
 old=${2:?old blob}
 real=${3:?real-trained blob}
 cd "$(dirname "$0")/.."
+. scripts/stamp.sh
 cargo build --release -q -p slf-host
 slf=./target/release/slf
 hci=${SLF_REAL:-/tmp/hci/real}
@@ -26,6 +27,8 @@ for n in smooth texture depth saturated dark; do
   [ -f "$out/lf/$n.npy" ] || "$slf" scene "$n" --size 40 -o "$out/lf/$n.npy" > /dev/null
 done
 models="demosaic=demosaic ppid=ppid interpolate=interpolate dct-plain=dct:off dct=dct old-plain=$old:off old=$old new=firmware/dictionaries/ensemble8.slfd real-trained=$real"
+stamp "bash scripts/results-ensemble.sh OUT_DIR ..."
+echo
 echo "## Realistic set"
 echo
 bash scripts/validate-ensemble.sh "$out/real" "$models" "$hci/antinous_128.npy" "$hci/dino_128.npy" \

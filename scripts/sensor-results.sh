@@ -15,6 +15,7 @@
 set -euo pipefail
 out=${1:?usage: sensor-results.sh OUT_DIR}
 cd "$(dirname "$0")/.."
+. scripts/stamp.sh
 . scripts/scene-tables.sh
 cargo build --release -q -p slf-host
 slf=${SLF_BIN:-./target/release/slf}
@@ -33,6 +34,8 @@ row() {
 }
 
 echo "# A real sensor, calibrated"
+echo
+stamp "bash scripts/sensor-results.sh OUT_DIR"
 echo
 echo "Made by \`bash scripts/sensor-results.sh OUT_DIR\` (scenes of ${size} x ${size} lenslets, 5 x 5 views,"
 echo "$exposures exposures of each calibration capture; \`RAYON_NUM_THREADS=${RAYON_NUM_THREADS:-all}\`)."

@@ -13,9 +13,12 @@
 set -euo pipefail
 out=${1:?usage: shear-check-results.sh OUT_DIR}
 cd "$(dirname "$0")/.."
+. scripts/stamp.sh
 . scripts/scene-tables.sh
 table_setup
 echo "# The shear check and the shear trial"
+echo
+stamp "bash scripts/shear-check-results.sh OUT_DIR"
 echo
 echo "Made by \`bash scripts/shear-check-results.sh OUT_DIR\` (scenes of ${size} x ${size} lenslets, the real"
 echo "crops at their own size, 5 x 5 views, pixel mask, k = 1, \`slf simulate --seed 1\`, the default preset;"

@@ -12,6 +12,7 @@
 set -euo pipefail
 out=${1:?usage: trial-by-decode.sh OUT_DIR}
 cd "$(dirname "$0")/.."
+. scripts/stamp.sh
 . scripts/scene-tables.sh
 table_setup
 add_real_scenes
@@ -28,12 +29,15 @@ row() {
 }
 settings=${SLF_SETTINGS:-pixel:1 pixel:3 lenslet:3 kronecker:3}
 each_capture "$settings" 1 row
+STAMP_LINE=$(stamp "bash scripts/trial-by-decode.sh OUT_DIR") && export STAMP_LINE
 python3 - "$rows" "$size" "$(git rev-parse --short HEAD)" "${RAYON_NUM_THREADS:-all}" "$settings" <<'PY'
 import statistics, sys
 asked = sys.argv[5].split()
 rows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1]) if l.strip()]
 rows = [r for r in rows if r[0] in asked]
 print("# The model trial: by pilot patches or by held-out decodes (issue 63)")
+print()
+print(__import__("os").environ["STAMP_LINE"])
 print()
 print(f"Made by `bash scripts/trial-by-decode.sh OUT_DIR` at {sys.argv[3]}: synthetic scenes at {sys.argv[2]} x "
       f"{sys.argv[2]} lenslets and the real crops, `slf simulate --seed 1`, `RAYON_NUM_THREADS={sys.argv[4]}`. "

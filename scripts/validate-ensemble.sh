@@ -23,6 +23,7 @@ out=${1:?usage: validate-ensemble.sh OUT_DIR "name=BLOB ..." LF.npy ...}
 models=${2:?models}
 shift 2
 cd "$(dirname "$0")/.."
+. scripts/stamp.sh
 cargo build --release -q -p slf-host
 slf=./target/release/slf
 mkdir -p "$out"
@@ -33,6 +34,8 @@ for s in $settings; do
   for lf in "$@"; do header="$header $(basename "$lf" .npy) ${s/:/ k=} |"; rule="$rule --- |"; done
   header="$header mean ${s/:/ k=} |"; rule="$rule --- |"
 done
+stamp "bash scripts/validate-ensemble.sh OUT_DIR ..."
+echo
 echo "$header"
 echo "$rule"
 psnr() { "$slf" eval "$1" "$2" | awk '/PSNR/ { for (i = 1; i <= NF; i++) if ($i ~ /^[0-9.]+$/) { print $i; exit } }'; }
