@@ -142,7 +142,7 @@ pub use decode::tile::{
     Checked, ConfigError, DecoderConfig, FrameReport, NoSeed, PatchFlags, PatchOrigin, PatchReport, PatchSeed,
     PatchSink, ResponseModel, SensorGeometry, Tile, TileDecoder, TileError, TileReport,
 };
-pub use decode::trial::{TIE_SPREAD, TrialErrors, dct_where_tied, tie_prior};
+pub use decode::trial::{ModelTrial, PairedErrors, ShearTrial, TIE_SPREAD, dct_where_tied, tie_prior};
 pub use operators::blob::{DEFAULT_ENSEMBLE, DEFAULT_FULL_VIEW_ENSEMBLE, Ensemble};
 pub use operators::dictionary::{Dictionary, DictionaryError};
 pub use operators::disparity::{Disparity, DisparityRange};

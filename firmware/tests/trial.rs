@@ -46,7 +46,7 @@ fn a_pilots_errors_are_the_held_out_estimates_of_each_model() {
     let (by_dct, by_other) = (estimated(&dct), estimated(&other));
     let mut ws = Box::new(Ws::new());
     for at in blocks() {
-        let t = dec.trial(&dct, &other, at, &mut FrameSource::new(&raw), &mut ws).unwrap();
+        let t = dec.trial(&dct, &other, at, &mut FrameSource::new(&raw), &mut ws).unwrap().errors;
         // The block's first window's patch, as the decode with the estimate reports it.
         let reported = |patches: &[(PatchOrigin, Vec<f32>, PatchReport)]| {
             let (_, _, r) = patches
@@ -89,10 +89,10 @@ fn the_trial_picks_the_model_nearer_the_truth_in_either_order() {
         let truth = [true_rms(&decode(&dec, &raw, &dct), &l), true_rms(&decode(&dec, &raw, &other), &l)];
         let nearer = if truth[0] < truth[1] { Pick::First } else { Pick::Second };
         let mut ws = Box::new(Ws::new());
-        let (mut forward, mut backward) = (TrialErrors::default(), TrialErrors::default());
+        let (mut forward, mut backward) = (PairedErrors::default(), PairedErrors::default());
         for at in blocks() {
-            forward.add(&dec.trial(&dct, &other, at, &mut FrameSource::new(&raw), &mut ws).unwrap());
-            backward.add(&dec.trial(&other, &dct, at, &mut FrameSource::new(&raw), &mut ws).unwrap());
+            forward += dec.trial(&dct, &other, at, &mut FrameSource::new(&raw), &mut ws).unwrap().errors;
+            backward += dec.trial(&other, &dct, at, &mut FrameSource::new(&raw), &mut ws).unwrap().errors;
         }
         assert_eq!(forward.pilots, 6);
         // Both orders: a trial that always said "first" (or "second") fails one of them.
@@ -121,22 +121,22 @@ fn the_picked_model_decodes_as_it_does_alone() {
 
 #[test]
 fn the_pick_is_the_smaller_sum_and_the_second_without_pilots_or_on_a_tie() {
-    assert_eq!(TrialErrors::default().pick(), Pick::Second);
-    let mut t = TrialErrors::one(1.0, 2.0);
+    assert_eq!(PairedErrors::default().pick(), Pick::Second);
+    let mut t = PairedErrors::one(1.0, 2.0);
     assert_eq!(t.pick(), Pick::First);
-    t.add(&TrialErrors::one(3.0, 1.0));
-    assert_eq!(t, TrialErrors { first: 4.0, second: 3.0, spread: 5.0, pilots: 2 });
+    t += PairedErrors::one(3.0, 1.0);
+    assert_eq!(t, PairedErrors { first: 4.0, second: 3.0, spread: 5.0, pilots: 2 });
     assert_eq!(t.pick(), Pick::Second);
-    assert_eq!(TrialErrors { first: 2.0, second: 2.0, spread: 0.0, pilots: 3 }.pick(), Pick::Second);
+    assert_eq!(PairedErrors { first: 2.0, second: 2.0, spread: 0.0, pilots: 3 }.pick(), Pick::Second);
     // No pilot: the sums say nothing.
-    assert_eq!(TrialErrors { first: 0.0, second: 5.0, spread: 0.0, pilots: 0 }.pick(), Pick::Second);
+    assert_eq!(PairedErrors { first: 0.0, second: 5.0, spread: 0.0, pilots: 0 }.pick(), Pick::Second);
 }
 
 #[test]
 fn a_leaning_pick_leaves_its_model_only_below_the_margin() {
     // Written from the definition: the other model where its summed squares are below
     // margin^2 times the kept one's, the kept one on a tie, above it or without pilots.
-    let reference = |t: &TrialErrors, towards: Pick, margin: f32| {
+    let reference = |t: &PairedErrors, towards: Pick, margin: f32| {
         let (kept, other) = if towards == Pick::First { (t.first, t.second) } else { (t.second, t.first) };
         let flip = |p: Pick| if p == Pick::First { Pick::Second } else { Pick::First };
         if t.pilots > 0 && f64::from(other) < f64::from(margin).powi(2) * f64::from(kept) {
@@ -147,18 +147,18 @@ fn a_leaning_pick_leaves_its_model_only_below_the_margin() {
     };
     let mut next = uniform(0x2545_f491_4f6c_dd1d);
     for i in 0..2000 {
-        let t = TrialErrors { first: next(), second: next(), spread: 0.0, pilots: (i % 3) as u32 };
+        let t = PairedErrors { first: next(), second: next(), spread: 0.0, pilots: (i % 3) as u32 };
         for (towards, margin) in [(Pick::First, 0.8), (Pick::Second, 0.8), (Pick::Second, 1.0), (Pick::First, 1.0)] {
             assert_eq!(t.pick_leaning(towards, margin), reference(&t, towards, margin), "{t:?} {towards:?} {margin}");
         }
         assert_eq!(t.pick_leaning(Pick::Second, 1.0), t.pick(), "{t:?}");
     }
     // At the margin's edges: 0.64 x is not below 0.8^2 x, just under it is.
-    let t = |second: f32| TrialErrors { first: 1.0, second, spread: 0.0, pilots: 4 };
+    let t = |second: f32| PairedErrors { first: 1.0, second, spread: 0.0, pilots: 4 };
     assert_eq!(t(0.7).pick_leaning(Pick::First, 0.8), Pick::First);
     assert_eq!(t(0.6).pick_leaning(Pick::First, 0.8), Pick::Second);
     assert_eq!(
-        TrialErrors { first: 1.0, second: 0.0, spread: 0.0, pilots: 0 }.pick_leaning(Pick::First, 0.8),
+        PairedErrors { first: 1.0, second: 0.0, spread: 0.0, pilots: 0 }.pick_leaning(Pick::First, 0.8),
         Pick::First
     );
 }
@@ -185,9 +185,9 @@ fn a_tie_is_a_difference_within_two_standard_errors_of_the_pilots_and_takes_the_
         // A shift between the models, from none to about the pilots' own spread.
         let shift = (case % 7) as f32 * 0.05;
         let pairs: Vec<(f32, f32)> = (0..n).map(|_| (next(), next() * 0.8 + shift)).collect();
-        let mut t = TrialErrors::default();
+        let mut t = PairedErrors::default();
         for &(a, b) in &pairs {
-            t.add(&TrialErrors::one(a, b));
+            t += PairedErrors::one(a, b);
         }
         let want = reference(&pairs);
         // Away from the edge (f32 sums against f64), the two must agree.
@@ -224,14 +224,14 @@ fn a_tie_is_a_difference_within_two_standard_errors_of_the_pilots_and_takes_the_
     assert!(tied > 300 && apart > 300, "{tied} tied, {apart} apart");
     // Pilots that all differ by the same amount are apart however small it is; two
     // pilots of opposite differences are tied.
-    let mut same = TrialErrors::default();
+    let mut same = PairedErrors::default();
     for _ in 0..4 {
-        same.add(&TrialErrors::one(1.0, 1.01));
+        same += PairedErrors::one(1.0, 1.01);
     }
     assert!(!same.tied());
     assert_eq!(same.pick_unless_tied(Some(Pick::Second)), Pick::First);
-    let mut opposite = TrialErrors::one(1.0, 2.0);
-    opposite.add(&TrialErrors::one(2.0, 0.9));
+    let mut opposite = PairedErrors::one(1.0, 2.0);
+    opposite += PairedErrors::one(2.0, 0.9);
     assert!(opposite.tied());
     assert_eq!(opposite.pick_unless_tied(Some(Pick::First)), Pick::First);
     assert_eq!(opposite.pick_unless_tied(None), Pick::Second);
@@ -264,20 +264,20 @@ fn the_shear_trial_pilots_half_pixel_blocks_and_finds_a_true_half_disparity_bett
     let dec = Decoder::new(decoder_config((10, 15), mask)).unwrap().with_disparities(halves);
     for at in blocks() {
         let t = dec.shear_trial(&dct, at, &mut FrameSource::new(&raw), &mut ws).unwrap();
-        assert_eq!(t, TrialErrors::default(), "{at:?}");
+        assert_eq!(t, ShearTrial::default(), "{at:?}");
     }
     // At half a pixel, the inner blocks are pilots, and the half disparity predicts their
     // held-out measurements better than the whole ones beside it.
     let raw = frames(&sheared_light_field(0.5), &mask);
-    let mut sum = TrialErrors::default();
+    let mut sum = ShearTrial::default();
     for at in blocks() {
         let d = dec.choose_disparity(at.0 as usize, at.1 as usize, &mut FrameSource::new(&raw)).unwrap();
         let t = dec.shear_trial(&dct, at, &mut FrameSource::new(&raw), &mut ws).unwrap();
-        assert_eq!(t.pilots, u32::from(!d.is_whole()), "{at:?} at {d:?}");
-        sum.add(&t);
+        assert_eq!(t.errors.pilots, u32::from(!d.is_whole()), "{at:?} at {d:?}");
+        sum += t;
     }
-    assert!(sum.pilots >= 2, "{sum:?}");
-    assert!(sum.first < sum.second, "half {} against whole {}", sum.first.sqrt(), sum.second.sqrt());
+    assert!(sum.errors.pilots >= 2, "{sum:?}");
+    assert!(sum.half() < sum.whole(), "half {} against whole {}", sum.half().sqrt(), sum.whole().sqrt());
 }
 
 /// A xorshift stream of values in [0, 1) from `seed` (fixed seeds: the tests repeat).
@@ -288,4 +288,60 @@ fn uniform(mut state: u64) -> impl FnMut() -> f32 {
         state ^= state << 17;
         (state >> 40) as f32 / (1u64 << 24) as f32
     }
+}
+
+/// A model that counts the solves it runs, as its decodes report them.
+struct Counting<'m, M> {
+    model: &'m M,
+    solves: std::cell::Cell<u32>,
+}
+
+impl<M: PatchModel<5, 5, 4, 4, 13, 5200>> PatchModel<5, 5, 4, 4, 13, 5200> for Counting<'_, M> {
+    fn decode(&self, cfg: &Sl0Config, ws: &mut Ws) -> Result<ModelOutcome, SolveError> {
+        let out = self.model.decode(cfg, ws);
+        // A failed solve ran too: one, as the trial counts it.
+        self.solves.set(self.solves.get() + out.as_ref().map_or(0, |o| u32::from(o.solves)));
+        out
+    }
+
+    fn estimating_solve(&self, cfg: &Sl0Config, ws: &mut Ws) -> Result<u16, SolveError> {
+        let out = self.model.estimating_solve(cfg, ws);
+        self.solves.set(self.solves.get() + out.as_ref().map_or(0, |&n| u32::from(n)));
+        out
+    }
+}
+
+#[test]
+fn a_trial_counts_the_solves_its_pilots_ran() {
+    let dct = Dictionary::<5, 5, 4, 4, 13>::dct();
+    let blob = slf_firmware::DEFAULT_ENSEMBLE;
+    let ensemble =
+        EnsembleModel::new(Ensemble::<5, 5, 4, 4, 13>::new(blob).unwrap(), MemberChoice::Screened(ChoiceRule::DEFAULT));
+    let mut ws = Box::new(Ws::new());
+    // The model trial: the DCT's solve and the screened ensemble's two or three a pilot.
+    let mask = Mask::pixel(4, 3, 13, L5).unwrap();
+    let raw = frames(&rough_light_field(3), &mask);
+    let dec = Decoder::new(decoder_config((10, 15), mask)).unwrap();
+    let (a, z) = (Counting { model: &dct, solves: 0.into() }, Counting { model: &ensemble, solves: 0.into() });
+    let mut sum = ModelTrial::default();
+    for at in blocks() {
+        sum += dec.trial(&a, &z, at, &mut FrameSource::new(&raw), &mut ws).unwrap();
+    }
+    assert_eq!(sum.errors.pilots, 6);
+    assert_eq!(sum.solves, a.solves.get() + z.solves.get());
+    assert!(z.solves.get() > a.solves.get(), "the ensemble solves more than the DCT: {sum:?}");
+    // The shear trial: three estimating solves a half-pixel pilot, none at a whole one.
+    let mask = Mask::pixel(4, 1, 13, L5).unwrap();
+    let raw = frames(&sheared_light_field(0.5), &mask);
+    let dec = Decoder::new(decoder_config((10, 15), mask))
+        .unwrap()
+        .with_disparities(DisparityRange::DEFAULT.with_halves(true));
+    let counted = Counting { model: &dct, solves: 0.into() };
+    let mut sum = ShearTrial::default();
+    for at in blocks() {
+        sum += dec.shear_trial(&counted, at, &mut FrameSource::new(&raw), &mut ws).unwrap();
+    }
+    assert!(sum.errors.pilots >= 2, "{sum:?}");
+    assert_eq!(sum.solves, counted.solves.get());
+    assert!(sum.solves >= 3 * sum.errors.pilots, "{sum:?}");
 }

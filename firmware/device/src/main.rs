@@ -50,9 +50,9 @@ mod device {
     use slf_firmware::{
         ChoiceRule, DEFAULT_FULL_VIEW_ENSEMBLE, DecoderConfig, DefectList, Dictionary, Disparity, DisparityRange,
         Ensemble, EnsembleModel, FrameSource, FullViewShape, FullViewWorkspace, HoldOut, LeU16Frame, LensletGrid,
-        LensletSize, Mask, MemberChoice, Overlap, OverlapDecoder, PatchModel, PatchOrigin, PatchReport, PatchSink,
-        Pick, Picked, Pixel, RawFormat, Response, ResponseModel, RowSink, ScheduledDictionary, SensorGeometry,
-        Sl0Config, TileDecoder, TrialErrors, tie_prior,
+        LensletSize, Mask, MemberChoice, Overlap, OverlapDecoder, PairedErrors, PatchModel, PatchOrigin, PatchReport,
+        PatchSink, Pick, Picked, Pixel, RawFormat, Response, ResponseModel, RowSink, ScheduledDictionary,
+        SensorGeometry, Sl0Config, TileDecoder, tie_prior,
     };
 
     use super::{bench_begin, bench_end};
@@ -352,7 +352,7 @@ mod device {
             hprintln!("error: the shipped ensemble has no trained schedules");
             return debug::EXIT_FAILURE;
         };
-        let mut trial = TrialErrors::default();
+        let mut trial = PairedErrors::default();
         for tile in decoder.tiles((1, 1)) {
             bench_begin(11);
             let r = decoder.trial(
@@ -364,7 +364,7 @@ mod device {
             );
             bench_end(11);
             match r {
-                Ok(t) => trial.add(&t),
+                Ok(t) => trial += t.errors,
                 Err(_) => failed += 1,
             }
         }

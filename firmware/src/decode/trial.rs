@@ -11,7 +11,9 @@
 //! decode and the second's, from the held-out measurements), and every other patch is
 //! decoded once, by the picked model ([`crate::solver::picked::Picked`]).
 
-use crate::decode::tile::{PatchOrigin, TileDecoder, TileSource};
+use core::ops::AddAssign;
+
+use crate::decode::tile::{PatchOrigin, SHEAR_MARGIN, TileDecoder, TileSource};
 use crate::sensor::mask::MaskFamily;
 use crate::solver::choice::PatchModel;
 use crate::solver::holdout::HoldOut;
@@ -19,15 +21,17 @@ use crate::solver::interpolate::bands_measured;
 use crate::solver::picked::Pick;
 use crate::solver::workspace::Workspace;
 
-/// What pilot patches measured of two models: the sums of their squared held-out error
-/// estimates (sensor units), over the pilots both estimated, and the sum of the squares of
-/// their differences pilot by pilot (the spread that says when the sums tie, [`Self::tied`]).
+/// Two held-out error estimates compared over the same pilot patches: the statistic both
+/// trials decide by ([`ModelTrial`], [`ShearTrial`]). `first` and `second` are the sums of
+/// the two sides' squared estimates (sensor units) over the pilots both estimated, and
+/// `spread` the sum of the squares of their differences pilot by pilot (what says when the
+/// sums tie, [`Self::tied`]). Which side is which is the trial's: its own type names them.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct TrialErrors {
-    /// The first model's squared estimates, summed.
+pub struct PairedErrors {
+    /// The first side's squared estimates, summed.
     pub first: f32,
-    /// The second model's.
+    /// The second side's.
     pub second: f32,
     /// The squared differences of the two, pilot by pilot, summed.
     pub spread: f32,
@@ -35,14 +39,83 @@ pub struct TrialErrors {
     pub pilots: u32,
 }
 
+/// The model trial's pilots: the first model's errors against the second's
+/// ([`TileDecoder::trial`]; every decode orders them the DCT first, the screened ensemble
+/// second, as [`tie_prior`] reads them), and the solves the pilots spent.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ModelTrial {
+    /// `first`: the first model's; `second`: the second's.
+    pub errors: PairedErrors,
+    /// Solves the pilots ran, counted as they ran (those of a pilot that gave no estimate
+    /// too).
+    pub solves: u32,
+}
+
+/// The shear trial's pilots: the errors at a block's half-pixel disparity against those at
+/// the better of the whole ones beside it ([`TileDecoder::shear_trial`]), and the solves the
+/// pilots spent.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ShearTrial {
+    /// `first`: at the half-pixel disparity; `second`: at the better whole one.
+    pub errors: PairedErrors,
+    /// Solves the pilots ran, counted as they ran.
+    pub solves: u32,
+}
+
+impl ShearTrial {
+    /// The squared errors at the half-pixel disparities, summed over the pilots.
+    pub fn half(&self) -> f32 {
+        self.errors.first
+    }
+
+    /// The squared errors at the better whole disparities, summed over the pilots.
+    pub fn whole(&self) -> f32 {
+        self.errors.second
+    }
+
+    /// Whether the frame's half-pixel shears alias: the whole disparities' errors below
+    /// [`SHEAR_MARGIN`] times the half ones' (RMS over the pilots together), the shear
+    /// check's margin on the frame's pilots; the trial's margin rule is the model trial's
+    /// ([`PairedErrors::pick_leaning`], leaning to the half disparities).
+    pub fn aliases(&self) -> bool {
+        self.errors.pick_leaning(Pick::First, SHEAR_MARGIN) == Pick::Second
+    }
+}
+
+impl AddAssign for PairedErrors {
+    /// Another set of pilots' errors added (a region's pilots together).
+    fn add_assign(&mut self, other: Self) {
+        self.first += other.first;
+        self.second += other.second;
+        self.spread += other.spread;
+        self.pilots += other.pilots;
+    }
+}
+
+impl AddAssign for ModelTrial {
+    fn add_assign(&mut self, other: Self) {
+        self.errors += other.errors;
+        self.solves += other.solves;
+    }
+}
+
+impl AddAssign for ShearTrial {
+    fn add_assign(&mut self, other: Self) {
+        self.errors += other.errors;
+        self.solves += other.solves;
+    }
+}
+
 /// How many standard errors apart the two sums of a trial must be for it to tell the
-/// models apart ([`TrialErrors::tied`]): about the 95 % level of a two-sided test on the
+/// models apart ([`PairedErrors::tied`]): about the 95 % level of a two-sided test on the
 /// pilots' paired differences.
 pub const TIE_SPREAD: f32 = 2.0;
 
 /// Whether a frame of `family` at `snapshots` is better decoded by the DCT than by the
 /// screened ensemble where the model trial's pilots cannot tell them apart
-/// ([`TrialErrors::tied`]); `None` where the sets favour neither, and the lower sum
+/// ([`PairedErrors::tied`]); `None` where the sets favour neither, and the lower sum
 /// decides as before.
 ///
 /// From the decodes by each model alone of 21 scenes (18 synthetic at 48 x 48 lenslets
@@ -68,19 +141,11 @@ pub fn tie_prior(family: MaskFamily, snapshots: usize) -> Option<Pick> {
     dct_where_tied(family, snapshots).map(|dct| if dct { Pick::First } else { Pick::Second })
 }
 
-impl TrialErrors {
+impl PairedErrors {
     /// One pilot's errors: `first` and `second` are the two models' squared estimates.
     pub fn one(first: f32, second: f32) -> Self {
         let d = first - second;
         Self { first, second, spread: d * d, pilots: 1 }
-    }
-
-    /// These errors and `other`'s, summed (a region's pilots together).
-    pub fn add(&mut self, other: &Self) {
-        self.first += other.first;
-        self.second += other.second;
-        self.spread += other.spread;
-        self.pilots += other.pilots;
     }
 
     /// Whether the two sums are within [`TIE_SPREAD`] standard errors of their difference,
@@ -146,7 +211,7 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
     /// sheared as the decode shears it, decoded by `first` and by `second` from
     /// [`HoldOut::DEFAULT`]'s measurements; their held-out errors as one pilot (no pilot
     /// where either cannot estimate: too few bands measured, a mixing response, a failed
-    /// solve). `ws` is clobbered.
+    /// solve), and the solves both decodes ran. `ws` is clobbered.
     ///
     /// # Errors
     /// The source's error.
@@ -157,13 +222,13 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
         (row, col): (u16, u16),
         source: &mut S,
         ws: &mut Workspace<PS, PT, PU, PV, B, N>,
-    ) -> Result<TrialErrors, S::Error>
+    ) -> Result<ModelTrial, S::Error>
     where
         A: PatchModel<PS, PT, PU, PV, B, N>,
         Z: PatchModel<PS, PT, PU, PV, B, N>,
         S: TileSource,
     {
-        let none = TrialErrors::default();
+        let none = ModelTrial::default();
         let Some((view_row, view_col)) = self.windows().next() else { return Ok(none) };
         let disparity = self.choose_disparity(row as usize, col as usize, source)?;
         let origin = PatchOrigin { lenslet_row: row, lenslet_col: col, view_row, view_col, disparity };
@@ -171,21 +236,23 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
         if bands_measured::<B, N>(ws.measurements()) < u32::from(self.config().sl0.min_bands) {
             return Ok(none);
         }
-        let (a, _) = self.estimate_error(first, &HoldOut::DEFAULT, origin, source, ws, true)?;
+        let (a, solves_a) = self.estimate_error(first, &HoldOut::DEFAULT, origin, source, ws, true)?;
         // The estimate read the patch again: the same held-out measurements for the second.
-        let (z, _) = self.estimate_error(second, &HoldOut::DEFAULT, origin, source, ws, true)?;
-        Ok(match (a, z) {
-            (Some(a), Some(z)) => TrialErrors::one(a * a, z * z),
-            _ => none,
-        })
+        let (z, solves_z) = self.estimate_error(second, &HoldOut::DEFAULT, origin, source, ws, true)?;
+        let errors = match (a, z) {
+            (Some(a), Some(z)) => PairedErrors::one(a * a, z * z),
+            _ => PairedErrors::default(),
+        };
+        Ok(ModelTrial { errors, solves: u32::from(solves_a) + u32::from(solves_z) })
     }
 
     /// The shear trial on the block at lenslet `(row, col)`: where its views agree best at a
     /// half-pixel disparity ([`Self::choose_disparity`]), the held-out error estimates of its
-    /// first window's patch at that disparity (`first`) and at the better of the whole ones
-    /// beside it (`second`), as one pilot, by the model's estimating solve as the shear
-    /// check's ([`TileDecoder::with_shear_check`]); no pilot at a whole disparity. Summed
-    /// over a frame's pilots, they say whether its half-pixel shears alias. `ws` is clobbered.
+    /// first window's patch at that disparity and at the better of the whole ones beside it,
+    /// as one pilot, by `model`'s estimating solve as the shear check's
+    /// ([`TileDecoder::with_shear_check`]), and the solves they ran; no pilot at a whole
+    /// disparity. Summed over a frame's pilots, they say whether its half-pixel shears alias
+    /// ([`ShearTrial::aliases`]). `ws` is clobbered.
     ///
     /// # Errors
     /// The source's error.
@@ -195,19 +262,21 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
         (row, col): (u16, u16),
         source: &mut S,
         ws: &mut Workspace<PS, PT, PU, PV, B, N>,
-    ) -> Result<TrialErrors, S::Error> {
+    ) -> Result<ShearTrial, S::Error> {
         let half = self.choose_disparity(row as usize, col as usize, source)?;
         if half.is_whole() {
-            return Ok(TrialErrors::default());
+            return Ok(ShearTrial::default());
         }
-        let [(_, at_half), (_, below), (_, above)] = self.shear_errors(model, (row, col), half, source, ws)?;
+        let ([(_, at_half), (_, below), (_, above)], solves) =
+            self.shear_errors(model, (row, col), half, source, ws)?;
         let whole = match (below, above) {
             (Some(b), Some(a)) => Some(b.min(a)),
             (b, a) => b.or(a),
         };
-        Ok(match (at_half, whole) {
-            (Some(h), Some(w)) => TrialErrors::one(h * h, w * w),
-            _ => TrialErrors::default(),
-        })
+        let errors = match (at_half, whole) {
+            (Some(h), Some(w)) => PairedErrors::one(h * h, w * w),
+            _ => PairedErrors::default(),
+        };
+        Ok(ShearTrial { errors, solves })
     }
 }

@@ -320,7 +320,7 @@ where
             |pick| HeldOutDecode::run(&plan, &Picked { first, second, pick }, &raw, HoldOut::DEFAULT, opts.batch_tiles);
         let (a, z) = (run(Pick::First)?, run(Pick::Second)?);
         if let (Some(ea), Some(ez)) = (a.frame_error(), z.frame_error()) {
-            let t = slf_firmware::TrialErrors::one((ea * ea) as f32, (ez * ez) as f32);
+            let t = slf_firmware::PairedErrors::one((ea * ea) as f32, (ez * ez) as f32);
             plan.pick = t.pick_leaning(towards, margin);
             by_decode = Some((ea, ez));
         }
@@ -365,15 +365,14 @@ where
     report.patch_views = PatchViews::of_views(PU, PV);
     report.grid = capture.description.turned_grid();
     report.off_sensor = plan.decoder.grid().map(|g| OffSensor::of(g, capture.description.lenslets)).unwrap_or_default();
-    // A pilot of either trial costs three solves: three estimating ones for the shear
-    // trial, the DCT's one and the ensemble's two for the model trial.
-    let pilots = |t: &Option<slf_firmware::TrialErrors>| u64::from(t.as_ref().map_or(0, |t| t.pilots));
-    report.solves += 3 * (pilots(&plan.shear_trial) + pilots(&plan.model_trial));
+    // The solves the trials' pilots ran, as they counted them.
+    report.solves += u64::from(plan.shear_trial.map_or(0, |t| t.solves) + plan.model_trial.map_or(0, |t| t.solves));
     report.shear_trial = plan.shear_trial.map(|t| {
-        let (half_error, whole_error) = rms(&t);
-        ShearTrialReport { pilots: t.pilots, halves: !plan.alias, half_error, whole_error }
+        let (half_error, whole_error) = rms(&t.errors);
+        ShearTrialReport { pilots: t.errors.pilots, halves: !plan.alias, half_error, whole_error }
     });
-    report.trial = plan.model_trial.map(|t| {
+    report.trial = plan.model_trial.map(|trial| {
+        let t = trial.errors;
         let (dct_error, ensemble_error) = rms(&t);
         let tied = match pick {
             ModelPick::UnlessTied { prior } => by_decode.is_none() && t.takes_prior(prior),

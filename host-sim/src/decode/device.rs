@@ -18,8 +18,8 @@ use std::path::Path;
 
 use anyhow::{Context, Result, bail, ensure};
 use slf_firmware::{
-    ChoiceRule, DEFAULT_FULL_VIEW_ENSEMBLE, Ensemble, EnsembleModel, FrameSource, MemberChoice, PatchOrigin,
-    PatchReport, PatchSink, Pick, Pixel, ScheduledDictionary, TrialErrors,
+    ChoiceRule, DEFAULT_FULL_VIEW_ENSEMBLE, Ensemble, EnsembleModel, FrameSource, MemberChoice, PairedErrors,
+    PatchOrigin, PatchReport, PatchSink, Pick, Pixel, ScheduledDictionary,
 };
 
 use crate::decode::calibrate::calibrate;
@@ -450,13 +450,13 @@ pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
     }
     // The model trial: the same pilots (every tile's block, unsheared), the same sums.
     let dct = model.scheduled_screen().context("the shipped ensemble has no trained schedules")?;
-    let mut host_trial = TrialErrors::default();
+    let mut host_trial = PairedErrors::default();
     for tile in decoder.tiles((1, 1)) {
         let at = (tile.lenslet_row, tile.lenslet_col);
         let t = decoder
             .trial(&dct, &model, at, &mut FrameSource::new(&raw), &mut ws)
             .map_err(|e| anyhow::anyhow!("{e}"))?;
-        host_trial.add(&t);
+        host_trial += t.errors;
     }
     let mask = capture.mask()?;
     let pick = host_trial.pick_unless_tied(slf_firmware::tie_prior(mask.family(), mask.snapshots()));

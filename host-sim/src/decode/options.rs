@@ -278,7 +278,7 @@ pub struct DecodeOptions {
     /// Whether a decode with half-pixel disparities first checks them on pilot patches
     /// against the whole ones beside them by the held-out error estimate, and decodes the
     /// frame with whole disparities only where the whole ones estimate clearly better
-    /// ([`crate::decode::trial::halves_alias`]). Off here, on in the default and best
+    /// ([`slf_firmware::ShearTrial::aliases`]). Off here, on in the default and best
     /// presets.
     pub shear_trial: bool,
 }

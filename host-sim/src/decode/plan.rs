@@ -6,10 +6,12 @@
 
 use anyhow::{Result, anyhow, ensure};
 use slf_firmware::decode::engine::plan::Grids;
-use slf_firmware::{FrameSource, HoldOut, PatchModel, Pick, RawFrame, Tile, TileDecoder, TrialErrors};
+use slf_firmware::{
+    FrameSource, HoldOut, ModelTrial, PairedErrors, PatchModel, Pick, RawFrame, ShearTrial, Tile, TileDecoder,
+};
 
 use crate::decode::options::{Balance, DecodeOptions, EstimateBy};
-use crate::decode::trial::{frame_shear_trial, frame_trial, halves_alias, pilot_budget};
+use crate::decode::trial::{frame_shear_trial, frame_trial, pilot_budget};
 use crate::io::capture::Capture;
 use crate::io::rows::RowShape;
 
@@ -32,12 +34,12 @@ pub struct FramePlan<'a, const PU: usize, const PV: usize, const N: usize> {
     pub range: (f32, f32),
     /// How overlapping estimates are weighed.
     pub window: slf_firmware::overlap::Window,
-    /// The shear trial's errors, where it ran.
-    pub shear_trial: Option<TrialErrors>,
+    /// The shear trial, where it ran.
+    pub shear_trial: Option<ShearTrial>,
     /// Whether the shear trial turned the half-pixel disparities off.
     pub alias: bool,
-    /// The model trial's errors, where it ran.
-    pub model_trial: Option<TrialErrors>,
+    /// The model trial, where it ran.
+    pub model_trial: Option<ModelTrial>,
 }
 
 impl<'a, const PU: usize, const PV: usize, const N: usize> FramePlan<'a, PU, PV, N> {
@@ -94,17 +96,18 @@ impl<'a, const PU: usize, const PV: usize, const N: usize> FramePlan<'a, PU, PV,
             base.iter().map(|t| usize::from(t.lenslet_rows / 5) * usize::from(t.lenslet_cols / 5)).sum();
         let budget = pilot_budget(blocks * shifts(opts.stride.0) * shifts(opts.stride.1));
         // The shear trial first: half-pixel shears off for the frame where its pilots
-        // estimate the whole ones clearly better (by the estimating solve, `second`'s), so
+        // estimate the whole ones clearly better (by `second`'s estimating solve, the one the
+        // decode's error estimate runs: the ensemble's is its DCT on the alone schedule), so
         // the model trial's pilots are sheared as the decode will be.
         let shear_trial = (opts.shear_trial && decoder.disparities().has_halves())
             .then(|| frame_shear_trial(&decoder, second, raw, &base, budget));
-        let alias = shear_trial.as_ref().is_some_and(halves_alias);
+        let alias = shear_trial.as_ref().is_some_and(ShearTrial::aliases);
         let decoder = if alias { decoder.with_disparities(decoder.disparities().with_halves(false)) } else { decoder };
         let (pick, model_trial) = match pick {
             ModelPick::Given(p) => (p, None),
             trial => {
                 let t = frame_trial(&decoder, first, second, raw, &base, budget);
-                (trial.of(&t), Some(t))
+                (trial.of(&t.errors), Some(t))
             }
         };
         let halo = decoder.disparities().halo(views.0.max(views.1));
@@ -138,7 +141,7 @@ impl<'a, const PU: usize, const PV: usize, const N: usize> FramePlan<'a, PU, PV,
 pub enum ModelPick {
     /// The one named.
     Given(Pick),
-    /// The one the model trial picks ([`slf_firmware::TrialErrors::pick_leaning`]): `towards` unless the
+    /// The one the model trial picks ([`slf_firmware::PairedErrors::pick_leaning`]): `towards` unless the
     /// other's pilots err below `margin` times its.
     Trial {
         /// The model kept on a tie or without pilots.
@@ -147,7 +150,7 @@ pub enum ModelPick {
         margin: f32,
     },
     /// The one whose pilots err less, unless the two tie within the pilots' spread
-    /// ([`slf_firmware::TrialErrors::pick_unless_tied`]); then `prior`, where there is one.
+    /// ([`slf_firmware::PairedErrors::pick_unless_tied`]); then `prior`, where there is one.
     UnlessTied {
         /// The model kept on a tie or without pilots.
         prior: Option<Pick>,
@@ -156,7 +159,7 @@ pub enum ModelPick {
 
 impl ModelPick {
     /// The model this rule picks from the trial's errors `t` (the named one, whatever `t`).
-    pub fn of(self, t: &TrialErrors) -> Pick {
+    pub fn of(self, t: &PairedErrors) -> Pick {
         match self {
             Self::Given(p) => p,
             Self::Trial { towards, margin } => t.pick_leaning(towards, margin),

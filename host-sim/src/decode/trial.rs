@@ -16,7 +16,11 @@
 //! (`docs/results-model-trial.md`).
 
 use rayon::prelude::*;
-use slf_firmware::{FrameSource, PatchModel, Pick, RawFrame, Tile, TileDecoder, TrialErrors, Workspace};
+use std::ops::AddAssign;
+
+use slf_firmware::{
+    FrameSource, ModelTrial, PairedErrors, PatchModel, RawFrame, ShearTrial, Tile, TileDecoder, Workspace,
+};
 
 /// The most pilots a frame's trial takes. With 64, the HCI crops' 196 tiles gave 49 pilots,
 /// and cotton and antinous at lenslet k = 3 went to the DCT (held-out RMS 0.00164 against
@@ -57,12 +61,12 @@ pub fn frame_trial<const PU: usize, const PV: usize, const N: usize, A, Z>(
     raw: &[RawFrame<'_, u16>],
     tiles: &[Tile],
     budget: usize,
-) -> TrialErrors
+) -> ModelTrial
 where
     A: PatchModel<5, 5, PU, PV, 13, N> + Sync,
     Z: PatchModel<5, 5, PU, PV, 13, N> + Sync,
 {
-    pilots::<PU, PV, N>(raw, tiles, budget, |source, at, ws| decoder.trial(first, second, at, source, ws))
+    pilots::<PU, PV, N, _>(raw, tiles, budget, |source, at, ws| decoder.trial(first, second, at, source, ws))
 }
 
 /// The shear trial over `tiles` (the disjoint grid's): on each of at most `budget`
@@ -75,17 +79,17 @@ pub fn frame_shear_trial<const PU: usize, const PV: usize, const N: usize, M>(
     raw: &[RawFrame<'_, u16>],
     tiles: &[Tile],
     budget: usize,
-) -> TrialErrors
+) -> ShearTrial
 where
     M: PatchModel<5, 5, PU, PV, 13, N> + Sync,
 {
-    pilots::<PU, PV, N>(raw, tiles, budget, |source, at, ws| decoder.shear_trial(model, at, source, ws))
+    pilots::<PU, PV, N, _>(raw, tiles, budget, |source, at, ws| decoder.shear_trial(model, at, source, ws))
 }
 
 /// `pilot` on the first block of each of at most `budget` of `tiles`, evenly
-/// spaced, in parallel (a workspace a thread); their errors summed (a pilot whose source
+/// spaced, in parallel (a workspace a thread); their trials summed (a pilot whose source
 /// failed counts as none).
-fn pilots<const PU: usize, const PV: usize, const N: usize>(
+fn pilots<const PU: usize, const PV: usize, const N: usize, T: AddAssign + Default + Send>(
     raw: &[RawFrame<'_, u16>],
     tiles: &[Tile],
     budget: usize,
@@ -93,9 +97,9 @@ fn pilots<const PU: usize, const PV: usize, const N: usize>(
         &mut FrameSource<'_, RawFrame<'_, u16>>,
         (u16, u16),
         &mut Workspace<5, 5, PU, PV, 13, N>,
-    ) -> Result<TrialErrors, slf_firmware::raw::ReadError>
+    ) -> Result<T, slf_firmware::raw::ReadError>
     + Sync,
-) -> TrialErrors {
+) -> T {
     let step = tiles.len().div_ceil(budget.max(1)).max(1);
     tiles
         .par_iter()
@@ -104,22 +108,14 @@ fn pilots<const PU: usize, const PV: usize, const N: usize>(
             || Box::new(Workspace::<5, 5, PU, PV, 13, N>::new()),
             |ws, t| pilot(&mut FrameSource::new(raw), (t.lenslet_row, t.lenslet_col), ws).unwrap_or_default(),
         )
-        .reduce(TrialErrors::default, |mut a, b| {
-            a.add(&b);
+        .reduce(T::default, |mut a, b| {
+            a += b;
             a
         })
 }
 
-/// Whether a frame's half-pixel shears alias, by its shear trial: the whole disparities'
-/// summed squared errors below [`slf_firmware::tile::SHEAR_MARGIN`] squared times the half
-/// ones' (the shear check's margin, on the frame's pilots together): the trial leaning to
-/// the half disparities (`first`) by that margin picks the whole ones.
-pub fn halves_alias(t: &TrialErrors) -> bool {
-    t.pick_leaning(Pick::First, slf_firmware::tile::SHEAR_MARGIN) == Pick::Second
-}
-
 /// A trial's errors as RMS over its pilots (first, second; 0 without pilots).
-pub fn rms(t: &TrialErrors) -> (f64, f64) {
+pub fn rms(t: &PairedErrors) -> (f64, f64) {
     let per = |sum: f32| (f64::from(sum) / f64::from(t.pilots.max(1))).sqrt();
     (per(t.first), per(t.second))
 }

@@ -23,7 +23,8 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         ws: &mut Workspace<PS, PT, PU, PV, B, N>,
     ) -> Result<Disparity, S::Error> {
         let mut best = (f32::INFINITY, half);
-        for (d, error) in self.shear_errors(model, (row, col), half, source, ws)? {
+        // The check's estimating solves are the block's: a patch's report counts its own.
+        for (d, error) in self.shear_errors(model, (row, col), half, source, ws)?.0 {
             // A whole disparity must estimate clearly better than the half one.
             let error = if d == half { error } else { error.map(|e| e / SHEAR_MARGIN) };
             if let Some(e) = error.filter(|e| *e < best.0) {
