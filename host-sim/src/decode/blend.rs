@@ -32,13 +32,14 @@
 //! cannot be made ([`crate::decode::report::DecodeReport::blend_skipped`]).
 
 use anyhow::{Result, ensure};
-use slf_firmware::{MaskFamily, PatchModel, RawFrame, RowSink};
+use slf_firmware::{MaskFamily, RawFrame, RowSink};
 
 use crate::decode::baselines::{PpidConfig, ppid};
 use crate::decode::held_out::{Held, HeldOutDecode, Hiding};
 use crate::decode::plan::FramePlan;
 use crate::io::capture::Capture;
 use crate::io::lightfield::LightField;
+use crate::io::patch::HostModel;
 use crate::io::rows::{RowShape, Rows, whole_width};
 
 /// Blocks either side of a block whose held-out errors its weight takes (3 x 3 blocks).
@@ -76,7 +77,7 @@ impl BaselineBlend {
         batch: usize,
     ) -> Result<Self>
     where
-        M: PatchModel<5, 5, PU, PV, 13, N> + Sync,
+        M: HostModel<PU, PV, N>,
     {
         ensure!(applies(plan), "the baseline blend is for a kronecker mask without a lenslet grid or leaky filters");
         let Held::Group(group) = Held::of(&plan.decoder) else {

@@ -19,7 +19,7 @@
 use std::time::Instant;
 
 use anyhow::{Result, anyhow, bail};
-use slf_firmware::{Dictionary, HoldOut, PatchModel, Pick, Picked, Sl0Config};
+use slf_firmware::{HoldOut, Pick, Picked, Sl0Config};
 
 use crate::decode::blend::{self, BaselineBlend};
 use crate::decode::held_out::HeldOutDecode;
@@ -38,12 +38,13 @@ use crate::decode::trial::{DCT_LEAN, rms};
 use crate::io::capture::Capture;
 use crate::io::grid::OffSensor;
 use crate::io::lightfield::LightField;
+use crate::io::patch::{BANDS, HostDictionary, HostEnsemble, HostModel};
 use crate::io::rows::{RowShape, Rows};
 
 /// A dictionary of the paper's patch: 5 x 5 lenslets x 4 x 4 views x 13 bands.
-pub type PaperDictionary = Dictionary<5, 5, 4, 4, 13>;
+pub type PaperDictionary = HostDictionary<4, 4>;
 /// A dictionary of the full-view patch: 5 x 5 lenslets x 5 x 5 views x 13 bands.
-pub type FullViewDictionary = Dictionary<5, 5, 5, 5, 13>;
+pub type FullViewDictionary = HostDictionary<5, 5>;
 
 /// Decodes `capture` with `basis` (see [`decode`]).
 ///
@@ -111,7 +112,7 @@ fn decode_basis<const PU: usize, const PV: usize, const N: usize>(
             )
         }
         Basis::Dct => {
-            let dictionary = Dictionary::<5, 5, PU, PV, 13>::dct();
+            let dictionary = HostDictionary::<PU, PV>::dct();
             // The DCT takes the schedules of the shipped blob, whose cold one is trained on
             // the DCT's solves (the screen's).
             match ensemble::<PU, PV>(None)?.schedules().filter(|_| trained) {
@@ -156,7 +157,7 @@ fn trial_decode<const PU: usize, const PV: usize, const N: usize>(
     match model.scheduled_screen() {
         Some(dct) => decode_picked_into::<PU, PV, N, _, _>(capture, &dct, &model, pick, opts, observer, sink),
         None => {
-            let dct = Dictionary::<5, 5, PU, PV, 13>::dct();
+            let dct = HostDictionary::<PU, PV>::dct();
             decode_picked_into::<PU, PV, N, _, _>(capture, &dct, &model, pick, opts, observer, sink)
         }
     }
@@ -167,9 +168,7 @@ fn trial_decode<const PU: usize, const PV: usize, const N: usize>(
 ///
 /// # Errors
 /// A blob that does not validate, or of the other patch (named, with the flag to change).
-pub fn ensemble<const PU: usize, const PV: usize>(
-    blob: Option<&[u8]>,
-) -> Result<slf_firmware::Ensemble<'_, 5, 5, PU, PV, 13>> {
+pub fn ensemble<const PU: usize, const PV: usize>(blob: Option<&[u8]>) -> Result<HostEnsemble<'_, PU, PV>> {
     let views = PatchViews::of_views(PU, PV).ok_or_else(|| anyhow!("no patch of {PU} x {PV} views"))?;
     let bytes = blob.unwrap_or(views.shipped_ensemble());
     if let Some(made) = PatchViews::of_blob(bytes).filter(|&m| m != views) {
@@ -180,7 +179,7 @@ pub fn ensemble<const PU: usize, const PV: usize>(
             views.shape_name()
         );
     }
-    slf_firmware::Ensemble::<5, 5, PU, PV, 13>::new(bytes).map_err(|e| anyhow!("ensemble blob: {e}"))
+    HostEnsemble::<PU, PV>::new(bytes).map_err(|e| anyhow!("ensemble blob: {e}"))
 }
 
 /// Patches the CS decoder decodes in `capture` with `views`-view patches (every tile's
@@ -206,7 +205,7 @@ pub fn patch_count(capture: &Capture, views: PatchViews) -> Result<u64> {
 ///
 /// # Errors
 /// A capture the decoder cannot take (band count, views, mask), with the reason.
-pub fn decode<const PU: usize, const PV: usize, const N: usize, M: PatchModel<5, 5, PU, PV, 13, N> + Sync>(
+pub fn decode<const PU: usize, const PV: usize, const N: usize, M: HostModel<PU, PV, N>>(
     capture: &Capture,
     model: &M,
     opts: &DecodeOptions,
@@ -220,7 +219,7 @@ pub fn decode<const PU: usize, const PV: usize, const N: usize, M: PatchModel<5,
 ///
 /// # Errors
 /// As [`decode`].
-pub fn decode_observed<const PU: usize, const PV: usize, const N: usize, M: PatchModel<5, 5, PU, PV, 13, N> + Sync>(
+pub fn decode_observed<const PU: usize, const PV: usize, const N: usize, M: HostModel<PU, PV, N>>(
     capture: &Capture,
     model: &M,
     opts: &DecodeOptions,
@@ -233,12 +232,7 @@ pub fn decode_observed<const PU: usize, const PV: usize, const N: usize, M: Patc
 ///
 /// # Errors
 /// As [`decode`], or what the sink returns.
-pub fn decode_observed_into<
-    const PU: usize,
-    const PV: usize,
-    const N: usize,
-    M: PatchModel<5, 5, PU, PV, 13, N> + Sync,
->(
+pub fn decode_observed_into<const PU: usize, const PV: usize, const N: usize, M: HostModel<PU, PV, N>>(
     capture: &Capture,
     model: &M,
     opts: &DecodeOptions,
@@ -262,8 +256,8 @@ pub fn decode_picked<const PU: usize, const PV: usize, const N: usize, A, Z>(
     observer: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<(LightField, DecodeReport)>
 where
-    A: PatchModel<5, 5, PU, PV, 13, N> + Sync,
-    Z: PatchModel<5, 5, PU, PV, 13, N> + Sync,
+    A: HostModel<PU, PV, N>,
+    Z: HostModel<PU, PV, N>,
 {
     let mut lf = empty_light_field(capture)?;
     let report = decode_picked_into(capture, first, second, pick, opts, observer, &mut lf)?;
@@ -276,7 +270,7 @@ where
 /// A light field too large to hold ([`LightField::check_size`]).
 pub fn empty_light_field(capture: &Capture) -> Result<LightField> {
     let d = &capture.description;
-    RowShape { views: (d.views[0], d.views[1]), rows: d.lenslets[0], cols: d.lenslets[1], bands: 13 }.zeros()
+    RowShape { views: (d.views[0], d.views[1]), rows: d.lenslets[0], cols: d.lenslets[1], bands: BANDS }.zeros()
 }
 
 /// [`decode_picked`], each finished lenslet row put into `sink` in order as the decode goes
@@ -295,8 +289,8 @@ pub fn decode_picked_into<const PU: usize, const PV: usize, const N: usize, A, Z
     sink: &mut Rows<'_>,
 ) -> Result<DecodeReport>
 where
-    A: PatchModel<5, 5, PU, PV, 13, N> + Sync,
-    Z: PatchModel<5, 5, PU, PV, 13, N> + Sync,
+    A: HostModel<PU, PV, N>,
+    Z: HostModel<PU, PV, N>,
 {
     let start = Instant::now();
     let raw = capture.raw_frames()?;

@@ -18,13 +18,14 @@ use std::path::Path;
 
 use anyhow::{Context, Result, bail, ensure};
 use slf_firmware::{
-    ChoiceRule, DEFAULT_FULL_VIEW_ENSEMBLE, Ensemble, EnsembleModel, FrameSource, MemberChoice, PairedErrors,
-    PatchOrigin, PatchReport, PatchSink, Pick, Pixel, ScheduledDictionary,
+    ChoiceRule, DEFAULT_FULL_VIEW_ENSEMBLE, EnsembleModel, FrameSource, MemberChoice, PairedErrors, PatchOrigin,
+    PatchReport, PatchSink, Pick, Pixel,
 };
 
 use crate::decode::calibrate::calibrate;
 use crate::io::calibration::Calibration;
 use crate::io::capture::Capture;
+use crate::io::patch::{HostDecoder, HostEnsemble, HostEnsembleModel, HostScheduledDictionary};
 use crate::io::sensor::{FilterDescription, SensorDescription};
 use crate::sim::calibration::calibration_captures;
 use crate::sim::camera::{CameraConfig, GridSettings, simulate};
@@ -407,7 +408,7 @@ pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
     let DeviceLog { patches: device, rows, count, gains, calibrated, calibrated_gains, trial } = parse(&text)?;
     let capture = Capture::load(capture_dir)?;
     // The device decodes full-view patches with the shipped full-view ensemble.
-    let ensemble = Ensemble::<5, 5, 5, 5, 13>::new(DEFAULT_FULL_VIEW_ENSEMBLE).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let ensemble = HostEnsemble::<5, 5>::new(DEFAULT_FULL_VIEW_ENSEMBLE).map_err(|e| anyhow::anyhow!("{e}"))?;
     let model = EnsembleModel::new(ensemble, MemberChoice::Screened(ChoiceRule::DEFAULT));
     // The config the device takes from `capture.rs` (the capture's noise ball) and its white
     // balance: the host's default. The device's tiles are its per-patch benchmark, unsheared;
@@ -489,7 +490,7 @@ fn check_calibrated(
     gains: &[f32],
     capture_dir: &Path,
     calibration: &Path,
-    model: &EnsembleModel<'_, 5, 5, 5, 5, 13>,
+    model: &HostEnsembleModel<'_, 5, 5>,
 ) -> Result<()> {
     let capture = Capture::load(capture_dir)?;
     let cal = Calibration::load(calibration)?;
@@ -503,18 +504,15 @@ fn check_calibrated(
     let defects = slf_firmware::DefectList::new(&c.defects).map_err(|e| anyhow::anyhow!("{e}"))?;
     let response = slf_firmware::Response::new(&c.response).map_err(|e| anyhow::anyhow!("{e}"))?;
     let raw_format = slf_firmware::RawFormat { black: c.black, white: c.white, ..plain.config().raw };
-    let decoder = slf_firmware::TileDecoder::<5, 5, 5, 5, 13, 8125>::new(slf_firmware::DecoderConfig {
-        raw: raw_format,
-        defects,
-        ..*plain.config()
-    })
-    .map_err(err)?
-    .with_response(&response, slf_firmware::ResponseModel::Unmix)
-    .map_err(err)?
-    .with_view_gains(Some((&c.view_gains, c.regions)))
-    .map_err(err)?
-    .with_grid(c.grid)
-    .map_err(err)?;
+    let decoder =
+        HostDecoder::<5, 5, 8125>::new(slf_firmware::DecoderConfig { raw: raw_format, defects, ..*plain.config() })
+            .map_err(err)?
+            .with_response(&response, slf_firmware::ResponseModel::Unmix)
+            .map_err(err)?
+            .with_view_gains(Some((&c.view_gains, c.regions)))
+            .map_err(err)?
+            .with_grid(c.grid)
+            .map_err(err)?;
     let host_gains = decoder
         .estimate_gains(&mut FrameSource::new(&raw))
         .map_err(|e| anyhow::anyhow!("{}: {e:?}", capture.source()))?;
@@ -561,8 +559,8 @@ fn check_calibrated(
 fn check_rows(
     rows: &HashMap<(usize, usize), Vec<f32>>,
     capture: &Capture,
-    dct: &ScheduledDictionary<5, 5, 5, 5, 13>,
-    model: &EnsembleModel<'_, 5, 5, 5, 5, 13>,
+    dct: &HostScheduledDictionary<5, 5>,
+    model: &HostEnsembleModel<'_, 5, 5>,
     pick: Pick,
 ) -> Result<()> {
     // The host's default, full-view patches (the device's), no flags; without the baseline

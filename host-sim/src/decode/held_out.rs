@@ -41,11 +41,12 @@
 
 use anyhow::{Result, ensure};
 use slf_firmware::raw::Invalid;
-use slf_firmware::{Frame, HoldOut, MaskFamily, PatchModel, RawFrame, RowSink, TileDecoder};
+use slf_firmware::{Frame, HoldOut, MaskFamily, RawFrame, RowSink};
 
 use crate::decode::plan::FramePlan;
 use crate::decode::strip::decode_rows;
 use crate::io::lightfield::LightField;
+use crate::io::patch::{HostDecoder, HostModel};
 use crate::io::rows::{RowShape, whole_width};
 
 /// The factor the held-out decode's error estimate is scaled by to be the full decode's
@@ -71,9 +72,7 @@ pub enum Held {
 
 impl Held {
     /// What a decoder's mask holds out.
-    pub fn of<const PU: usize, const PV: usize, const N: usize>(
-        decoder: &TileDecoder<'_, 5, 5, PU, PV, 13, N>,
-    ) -> Self {
+    pub fn of<const PU: usize, const PV: usize, const N: usize>(decoder: &HostDecoder<'_, PU, PV, N>) -> Self {
         let c = decoder.config();
         let (lu, lv) = (usize::from(c.sensor.lenslet.rows), usize::from(c.sensor.lenslet.cols));
         let (br, bc) = c.mask.block();
@@ -216,7 +215,7 @@ impl Tally {
 /// The row sink of the held-out decode: each finished lenslet row's values at the held-out
 /// samples under it, against the samples, tallied per lenslet.
 struct Tallies<'a, const PU: usize, const PV: usize, const N: usize> {
-    decoder: &'a TileDecoder<'a, 5, 5, PU, PV, 13, N>,
+    decoder: &'a HostDecoder<'a, PU, PV, N>,
     raw: &'a [RawFrame<'a, u16>],
     hiding: Hiding,
     shape: RowShape,
@@ -301,7 +300,7 @@ impl HeldOutDecode {
         batch: usize,
     ) -> Result<Self>
     where
-        M: PatchModel<5, 5, PU, PV, 13, N> + Sync,
+        M: HostModel<PU, PV, N>,
     {
         Self::run_hiding(plan, model, raw, Hiding::Hashed(hold, Held::of(&plan.decoder)), None, batch)
     }
@@ -320,7 +319,7 @@ impl HeldOutDecode {
         batch: usize,
     ) -> Result<Self>
     where
-        M: PatchModel<5, 5, PU, PV, 13, N> + Sync,
+        M: HostModel<PU, PV, N>,
     {
         let hidden = HeldOutFrame::of(raw, hiding);
         let shape = plan.shape;

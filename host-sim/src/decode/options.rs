@@ -6,6 +6,8 @@ use anyhow::{Result, anyhow, bail, ensure};
 use slf_firmware::{DisparityRange, Plausibility, Response, ResponseModel, Sl0Config};
 
 use crate::io::capture::Capture;
+use crate::io::patch::HostEnsemble;
+use crate::io::patch::{BANDS, LENSLETS};
 
 /// How many of a lenslet's views a patch holds per axis (`slf decode --patch-views`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -33,7 +35,7 @@ impl PatchViews {
     /// The patch's dimensions `[PS, PT, PU, PV, B]`.
     pub fn dims(self) -> [usize; 5] {
         let v = self.count();
-        [5, 5, v, v, 13]
+        [LENSLETS, LENSLETS, v, v, BANDS]
     }
 
     /// The patch a capture with lenslets of `views` (rows, cols) views decodes with when
@@ -71,7 +73,7 @@ impl PatchViews {
     /// `5 x 5 x 4 x 4 x 13`, as messages name a patch.
     pub fn shape_name(self) -> String {
         let v = self.count();
-        format!("5 x 5 x {v} x {v} x 13")
+        format!("{LENSLETS} x {LENSLETS} x {v} x {v} x {BANDS}")
     }
 }
 
@@ -123,7 +125,7 @@ impl Basis {
 
 /// The largest dictionary blob of a decoder's patch: 65,535 members of the full-view
 /// patch, the format's limit.
-pub const MAX_BLOB: usize = slf_firmware::blob::blob_len([5, 5, 5, 5, 13], u16::MAX as usize);
+pub const MAX_BLOB: usize = slf_firmware::blob::blob_len(slf_firmware::FullViewShape::DIMS, u16::MAX as usize);
 
 /// Reads and validates a dictionary blob file, of either patch ([`PatchViews`]); a file
 /// larger than [`MAX_BLOB`], a FIFO or a device is refused before reading.
@@ -138,9 +140,9 @@ pub fn read_blob(path: &std::path::Path) -> Result<Vec<u8>> {
     )?;
     let blob = std::fs::read(path).map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
     let checked = match PatchViews::of_blob(&blob) {
-        Some(PatchViews::Five) => slf_firmware::Ensemble::<5, 5, 5, 5, 13>::new(&blob).map(|_| ()),
+        Some(PatchViews::Five) => HostEnsemble::<5, 5>::new(&blob).map(|_| ()),
         // The paper's patch also reports a blob of neither shape (its dimension check).
-        _ => slf_firmware::Ensemble::<5, 5, 4, 4, 13>::new(&blob).map(|_| ()),
+        _ => HostEnsemble::<4, 4>::new(&blob).map(|_| ()),
     };
     checked.map_err(|e| anyhow!("{}: {e}", path.display()))?;
     Ok(blob)
@@ -186,7 +188,7 @@ pub enum Balance {
     #[default]
     GreyWorld,
     /// These gains (e.g. from a white reference or a known illuminant).
-    Gains([f32; 13]),
+    Gains([f32; BANDS]),
 }
 
 /// How to decode.
@@ -248,7 +250,7 @@ pub struct DecodeOptions {
     /// The filters' response matrix (row-major, filter x band) and where the decode puts
     /// it ([`slf_firmware::response`], [`ResponseModel`]): a calibration's, whose leaked
     /// light the decode then separates. `None`: one-hot filters.
-    pub response: Option<(Response<13>, ResponseModel)>,
+    pub response: Option<(Response<BANDS>, ResponseModel)>,
     /// The plausibility check of every solved patch ([`slf_firmware::TileDecoder::with_plausibility`]):
     /// [`Plausibility::DEFAULT`] unless set.
     pub plausibility: Plausibility,

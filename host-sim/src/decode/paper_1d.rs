@@ -13,6 +13,7 @@ use slf_firmware::{
     Dictionary, Ended, LensletSize, Mask, MaskFamily, PaperShape, PaperWorkspace, Sl0Config, blob, solve,
 };
 
+use crate::io::patch::HostDictionary;
 use crate::sim::scene::{self, SceneSize};
 
 /// A scalar for both paths: f32 or f64.
@@ -59,7 +60,7 @@ pub struct Factors<T: Real>(pub Vec<(usize, Vec<T>)>);
 
 impl<T: Real> Factors<T> {
     /// A firmware dictionary's matrices (f32 values, widened to `T`).
-    pub fn from_dictionary<const PU: usize, const PV: usize>(dict: &Dictionary<5, 5, PU, PV, 13>) -> Self {
+    pub fn from_dictionary<const PU: usize, const PV: usize>(dict: &HostDictionary<PU, PV>) -> Self {
         let d = dict.synthesis();
         let conv = |m: &[f32], n: usize| (n, m.iter().map(|&x| T::from(x)).collect());
         Self(vec![
@@ -76,7 +77,7 @@ impl Factors<f64> {
     /// The 5D DCT computed in f64, orthonormal to f64 precision (the f32 tables are
     /// orthonormal only to about 1e-7, which an f64 comparison would see).
     pub fn dct_f64() -> Self {
-        Self::dct_f64_of([5, 5, 4, 4, 13])
+        Self::dct_f64_of(slf_firmware::PaperShape::DIMS)
     }
 
     /// [`Self::dct_f64`] for a patch of `dims` (e.g. the full-view patch's `[5, 5, 5, 5, 13]`).

@@ -12,10 +12,11 @@ use slf_firmware::{Response, ResponseModel};
 use crate::decode::baselines::BaselineReport;
 use crate::decode::calibrate::{corrected, unmix, unmixing};
 use crate::decode::cs::{DecodeOptions, DecodeReport, decode_into};
-use crate::decode::settings::{DecodeSettings, GridChoice, Method, PATCH_BANDS, ResponseChoice};
+use crate::decode::settings::{DecodeSettings, GridChoice, Method, ResponseChoice};
 use crate::io::calibration::Calibration;
 use crate::io::capture::Capture;
 use crate::io::lightfield::LightField;
+use crate::io::patch::BANDS;
 use crate::io::rows::{MapRows, RowShape, Rows, put_light_field};
 
 /// A decode's light field and what it reports.
@@ -142,9 +143,9 @@ impl DecodeSettings {
         );
         // Compressed sensing puts the response in the firmware's decode; baselines unmix
         // their spectra here.
-        let rows: Option<Vec<[f32; PATCH_BANDS]>> =
+        let rows: Option<Vec<[f32; BANDS]>> =
             response.map(|r| r.iter().filter_map(|row| row.as_slice().try_into().ok()).collect());
-        let modelled = match rows.and_then(|rows| <[[f32; PATCH_BANDS]; PATCH_BANDS]>::try_from(rows).ok()) {
+        let modelled = match rows.and_then(|rows| <[[f32; BANDS]; BANDS]>::try_from(rows).ok()) {
             Some(r) if self.method.baseline().is_none() => Some((
                 Response::new(&r).map_err(|e| anyhow::anyhow!("the calibration's response matrix: {e}"))?,
                 self.response_model.model(),
@@ -171,7 +172,7 @@ impl DecodeSettings {
     fn run_corrected(
         &self,
         capture: &Capture,
-        response: Option<(Response<PATCH_BANDS>, ResponseModel)>,
+        response: Option<(Response<BANDS>, ResponseModel)>,
         progress: bool,
         observer: &(dyn Fn(usize, usize) + Sync),
         sink: &mut Rows<'_>,

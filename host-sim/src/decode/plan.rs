@@ -6,19 +6,18 @@
 
 use anyhow::{Result, anyhow, ensure};
 use slf_firmware::decode::engine::plan::Grids;
-use slf_firmware::{
-    FrameSource, HoldOut, ModelTrial, PairedErrors, PatchModel, Pick, RawFrame, ShearTrial, Tile, TileDecoder,
-};
+use slf_firmware::{FrameSource, HoldOut, ModelTrial, PairedErrors, Pick, RawFrame, ShearTrial, Tile};
 
 use crate::decode::options::{Balance, DecodeOptions, EstimateBy};
 use crate::decode::trial::{frame_shear_trial, frame_trial, pilot_budget};
 use crate::io::capture::Capture;
+use crate::io::patch::{BANDS, HostDecoder, HostModel};
 use crate::io::rows::RowShape;
 
 /// What a decode of one frame does, decided before its first row.
 pub struct FramePlan<'a, const PU: usize, const PV: usize, const N: usize> {
     /// The tile decoder, with the shear trial's disparities.
-    pub decoder: TileDecoder<'a, 5, 5, PU, PV, 13, N>,
+    pub decoder: HostDecoder<'a, PU, PV, N>,
     /// Which of the two models decodes the frame.
     pub pick: Pick,
     /// The patch grids: the disjoint grid's tiles row by row, the shifted grids' (with the
@@ -57,11 +56,11 @@ impl<'a, const PU: usize, const PV: usize, const N: usize> FramePlan<'a, PU, PV,
         raw: &[RawFrame<'_, u16>],
     ) -> Result<Self>
     where
-        A: PatchModel<5, 5, PU, PV, 13, N> + Sync,
-        Z: PatchModel<5, 5, PU, PV, 13, N> + Sync,
+        A: HostModel<PU, PV, N>,
+        Z: HostModel<PU, PV, N>,
     {
         let d = &capture.description;
-        ensure!(d.bands_nm.len() == 13, "the decoder's patch has 13 bands, the capture {}", d.bands_nm.len());
+        ensure!(d.bands_nm.len() == BANDS, "the decoder's patch has {BANDS} bands, the capture {}", d.bands_nm.len());
         if let Some(asked) = opts.patch_views {
             ensure!(
                 asked.count() == PU && asked.count() == PV,
@@ -126,7 +125,7 @@ impl<'a, const PU: usize, const PV: usize, const N: usize> FramePlan<'a, PU, PV,
             grids,
             seeded: opts.seeds(),
             adaptive: opts.adaptive,
-            shape: RowShape { views, rows: lenslets.0, cols: lenslets.1, bands: 13 },
+            shape: RowShape { views, rows: lenslets.0, cols: lenslets.1, bands: BANDS },
             range,
             window: opts.window,
             shear_trial,
@@ -177,7 +176,7 @@ impl ModelPick {
 pub fn tile_decoder<'a, const PU: usize, const PV: usize, const N: usize>(
     capture: &'a Capture,
     opts: &'a DecodeOptions,
-) -> Result<TileDecoder<'a, 5, 5, PU, PV, 13, N>> {
+) -> Result<HostDecoder<'a, PU, PV, N>> {
     let decoder = capture.decoder::<PU, PV, N>(opts.solver_config(capture))?;
     // The response first: the white balance's gains are of the unmixed spectrum.
     let decoder = match &opts.response {
@@ -187,7 +186,7 @@ pub fn tile_decoder<'a, const PU: usize, const PV: usize, const N: usize>(
         None => decoder,
     };
     let gains = match opts.balance {
-        Balance::Off => [1.0; 13],
+        Balance::Off => [1.0; BANDS],
         Balance::GreyWorld => {
             let raw = capture.raw_frames()?;
             decoder
@@ -213,7 +212,7 @@ pub fn tile_decoder<'a, const PU: usize, const PV: usize, const N: usize>(
 /// held-out decode cannot compare samples with the light field).
 pub fn patch_estimates<const PU: usize, const PV: usize, const N: usize>(
     opts: &DecodeOptions,
-    decoder: &TileDecoder<'_, 5, 5, PU, PV, 13, N>,
+    decoder: &HostDecoder<'_, PU, PV, N>,
 ) -> bool {
     opts.error_estimate && (opts.estimate_by == EstimateBy::Patches || !decoder.samples_are_values())
 }

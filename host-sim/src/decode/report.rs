@@ -6,6 +6,7 @@ use slf_firmware::{Ended, PatchOrigin, PatchReport, TileReport};
 
 use crate::decode::options::PatchViews;
 use crate::io::grid::{GridDescription, OffSensor};
+use crate::io::patch::BANDS;
 
 /// Which decoder made a patch: a row of [`DecodeReport::member_map`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -70,7 +71,7 @@ pub struct DecodeReport {
     /// Wall time, seconds.
     pub seconds: f64,
     /// The band gains the decode used (1 without white balance).
-    pub gains: [f32; 13],
+    pub gains: [f32; BANDS],
     /// The patch it decoded with (`None` only in a report made by hand).
     pub patch_views: Option<PatchViews>,
     /// Each estimated patch's error estimate (RMS per value, the output's units), by

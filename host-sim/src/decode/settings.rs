@@ -24,6 +24,7 @@ use crate::decode::cs::{
 };
 use crate::decode::preset::Preset;
 use crate::io::message::number as show;
+use crate::io::patch::BANDS;
 use crate::sim::flags::parse;
 
 /// Decode method: compressed sensing, or a baseline without it.
@@ -487,8 +488,8 @@ impl DecodeSettings {
         let base = self.preset.options();
         let balance = match &self.gains {
             Some(g) => {
-                let g: [f32; 13] =
-                    g.as_slice().try_into().map_err(|_| anyhow!("--gains: 13 values, got {}", g.len()))?;
+                let g: [f32; BANDS] =
+                    g.as_slice().try_into().map_err(|_| anyhow!("--gains: {BANDS} values, got {}", g.len()))?;
                 if let Some((b, bad)) = g.iter().enumerate().find(|(_, x)| !gains::valid_gain(**x)) {
                     bail!(
                         "--gains: gain {} is {}: each must be in [1/{m}, {m}] (the decode's thresholds are in units \
@@ -550,7 +551,7 @@ impl DecodeSettings {
             }
         }
         // Flags the decode would otherwise ignore in silence.
-        let bands = PATCH_BANDS;
+        let bands = BANDS;
         ensure!(
             usize::from(options.sl0.min_bands) <= bands,
             "--min-bands {}: at most {bands}, the patch's bands (above, every patch would be interpolated; 0 \
@@ -622,9 +623,6 @@ impl DecodeSettings {
         .collect()
     }
 }
-
-/// Bands of the decoder's patch (the camera's 13).
-pub(crate) const PATCH_BANDS: usize = 13;
 
 /// `--grid`: which lenslet grid a decode reads the frames through.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]

@@ -20,12 +20,13 @@ use slf_firmware::decode::engine::plan::Planned;
 use slf_firmware::decode::engine::rows::Fill;
 use slf_firmware::decode::engine::schedule::{Next, Schedule};
 use slf_firmware::decode::engine::strip::{SeedPatches, Seeds, Strip, StripShape};
-use slf_firmware::{Frame, FrameSource, PatchModel, TileReport, Workspace};
+use slf_firmware::{Frame, FrameSource, TileReport};
 
 use crate::decode::plan::FramePlan;
 use crate::decode::report::DecodeReport;
 use crate::decode::seams::{Spectra, seam_score};
 use crate::decode::tile_sums::TileSums;
+use crate::io::patch::{BANDS, HostModel, HostWorkspace, LENSLETS};
 use crate::io::rows::{RowShape, Rows};
 
 /// Tiles a batch holds by default, per worker thread: enough that the threads rarely wait
@@ -34,7 +35,7 @@ pub const BATCH_TILES_PER_THREAD: usize = 8;
 
 /// The engine's seeds as the spectra the adaptive rule scores.
 struct SeedRows<'r> {
-    seeds: Seeds<'r, 13>,
+    seeds: Seeds<'r, BANDS>,
     shape: RowShape,
 }
 
@@ -72,7 +73,7 @@ pub fn decode_rows<const PU: usize, const PV: usize, const N: usize, M, F>(
     sink: &mut Rows<'_>,
 ) -> Result<DecodeReport>
 where
-    M: PatchModel<5, 5, PU, PV, 13, N> + Sync,
+    M: HostModel<PU, PV, N>,
     F: Frame + Sync,
 {
     let start = Instant::now();
@@ -97,11 +98,11 @@ where
         }
     };
     let lenslets = (shape.rows, shape.cols);
-    let run = |tiles: &[Planned], seeds: Option<Seeds<'_, 13>>| -> Decoded<PU, PV> {
+    let run = |tiles: &[Planned], seeds: Option<Seeds<'_, BANDS>>| -> Decoded<PU, PV> {
         tiles
             .par_iter()
             .map_init(
-                || Box::new(Workspace::<5, 5, PU, PV, 13, N>::new()),
+                || Box::new(HostWorkspace::<PU, PV, N>::new()),
                 |ws, &planned| {
                     let mut sums = TileSums::new(planned.tile, shape.views, plan.window, plan.grids.halo());
                     let mut source = FrameSource::new(raw);
@@ -110,7 +111,7 @@ where
                             model,
                             planned.tile,
                             &mut source,
-                            &mut SeedPatches::<5, 5, PU, PV, 13> { seeds, lenslets },
+                            &mut SeedPatches::<LENSLETS, LENSLETS, PU, PV, BANDS> { seeds, lenslets },
                             &mut sums,
                             ws,
                         ),
@@ -125,7 +126,7 @@ where
     };
     let mut report = DecodeReport::default();
     let mut maps = Vec::new();
-    let mut account = |decoded: Decoded<PU, PV>, into: &mut Strip<'_, 13>, report: &mut DecodeReport| {
+    let mut account = |decoded: Decoded<PU, PV>, into: &mut Strip<'_, BANDS>, report: &mut DecodeReport| {
         for (planned, mut sums, r) in decoded {
             into.join(&sums.sums());
             match r {
@@ -153,8 +154,8 @@ where
         seed_slots: needs.seed_rows,
         seeded: seeds_needed,
     };
-    let mut buf = vec![0.0f32; held.buffer_len::<13>()];
-    let mut strip = Strip::<13>::new(&mut buf, held, plan.range, plan.window)
+    let mut buf = vec![0.0f32; held.buffer_len::<BANDS>()];
+    let mut strip = Strip::<BANDS>::new(&mut buf, held, plan.range, plan.window)
         .map_err(|e| anyhow::anyhow!("{e} ({slots} rows of {} x {} lenslets)", shape.rows, shape.cols))?;
     let (mut fill, mut unused) = (Fill::default(), Fill::default());
     loop {

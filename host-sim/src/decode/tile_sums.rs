@@ -8,6 +8,7 @@ use slf_firmware::overlap::Window;
 use slf_firmware::{PatchOrigin, PatchReport, PatchSink, SolveError, Tile};
 
 use crate::decode::report::PatchDecoder;
+use crate::io::patch::BANDS;
 
 /// A tile's weighted sums and report: the [`PatchSink`] a tile decodes into before its
 /// sums join the frame's rows.
@@ -27,7 +28,7 @@ pub(crate) struct TileSums<const PU: usize, const PV: usize> {
 
 impl<const PU: usize, const PV: usize> TileSums<PU, PV> {
     pub fn new(tile: Tile, views: (usize, usize), window: Window, halo: usize) -> Self {
-        let (sums, pixels) = Sums::<13>::lens(&tile, views, halo);
+        let (sums, pixels) = Sums::<BANDS>::lens(&tile, views, halo);
         Self {
             tile,
             views,
@@ -44,7 +45,7 @@ impl<const PU: usize, const PV: usize> TileSums<PU, PV> {
     }
 
     /// The sums, as the engine reads and adds them.
-    pub fn sums(&mut self) -> Sums<'_, 13> {
+    pub fn sums(&mut self) -> Sums<'_, BANDS> {
         Sums {
             tile: self.tile,
             views: self.views,

@@ -18,9 +18,8 @@
 use rayon::prelude::*;
 use std::ops::AddAssign;
 
-use slf_firmware::{
-    FrameSource, ModelTrial, PairedErrors, PatchModel, RawFrame, ShearTrial, Tile, TileDecoder, Workspace,
-};
+use crate::io::patch::{HostDecoder, HostModel, HostWorkspace};
+use slf_firmware::{FrameSource, ModelTrial, PairedErrors, RawFrame, ShearTrial, Tile};
 
 /// The most pilots a frame's trial takes. With 64, the HCI crops' 196 tiles gave 49 pilots,
 /// and cotton and antinous at lenslet k = 3 went to the DCT (held-out RMS 0.00164 against
@@ -55,7 +54,7 @@ pub const DCT_LEAN: f32 = 0.8;
 /// The model trial over `tiles` (the disjoint grid's): one pilot on each of at most
 /// `budget` ([`pilot_budget`]) of them, evenly spaced, in parallel; their errors summed.
 pub fn frame_trial<const PU: usize, const PV: usize, const N: usize, A, Z>(
-    decoder: &TileDecoder<'_, 5, 5, PU, PV, 13, N>,
+    decoder: &HostDecoder<'_, PU, PV, N>,
     first: &A,
     second: &Z,
     raw: &[RawFrame<'_, u16>],
@@ -63,8 +62,8 @@ pub fn frame_trial<const PU: usize, const PV: usize, const N: usize, A, Z>(
     budget: usize,
 ) -> ModelTrial
 where
-    A: PatchModel<5, 5, PU, PV, 13, N> + Sync,
-    Z: PatchModel<5, 5, PU, PV, 13, N> + Sync,
+    A: HostModel<PU, PV, N>,
+    Z: HostModel<PU, PV, N>,
 {
     pilots::<PU, PV, N, _>(raw, tiles, budget, |source, at, ws| decoder.trial(first, second, at, source, ws))
 }
@@ -74,14 +73,14 @@ where
 /// errors at it and at the better whole one beside it
 /// ([`TileDecoder::shear_trial`]), summed.
 pub fn frame_shear_trial<const PU: usize, const PV: usize, const N: usize, M>(
-    decoder: &TileDecoder<'_, 5, 5, PU, PV, 13, N>,
+    decoder: &HostDecoder<'_, PU, PV, N>,
     model: &M,
     raw: &[RawFrame<'_, u16>],
     tiles: &[Tile],
     budget: usize,
 ) -> ShearTrial
 where
-    M: PatchModel<5, 5, PU, PV, 13, N> + Sync,
+    M: HostModel<PU, PV, N>,
 {
     pilots::<PU, PV, N, _>(raw, tiles, budget, |source, at, ws| decoder.shear_trial(model, at, source, ws))
 }
@@ -96,7 +95,7 @@ fn pilots<const PU: usize, const PV: usize, const N: usize, T: AddAssign + Defau
     pilot: impl Fn(
         &mut FrameSource<'_, RawFrame<'_, u16>>,
         (u16, u16),
-        &mut Workspace<5, 5, PU, PV, 13, N>,
+        &mut HostWorkspace<PU, PV, N>,
     ) -> Result<T, slf_firmware::raw::ReadError>
     + Sync,
 ) -> T {
@@ -105,7 +104,7 @@ fn pilots<const PU: usize, const PV: usize, const N: usize, T: AddAssign + Defau
         .par_iter()
         .step_by(step)
         .map_init(
-            || Box::new(Workspace::<5, 5, PU, PV, 13, N>::new()),
+            || Box::new(HostWorkspace::<PU, PV, N>::new()),
             |ws, t| pilot(&mut FrameSource::new(raw), (t.lenslet_row, t.lenslet_col), ws).unwrap_or_default(),
         )
         .reduce(T::default, |mut a, b| {

@@ -24,6 +24,7 @@ use crate::io::sensor::SensorDescription;
 /// The largest `capture.json` read (a long defect list fits many times over).
 pub const MAX_DESCRIPTION: u64 = 64 << 20;
 
+use crate::io::patch::HostDecoder;
 use slf_firmware::shape::MAX_BANDS;
 
 /// The description file's name inside a capture folder.
@@ -375,7 +376,7 @@ impl Capture {
     pub fn decoder<const PU: usize, const PV: usize, const N: usize>(
         &self,
         sl0: Sl0Config,
-    ) -> Result<TileDecoder<'_, 5, 5, PU, PV, 13, N>> {
+    ) -> Result<HostDecoder<'_, PU, PV, N>> {
         let mask = self.mask().map_err(|e| anyhow!("{}: {}", self.source(), one_line(&e)))?;
         let config =
             DecoderConfig { sensor: self.sensor(), mask, raw: self.raw_format(), defects: self.defects(), sl0 };

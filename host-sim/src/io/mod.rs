@@ -17,6 +17,7 @@
 //! - [`import`]: views, hyperspectral cubes, HDF5 light fields and band resampling;
 //! - [`message`]: an error as the one line a user reads;
 //! - [`output`]: results written whole, never over an input of the same run;
+//! - [`patch`]: the patch the host decodes, its extents named once;
 //! - [`rows`]: a light field put a lenslet row at a time (a streamed decode's sink);
 //! - [`sensor`]: a simulated sensor's imperfections as its captures record them;
 //! - [`stdout`]: lines to standard output that fail as errors ([`crate::outln!`]).
@@ -38,6 +39,7 @@ pub mod message;
 pub mod npy;
 pub mod npy_rows;
 pub mod output;
+pub mod patch;
 pub mod rows;
 pub mod sensor;
 #[macro_use]

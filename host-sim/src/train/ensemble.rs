@@ -29,16 +29,17 @@ use rand::seq::index::sample;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
+use slf_firmware::Dictionary;
 use slf_firmware::dictionary::Factors;
 use slf_firmware::transform::analyze;
-use slf_firmware::{Dictionary, PatchShape};
 
 use crate::decode::cs::PatchViews;
 use crate::io::lightfield::LightField;
+use crate::io::patch::{BANDS, HostDictionary, HostShape, LENSLETS};
 
 /// The patch's mode sizes.
 const fn dims<const PU: usize, const PV: usize>() -> [usize; 5] {
-    [5, 5, PU, PV, 13]
+    [LENSLETS, LENSLETS, PU, PV, BANDS]
 }
 const CHUNK: usize = 64;
 
@@ -89,7 +90,7 @@ pub fn sample_patches<const PU: usize, const PV: usize, const N: usize>(
         let (r, c) = (rng.random_range(0..=lf.rows - 5), rng.random_range(0..=lf.cols - 5));
         let (u0, v0) = (rng.random_range(0..=lf.views.0 - PU), rng.random_range(0..=lf.views.1 - PV));
         for i in 0..N {
-            let [s, t, u, v, b] = PatchShape::<5, 5, PU, PV, 13, N>::coordinates(i);
+            let [s, t, u, v, b] = HostShape::<PU, PV, N>::coordinates(i);
             out.push(lf.get(u0 + u, v0 + v, r + s, c + t, b));
         }
     }
@@ -102,7 +103,7 @@ pub struct Member(pub [Vec<f64>; 5]);
 
 impl Member {
     /// The f32 dictionary (checked orthonormal by the firmware).
-    pub fn dictionary<const PU: usize, const PV: usize>(&self) -> Dictionary<5, 5, PU, PV, 13> {
+    pub fn dictionary<const PU: usize, const PV: usize>(&self) -> HostDictionary<PU, PV> {
         fn m<const D: usize>(v: &[f64]) -> [[f32; D]; D] {
             core::array::from_fn(|i| core::array::from_fn(|j| v[i * D + j] as f32))
         }
@@ -111,7 +112,7 @@ impl Member {
             m2: m::<5>(&self.0[1]),
             m3: m::<PU>(&self.0[2]),
             m4: m::<PV>(&self.0[3]),
-            m5: m::<13>(&self.0[4]),
+            m5: m::<BANDS>(&self.0[4]),
         };
         // Procrustes and eigenvectors are orthonormal to ~1e-15 in f64; f32 rounding keeps
         // them within 1e-6, far inside the firmware's 1e-4.
@@ -196,7 +197,7 @@ pub fn top_tau(s: &[f32], tau: usize) -> (f64, Vec<u16>) {
 fn coefficients<const PU: usize, const PV: usize, const N: usize>(
     patches: &[f32],
     p: usize,
-    dict: &Dictionary<5, 5, PU, PV, 13>,
+    dict: &HostDictionary<PU, PV>,
 ) -> Box<[f32; N]> {
     let mut x: Box<[f32; N]> = Box::new([0.0; N]);
     x.copy_from_slice(&patches[p * N..(p + 1) * N]);
@@ -208,7 +209,7 @@ fn coefficients<const PU: usize, const PV: usize, const N: usize>(
 /// Mean relative coding error of every patch in `dict` at `tau`.
 pub fn coding_error<const PU: usize, const PV: usize, const N: usize>(
     patches: &[f32],
-    dict: &Dictionary<5, 5, PU, PV, 13>,
+    dict: &HostDictionary<PU, PV>,
     tau: usize,
 ) -> f64 {
     let count = patches.len() / N;
@@ -220,7 +221,7 @@ pub fn coding_error<const PU: usize, const PV: usize, const N: usize>(
 /// Mean relative coding error with each patch in its best member: the ensemble's error.
 pub fn ensemble_error<const PU: usize, const PV: usize, const N: usize>(
     patches: &[f32],
-    members: &[Dictionary<5, 5, PU, PV, 13>],
+    members: &[HostDictionary<PU, PV>],
     tau: usize,
 ) -> f64 {
     let count = patches.len() / N;
@@ -239,7 +240,7 @@ pub fn ensemble_error<const PU: usize, const PV: usize, const N: usize>(
 /// Each patch's best member and its error.
 pub fn assign<const PU: usize, const PV: usize, const N: usize>(
     patches: &[f32],
-    members: &[Dictionary<5, 5, PU, PV, 13>],
+    members: &[HostDictionary<PU, PV>],
     tau: usize,
 ) -> Vec<(usize, f64)> {
     (0..patches.len() / N)
@@ -359,7 +360,7 @@ pub fn init_members<const PU: usize, const PV: usize, const N: usize>(
 pub fn train<const PU: usize, const PV: usize, const N: usize>(
     patches: &[f32],
     cfg: &TrainConfig,
-) -> (Vec<Dictionary<5, 5, PU, PV, 13>>, Vec<IterationReport>) {
+) -> (Vec<HostDictionary<PU, PV>>, Vec<IterationReport>) {
     let count = patches.len() / N;
     let fixed = usize::from(cfg.dct_member && cfg.members > 0);
     let mut members = init_members::<PU, PV, N>(patches, cfg);
@@ -367,7 +368,7 @@ pub fn train<const PU: usize, const PV: usize, const N: usize>(
     let bar = progress_bar(cfg.iterations as u64, cfg.progress);
     let mut reports = Vec::new();
     for _ in 0..cfg.iterations {
-        let dicts: Vec<Dictionary<5, 5, PU, PV, 13>> = members.iter().map(Member::dictionary).collect();
+        let dicts: Vec<HostDictionary<PU, PV>> = members.iter().map(Member::dictionary).collect();
         let assignment = assign::<PU, PV, N>(patches, &dicts, cfg.tau);
         let ensemble_error = assignment.iter().map(|a| a.1).sum::<f64>() / count as f64;
         let groups: Vec<Vec<usize>> =

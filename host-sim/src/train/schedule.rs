@@ -34,6 +34,9 @@
 //! library's, which may differ between machines), so the same inputs give the same blob
 //! bytes on any thread count and machine of the same build.
 
+use crate::io::patch::{
+    BANDS, HostDictionary, HostEnsemble, HostSchedule, HostSchedules, HostShape, HostWeights, LENSLETS,
+};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -44,11 +47,11 @@ use slf_firmware::projection::project_coefficients;
 use slf_firmware::schedule::{MAX_STEPS, Schedule, Schedules, Weights};
 use slf_firmware::transform::{analyze, analyze_preserving, synthesize};
 use slf_firmware::workspace::Measurements;
-use slf_firmware::{Dictionary, LensletSize, Mask, PatchShape};
+use slf_firmware::{LensletSize, Mask};
 
 /// The patch's mode sizes (5 x 5 lenslets, `PU x PV` views, 13 bands).
 const fn dims<const PU: usize, const PV: usize>() -> [usize; 5] {
-    [5, 5, PU, PV, 13]
+    [LENSLETS, LENSLETS, PU, PV, BANDS]
 }
 
 /// The floor of every step's sigma: the decoder's `Sl0Config::DEFAULT.sigma_min`.
@@ -137,7 +140,7 @@ pub fn random_pattern<const PU: usize, const PV: usize, const N: usize>(rng: &mu
     let (r0, c0) = (rng.random_range(0..200usize), rng.random_range(0..200usize));
     let mut measured = vec![false; N];
     for (i, m) in measured.iter_mut().enumerate() {
-        let [s, t, u, v, b] = PatchShape::<5, 5, PU, PV, 13, N>::coordinates(i);
+        let [s, t, u, v, b] = HostShape::<PU, PV, N>::coordinates(i);
         let (row, col) = ((r0 + s) * PU + u, (c0 + t) * PV + v);
         *m = mask.bands_at(row, col).iter().any(|&x| x as usize == b);
     }
@@ -214,7 +217,7 @@ impl<const PU: usize, const PV: usize> Params<PU, PV> {
     }
 
     /// The group weights, in [1/64, 64].
-    pub fn weights(&self) -> Weights<5, 5, PU, PV, 13> {
+    pub fn weights(&self) -> HostWeights<PU, PV> {
         let mut w = Weights::ONES;
         for (mode, logs) in w.modes_mut().into_iter().zip(&self.log_weights) {
             for (x, l) in mode.iter_mut().zip(logs) {
@@ -228,7 +231,7 @@ impl<const PU: usize, const PV: usize> Params<PU, PV> {
     ///
     /// # Errors
     /// More than [`MAX_STEPS`] steps.
-    pub fn schedule(&self) -> anyhow::Result<Schedule<5, 5, PU, PV, 13>> {
+    pub fn schedule(&self) -> anyhow::Result<HostSchedule<PU, PV>> {
         Schedule::new(&self.sigma(), &self.mu(), self.weights()).map_err(|e| anyhow::anyhow!("{e}"))
     }
 }
@@ -243,7 +246,7 @@ pub struct Trajectory {
 /// The start of a solve from `signal` (a patch estimate; zeros in the unmeasured entries
 /// for the cold start): analysed in `dict`, projected onto the measurements.
 pub fn start<const PU: usize, const PV: usize, const N: usize>(
-    dict: &Dictionary<5, 5, PU, PV, 13>,
+    dict: &HostDictionary<PU, PV>,
     problem: &Problem<N>,
     signal: &[f32],
 ) -> Vec<f32> {
@@ -270,8 +273,8 @@ pub fn cold_start<const N: usize>(problem: &Problem<N>, fill: bool) -> Vec<f32> 
 
 /// The solve from `start` (coefficients in `dict`), keeping every step's coefficients.
 pub fn unroll<const PU: usize, const PV: usize, const N: usize>(
-    dict: &Dictionary<5, 5, PU, PV, 13>,
-    schedule: &Schedule<5, 5, PU, PV, 13>,
+    dict: &HostDictionary<PU, PV>,
+    schedule: &HostSchedule<PU, PV>,
     problem: &Problem<N>,
     start: &[f32],
 ) -> Trajectory {
@@ -296,7 +299,7 @@ pub fn unroll<const PU: usize, const PV: usize, const N: usize>(
 
 /// The decoded patch of a solve's last coefficients.
 pub fn patch_of<const PU: usize, const PV: usize, const N: usize>(
-    dict: &Dictionary<5, 5, PU, PV, 13>,
+    dict: &HostDictionary<PU, PV>,
     coeffs: &[f32],
 ) -> Vec<f32> {
     let mut c: Box<[f32; N]> = Box::new([0.0; N]);
@@ -310,9 +313,9 @@ pub fn patch_of<const PU: usize, const PV: usize, const N: usize>(
 /// [`LOSS_FLOOR`]), and its gradient with respect to every parameter (in [`Params::flat`]'s
 /// order).
 pub fn loss_and_gradient<const PU: usize, const PV: usize, const N: usize>(
-    dict: &Dictionary<5, 5, PU, PV, 13>,
+    dict: &HostDictionary<PU, PV>,
     params: &Params<PU, PV>,
-    schedule: &Schedule<5, 5, PU, PV, 13>,
+    schedule: &HostSchedule<PU, PV>,
     problem: &Problem<N>,
     start: &[f32],
 ) -> (f64, Vec<f64>) {
@@ -348,7 +351,7 @@ pub fn loss_and_gradient<const PU: usize, const PV: usize, const N: usize>(
         let mu = mu_all[t];
         let (mut dmu, mut dinv) = (0.0f64, 0.0f64);
         for (i, (g, &s)) in g.iter_mut().zip(&path.coeffs[t]).enumerate() {
-            let idx = PatchShape::<5, 5, PU, PV, 13, N>::coordinates(i);
+            let idx = HostShape::<PU, PV, N>::coordinates(i);
             let w = weights.at(idx);
             let x = w * s * s * inv;
             let a = libm::expf(-x);
@@ -417,7 +420,7 @@ impl Fit {
 /// Trains `params` on `problems`, each with its dictionary index into `dicts` and its start.
 fn fit<const PU: usize, const PV: usize, const N: usize>(
     params: &mut Params<PU, PV>,
-    dicts: &[Dictionary<5, 5, PU, PV, 13>],
+    dicts: &[HostDictionary<PU, PV>],
     problems: &[(usize, Problem<N>, Vec<f32>)],
     cfg: &ScheduleConfig,
     seed: u64,
@@ -460,8 +463,8 @@ fn fit<const PU: usize, const PV: usize, const N: usize>(
 
 /// Mean squared error per value of solving every problem with `schedule`.
 pub fn mean_error<const PU: usize, const PV: usize, const N: usize>(
-    dicts: &[Dictionary<5, 5, PU, PV, 13>],
-    schedule: &Schedule<5, 5, PU, PV, 13>,
+    dicts: &[HostDictionary<PU, PV>],
+    schedule: &HostSchedule<PU, PV>,
     problems: &[(usize, Problem<N>, Vec<f32>)],
 ) -> f64 {
     let errors: Vec<f64> = problems
@@ -490,11 +493,11 @@ pub struct ScheduleReport {
 /// # Errors
 /// More steps than [`MAX_STEPS`], or no patch.
 pub fn train<const PU: usize, const PV: usize, const N: usize>(
-    members: &[Dictionary<5, 5, PU, PV, 13>],
+    members: &[HostDictionary<PU, PV>],
     dct: Option<usize>,
     patches: &[f32],
     cfg: &ScheduleConfig,
-) -> anyhow::Result<(Schedules<5, 5, PU, PV, 13>, ScheduleReport)> {
+) -> anyhow::Result<(HostSchedules<PU, PV>, ScheduleReport)> {
     anyhow::ensure!(
         [cfg.cold_steps, cfg.warm_steps, cfg.alone_steps].iter().all(|s| (1..=MAX_STEPS).contains(s)),
         "schedule steps: 1 to {MAX_STEPS} each (cold {}, warm {}, alone {})",
@@ -504,7 +507,7 @@ pub fn train<const PU: usize, const PV: usize, const N: usize>(
     );
     anyhow::ensure!(patches.len() >= N, "no training patch");
     let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed);
-    let screen = Dictionary::<5, 5, PU, PV, 13>::dct();
+    let screen = HostDictionary::<PU, PV>::dct();
     let mut dicts = vec![screen];
     dicts.extend_from_slice(members);
     let problems: Vec<Problem<N>> = patches
@@ -593,7 +596,7 @@ fn train_schedule_blob_of<const PU: usize, const PV: usize, const N: usize>(
     output: &std::path::Path,
 ) -> anyhow::Result<()> {
     let start_time = std::time::Instant::now();
-    let ensemble = slf_firmware::Ensemble::<5, 5, PU, PV, 13>::new(blob).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let ensemble = HostEnsemble::<PU, PV>::new(blob).map_err(|e| anyhow::anyhow!("{e}"))?;
     let members: Vec<_> = (0..ensemble.len())
         .map(|k| ensemble.member(k).map_err(|e| anyhow::anyhow!("{e}")))
         .collect::<anyhow::Result<_>>()?;

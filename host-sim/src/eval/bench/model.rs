@@ -2,9 +2,10 @@
 //! the same tile pipeline as the f32 decoder.
 
 use anyhow::Result;
-use slf_firmware::{Dictionary, Ended, ModelOutcome, Outcome, PatchModel, Sl0Config, SolveError, Workspace};
+use slf_firmware::{Dictionary, Ended, ModelOutcome, Outcome, PatchModel, Sl0Config, SolveError};
 
 use crate::decode::paper_1d::{Factors, analyze_5d, solve_5d, solve_5d_seeded};
+use crate::io::patch::{BANDS, HostDictionary, HostWorkspace, LENSLETS};
 
 /// The f64 reference: SL0 with the DCT in f64 (the host's 5D reference), written back
 /// through the workspace so it runs in the same tile pipeline as the f32 decoder; for
@@ -13,18 +14,24 @@ pub struct F64Dct<const PU: usize, const PV: usize> {
     factors: Factors<f64>,
     /// The f32 DCT tables widened to f64, for writing the result back through them.
     widened: Factors<f64>,
-    dict: Dictionary<5, 5, PU, PV, 13>,
+    dict: HostDictionary<PU, PV>,
 }
 
 impl<const PU: usize, const PV: usize> Default for F64Dct<PU, PV> {
     fn default() -> Self {
         let dict = Dictionary::dct();
-        Self { factors: Factors::dct_f64_of([5, 5, PU, PV, 13]), widened: Factors::from_dictionary(&dict), dict }
+        Self {
+            factors: Factors::dct_f64_of([LENSLETS, LENSLETS, PU, PV, BANDS]),
+            widened: Factors::from_dictionary(&dict),
+            dict,
+        }
     }
 }
 
-impl<const PU: usize, const PV: usize, const N: usize> PatchModel<5, 5, PU, PV, 13, N> for F64Dct<PU, PV> {
-    fn decode(&self, cfg: &Sl0Config, ws: &mut Workspace<5, 5, PU, PV, 13, N>) -> Result<ModelOutcome, SolveError> {
+impl<const PU: usize, const PV: usize, const N: usize> PatchModel<LENSLETS, LENSLETS, PU, PV, BANDS, N>
+    for F64Dct<PU, PV>
+{
+    fn decode(&self, cfg: &Sl0Config, ws: &mut HostWorkspace<PU, PV, N>) -> Result<ModelOutcome, SolveError> {
         cfg.validate()?;
         let m = ws.measurements();
         if m.count() == 0 {
@@ -35,11 +42,7 @@ impl<const PU: usize, const PV: usize, const N: usize> PatchModel<5, 5, PU, PV, 
         Ok(self.write_back(&x, iterations, ws))
     }
 
-    fn decode_seeded(
-        &self,
-        cfg: &Sl0Config,
-        ws: &mut Workspace<5, 5, PU, PV, 13, N>,
-    ) -> Result<ModelOutcome, SolveError> {
+    fn decode_seeded(&self, cfg: &Sl0Config, ws: &mut HostWorkspace<PU, PV, N>) -> Result<ModelOutcome, SolveError> {
         cfg.validate()?;
         let m = ws.measurements();
         if m.count() == 0 {
@@ -60,7 +63,7 @@ impl<const PU: usize, const PV: usize> F64Dct<PU, PV> {
         &self,
         x: &[f64],
         iterations: u32,
-        ws: &mut Workspace<5, 5, PU, PV, 13, N>,
+        ws: &mut HostWorkspace<PU, PV, N>,
     ) -> ModelOutcome {
         let s = analyze_5d(&self.widened, x);
         for (dst, v) in ws.coefficients_mut().iter_mut().zip(&s) {
