@@ -287,6 +287,17 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
     }
 }
 
+/// Where a member's solve starts, which says its schedule ([`EnsembleModel`]'s solves).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Start {
+    /// From the measurements alone.
+    Cold,
+    /// From another member's solution.
+    Warm,
+    /// From a seed: the overlapping neighbours' decode.
+    Seeded,
+}
+
 /// An ensemble with its member choice. Config: immutable, the blob stays in flash.
 #[derive(Clone, Debug)]
 pub struct EnsembleModel<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> {
@@ -344,42 +355,22 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         self.schedules.map(|schedules| ScheduledDictionary { dictionary: self.screen.clone(), schedules })
     }
 
-    /// A solve from the measurements alone: the cold trained schedule, or [`solve`].
-    fn cold<const N: usize>(
+    /// A solve of `ws` by `dict` from `start`: the trained schedule for it ([`Start::Cold`]:
+    /// the cold one; otherwise the warm one), or without schedules the hand-set solve
+    /// ([`solve`], [`solve_warm`], [`solve_seeded`]).
+    fn solve_from<const N: usize>(
         &self,
+        start: Start,
         dict: &Dictionary<PS, PT, PU, PV, B>,
         cfg: &Sl0Config,
         ws: &mut Ws<PS, PT, PU, PV, B, N>,
     ) -> Result<Outcome, SolveError> {
-        match &self.schedules {
-            Some(s) => solve_scheduled(dict, cfg, &s.cold, ws),
-            None => solve(dict, cfg, ws),
-        }
-    }
-
-    /// A solve from another member's solution: the warm trained schedule, or [`solve_warm`].
-    fn warm<const N: usize>(
-        &self,
-        dict: &Dictionary<PS, PT, PU, PV, B>,
-        cfg: &Sl0Config,
-        ws: &mut Ws<PS, PT, PU, PV, B, N>,
-    ) -> Result<Outcome, SolveError> {
-        match &self.schedules {
-            Some(s) => solve_warm_scheduled(dict, cfg, &s.warm, ws),
-            None => solve_warm(dict, cfg, ws),
-        }
-    }
-
-    /// A solve from a seed: the warm trained schedule, or [`solve_seeded`].
-    fn seeded_solve<const N: usize>(
-        &self,
-        dict: &Dictionary<PS, PT, PU, PV, B>,
-        cfg: &Sl0Config,
-        ws: &mut Ws<PS, PT, PU, PV, B, N>,
-    ) -> Result<Outcome, SolveError> {
-        match &self.schedules {
-            Some(s) => solve_warm_scheduled(dict, cfg, &s.warm, ws),
-            None => solve_seeded(dict, cfg, ws),
+        match (&self.schedules, start) {
+            (Some(s), Start::Cold) => solve_scheduled(dict, cfg, &s.cold, ws),
+            (Some(s), Start::Warm | Start::Seeded) => solve_warm_scheduled(dict, cfg, &s.warm, ws),
+            (None, Start::Cold) => solve(dict, cfg, ws),
+            (None, Start::Warm) => solve_warm(dict, cfg, ws),
+            (None, Start::Seeded) => solve_seeded(dict, cfg, ws),
         }
     }
 
@@ -442,7 +433,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let mut best = (f32::INFINITY, 0u16);
         for k in 0..self.ensemble.len() as u16 {
             let member = self.member(k)?;
-            let outcome = self.cold(&member, cfg, ws)?;
+            let outcome = self.solve_from(Start::Cold, &member, cfg, ws)?;
             if outcome.ended == Ended::Flat {
                 // Flat patches decode the same with every member (no solve).
                 return Ok(ModelOutcome { outcome, member: Some(k), solves: 1 });
@@ -452,7 +443,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                 best = (s, k);
             }
         }
-        let outcome = self.cold(&self.member(best.1)?, cfg, ws)?;
+        let outcome = self.solve_from(Start::Cold, &self.member(best.1)?, cfg, ws)?;
         Ok(ModelOutcome { outcome, member: Some(best.1), solves: self.ensemble.len() as u16 + 1 })
     }
 
@@ -467,7 +458,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         ws: &mut Ws<PS, PT, PU, PV, B, N>,
         resolve: bool,
     ) -> Result<ModelOutcome, SolveError> {
-        let first = self.cold(&self.screen, cfg, ws)?;
+        let first = self.solve_from(Start::Cold, &self.screen, cfg, ws)?;
         if first.ended == Ended::Flat {
             return Ok(ModelOutcome { outcome: first, member: self.screen_member, solves: 1 });
         }
@@ -476,12 +467,13 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let (Some(chosen), Some(dct)) = (best.1, self.screen_member) else {
             // No other member, or no DCT member to compete: solve with the screen's pick.
             let k = best.1.or(self.screen_member).unwrap_or(0);
-            let outcome = self.warm(&self.member(k)?, cfg, ws)?;
+            let outcome = self.solve_from(Start::Warm, &self.member(k)?, cfg, ws)?;
             return Ok(ModelOutcome { outcome, member: Some(k), solves: 2 });
         };
         let member = self.member(chosen)?;
         ws.measurements.stash(&ws.signal);
-        let solved = self.warm(&member, cfg, ws).map(|outcome| (outcome, self.score(&member, rule, ws)));
+        let solved =
+            self.solve_from(Start::Warm, &member, cfg, ws).map(|outcome| (outcome, self.score(&member, rule, ws)));
         let (outcome, member_score) = solved.inspect_err(|_| ws.measurements.drop_stash())?;
         let dct_wins = dct_score < DCT_MARGIN * member_score;
         // The stash keeps the DCT's solution in the unmeasured entries only, which is all
@@ -498,7 +490,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         }
         ws.measurements.drop_stash();
         if dct_wins {
-            let outcome = self.warm(&self.screen, cfg, ws)?;
+            let outcome = self.solve_from(Start::Warm, &self.screen, cfg, ws)?;
             return Ok(ModelOutcome { outcome, member: Some(dct), solves: 3 });
         }
         Ok(ModelOutcome { outcome, member: Some(chosen), solves: 2 })
@@ -525,17 +517,18 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let best = self.screen_members(rule, ws)?;
         let (Some(chosen), Some(dct)) = (best.1, self.screen_member) else {
             let k = best.1.or(self.screen_member).unwrap_or(0);
-            let outcome = self.seeded_solve(&self.member(k)?, cfg, ws)?;
+            let outcome = self.solve_from(Start::Seeded, &self.member(k)?, cfg, ws)?;
             return Ok(ModelOutcome { outcome, member: Some(k), solves: 1 });
         };
         let member = self.member(chosen)?;
         let selection = !ws.measurements.interpolates();
         if !selection {
-            let outcome = self.seeded_solve(&member, cfg, ws)?;
+            let outcome = self.solve_from(Start::Seeded, &member, cfg, ws)?;
             return Ok(ModelOutcome { outcome, member: Some(chosen), solves: 1 });
         }
         ws.measurements.stash(&ws.signal);
-        let solved = self.seeded_solve(&member, cfg, ws).map(|outcome| (outcome, self.score(&member, rule, ws)));
+        let solved =
+            self.solve_from(Start::Seeded, &member, cfg, ws).map(|outcome| (outcome, self.score(&member, rule, ws)));
         let (outcome, member_score) = solved.inspect_err(|_| ws.measurements.drop_stash())?;
         if dct_score < DCT_MARGIN * member_score {
             let Workspace { signal, measurements, .. } = ws;

@@ -3,6 +3,10 @@
 
 use super::*;
 
+/// A block's held-out error estimates at a half-pixel disparity and at the whole ones beside
+/// it (`None` where none), in that order.
+pub(crate) type ShearEstimates = [(Disparity, Option<f32>); 3];
+
 impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
     TileDecoder<'a, PS, PT, PU, PV, B, N>
 {
@@ -32,6 +36,34 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             }
         }
         Ok(best.1)
+    }
+
+    /// The held-out error estimates of the first window's patch of the block at lenslet
+    /// `(row, col)` sheared to `half` and to the whole disparities beside it (`None` where
+    /// no estimate: no window, too few measurements), and the solves they ran.
+    ///
+    /// # Errors
+    /// The source's error.
+    pub(crate) fn shear_errors<M: PatchModel<PS, PT, PU, PV, B, N>, S: TileSource>(
+        &self,
+        model: &M,
+        (row, col): (u16, u16),
+        half: Disparity,
+        source: &mut S,
+        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ) -> Result<(ShearEstimates, u32), S::Error> {
+        let h = half.in_halves();
+        let mut out =
+            [half, Disparity::halves(h.saturating_sub(1)), Disparity::halves(h.saturating_add(1))].map(|d| (d, None));
+        let mut solves = 0;
+        let Some((view_row, view_col)) = self.windows().next() else { return Ok((out, solves)) };
+        for (d, error) in &mut out {
+            let origin = PatchOrigin { lenslet_row: row, lenslet_col: col, view_row, view_col, disparity: *d };
+            self.read_patch(origin, source, ws)?;
+            let (e, n) = self.estimate_error(model, &HoldOut::DEFAULT, origin, source, ws, false)?;
+            (*error, solves) = (e, solves + u32::from(n));
+        }
+        Ok((out, solves))
     }
 
     /// The held-out measurements the error estimate takes, if the decoder estimates.

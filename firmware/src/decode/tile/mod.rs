@@ -88,10 +88,6 @@ pub struct Tile {
 /// shear check ([`TileDecoder::with_shear_check`]) to take it.
 pub const SHEAR_MARGIN: f32 = 0.7;
 
-/// A block's held-out error estimates at a half-pixel disparity and at the whole ones beside
-/// it (`None` where none), in that order.
-pub(super) type ShearEstimates = [(Disparity, Option<f32>); 3];
-
 /// Where a patch sits: its first lenslet, its angular window's first view, and the
 /// disparity it was sheared to ([`crate::operators::disparity`]; zero: unsheared).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -436,34 +432,6 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     /// Whether half-pixel disparities are checked against the whole ones.
     pub fn shear_check(&self) -> bool {
         self.shear_check
-    }
-
-    /// The held-out error estimates of the first window's patch of the block at lenslet
-    /// `(row, col)` sheared to `half` and to the whole disparities beside it (`None` where
-    /// no estimate: no window, too few measurements), and the solves they ran.
-    ///
-    /// # Errors
-    /// The source's error.
-    pub(super) fn shear_errors<M: PatchModel<PS, PT, PU, PV, B, N>, S: TileSource>(
-        &self,
-        model: &M,
-        (row, col): (u16, u16),
-        half: Disparity,
-        source: &mut S,
-        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
-    ) -> Result<(ShearEstimates, u32), S::Error> {
-        let h = half.in_halves();
-        let mut out =
-            [half, Disparity::halves(h.saturating_sub(1)), Disparity::halves(h.saturating_add(1))].map(|d| (d, None));
-        let mut solves = 0;
-        let Some((view_row, view_col)) = self.windows().next() else { return Ok((out, solves)) };
-        for (d, error) in &mut out {
-            let origin = PatchOrigin { lenslet_row: row, lenslet_col: col, view_row, view_col, disparity: *d };
-            self.read_patch(origin, source, ws)?;
-            let (e, n) = self.estimate_error(model, &HoldOut::DEFAULT, origin, source, ws, false)?;
-            (*error, solves) = (e, solves + u32::from(n));
-        }
-        Ok((out, solves))
     }
 
     /// The error estimate of the patch at `origin`, whose measurements are in `ws`
