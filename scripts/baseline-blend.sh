@@ -16,7 +16,6 @@
 set -euo pipefail
 out=${1:?usage: baseline-blend.sh OUT_DIR}
 cd "$(dirname "$0")/.."
-. scripts/stamp.sh
 . scripts/scene-tables.sh
 table_setup
 add_real_scenes

@@ -17,7 +17,6 @@ set -euo pipefail
 out=${1:?usage: before-after.sh OUT_DIR}
 before=${SLF_BEFORE:?SLF_BEFORE: the binary to compare with}
 cd "$(dirname "$0")/.."
-. scripts/stamp.sh
 . scripts/scene-tables.sh
 table_setup
 add_real_scenes

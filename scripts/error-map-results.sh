@@ -17,16 +17,12 @@
 set -euo pipefail
 out=${1:?usage: error-map-results.sh OUT_DIR}
 cd "$(dirname "$0")/.."
-. scripts/stamp.sh
 . scripts/scene-tables.sh
 table_setup
 settings=${SLF_SETTINGS:-pixel:1 pixel:3 lenslet:3 kronecker:3}
 methods=${SLF_ESTIMATE_BY:-decode patches}
 fitted="smooth texture depth saturated dark"
-echo "# The error estimate"
-echo
-stamp "bash scripts/error-map-results.sh OUT_DIR"
-echo
+page_head "The error estimate" "bash scripts/error-map-results.sh OUT_DIR"
 echo "Made by \`bash scripts/error-map-results.sh OUT_DIR\` at $(git rev-parse --short HEAD) (scenes of ${size} x ${size} lenslets, 5 x 5"
 echo "views, \`slf simulate --seed 1\`; \`RAYON_NUM_THREADS=${RAYON_NUM_THREADS:-all}\`). Per decode: the true PSNR and"
 echo "the one the map estimates (at the truth's data range), the rank correlation (Spearman) of the"

@@ -9,10 +9,8 @@
 set -euo pipefail
 out=${1:?usage: grid-blur.sh OUT_DIR}
 cd "$(dirname "$0")/.."
-. scripts/stamp.sh
-cargo build --release -q -p slf-host
-slf=${SLF_BIN:-./target/release/slf}
-mkdir -p "$out"
+. scripts/scene-tables.sh
+table_setup
 lf="$out/office.npy"
 [ -f "$lf" ] || "$slf" scene office --size 64 -o "$lf" > /dev/null
 stamp "bash scripts/grid-blur.sh OUT_DIR"

@@ -15,7 +15,6 @@
 set -euo pipefail
 out=${1:?usage: grid-results.sh OUT_DIR}
 cd "$(dirname "$0")/.."
-. scripts/stamp.sh
 . scripts/scene-tables.sh
 cargo build --release -q -p slf-host
 slf=${SLF_BIN:-./target/release/slf}
@@ -49,10 +48,7 @@ cell() { printf ' %.2f / %.4f / %.2f |' "$p" "$q" "$a"; }
 # (`slf eval --border 2`): a turned array's corner lenslets reach past the sensor.
 interior_psnr() { "$slf" eval "$lf" "$out/rec.npy" --border 2 | awk '/^PSNR/ { print $2 }'; }
 
-echo "# A real lenslet array"
-echo
-stamp "bash scripts/grid-results.sh OUT_DIR"
-echo
+page_head "A real lenslet array" "bash scripts/grid-results.sh OUT_DIR"
 echo "Made by \`bash scripts/grid-results.sh OUT_DIR\` (scenes of ${size} x ${size} lenslets and the HCI"
 echo "crops present, 5 x 5 views; \`RAYON_NUM_THREADS=${RAYON_NUM_THREADS:-all}\`). Each cell is PSNR / SSIM /"
 echo "SA (degrees). (a) reads the capture as if its array were aligned (\`--grid aligned\`), (b)"

@@ -11,7 +11,6 @@
 set -euo pipefail
 out=${1:?usage: halves-check.sh OUT_DIR}
 cd "$(dirname "$0")/.."
-. scripts/stamp.sh
 . scripts/scene-tables.sh
 SLF_SIZE=${SLF_SIZE:-64} table_setup
 add_real_scenes

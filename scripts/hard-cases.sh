@@ -14,7 +14,6 @@
 set -euo pipefail
 out=${1:?usage: hard-cases.sh OUT_DIR}
 cd "$(dirname "$0")/.."
-. scripts/stamp.sh
 . scripts/scene-tables.sh
 cargo build --release -q -p slf-host
 slf=${SLF_BIN:-./target/release/slf}
@@ -22,10 +21,7 @@ size=${SLF_SIZE:-64}
 scenes=${SLF_SCENES:-mosaic mosaic-2 field print speculars narrow dim canopy canopy-dim}
 methods="demosaic=--method,demosaic ppid=--method,ppid preview=--preset,preview default=--preset,default best=--preset,best"
 mkdir -p "$out"
-echo "# The hard-case set"
-echo
-stamp "bash scripts/hard-cases.sh OUT_DIR"
-echo
+page_head "The hard-case set" "bash scripts/hard-cases.sh OUT_DIR"
 echo "Made by \`bash scripts/hard-cases.sh OUT_DIR\` (scenes of ${size} x ${size} lenslets, 5 x 5 views;"
 echo "\`RAYON_NUM_THREADS=${RAYON_NUM_THREADS:-all}\`). Each scene is described in"
 echo "\`host-sim/src/sim/hard.rs\`. Margins: the default's and the preview's PSNR less the"

@@ -25,10 +25,7 @@ before_max=${SLF_BEFORE_MAX_MB:-150}
 label=${SLF_BEFORE_LABEL:-$before}
 export RAYON_NUM_THREADS=${RAYON_NUM_THREADS:-2}
 mkdir -p "$out"
-echo "# Peak memory against frame size"
-echo
-stamp "bash scripts/memory-scale.sh OUT_DIR"
-echo
+page_head "Peak memory against frame size" "bash scripts/memory-scale.sh OUT_DIR"
 echo "Made by \`bash scripts/memory-scale.sh OUT_DIR > docs/results-memory.md\` (texture scene, pixel k = 1,"
 echo "\`slf simulate --seed 1\`; \`RAYON_NUM_THREADS=$RAYON_NUM_THREADS\`; $(nproc) cores). Peak resident memory of"
 echo "\`slf decode CAP -o OUT.npy\` (the whole process) from \`/usr/bin/time -v\`; output: the decoded light"

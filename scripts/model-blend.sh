@@ -12,7 +12,6 @@ set -euo pipefail
 out=${1:?usage: model-blend.sh OUT_DIR}
 py=${SLF_PYTHON:-python3}
 cd "$(dirname "$0")/.."
-. scripts/stamp.sh
 . scripts/scene-tables.sh
 table_setup
 add_real_scenes

@@ -17,7 +17,6 @@
 set -euo pipefail
 root=${1:?usage: model-tie.sh OUT_DIR}
 cd "$(dirname "$0")/.."
-. scripts/stamp.sh
 . scripts/scene-tables.sh
 out=$root
 table_setup

@@ -11,13 +11,9 @@
 set -euo pipefail
 out=${1:?usage: model-trial-results.sh OUT_DIR}
 cd "$(dirname "$0")/.."
-. scripts/stamp.sh
 . scripts/scene-tables.sh
 table_setup
-echo "# The model trial"
-echo
-stamp "bash scripts/model-trial-results.sh OUT_DIR"
-echo
+page_head "The model trial" "bash scripts/model-trial-results.sh OUT_DIR"
 echo "Made by \`bash scripts/model-trial-results.sh OUT_DIR\` (scenes of ${size} x ${size} lenslets, the real crops"
 echo "at their own size, 5 x 5 views, \`slf simulate --seed 1\`; \`RAYON_NUM_THREADS=${RAYON_NUM_THREADS:-all}\`). \"before\": \`--model-trial false\`"
 echo "(the screened ensemble on every patch; the shear trial on in all three, as in the default:"

@@ -11,14 +11,10 @@
 set -euo pipefail
 out=${1:?usage: plausible-results.sh OUT_DIR}
 cd "$(dirname "$0")/.."
-. scripts/stamp.sh
 . scripts/scene-tables.sh
 table_setup
 methods="default=--preset,default dct=--dictionary,dct preview=--preset,preview"
-echo "# The plausibility check"
-echo
-stamp "bash scripts/plausible-results.sh OUT_DIR"
-echo
+page_head "The plausibility check" "bash scripts/plausible-results.sh OUT_DIR"
 echo "Made by \`bash scripts/plausible-results.sh OUT_DIR\` (scenes of ${size} x ${size} lenslets, 5 x 5"
 echo "views, \`slf simulate --seed 1\`; \`RAYON_NUM_THREADS=${RAYON_NUM_THREADS:-all}\`). \"over\": blocks of 5 x 5"
 echo "lenslets decoded above 2 x the truth's maximum + 0.05. \"implausible\": patches the check"

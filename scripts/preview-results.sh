@@ -14,14 +14,10 @@
 set -euo pipefail
 out=${1:?usage: preview-results.sh OUT_DIR}
 cd "$(dirname "$0")/.."
-. scripts/stamp.sh
 . scripts/scene-tables.sh
 table_setup
 settings=${SLF_SETTINGS:-pixel:1 pixel:3 lenslet:3 kronecker:3}
-echo "# The preview and its model trial"
-echo
-stamp "bash scripts/preview-results.sh OUT_DIR"
-echo
+page_head "The preview and its model trial" "bash scripts/preview-results.sh OUT_DIR"
 echo "Made by \`bash scripts/preview-results.sh OUT_DIR\` (scenes of ${size} x ${size} lenslets, the real crops"
 echo "at their own size, 5 x 5 views, \`slf simulate --seed 3\`; \`RAYON_NUM_THREADS=${RAYON_NUM_THREADS:-all}\`)."
 echo "\"before\": \`--preset preview --model-trial false --sheared-fallback false\` (the DCT on every patch,"

@@ -23,7 +23,6 @@
 set -euo pipefail
 out=${1:?usage: roofline.sh OUT_DIR}
 cd "$(dirname "$0")/.."
-. scripts/stamp.sh
 . scripts/scene-tables.sh
 SLF_SIZE=${SLF_SIZE:-64} SLF_SCENES=${SLF_SCENES:-depth office canopy} table_setup
 settings=${SLF_SETTINGS:-pixel:1 pixel:3}
@@ -36,10 +35,7 @@ ghz=$(val clock_ghz); peak=$(val peak_gmacs); tmacs=$(val transform_macs)
 # The kernels' mean share of the core's peak (synthesis, analysis, projection; both dictionaries).
 kernel_peak=$(awk '$2 == "ns" && $4 == "macs" { s += $11; n++ } END { printf "%.3f", s / n }' "$kernels")
 
-echo "# Roofline: the decode's arithmetic beside the machine's peak"
-echo
-stamp "bash scripts/roofline.sh OUT_DIR"
-echo
+page_head "Roofline: the decode's arithmetic beside the machine's peak" "bash scripts/roofline.sh OUT_DIR"
 echo "Made by \`bash scripts/roofline.sh OUT_DIR\` ($(date -u +%Y-%m-%d), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs),"
 echo "one thread, the release build for x86-64-v3). Issue 62: how far the decode is from what the"
 echo "machines can do, and where its time goes."

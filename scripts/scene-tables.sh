@@ -1,7 +1,9 @@
 # Sourced by the scripts that tabulate decodes per scene (hard-cases.sh, sensor-results.sh,
 # plausible-results.sh, error-map-results.sh, shear-check-results.sh): the scene lists with the
 # real crops, a scene's light field and capture, and one decode measured.
-# They set `out` and call `table_setup` first.
+# They set `out` and call `table_setup` first. It brings scripts/stamp.sh (each page's stamp).
+
+. scripts/stamp.sh
 
 # Every scene `slf scene` names but `random`: the test scenes, the realistic ones and the hard
 # cases (the issue-49 tables run over all of them).

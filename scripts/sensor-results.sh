@@ -15,7 +15,6 @@
 set -euo pipefail
 out=${1:?usage: sensor-results.sh OUT_DIR}
 cd "$(dirname "$0")/.."
-. scripts/stamp.sh
 . scripts/scene-tables.sh
 cargo build --release -q -p slf-host
 slf=${SLF_BIN:-./target/release/slf}
@@ -33,10 +32,7 @@ row() {
   printf '| %s | %s | %.2f | %.4f | %.2f | %.2f |\n' "$setting" "$label" "$p" "$q" "$a" "${t:-0}"
 }
 
-echo "# A real sensor, calibrated"
-echo
-stamp "bash scripts/sensor-results.sh OUT_DIR"
-echo
+page_head "A real sensor, calibrated" "bash scripts/sensor-results.sh OUT_DIR"
 echo "Made by \`bash scripts/sensor-results.sh OUT_DIR\` (scenes of ${size} x ${size} lenslets, 5 x 5 views,"
 echo "$exposures exposures of each calibration capture; \`RAYON_NUM_THREADS=${RAYON_NUM_THREADS:-all}\`)."
 echo "A real sensor has the leakage and vignetting its row names, a 3 DN dark spread, 1 % PRNU and"

@@ -13,13 +13,9 @@
 set -euo pipefail
 out=${1:?usage: shear-check-results.sh OUT_DIR}
 cd "$(dirname "$0")/.."
-. scripts/stamp.sh
 . scripts/scene-tables.sh
 table_setup
-echo "# The shear check and the shear trial"
-echo
-stamp "bash scripts/shear-check-results.sh OUT_DIR"
-echo
+page_head "The shear check and the shear trial" "bash scripts/shear-check-results.sh OUT_DIR"
 echo "Made by \`bash scripts/shear-check-results.sh OUT_DIR\` (scenes of ${size} x ${size} lenslets, the real"
 echo "crops at their own size, 5 x 5 views, pixel mask, k = 1, \`slf simulate --seed 1\`, the default preset;"
 echo "\`RAYON_NUM_THREADS=${RAYON_NUM_THREADS:-all}\`). \"none\": \`--shear-trial false\`; \"trial\": the default;"

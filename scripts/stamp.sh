@@ -16,3 +16,12 @@ stamp() {
   settings=$(env | { grep -E '^(RAYON_[A-Z_]+|SLF_[A-Z_]+)=' || true; } | sort | tr '\n' ' ' | sed 's/ $//')
   echo "> Made by \`$*\` at $hash$dirty ($when UTC) on $(nproc) cores of ${cpu:-an unknown CPU}${settings:+; settings: $settings}."
 }
+
+# page_head TITLE COMMAND...: a results page's title and its stamp, each with a blank line after.
+page_head() {
+  local title=$1
+  shift
+  printf '# %s\n\n' "$title"
+  stamp "$@"
+  echo
+}

@@ -12,7 +12,6 @@
 set -euo pipefail
 out=${1:?usage: trial-by-decode.sh OUT_DIR}
 cd "$(dirname "$0")/.."
-. scripts/stamp.sh
 . scripts/scene-tables.sh
 table_setup
 add_real_scenes
