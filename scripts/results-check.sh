@@ -2,36 +2,47 @@
 # Makes a few figures of the results pages again and fails when one moved past its tolerance
 # (issue 64; CI runs it, as it runs `budgets.sh --check` for the device's table). Each check
 # below names a page, the table (the first after a line holding the marker), the row (its
-# first cell), the column (its header) and how the figure is made: a scene rendered at a size,
-# simulated with a mask, k and seed, decoded with the flags, and scored by `slf eval` (PSNR,
-# dB). A page whose figures the current decode no longer gives is stale: make it again with
-# its script (its stamp names the command) or, if the change was meant, move the check.
+# first cell), the column (its header) and how the figure is made: a scene at 48 x 48
+# lenslets, simulated with a mask, k and seed, decoded with the flags, and scored by
+# `slf eval` (PSNR, dB), by the same helpers the table scripts use (scene-tables.sh). A page
+# whose figures the current decode no longer gives is stale: make it again with its script
+# (its stamp names the command) or, if the change was meant, move the check.
 #
 #   bash scripts/results-check.sh [OUT_DIR]
 #
-# The checks run on 48 x 48-lenslet scenes: under a minute on 2 cores after the build.
+# Under a minute on 2 cores after the build.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. scripts/scene-tables.sh
 out=${1:-target/results-check}
-mkdir -p "$out"
-cargo build --release -q -p slf-host
-SLF_BIN=${SLF_BIN:-./target/release/slf} python3 - "$out" <<'PY'
-import os, re, subprocess, sys
+table_setup
+size=48
+tie="**48 x 48, seed 1, with the real crops, pixel k = 1**"
+blend="**kronecker k = 3**"
+# page | marker | row | column | scene | mask:k | seed | decode flags
+checks=(
+  "results-model-tie.md|$tie|smooth|DCT|smooth|pixel:1|1|--baseline-blend false --dictionary dct"
+  "results-model-tie.md|$tie|smooth|ensemble|smooth|pixel:1|1|--baseline-blend false --model-trial false"
+  "results-model-tie.md|$tie|depth|DCT|depth|pixel:1|1|--baseline-blend false --dictionary dct"
+  "results-model-tie.md|$tie|depth|ensemble|depth|pixel:1|1|--baseline-blend false --model-trial false"
+  "results-baseline-blend.md|$blend|smooth|blend|smooth|kronecker:3|1|"
+  "results-baseline-blend.md|$blend|smooth|decode|smooth|kronecker:3|1|--baseline-blend false"
+  "results-baseline-blend.md|$blend|smooth|PPID|smooth|kronecker:3|1|--method ppid"
+)
+made="$out/made.tsv"
+: > "$made"
+for c in "${checks[@]}"; do
+  IFS='|' read -r page marker row column name setting seed flags <<< "$c"
+  scene_light_field "$name"
+  scene_capture "$setting" "$seed"
+  # shellcheck disable=SC2086 # the flags are words
+  decode_eval "$cap" $flags
+  printf '%s\t%s\t%s\t%s\t%s\n' "$page" "$marker" "$row" "$column" "$p" >> "$made"
+done
+python3 - "$made" <<'PY'
+import os, sys
 
-out, slf = sys.argv[1], os.environ["SLF_BIN"]
 TOLERANCE = 0.011  # dB: the pages print two decimals
-TIE = "**48 x 48, seed 1, with the real crops, pixel k = 1**"
-BLEND = "**kronecker k = 3**"
-# page, marker, row, column, scene, size, mask:k, seed, decode flags
-CHECKS = [
-    ("results-model-tie.md", TIE, "smooth", "DCT", "smooth", 48, "pixel:1", 1, "--baseline-blend false --dictionary dct"),
-    ("results-model-tie.md", TIE, "smooth", "ensemble", "smooth", 48, "pixel:1", 1, "--baseline-blend false --model-trial false"),
-    ("results-model-tie.md", TIE, "depth", "DCT", "depth", 48, "pixel:1", 1, "--baseline-blend false --dictionary dct"),
-    ("results-model-tie.md", TIE, "depth", "ensemble", "depth", 48, "pixel:1", 1, "--baseline-blend false --model-trial false"),
-    ("results-baseline-blend.md", BLEND, "smooth", "blend", "smooth", 48, "kronecker:3", 1, ""),
-    ("results-baseline-blend.md", BLEND, "smooth", "decode", "smooth", 48, "kronecker:3", 1, "--baseline-blend false"),
-    ("results-baseline-blend.md", BLEND, "smooth", "PPID", "smooth", 48, "kronecker:3", 1, "--method ppid"),
-]
 
 
 def cell(page, marker, row, column):
@@ -51,29 +62,12 @@ def cell(page, marker, row, column):
     return float(body[0][header.index(column)])
 
 
-def run(*args):
-    return subprocess.run([slf, *args], check=True, capture_output=True, text=True).stdout
-
-
-def psnr(scene, size, setting, seed, flags):
-    lf = os.path.join(out, f"{scene}-{size}.npy")
-    if not os.path.exists(lf):
-        run("scene", scene, "--size", str(size), "-o", lf)
-    mask, k = setting.split(":")
-    cap = os.path.join(out, f"cap-{scene}-{size}-{mask}-{k}-{seed}")
-    if not os.path.isdir(cap):
-        run("simulate", lf, "-o", cap, "--mask", mask, "-s", k, "--seed", str(seed))
-    rec = os.path.join(out, "rec.npy")
-    run("decode", cap, "-o", rec, "--quiet", *flags.split())
-    return float(re.search(r"^PSNR\s+([-\d.]+)", run("eval", lf, rec), re.M).group(1))
-
-
 moved = 0
 print("| page | row | column | page says | made now | difference |")
 print("| --- | --- | --- | --- | --- | --- |")
-for page, marker, row, column, scene, size, setting, seed, flags in CHECKS:
-    want = cell(page, marker, row, column)
-    have = psnr(scene, size, setting, seed, flags)
+for line in open(sys.argv[1]):
+    page, marker, row, column, have = line.rstrip("\n").split("\t")
+    want, have = cell(page, marker, row, column), float(have)
     bad = abs(have - want) > TOLERANCE
     moved += bad
     print(f"| {page} | {row} | {column} | {want:.2f} | {have:.2f} | {have - want:+.2f}{' MOVED' if bad else ''} |")
