@@ -10,7 +10,11 @@
 //!    change of the default decode (`docs/defaults.md`) says so in a `> Dated:` line naming
 //!    the first change it predates.
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use std::path::Path;
+
+use common::{files, root};
 
 /// The most lines a source file may hold.
 const MAX_LINES: usize = 800;
@@ -18,26 +22,6 @@ const MAX_LINES: usize = 800;
 const MAX_README_LINES: usize = 300;
 /// Files that are data, written by a generator, not code to read.
 const DATA_TABLES: &[&str] = &["host-sim/src/sim/spectra_data.rs"];
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// Every file below `dir` whose name ends in one of `exts`, `target/` and hidden folders aside.
-fn files(dir: &Path, exts: &[&str], out: &mut Vec<PathBuf>) {
-    let Ok(entries) = std::fs::read_dir(dir) else { return };
-    for entry in entries.flatten() {
-        let path = entry.path();
-        let name = entry.file_name().to_string_lossy().into_owned();
-        if path.is_dir() {
-            if !name.starts_with('.') && name != "target" {
-                files(&path, exts, out);
-            }
-        } else if exts.iter().any(|e| name.ends_with(e)) {
-            out.push(path);
-        }
-    }
-}
 
 fn relative(path: &Path) -> String {
     path.strip_prefix(root()).unwrap_or(path).to_string_lossy().replace('\\', "/")

@@ -19,8 +19,12 @@
 //! The crate roots (`lib.rs`), the firmware's `prelude.rs` and the command line (a binary
 //! on top of the host library) are above every layer and are not checked.
 
+mod common;
+
 use std::collections::{BTreeMap, BTreeSet};
-use std::path::{Path, PathBuf};
+use std::path::Path;
+
+use common::{files as files_in, root};
 
 /// The firmware's layers, lowest first.
 const FIRMWARE: &[&str] = &["log", "sensor", "operators", "solver", "decode"];
@@ -41,7 +45,7 @@ struct Source {
 
 fn read_sources(src: &Path, skip: &[&str]) -> Vec<Source> {
     let mut files = Vec::new();
-    collect(src, &mut files);
+    files_in(src, &[".rs"], &mut files);
     let mut out = Vec::new();
     for path in files {
         let rel = path.strip_prefix(src).unwrap().to_string_lossy().replace('\\', "/");
@@ -52,17 +56,6 @@ fn read_sources(src: &Path, skip: &[&str]) -> Vec<Source> {
         out.push(Source { module: module_of(&rel), file: rel, text });
     }
     out
-}
-
-fn collect(dir: &Path, out: &mut Vec<PathBuf>) {
-    for entry in std::fs::read_dir(dir).unwrap() {
-        let path = entry.unwrap().path();
-        if path.is_dir() {
-            collect(&path, out);
-        } else if path.extension().is_some_and(|e| e == "rs") {
-            out.push(path);
-        }
-    }
 }
 
 /// `solver/sl0.rs` -> `[solver, sl0]`; `solver/mod.rs` -> `[solver]`.
@@ -295,10 +288,6 @@ fn cycles(edges: &BTreeMap<Module, BTreeSet<Module>>) -> Vec<String> {
         visit(m, edges, &mut Vec::new(), &mut done, &mut out);
     }
     out
-}
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
 #[test]
