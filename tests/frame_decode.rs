@@ -43,7 +43,7 @@ struct Average {
     count: Vec<u32>,
 }
 
-impl PatchSink<5200> for Average {
+impl PatchSink<PaperShape> for Average {
     type Error = core::convert::Infallible;
     fn accept(&mut self, o: PatchOrigin, p: &[f32; 5200], _: &PatchReport) -> Result<(), Self::Error> {
         for (i, &x) in p.iter().enumerate() {
@@ -83,7 +83,7 @@ fn decode_psnr(l: &[f32], mask: Mask<'static>) -> f64 {
         defects: DefectList::EMPTY,
         sl0: Sl0Config::DEFAULT,
     };
-    let decoder = TileDecoder::<5, 5, 4, 4, 13, 5200>::new(config).unwrap();
+    let decoder = TileDecoder::<PaperShape>::new(config).unwrap();
     let mut sink = Average { sum: vec![0.0; l.len()], count: vec![0; l.len()] };
     let mut ws = Box::new(PaperWorkspace::new());
     let r = decoder.decode_frame(&Dictionary::dct(), (1, 2), &mut FrameSource::new(&raw), &mut sink, &mut ws);

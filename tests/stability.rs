@@ -209,11 +209,11 @@ fn f32_decoder_within_005_db_of_the_f64_reference_on_the_test_scenes() {
         let opts = DecodeOptions { noise: NoiseSource::Config, ..DecodeOptions::default() };
         // Both patches: the paper's and the full-view one.
         let (f32r, _) = decode::<4, 4, 5200, _>(&cap, &Dictionary::dct(), &opts).unwrap();
-        let (f64r, _) = decode::<4, 4, 5200, _>(&cap, &F64Dct::<4, 4>::default(), &opts).unwrap();
+        let (f64r, _) = decode::<4, 4, 5200, _>(&cap, &F64Dct::<4, 4, 5200>::default(), &opts).unwrap();
         let (a, b) = (peak_psnr(&truth, &f32r), peak_psnr(&truth, &f64r));
         assert!((a - b).abs() <= 0.05, "{name}, 4 views: f32 {a:.3} dB vs f64 {b:.3} dB");
         let (f32r, _) = decode::<5, 5, 8125, _>(&cap, &Dictionary::dct(), &opts).unwrap();
-        let (f64r, _) = decode::<5, 5, 8125, _>(&cap, &F64Dct::<5, 5>::default(), &opts).unwrap();
+        let (f64r, _) = decode::<5, 5, 8125, _>(&cap, &F64Dct::<5, 5, 8125>::default(), &opts).unwrap();
         let (a, b) = (peak_psnr(&truth, &f32r), peak_psnr(&truth, &f64r));
         assert!((a - b).abs() <= 0.05, "{name}, 5 views: f32 {a:.3} dB vs f64 {b:.3} dB");
     }

@@ -5,6 +5,7 @@
 //! the core's f32 FMA peak: `macs / time / peak`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use slf_firmware::Shape;
 use slf_firmware::ascent::ascend;
 use slf_firmware::ball::Ball;
 use slf_firmware::projection::{project_coefficients, projection_macs};
@@ -41,7 +42,7 @@ fn measured_workspace(mask: &Mask) -> Box<PaperWorkspace> {
 }
 
 fn benches(c: &mut Criterion) {
-    let dict = Dictionary::<5, 5, 4, 4, 13>::dct();
+    let dict = Dictionary::<PaperShape>::dct();
     let cfg = Sl0Config::DEFAULT;
     let macs = PaperShape::TRANSFORM_MACS as f64;
 
@@ -57,7 +58,7 @@ fn benches(c: &mut Criterion) {
         let out = solve(&dict, &cfg, &mut ws).unwrap();
         // Per step: one projection; plus the start's analysis and the final synthesis.
         let count = ws.measurements().count();
-        let step_macs = projection_macs::<5, 5, 4, 4, 13>(count);
+        let step_macs = projection_macs::<PaperShape>(count);
         let solve_macs = (out.iterations as usize * step_macs) as f64 + 2.0 * macs;
         eprintln!("projection pixel k={k}: {step_macs} multiply-adds ({count} measurements)");
         let mut coeffs = Box::new([0.0f32; 5200]);
@@ -69,7 +70,7 @@ fn benches(c: &mut Criterion) {
                 project_coefficients(&dict, black_box(&mut coeffs), &mut scratch, ws.measurements(), &exact, None)
             })
         });
-        let ensemble = Ensemble::<5, 5, 4, 4, 13>::new(DEFAULT_ENSEMBLE).unwrap();
+        let ensemble = Ensemble::<PaperShape>::new(DEFAULT_ENSEMBLE).unwrap();
         let member = ensemble.member(1).unwrap(); // 0 is the DCT
         c.bench_function(&format!("project pixel k={k} learned member"), |bench| {
             bench.iter(|| {

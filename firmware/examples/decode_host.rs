@@ -15,7 +15,7 @@ struct Collect {
     rejected: usize,
 }
 
-impl PatchSink<PAPER_N> for Collect {
+impl PatchSink<PaperShape> for Collect {
     type Error = core::convert::Infallible;
     fn accept(&mut self, at: PatchOrigin, patch: &PaperPatch, _: &PatchReport) -> Result<(), Self::Error> {
         self.patches.push((at, Box::new(*patch)));

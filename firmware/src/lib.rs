@@ -15,15 +15,16 @@
 //! From the sensor to decoded patches, one folder each; a layer uses only the layers
 //! before it (the repository's `tests/layers.rs` checks every `crate::` path):
 //!
-//! - **sensor** ([`sensor`]: [`raw`], [`source`](sensor::source), [`defects`], [`grid`], [`spi`],
-//!   [`mask`], [`gains`], [`response`]): samples, which of them are measurements, frames in memory or
+//! - **sensor** ([`sensor`]: [`extent`](sensor::extent), [`raw`], [`source`](sensor::source), [`defects`], [`grid`], [`spi`],
+//!   [`mask`], [`gains`], [`response`]): an extent (bands, views, lenslets) as a type; samples, which of them are measurements, frames in memory or
 //!   flash, a frame buffer read over `embedded-hal` SPI, the [`TileSource`] trait they all
 //!   implement; the lenslet grid (where a real, turned lenslet array puts each view); which band each pixel sees in each snapshot (the three mask families
 //!   `kronecker`, `lenslet`, `pixel`); the white balance, a gain per band that the decode
 //!   divides out of the measurements and multiplies back; and the filters' [`response`]
 //!   matrix, what a real filter lets through of each band.
-//! - **operators** ([`operators`]: [`shape`], [`disparity`], [`dct`], [`dictionary`],
-//!   [`schedule`], [`blob`], [`transform`]): the patch geometry in the types, sheared patches that align
+//! - **operators** ([`operators`]: [`mode`], [`shape`], [`disparity`], [`dct`], [`dictionary`],
+//!   [`schedule`], [`blob`], [`transform`]): the patch geometry as one type ([`Shape`], the one
+//!   parameter of every solver function), one mode's matrix and the products by it, sheared patches that align
 //!   the views on a depth, dictionaries (the 5D DCT and blobs in flash, with the trained
 //!   schedules of their solves) and the separable
 //!   synthesis and analysis transforms.
@@ -68,9 +69,9 @@
 //! Decode one patch whose every pixel saw three bands, with the 5D DCT:
 //!
 //! ```
-//! use slf_firmware::{Dictionary, PaperShape, PaperWorkspace, Sl0Config, solve};
+//! use slf_firmware::{Dictionary, PaperShape, PaperWorkspace, Shape, Sl0Config, solve};
 //!
-//! static DCT: Dictionary<5, 5, 4, 4, 13> = Dictionary::dct(); // a table in flash
+//! static DCT: Dictionary<PaperShape> = Dictionary::dct(); // a table in flash
 //! let mut ws = PaperWorkspace::new(); // 66 KiB; on a device, a `static`
 //! let truth = |b: usize| 0.2 + 0.05 * b as f32; // a smooth spectrum everywhere
 //! for p in 0..PaperShape::PIXELS {
@@ -125,7 +126,7 @@ pub mod solver;
 
 // Every module by its path of before the layer folders, for integrators' code.
 pub use decode::{overlap, tile, trial};
-pub use operators::{blob, dct, dictionary, disparity, schedule, shape, transform};
+pub use operators::{blob, dct, dictionary, disparity, mode, schedule, shape, transform};
 pub use sensor::{defects, gains, grid, mask, raw, response, spi};
 pub use solver::{
     ascent, ball, choice, fractional, holdout, interpolate, mixing, picked, pinv, plausible, projection, shares, sl0,
@@ -146,9 +147,10 @@ pub use decode::trial::{ModelTrial, PairedErrors, ShearTrial, TIE_SPREAD, dct_wh
 pub use operators::blob::{DEFAULT_ENSEMBLE, DEFAULT_FULL_VIEW_ENSEMBLE, Ensemble};
 pub use operators::dictionary::{Dictionary, DictionaryError};
 pub use operators::disparity::{Disparity, DisparityRange};
-pub use operators::shape::{FullViewShape, PaperShape, PatchShape};
+pub use operators::shape::{FullViewShape, PaperShape, PatchShape, Shape};
 pub use prelude::{PAPER_N, PaperDecoder, PaperDictionary, PaperEnsemble, PaperEnsembleModel, PaperPatch, SetupError};
 pub use sensor::defects::{DefectList, Pixel};
+pub use sensor::extent::{Array, BandCount, Bands, Extent, Fixed};
 pub use sensor::grid::{GridError, LensletGrid};
 pub use sensor::mask::{BandTile, LensletSize, Mask, MaskFamily, SensingError};
 pub use sensor::raw::{Frame, FrameSource, LeU16Frame, RawFormat, RawFrame};

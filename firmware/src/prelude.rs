@@ -20,7 +20,9 @@ pub use crate::decode::tile::{
 pub use crate::operators::blob::{DEFAULT_ENSEMBLE, DEFAULT_FULL_VIEW_ENSEMBLE, Ensemble};
 pub use crate::operators::dictionary::{Dictionary, DictionaryError};
 pub use crate::operators::disparity::{Disparity, DisparityRange};
+pub use crate::operators::shape::{FullViewShape, PaperShape, PatchShape, PerValue, Shape};
 pub use crate::sensor::defects::{DefectList, Pixel};
+pub use crate::sensor::extent::{Array, Fixed};
 pub use crate::sensor::mask::{BandTile, LensletSize, Mask, MaskFamily, SensingError};
 pub use crate::sensor::raw::{FrameSource, LeU16Frame, RawFormat, RawFrame};
 pub use crate::sensor::spi::{SpiFrameBuffer, SpiSourceError};
@@ -35,19 +37,19 @@ pub const PAPER_N: usize = 5200;
 pub type PaperPatch = [f32; PAPER_N];
 
 /// The tile decoder for the paper's patch.
-pub type PaperDecoder<'a> = TileDecoder<'a, 5, 5, 4, 4, 13, PAPER_N>;
+pub type PaperDecoder<'a> = TileDecoder<'a, PaperShape>;
 
 /// The overlapped decoder for the paper's patch.
-pub type PaperOverlapDecoder<'a> = OverlapDecoder<'a, 5, 5, 4, 4, 13, PAPER_N>;
+pub type PaperOverlapDecoder<'a> = OverlapDecoder<'a, PaperShape>;
 
 /// A dictionary (one member, or the 5D DCT) of the paper's patch.
-pub type PaperDictionary = Dictionary<5, 5, 4, 4, 13>;
+pub type PaperDictionary = Dictionary<PaperShape>;
 
 /// An ensemble blob of the paper's patch, validated.
-pub type PaperEnsemble<'a> = Ensemble<'a, 5, 5, 4, 4, 13>;
+pub type PaperEnsemble<'a> = Ensemble<'a, PaperShape>;
 
 /// An ensemble with its member choice, for the paper's patch.
-pub type PaperEnsembleModel<'a> = EnsembleModel<'a, 5, 5, 4, 4, 13>;
+pub type PaperEnsembleModel<'a> = EnsembleModel<'a, PaperShape>;
 
 /// Values in the full-view patch: 5 x 5 x 5 x 5 x 13, every view of a 5 x 5-view lenslet.
 pub const FULL_VIEW_N: usize = 8125;
@@ -56,20 +58,20 @@ pub const FULL_VIEW_N: usize = 8125;
 pub type FullViewPatch = [f32; FULL_VIEW_N];
 
 /// The tile decoder for the full-view patch.
-pub type FullViewDecoder<'a> = TileDecoder<'a, 5, 5, 5, 5, 13, FULL_VIEW_N>;
+pub type FullViewDecoder<'a> = TileDecoder<'a, FullViewShape>;
 
 /// The overlapped decoder for the full-view patch.
-pub type FullViewOverlapDecoder<'a> = OverlapDecoder<'a, 5, 5, 5, 5, 13, FULL_VIEW_N>;
+pub type FullViewOverlapDecoder<'a> = OverlapDecoder<'a, FullViewShape>;
 
 /// A dictionary (one member, or the 5D DCT) of the full-view patch.
-pub type FullViewDictionary = Dictionary<5, 5, 5, 5, 13>;
+pub type FullViewDictionary = Dictionary<FullViewShape>;
 
 /// An ensemble blob of the full-view patch, validated
 /// ([`crate::DEFAULT_FULL_VIEW_ENSEMBLE`] is the shipped one).
-pub type FullViewEnsemble<'a> = Ensemble<'a, 5, 5, 5, 5, 13>;
+pub type FullViewEnsemble<'a> = Ensemble<'a, FullViewShape>;
 
 /// An ensemble with its member choice, for the full-view patch: the device's default model.
-pub type FullViewEnsembleModel<'a> = EnsembleModel<'a, 5, 5, 5, 5, 13>;
+pub type FullViewEnsembleModel<'a> = EnsembleModel<'a, FullViewShape>;
 
 /// What can go wrong while setting a decoder up, so that set-up code can use `?` across
 /// layers. Decoding itself reports per tile and per patch ([`TileError`], [`TileReport`]).

@@ -82,7 +82,7 @@ fn the_residual_drops_what_sorting_drops_ties_included() {
 fn choice_finds_the_member_a_patch_is_made_of_at_the_stated_cost() {
     let cold = Sl0Config { warm_start: 1.0, ..Sl0Config::DEFAULT };
     let members = vec![Dictionary::dct(), random_dictionary(11), random_dictionary(12), random_dictionary(13)];
-    let e = Ensemble::<5, 5, 4, 4, 13>::new(blob(&members)).unwrap();
+    let e = Ensemble::<PaperShape>::new(blob(&members)).unwrap();
     let mask = Mask::pixel(3, 3, 13, L5).unwrap();
     for (choice, solves) in [
         (MemberChoice::Exhaustive(ChoiceRule::DEFAULT), &[5u16][..]),
@@ -112,10 +112,10 @@ fn choice_finds_the_member_a_patch_is_made_of_at_the_stated_cost() {
 #[test]
 fn the_shipped_ensemble_decodes_a_patch() {
     let model = EnsembleModel::new(
-        Ensemble::<5, 5, 4, 4, 13>::new(DEFAULT_ENSEMBLE).unwrap(),
+        Ensemble::<PaperShape>::new(DEFAULT_ENSEMBLE).unwrap(),
         MemberChoice::Screened(ChoiceRule::DEFAULT),
     );
-    let truth = smooth_patch::<5, 5, 4, 4, 13, 5200>(4);
+    let truth = smooth_patch::<PaperShape>(4);
     let mask = Mask::pixel(3, 3, 13, L5).unwrap();
     let mut ws = Box::new(PaperWorkspace::new());
     measure(&mask, (0, 0), &truth, &mut ws);
@@ -123,7 +123,7 @@ fn the_shipped_ensemble_decodes_a_patch() {
     assert!(out.member.is_some_and(|m| m < 8));
     assert!(ws.patch().iter().all(|x| x.is_finite()));
     // A single dictionary is a model too: one solve, no member.
-    let out = Dictionary::<5, 5, 4, 4, 13>::dct().decode(&Sl0Config::DEFAULT, &mut ws).unwrap();
+    let out = Dictionary::<PaperShape>::dct().decode(&Sl0Config::DEFAULT, &mut ws).unwrap();
     assert_eq!((out.solves, out.member), (1, None));
     // No measurement: the typed error comes through the model.
     ws.measurements_mut().clear();
@@ -141,7 +141,7 @@ fn dct_win_patch() -> Vec<f32> {
     x
 }
 
-fn score(dict: &Dictionary<5, 5, 4, 4, 13>, patch: &[f32]) -> f64 {
+fn score(dict: &Dictionary<PaperShape>, patch: &[f32]) -> f64 {
     let mut c = Box::new([0.0f32; 5200]);
     analyze_preserving(dict, patch.try_into().unwrap(), &mut c);
     f64::from(ChoiceRule::DEFAULT.score(&c[..]))
@@ -154,7 +154,7 @@ fn score(dict: &Dictionary<5, 5, 4, 4, 13>, patch: &[f32]) -> f64 {
 #[test]
 fn a_dct_win_is_the_score_weighted_mean_of_the_two_solutions() {
     let members = vec![Dictionary::dct(), random_dictionary(21)];
-    let e = Ensemble::<5, 5, 4, 4, 13>::new(blob(&members)).unwrap();
+    let e = Ensemble::<PaperShape>::new(blob(&members)).unwrap();
     let mask = Mask::pixel(3, 3, 13, L5).unwrap();
     let truth = dct_win_patch();
     for noise in [0.0f32, 0.02] {
@@ -206,7 +206,7 @@ fn a_dct_win_is_the_score_weighted_mean_of_the_two_solutions() {
 #[test]
 fn a_screened_decode_leaves_the_measurements_as_they_were() {
     let members = vec![Dictionary::dct(), random_dictionary(21)];
-    let e = Ensemble::<5, 5, 4, 4, 13>::new(blob(&members)).unwrap();
+    let e = Ensemble::<PaperShape>::new(blob(&members)).unwrap();
     let mask = Mask::pixel(3, 3, 13, L5).unwrap();
     let mut won = [false; 2];
     for truth in [dct_win_patch(), sparse_in(&members[1], 5)] {

@@ -3,6 +3,8 @@
 mod common;
 
 use common::*;
+use slf_firmware::FullViewShape;
+use slf_firmware::PaperShape;
 use slf_firmware::blob::write_blob;
 use slf_firmware::blob::{BLOB_VERSION, HEADER_LEN, blob_len};
 use slf_firmware::dct::dct_matrix;
@@ -10,7 +12,7 @@ use slf_firmware::dictionary::Factors;
 use slf_firmware::dictionary::{ORTHONORMAL_TOLERANCE, orthonormality_error};
 use slf_firmware::{Dictionary, DictionaryError, Ensemble};
 
-type Dict = Dictionary<5, 5, 4, 4, 13>;
+type Dict = Dictionary<PaperShape>;
 const DIMS: [usize; 5] = [5, 5, 4, 4, 13];
 
 fn check_dct<const D: usize>() {
@@ -78,7 +80,7 @@ fn blob_round_trip() {
     let m = members();
     let blob = blob_of(&m);
     assert_eq!(&blob[..4], b"SLFD");
-    let e = Ensemble::<5, 5, 4, 4, 13>::new(&blob).unwrap();
+    let e = Ensemble::<PaperShape>::new(&blob).unwrap();
     assert_eq!(e.len(), 3);
     for (i, want) in m.iter().enumerate() {
         assert_eq!(&e.member(i).unwrap(), want, "member {i}");
@@ -121,7 +123,7 @@ fn put_f32(blob: &mut [u8], at: usize, x: f32) {
 #[test]
 fn each_corrupt_blob_gets_its_own_error() {
     let good = blob_of(&members());
-    let read = |b: &[u8]| Ensemble::<5, 5, 4, 4, 13>::new(b).map(|_| ()).unwrap_err();
+    let read = |b: &[u8]| Ensemble::<PaperShape>::new(b).map(|_| ()).unwrap_err();
     let member_bytes = 4 * (25 + 25 + 16 + 16 + 169);
 
     assert_eq!(read(&good[..10]), DictionaryError::TooShort { len: 10 });
@@ -175,13 +177,13 @@ fn each_corrupt_blob_gets_its_own_error() {
     assert_eq!(read(&b), DictionaryError::NotOrthonormal { member: 2, mode: 5 });
 
     // A blob for another patch shape.
-    let other: Vec<Dictionary<5, 5, 5, 5, 13>> = vec![Dictionary::dct()];
+    let other: Vec<Dictionary<FullViewShape>> = vec![Dictionary::dct()];
     let mut ob = vec![0u8; blob_len([5, 5, 5, 5, 13], 1)];
     write_blob(&other, &mut ob).unwrap();
     assert_eq!(read(&ob), DictionaryError::ShapeMismatch { found: [5, 5, 5, 5, 13] });
 
     // Member index and member count errors.
-    let e = Ensemble::<5, 5, 4, 4, 13>::new(&good).unwrap();
+    let e = Ensemble::<PaperShape>::new(&good).unwrap();
     assert_eq!(e.member(3).unwrap_err(), DictionaryError::NoSuchMember { index: 3, members: 3 });
     assert_eq!(Dict::from_blob(&good).unwrap_err(), DictionaryError::MemberCount { found: 3 });
 
@@ -191,7 +193,7 @@ fn each_corrupt_blob_gets_its_own_error() {
         write_blob(&members(), &mut small).unwrap_err(),
         DictionaryError::BufferTooSmall { needed: good.len() as u32 }
     );
-    assert_eq!(write_blob::<5, 5, 4, 4, 13>(&[], &mut small).unwrap_err(), DictionaryError::MemberCount { found: 0 });
+    assert_eq!(write_blob::<PaperShape>(&[], &mut small).unwrap_err(), DictionaryError::MemberCount { found: 0 });
 
     // Every error prints a message.
     assert!(DictionaryError::Checksum { stored: 1, computed: 2 }.to_string().contains("checksum"));
@@ -199,7 +201,7 @@ fn each_corrupt_blob_gets_its_own_error() {
 
 #[test]
 fn factors_report_the_mode_that_is_wrong() {
-    let f: Factors<5, 5, 4, 4, 13> = DCT.synthesis().clone();
+    let f: Factors<PaperShape> = DCT.synthesis().clone();
     assert_eq!(f.first_non_finite(), None);
     assert!(f.orthonormality_errors().iter().all(|&e| e <= 1e-6));
 }
@@ -213,7 +215,7 @@ fn the_dct_symmetry_is_found_where_it_holds_and_used_correctly() {
     assert!(has_parity(&dct_matrix::<13>()) && has_parity(&dct_matrix::<7>()) && has_parity(&dct_matrix::<1>()));
     // Built from its matrices (as a blob member is), the DCT is found symmetric again.
     assert_eq!(Dict::new(Dict::dct().synthesis().clone()).unwrap().parity(), [true; 4]);
-    assert_eq!(random_dictionary::<5, 5, 4, 4, 13>(3).parity(), [false; 4]);
+    assert_eq!(random_dictionary::<PaperShape>(3).parity(), [false; 4]);
     // Two atoms swapped: still orthonormal, no longer even / odd in order.
     let mut f = Dict::dct().synthesis().clone();
     let t = transpose(&f.m2);
@@ -221,7 +223,7 @@ fn the_dct_symmetry_is_found_where_it_holds_and_used_correctly() {
     assert_eq!(Dict::new(f).unwrap().parity(), [true, false, true, true]);
     // A random dictionary with the DCT in mode 3 only folds mode 3, and its transforms still
     // match the dense Kronecker matrix (f64) to 1e-5.
-    let mut f = random_dictionary::<5, 5, 4, 4, 13>(4).synthesis().clone();
+    let mut f = random_dictionary::<PaperShape>(4).synthesis().clone();
     f.m3 = transpose(&dct_matrix::<4>());
     let mixed = Dict::new(f).unwrap();
     assert_eq!(mixed.parity(), [false, false, true, false]);

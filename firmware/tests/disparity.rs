@@ -36,7 +36,7 @@ fn sheared_operator_matches_dense_gather_times_basis() {
     {
         let mask = Mask::pixel(seed, k, 4, L3).unwrap();
         let dec = small_decoder(mask);
-        let dict = random_dictionary::<3, 3, 2, 2, 4>(seed + 10);
+        let dict = random_dictionary::<PatchShape<3, 3, 2, 2, 4, 144>>(seed + 10);
         let (kd, n) = dense_kronecker(dict.synthesis());
         let mut r = rng(seed);
         let c: Vec<f32> = (0..n).map(|_| r.random_range(-1.0f32..1.0)).collect();
@@ -68,7 +68,7 @@ fn sheared_operator_matches_dense_gather_times_basis() {
         }
         assert!(gather.len() >= 8, "case {seed}: the patch reads too little of the sensor");
         let raw: Vec<RawFrame<f32>> = frames.iter().map(|f| RawFrame::new(f, rows, cols).unwrap()).collect();
-        let mut ws = Box::new(Workspace::<3, 3, 2, 2, 4, 144>::new());
+        let mut ws = Box::new(Workspace::<PatchShape<3, 3, 2, 2, 4, 144>>::new());
         let o = PatchOrigin {
             lenslet_row: origin.0 as u16,
             lenslet_col: origin.1 as u16,
@@ -99,7 +99,7 @@ fn sheared_operator_and_its_adjoint_agree() {
     let (rows, cols) = SMALL.frame_size();
     let mask = Mask::pixel(7, 2, 4, L3).unwrap();
     let dec = small_decoder(mask);
-    let dict = random_dictionary::<3, 3, 2, 2, 4>(8);
+    let dict = random_dictionary::<PatchShape<3, 3, 2, 2, 4, 144>>(8);
     let mut r = rng(9);
     let frames: Vec<Vec<f32>> =
         (0..2).map(|_| (0..rows * cols).map(|_| 10.0 + r.random_range(0.0f32..1.0)).collect()).collect();
@@ -107,7 +107,7 @@ fn sheared_operator_and_its_adjoint_agree() {
     for d in [-2i8, -1, 1, 2] {
         let o =
             PatchOrigin { lenslet_row: 4, lenslet_col: 4, view_row: 1, view_col: 0, disparity: Disparity::pixels(d) };
-        let mut ws = Box::new(Workspace::<3, 3, 2, 2, 4, 144>::new());
+        let mut ws = Box::new(Workspace::<PatchShape<3, 3, 2, 2, 4, 144>>::new());
         dec.read_patch(o, &mut FrameSource::new(&raw), &mut ws).unwrap();
         let m = ws.measurements();
         let omega: Vec<usize> = (0..144).filter(|&i| m.get(i).is_some()).collect();
@@ -182,7 +182,7 @@ fn ranges_are_checked_and_searched_nearest_zero_first() {
 // The paper's patch on lenslets of 5 x 5 views.
 const L5: LensletSize = LensletSize { rows: 5, cols: 5 };
 const SENSOR: SensorGeometry = SensorGeometry { lenslets: (17, 19), lenslet: L5 };
-type Decoder<'a> = TileDecoder<'a, 5, 5, 4, 4, 13, 5200>;
+type Decoder<'a> = TileDecoder<'a, PaperShape>;
 
 /// A Lambertian scene at disparity `d` everywhere: the value of band `b` at sensor pixel
 /// `(row, col)`. View `(u, v)` of lenslet `(y, x)` sees the scene point
@@ -217,7 +217,7 @@ fn plane(mask: &Mask, d: i32, seed: u64) -> Vec<Vec<f32>> {
 #[derive(Default)]
 struct Collect(Vec<(PatchOrigin, Vec<f32>, bool)>);
 
-impl PatchSink<5200> for Collect {
+impl PatchSink<PaperShape> for Collect {
     type Error = ();
     fn accept(&mut self, origin: PatchOrigin, patch: &[f32; 5200], r: &PatchReport) -> Result<(), ()> {
         self.0.push((origin, patch.to_vec(), r.fallback));

@@ -14,6 +14,7 @@ use rand::Rng;
 use slf_firmware::ball::Ball;
 use slf_firmware::disparity::{Disparity, HalfViews};
 use slf_firmware::fractional::{project_fractional, to_sensor};
+use slf_firmware::shape::ValueCount;
 use slf_firmware::*;
 
 /// One measurement of a patch, from the definition: the grid entries it averages.
@@ -89,7 +90,7 @@ fn half_pixel_read_and_projection_match_the_dense_definition() {
     ] {
         let mask = Mask::pixel(seed, k, 4, L3).unwrap();
         let dec = small_decoder(mask);
-        let dict = random_dictionary::<3, 3, 2, 2, 4>(seed + 20);
+        let dict = random_dictionary::<PatchShape<3, 3, 2, 2, 4, 144>>(seed + 20);
         let (kd, n) = dense_kronecker(dict.synthesis());
         let mut r = rng(seed);
         let c: Vec<f32> = (0..n).map(|_| r.random_range(-1.0f32..1.0)).collect();
@@ -103,7 +104,7 @@ fn half_pixel_read_and_projection_match_the_dense_definition() {
             frames[*j][pr * cols + pc] = 10.0 + value as f32;
         }
         let raw: Vec<RawFrame<f32>> = frames.iter().map(|f| RawFrame::new(f, rows, cols).unwrap()).collect();
-        let mut ws = Box::new(Workspace::<3, 3, 2, 2, 4, 144>::new());
+        let mut ws = Box::new(Workspace::<PatchShape<3, 3, 2, 2, 4, 144>>::new());
         let o = PatchOrigin {
             lenslet_row: origin.0 as u16,
             lenslet_col: origin.1 as u16,
@@ -162,12 +163,12 @@ fn half_pixel_read_and_projection_match_the_dense_definition() {
 #[test]
 fn full_blocks_project_like_the_dense_definition() {
     type Grid = PatchShape<5, 5, 2, 2, 2, 200>;
-    let dict = random_dictionary::<5, 5, 2, 2, 2>(41);
+    let dict = random_dictionary::<PatchShape<5, 5, 2, 2, 2, 200>>(41);
     let (kd, n) = dense_kronecker(dict.synthesis());
     let half = HalfViews { rows: 0b10, cols: 0b10 };
     for (case, keep) in [(0, 1.0f32), (1, 0.6), (2, 0.3)] {
         let mut r = rng(50 + case);
-        let mut m = Measurements::<200>::new();
+        let mut m = Measurements::<ValueCount<200>>::new();
         let mut rows: Vec<Vec<(usize, f64)>> = Vec::new();
         let mut y = Vec::new();
         for u in 0..2 {
@@ -211,8 +212,8 @@ fn full_blocks_project_like_the_dense_definition() {
 fn the_noise_ball_moves_a_fraction_of_the_exact_projection() {
     let mask = Mask::pixel(7, 2, 4, L3).unwrap();
     let defined = rows_of(&mask, (3, 3), (0, 0), 1);
-    let dict = random_dictionary::<3, 3, 2, 2, 4>(31);
-    let mut m = Measurements::<144>::new();
+    let dict = random_dictionary::<PatchShape<3, 3, 2, 2, 4, 144>>(31);
+    let mut m = Measurements::<ValueCount<144>>::new();
     let mut r = rng(7);
     for (row, ..) in &defined {
         m.set(row.slot, r.random_range(0.0f32..1.0)).unwrap();
@@ -239,10 +240,10 @@ fn the_noise_ball_moves_a_fraction_of_the_exact_projection() {
 #[test]
 fn a_half_pixel_solve_meets_its_measurements_and_to_sensor_gives_the_pixels() {
     let mask = Mask::pixel(11, 3, 4, L3).unwrap();
-    let dict = Dictionary::<3, 3, 2, 2, 4>::dct();
+    let dict = Dictionary::<PatchShape<3, 3, 2, 2, 4, 144>>::dct();
     let defined = rows_of(&mask, (3, 3), (0, 1), -1);
-    let truth = smooth_patch::<3, 3, 2, 2, 4, 144>(5);
-    let mut ws = Box::new(Workspace::<3, 3, 2, 2, 4, 144>::new());
+    let truth = smooth_patch::<PatchShape<3, 3, 2, 2, 4, 144>>(5);
+    let mut ws = Box::new(Workspace::<PatchShape<3, 3, 2, 2, 4, 144>>::new());
     for (row, ..) in &defined {
         let y: f64 = row.taps.iter().map(|&(i, w)| w * f64::from(truth[i])).sum();
         ws.measurements_mut().set(row.slot, y as f32).unwrap();
@@ -259,7 +260,7 @@ fn a_half_pixel_solve_meets_its_measurements_and_to_sensor_gives_the_pixels() {
     }
     // to_sensor: each slot becomes the value its pixel measured, from the taps.
     let mut sensor = patch;
-    to_sensor::<3, 3, 2, 2, 4, 144>(ws.measurements().half_views(), &mut sensor);
+    to_sensor::<PatchShape<3, 3, 2, 2, 4, 144>>(ws.measurements().half_views(), &mut sensor);
     for (row, ..) in &defined {
         let want: f64 = row.taps.iter().map(|&(i, w)| w * f64::from(patch[i])).sum();
         assert!((f64::from(sensor[row.slot]) - want).abs() < 1e-6, "to_sensor at {}", row.slot);

@@ -155,7 +155,7 @@ struct Check {
     non_finite: u32,
 }
 
-impl PatchSink<PAPER_N> for Check {
+impl PatchSink<PaperShape> for Check {
     type Error = core::convert::Infallible;
     fn accept(&mut self, _: PatchOrigin, p: &PaperPatch, _: &PatchReport) -> Result<(), Self::Error> {
         self.accepted += 1;

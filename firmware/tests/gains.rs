@@ -7,13 +7,14 @@ mod common;
 use common::*;
 use rand::Rng;
 use slf_firmware::gains::{MAX_RATIO, gains_from_sums};
+use slf_firmware::shape::ValueCount;
 use slf_firmware::*;
 
 const L5: LensletSize = LensletSize { rows: 5, cols: 5 };
 const SENSOR: SensorGeometry = SensorGeometry { lenslets: (10, 15), lenslet: L5 };
 const ROWS: usize = 50;
 const COLS: usize = 75;
-type Decoder<'a> = TileDecoder<'a, 5, 5, 4, 4, 13, 5200>;
+type Decoder<'a> = TileDecoder<'a, PaperShape>;
 
 #[test]
 fn gains_from_sums_by_hand() {
@@ -107,7 +108,7 @@ fn frame_estimate_matches_slow_reference() {
 #[derive(Default)]
 struct Collect(Vec<(PatchOrigin, Vec<f32>)>);
 
-impl PatchSink<5200> for Collect {
+impl PatchSink<PaperShape> for Collect {
     type Error = ();
     fn accept(&mut self, origin: PatchOrigin, patch: &[f32; 5200], _: &PatchReport) -> Result<(), ()> {
         self.0.push((origin, patch.to_vec()));
@@ -174,10 +175,10 @@ fn bad_gains_are_refused() {
         let mut g = [1.0f32; 13];
         g[4] = bad;
         assert_eq!(dec.with_gains(&g).err(), Some(ConfigError::Gains), "gain {bad}");
-        let mut m = Measurements::<5200>::new();
+        let mut m = Measurements::<ValueCount<5200>>::new();
         assert_eq!(m.set_gains(&g), Err(SolveError::BadGains));
         assert_eq!(m.gains(), &[1.0; 32], "a refused set leaves the gains");
     }
-    let mut m = Measurements::<5200>::new();
+    let mut m = Measurements::<ValueCount<5200>>::new();
     assert_eq!(m.set_gains(&[1.0; 33]), Err(SolveError::BadGains));
 }

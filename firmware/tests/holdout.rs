@@ -8,7 +8,7 @@ use rand::Rng;
 use slf_firmware::holdout::{Unit, estimate, hold_out};
 use slf_firmware::*;
 
-type Ws = Workspace<5, 5, 4, 4, 13, 5200>;
+type Ws = Workspace<PaperShape>;
 
 #[test]
 fn the_held_out_measurements_are_left_out_and_nothing_else() {
@@ -23,20 +23,20 @@ fn the_held_out_measurements_are_left_out_and_nothing_else() {
         }
     }
     let before = ws.measurements().count();
-    let expect = (0..5200).filter(|&i| values[i].is_some() && hold.held::<4, 4, 13>(Unit::Measurement, i)).count();
+    let expect = (0..5200).filter(|&i| values[i].is_some() && hold.held::<PaperShape>(Unit::Measurement, i)).count();
     // About one in eight, spread (a test that fails for a hash that holds none or all).
     assert!(expect * 8 > before / 2 && expect * 8 < before * 2, "{expect} of {before}");
-    assert_eq!(hold_out::<5, 5, 4, 4, 13, 5200>(&hold, ws.measurements_mut()) as usize, expect);
+    assert_eq!(hold_out::<PaperShape>(&hold, ws.measurements_mut()) as usize, expect);
     assert_eq!(ws.measurements().count(), before - expect);
     for (i, v) in values.iter().enumerate() {
-        let kept = if hold.held::<4, 4, 13>(Unit::Measurement, i) { None } else { *v };
+        let kept = if hold.held::<PaperShape>(Unit::Measurement, i) { None } else { *v };
         assert_eq!(ws.measurements().get(i), kept, "entry {i}");
     }
     // A patch whose every measurement would be held out keeps them all.
     let mut one = Box::new(Ws::new());
-    let i = (0..5200).find(|&i| hold.held::<4, 4, 13>(Unit::Measurement, i)).unwrap();
+    let i = (0..5200).find(|&i| hold.held::<PaperShape>(Unit::Measurement, i)).unwrap();
     one.measurements_mut().set(i, 0.5).unwrap();
-    assert_eq!(hold_out::<5, 5, 4, 4, 13, 5200>(&hold, one.measurements_mut()), 0);
+    assert_eq!(hold_out::<PaperShape>(&hold, one.measurements_mut()), 0);
     assert_eq!(one.measurements().get(i), Some(0.5));
 }
 
@@ -60,7 +60,7 @@ fn the_estimate_is_the_held_out_error_less_the_noise() {
     let m = ws.measurements();
     let (mut r2, mut var, mut n) = (0.0f64, 0.0f64, 0.0f64);
     for (i, &x) in predicted.iter().enumerate() {
-        let Some(y) = m.get(i).filter(|_| hold.held::<4, 4, 13>(Unit::Measurement, i)) else { continue };
+        let Some(y) = m.get(i).filter(|_| hold.held::<PaperShape>(Unit::Measurement, i)) else { continue };
         let g = f64::from(gains[i % 13]);
         r2 += ((f64::from(x) - f64::from(y)) * g).powi(2);
         var += f64::from(noise).powi(2) + f64::from(shot) * (f64::from(y) * g).max(0.0);
@@ -68,17 +68,17 @@ fn the_estimate_is_the_held_out_error_less_the_noise() {
     }
     let share = m.count() as f64 / 5200.0;
     let want = ((r2 / n - var / n).max(0.0) * (1.0 - share) + var / n * share).sqrt();
-    let got = f64::from(estimate::<5, 5, 4, 4, 13, 5200>(&hold, m, &predicted, noise, shot).unwrap());
+    let got = f64::from(estimate::<PaperShape>(&hold, m, &predicted, noise, shot).unwrap());
     assert!((got - want).abs() <= 1e-5 * want, "{got} against {want}");
     // Nothing held out, no estimate.
-    assert_eq!(estimate::<5, 5, 4, 4, 13, 5200>(&hold, &Measurements::new(), &predicted, noise, shot), None);
+    assert_eq!(estimate::<PaperShape>(&hold, &Measurements::new(), &predicted, noise, shot), None);
 }
 
 const L5: LensletSize = LensletSize { rows: 5, cols: 5 };
 
 fn decode(frames: &[Vec<f32>], mask: Mask<'static>, hold: Option<HoldOut>) -> Patches {
     let config = decoder_config((10, 15), mask);
-    let dec = TileDecoder::<5, 5, 4, 4, 13, 5200>::new(config).unwrap().with_error_estimate(hold).unwrap();
+    let dec = TileDecoder::<PaperShape>::new(config).unwrap().with_error_estimate(hold).unwrap();
     let raw: Vec<RawFrame<f32>> = frames.iter().map(|f| RawFrame::new(f, 50, 75).unwrap()).collect();
     let mut sink = Patches::default();
     let mut ws = Box::new(Ws::new());
@@ -132,7 +132,7 @@ fn the_estimate_leaves_the_decode_as_it_was_and_follows_the_true_error() {
 #[test]
 fn a_fold_below_two_is_refused() {
     let config = decoder_config((10, 15), Mask::pixel(4, 3, 13, L5).unwrap());
-    let dec = TileDecoder::<5, 5, 4, 4, 13, 5200>::new(config).unwrap();
+    let dec = TileDecoder::<PaperShape>::new(config).unwrap();
     assert_eq!(dec.error_estimate(), None);
     for fold in [0, 1] {
         assert_eq!(dec.with_error_estimate(Some(HoldOut { fold })).unwrap_err(), ConfigError::HoldOut);
@@ -160,9 +160,9 @@ fn the_unit_held_out_follows_the_mask() {
                 ws.measurements_mut().set(p * 13 + b, frame[row * 75 + col]).unwrap();
             }
         }
-        assert_eq!(Unit::of::<5, 5, 4, 4, 13, 5200>(ws.measurements()), unit, "{:?}", mask.family());
+        assert_eq!(Unit::of::<PaperShape>(ws.measurements()), unit, "{:?}", mask.family());
         let before = ws.measurements().count();
-        let held = hold_out::<5, 5, 4, 4, 13, 5200>(&HoldOut::DEFAULT, ws.measurements_mut()) as usize;
+        let held = hold_out::<PaperShape>(&HoldOut::DEFAULT, ws.measurements_mut()) as usize;
         assert!(held * 16 > before && held * 4 < before, "{held} of {before}");
         if unit == Unit::LensletBand {
             // Every view of a held-out group is out: no lenslet keeps part of a band.

@@ -5,7 +5,9 @@ mod common;
 
 use common::*;
 use rand::Rng;
+use slf_firmware::PatchShape;
 use slf_firmware::interpolate::{bands_measured, interpolate_bands};
+use slf_firmware::shape::ValueCount;
 use slf_firmware::{Ended, Measurements};
 
 /// One pixel in f64: for each band, the nearest measured band below and above; linear
@@ -29,7 +31,7 @@ fn interpolation_matches_the_reference_and_fills_unmeasured_pixels_with_the_mean
     const N: usize = 40 * B;
     for seed in 0..20u64 {
         let mut r = rng(seed);
-        let mut m = Measurements::<N>::new();
+        let mut m = Measurements::<ValueCount<N>>::new();
         let mut per_pixel = Vec::new();
         let mut union = [false; B];
         for p in 0..N / B {
@@ -46,9 +48,12 @@ fn interpolation_matches_the_reference_and_fills_unmeasured_pixels_with_the_mean
             }
             per_pixel.push(pixel);
         }
-        assert_eq!(bands_measured::<B, N>(&m), union.iter().filter(|&&u| u).count() as u32);
+        assert_eq!(
+            bands_measured::<PatchShape<1, 1, 1, { N / B }, B, N>>(&m),
+            union.iter().filter(|&&u| u).count() as u32
+        );
         let mut out = [f32::NAN; N];
-        let missing = interpolate_bands::<B, N>(&m, &mut out);
+        let missing = interpolate_bands::<PatchShape<1, 1, 1, { N / B }, B, N>>(&m, &mut out);
         assert_eq!(missing, per_pixel.iter().filter(|p| p.is_empty()).count());
         let spectra: Vec<Vec<f64>> = per_pixel
             .iter()
@@ -70,7 +75,10 @@ fn interpolation_matches_the_reference_and_fills_unmeasured_pixels_with_the_mean
     }
     // Nothing measured: nothing to interpolate from, all zeros.
     let mut out = [1.0f32; N];
-    assert_eq!(interpolate_bands::<B, N>(&Measurements::<N>::new(), &mut out), N / B);
+    assert_eq!(
+        interpolate_bands::<PatchShape<1, 1, 1, { N / B }, B, N>>(&Measurements::<ValueCount<N>>::new(), &mut out),
+        N / B
+    );
     assert!(out.iter().all(|&x| x == 0.0));
     assert_eq!(Ended::Interpolated, slf_firmware::Outcome::interpolated().ended);
 }

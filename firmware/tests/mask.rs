@@ -1,6 +1,7 @@
 //! Mask families: reproducible from a seed, k distinct bands per position, the structure
 //! each family promises, explicit periodic tiles, and defect lists.
 
+use slf_firmware::Fixed;
 use std::collections::HashSet;
 
 use slf_firmware::{BandTile, DefectList, LensletSize, Mask, MaskFamily, Pixel, SensingError};
@@ -126,7 +127,7 @@ fn bad_masks_are_typed_errors() {
 #[test]
 fn kronecker_phi_is_the_papers_form() {
     let mask = Mask::kronecker(4, 3, 13, L5, (5, 5)).unwrap();
-    let phi = mask.kronecker_phi::<5, 5, 4, 4>(30, 60).unwrap();
+    let phi = mask.kronecker_phi::<Fixed<5>, Fixed<5>, Fixed<4>, Fixed<4>>(30, 60).unwrap();
     assert_eq!(phi.bands, mask.bands_at(30, 60));
     // Row shuffles are permutations, the same for every block.
     let mut p = phi.shuffle3;
@@ -135,10 +136,16 @@ fn kronecker_phi_is_the_papers_form() {
     let mut p = phi.shuffle1;
     p.sort();
     assert_eq!(p, [0, 1, 2, 3, 4]);
-    assert_eq!(mask.kronecker_phi::<5, 5, 4, 4>(0, 0).unwrap().shuffle1, phi.shuffle1);
-    assert_eq!(mask.kronecker_phi::<4, 4, 4, 4>(0, 0).unwrap_err(), SensingError::BlockMismatch);
+    assert_eq!(mask.kronecker_phi::<Fixed<5>, Fixed<5>, Fixed<4>, Fixed<4>>(0, 0).unwrap().shuffle1, phi.shuffle1);
+    assert_eq!(
+        mask.kronecker_phi::<Fixed<4>, Fixed<4>, Fixed<4>, Fixed<4>>(0, 0).unwrap_err(),
+        SensingError::BlockMismatch
+    );
     let pixel = Mask::pixel(4, 3, 13, L5).unwrap();
-    assert_eq!(pixel.kronecker_phi::<5, 5, 4, 4>(0, 0).unwrap_err(), SensingError::NotKronecker);
+    assert_eq!(
+        pixel.kronecker_phi::<Fixed<5>, Fixed<5>, Fixed<4>, Fixed<4>>(0, 0).unwrap_err(),
+        SensingError::NotKronecker
+    );
     assert_eq!(pixel.family(), MaskFamily::Pixel);
 }
 

@@ -7,8 +7,11 @@ mod common;
 use common::*;
 use nalgebra::DMatrix;
 use rand::Rng;
+use slf_firmware::PaperShape;
+use slf_firmware::Shape;
 use slf_firmware::ball::Ball;
 use slf_firmware::mixing::{BandModel, project_mixed, project_signal};
+use slf_firmware::shape::ValueCount;
 use slf_firmware::{Dictionary, Measurements, PatchShape, Response, SensingError, Sl0Config, Workspace, solve};
 
 /// A leaky filter set: filter `f` passes `1 - leak` of its band and `leak` spread over the
@@ -62,12 +65,12 @@ fn balanced64<const B: usize>(r: &[[f32; B]; B], g: &[f32]) -> Vec<Vec<f64>> {
 fn check<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>() {
     let r32 = leaky::<B>(0.25);
     let resp = Response::new(&r32).unwrap();
-    for (dseed, dict) in [(0u64, Dictionary::<PS, PT, PU, PV, B>::dct()), (3, random_dictionary(3))] {
+    for (dseed, dict) in [(0u64, Dictionary::<PatchShape<PS, PT, PU, PV, B, N>>::dct()), (3, random_dictionary(3))] {
         let (k, n) = dense_kronecker(dict.synthesis());
         for (case, per_pixel) in [1usize, 2, 4].into_iter().enumerate() {
             let mut r = rng(40 + 10 * dseed + case as u64);
             // Each pixel `per_pixel` random filters (none for every fifth pixel).
-            let mut m = Measurements::<N>::new();
+            let mut m = Measurements::<ValueCount<N>>::new();
             let mut rows: Vec<(usize, usize, f32)> = Vec::new(); // (pixel, filter, y)
             for p in 0..N / B {
                 if p % 5 == 2 {
@@ -121,7 +124,7 @@ fn check<const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                 // The signal-space projection does the same per pixel, from the synthesis.
                 let mut signal: Box<[f32; N]> =
                     Box::new(dense_apply(&k, n, &s).iter().map(|&v| v as f32).collect::<Vec<_>>().try_into().unwrap());
-                project_signal(&model, &mut signal, &m, &exact);
+                project_signal::<PatchShape<PS, PT, PU, PV, B, N>>(&model, &mut signal, &m, &exact);
                 let e = rel_err(&signal[..], &x);
                 assert!(e <= 5e-6, "{what}: signal-space projection rel err {e}");
             }
@@ -137,9 +140,14 @@ fn mixed_projection_matches_dense_reference() {
 
 /// Measurements of `truth` through `resp` (pixel mask of `k` filters a pixel, seeded),
 /// the filter values written where the one-hot model reads a band.
-fn measure_mixed<const N: usize>(truth: &[f32], r: &[[f32; 13]; 13], k: usize, seed: u64) -> Measurements<N> {
+fn measure_mixed<const N: usize>(
+    truth: &[f32],
+    r: &[[f32; 13]; 13],
+    k: usize,
+    seed: u64,
+) -> Measurements<ValueCount<N>> {
     let mut rng = rng(seed);
-    let mut m = Measurements::<N>::new();
+    let mut m = Measurements::<ValueCount<N>>::new();
     for p in 0..N / 13 {
         let mut fs: Vec<usize> = (0..13).collect();
         for _ in 0..k {
@@ -153,13 +161,13 @@ fn measure_mixed<const N: usize>(truth: &[f32], r: &[[f32; 13]; 13], k: usize, s
 
 #[test]
 fn a_solve_that_models_the_response_recovers_the_spectrum() {
-    type Ws = Workspace<5, 5, 4, 4, 13, 5200>;
-    let dct = Dictionary::<5, 5, 4, 4, 13>::dct();
+    type Ws = Workspace<PaperShape>;
+    let dct = Dictionary::<PaperShape>::dct();
     for leak in [0.1f32, 0.3] {
         let r = leaky::<13>(leak);
         let resp = Response::new(&r).unwrap();
         for k in [1usize, 3] {
-            let truth = smooth_patch::<5, 5, 4, 4, 13, 5200>(7 + k as u64);
+            let truth = smooth_patch::<PaperShape>(7 + k as u64);
             let m = measure_mixed::<5200>(&truth, &r, k, 11);
             let mut ws: Box<Ws> = Box::new(Ws::new());
             *ws.measurements_mut() = m.clone();
@@ -200,9 +208,9 @@ fn a_solve_that_models_the_response_recovers_the_spectrum() {
 
 #[test]
 fn the_identity_response_is_the_one_hot_decode() {
-    type Ws = Workspace<5, 5, 4, 4, 13, 5200>;
-    let dct = Dictionary::<5, 5, 4, 4, 13>::dct();
-    let truth = smooth_patch::<5, 5, 4, 4, 13, 5200>(3);
+    type Ws = Workspace<PaperShape>;
+    let dct = Dictionary::<PaperShape>::dct();
+    let truth = smooth_patch::<PaperShape>(3);
     let m = measure_mixed::<5200>(&truth, &leaky::<13>(0.0), 2, 5);
     let decode = |set: bool| {
         let mut ws: Box<Ws> = Box::new(Ws::new());
@@ -214,5 +222,5 @@ fn the_identity_response_is_the_one_hot_decode() {
         ws.patch().to_vec()
     };
     assert_eq!(decode(true), decode(false));
-    assert_eq!(PatchShape::<5, 5, 4, 4, 13, 5200>::PIXELS, 400);
+    assert_eq!(PaperShape::PIXELS, 400);
 }

@@ -16,8 +16,8 @@ const L5: LensletSize = LensletSize { rows: 5, cols: 5 };
 const SENSOR: SensorGeometry = SensorGeometry { lenslets: (8, 11), lenslet: L5 };
 const ROWS: usize = 8;
 const COLS: usize = 11;
-type Decoder<'a> = TileDecoder<'a, 5, 5, 4, 4, 13, 5200>;
-type Overlapped<'a> = OverlapDecoder<'a, 5, 5, 4, 4, 13, 5200>;
+type Decoder<'a> = TileDecoder<'a, PaperShape>;
+type Overlapped<'a> = OverlapDecoder<'a, PaperShape>;
 
 /// A light field with texture at every lenslet, `[s][t][u][v][b]`.
 fn light_field() -> Vec<f32> {
@@ -91,7 +91,7 @@ fn origins(dec: &Decoder, stride: (usize, usize)) -> Vec<(usize, usize)> {
 
 struct Collect(Vec<(PatchOrigin, Vec<f32>)>);
 
-impl PatchSink<5200> for Collect {
+impl PatchSink<PaperShape> for Collect {
     type Error = ();
     fn accept(&mut self, o: PatchOrigin, p: &[f32; 5200], _: &PatchReport) -> Result<(), ()> {
         self.0.push((o, p.to_vec()));
@@ -103,11 +103,11 @@ impl PatchSink<5200> for Collect {
 /// lenslet, clamped to the sensor.
 struct FrameSeeds(Vec<f32>);
 
-impl PatchSeed<5200> for FrameSeeds {
+impl PatchSeed<PaperShape> for FrameSeeds {
     fn seed(&mut self, o: PatchOrigin, patch: &mut [f32; 5200]) -> bool {
         for (i, x) in patch.iter_mut().enumerate() {
             let [s, t, u, v, b] = PaperShape::coordinates(i);
-            let Some((r, c)) = o.lenslet::<5, 5>(s, t, u, v, (5, 5)) else { continue };
+            let Some((r, c)) = o.lenslet::<PaperShape>(s, t, u, v, (5, 5)) else { continue };
             let (r, c) = (r.clamp(0, ROWS as isize - 1) as usize, c.clamp(0, COLS as isize - 1) as usize);
             let (vu, vv) = (o.view_row as usize + u, o.view_col as usize + v);
             *x = self.0[(((r * COLS + c) * 5 + vu) * 5 + vv) * 13 + b];
@@ -147,7 +147,7 @@ fn reference(dec: &Decoder, raw: &[RawFrame<f32>], stride: (usize, usize), windo
         for (o, p) in &got.0 {
             for (i, &x) in p.iter().enumerate() {
                 let [s, t, u, v, b] = PaperShape::coordinates(i);
-                let w = f64::from(window.weight::<5, 5>(s, t));
+                let w = f64::from(window.weight::<PaperShape>(s, t));
                 let (row, col) = (o.lenslet_row as usize + s, o.lenslet_col as usize + t);
                 let (vu, vv) = (o.view_row as usize + u, o.view_col as usize + v);
                 let j = (((row * COLS + col) * 5 + vu) * 5 + vv) * 13 + b;
@@ -346,9 +346,9 @@ fn bad_strides_and_strips_are_refused() {
 
 #[test]
 fn tapered_weights_are_one_two_three_two_one() {
-    let w: Vec<f32> = (0..5).map(|s| Window::Tapered.weight::<5, 5>(s, 2)).collect();
+    let w: Vec<f32> = (0..5).map(|s| Window::Tapered.weight::<PaperShape>(s, 2)).collect();
     assert_eq!(w, [3.0, 6.0, 9.0, 6.0, 3.0]);
-    assert_eq!(Window::Uniform.weight::<5, 5>(0, 4), 1.0);
+    assert_eq!(Window::Uniform.weight::<PaperShape>(0, 4), 1.0);
 }
 
 #[test]
@@ -364,7 +364,7 @@ fn the_devices_overlapped_decode_fits_its_part() {
             defects: DefectList::EMPTY,
             sl0: Sl0Config::DEFAULT,
         };
-        let tiles = TileDecoder::<5, 5, 5, 5, 13, 8125>::new(config).unwrap();
+        let tiles = TileDecoder::<FullViewShape>::new(config).unwrap();
         OverlapDecoder::new(tiles.with_disparities(DisparityRange::DEFAULT), Overlap::DEFAULT).unwrap()
     };
     let ws = core::mem::size_of::<FullViewWorkspace>();

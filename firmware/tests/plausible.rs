@@ -6,9 +6,10 @@ mod common;
 use common::*;
 use rand::Rng;
 use slf_firmware::plausible::{clip, implausible};
+use slf_firmware::shape::ValueCount;
 use slf_firmware::*;
 
-type Ws = Workspace<5, 5, 4, 4, 13, 5200>;
+type Ws = Workspace<PaperShape>;
 
 /// Random measurements: about one entry a pixel (some negative, some pixels empty).
 fn random_measurements(seed: u64) -> Box<Ws> {
@@ -27,7 +28,7 @@ fn random_measurements(seed: u64) -> Box<Ws> {
 
 /// The bound of value `(s, t, u, v, b)` by the definition: the brightest measurement of the
 /// pixels within 1 in every coordinate if one of them measured band `b`, else the patch's.
-fn reference_bound(m: &Measurements<5200>, p: &Plausibility, at: [usize; 5]) -> f32 {
+fn reference_bound(m: &Measurements<ValueCount<5200>>, p: &Plausibility, at: [usize; 5]) -> f32 {
     let [s, t, u, v, b] = at;
     let (mut near, mut seen, mut wide) = (f32::NEG_INFINITY, false, f32::NEG_INFINITY);
     for i in 0..5200 {
@@ -48,7 +49,7 @@ fn bounds_are_the_neighbourhoods_brightest_measurement() {
     let p = Plausibility::DEFAULT;
     for seed in 0..3 {
         let ws = random_measurements(seed);
-        let bounds = p.bounds::<5, 5, 4, 4, 13, 5200>(ws.measurements());
+        let bounds = p.bounds::<PaperShape>(ws.measurements());
         let mut r = rng(100 + seed);
         let patch: Vec<f32> = (0..5200).map(|_| r.random_range(0.0..1.0f32)).collect();
         let patch: [f32; 5200] = patch.try_into().unwrap();
@@ -61,27 +62,27 @@ fn bounds_are_the_neighbourhoods_brightest_measurement() {
             }
         }
         assert!(above > 100 && above < 5000, "a test that can fail either way: {above}");
-        assert_eq!(implausible::<5, 5, 4, 4, 13, 5200>(&bounds, &patch), above, "seed {seed}");
+        assert_eq!(implausible::<PaperShape>(&bounds, &patch), above, "seed {seed}");
         let mut out = patch;
-        clip::<5, 5, 4, 4, 13, 5200>(&bounds, &mut out);
+        clip::<PaperShape>(&bounds, &mut out);
         assert_eq!(out, clipped, "seed {seed}");
     }
     // Off: no bound at all.
     let ws = random_measurements(7);
-    let off = Plausibility::OFF.bounds::<5, 5, 4, 4, 13, 5200>(ws.measurements());
-    assert_eq!(implausible::<5, 5, 4, 4, 13, 5200>(&off, &[1e30; 5200]), 0);
+    let off = Plausibility::OFF.bounds::<PaperShape>(ws.measurements());
+    assert_eq!(implausible::<PaperShape>(&off, &[1e30; 5200]), 0);
     // A NaN is above any bound.
-    let on = Plausibility::DEFAULT.bounds::<5, 5, 4, 4, 13, 5200>(ws.measurements());
+    let on = Plausibility::DEFAULT.bounds::<PaperShape>(ws.measurements());
     let mut nan = [0.0f32; 5200];
     nan[17] = f32::NAN;
-    assert_eq!(implausible::<5, 5, 4, 4, 13, 5200>(&on, &nan), 1);
+    assert_eq!(implausible::<PaperShape>(&on, &nan), 1);
 }
 
 /// The DCT's decode with every unmeasured value raised by 1: a diverged solve that still
 /// meets its measurements.
-struct Diverging(Dictionary<5, 5, 4, 4, 13>);
+struct Diverging(Dictionary<PaperShape>);
 
-impl PatchModel<5, 5, 4, 4, 13, 5200> for Diverging {
+impl PatchModel<PaperShape> for Diverging {
     fn decode(&self, cfg: &Sl0Config, ws: &mut Ws) -> Result<ModelOutcome, SolveError> {
         let outcome = solve(&self.0, cfg, ws)?;
         let measured: Vec<bool> = (0..5200).map(|i| ws.measurements().get(i).is_some()).collect();
@@ -112,7 +113,7 @@ fn decode_dark(bound: Plausibility) -> (Patches, TileReport) {
     let mask = Mask::pixel(5, 1, 13, L5).unwrap();
     let frame = dark_frame(&mask);
     let config = decoder_config((10, 10), mask);
-    let dec = TileDecoder::<5, 5, 4, 4, 13, 5200>::new(config).unwrap().with_plausibility(bound).unwrap();
+    let dec = TileDecoder::<PaperShape>::new(config).unwrap().with_plausibility(bound).unwrap();
     let raw = [RawFrame::new(&frame, 50, 50).unwrap()];
     let mut sink = Patches::default();
     let mut ws = Box::new(Ws::new());
@@ -142,7 +143,7 @@ fn a_dark_patch_decoded_bright_is_decoded_again_and_never_passed_on_bright() {
 #[test]
 fn a_bound_out_of_range_is_refused() {
     let config = decoder_config((10, 10), Mask::pixel(5, 1, 13, L5).unwrap());
-    let dec = TileDecoder::<5, 5, 4, 4, 13, 5200>::new(config).unwrap();
+    let dec = TileDecoder::<PaperShape>::new(config).unwrap();
     assert_eq!(dec.plausibility(), Plausibility::DEFAULT);
     for bad in [
         Plausibility { factor: 0.5, margin: 0.05 },

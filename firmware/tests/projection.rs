@@ -5,14 +5,19 @@ mod common;
 
 use common::*;
 use rand::Rng;
+use slf_firmware::PatchShape;
 use slf_firmware::ball::Ball;
 use slf_firmware::projection::{project_coefficients, weigh};
+use slf_firmware::shape::ValueCount;
 use slf_firmware::transform::analyze_preserving;
 use slf_firmware::{Dictionary, Measurements};
 
 /// Measures `per_pixel` random bands of each pixel (none for every seventh pixel) with
 /// random values; returns the measurements and the measured indices.
-fn random_measurements<const B: usize, const N: usize>(seed: u64, per_pixel: usize) -> (Measurements<N>, Vec<usize>) {
+fn random_measurements<const B: usize, const N: usize>(
+    seed: u64,
+    per_pixel: usize,
+) -> (Measurements<ValueCount<N>>, Vec<usize>) {
     let mut r = rng(seed);
     let mut m = Measurements::new();
     let mut idx = Vec::new();
@@ -67,7 +72,7 @@ fn dense_projection(
 
 fn check<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>() {
     let mut inside = 0;
-    for (dseed, dict) in [(0u64, Dictionary::<PS, PT, PU, PV, B>::dct()), (5, random_dictionary(5))] {
+    for (dseed, dict) in [(0u64, Dictionary::<PatchShape<PS, PT, PU, PV, B, N>>::dct()), (5, random_dictionary(5))] {
         let (k, n) = dense_kronecker(dict.synthesis());
         for (case, per_pixel) in [1usize, 3, B].into_iter().enumerate() {
             let (m, idx) = random_measurements::<B, N>(10 * dseed + case as u64, per_pixel);
@@ -112,7 +117,7 @@ fn check<const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                     // The solver's path: the weights made once, read by each step. The same
                     // sums in the same order: the same bits.
                     let mut weights = Box::new([f32::NAN; N]);
-                    weigh::<B, N>(&m, &ball, &mut weights);
+                    weigh::<PatchShape<PS, PT, PU, PV, B, N>>(&m, &ball, &mut weights);
                     let mut weighed = start.clone();
                     let r = project_coefficients(&dict, &mut weighed, &mut scratch, &m, &ball, Some(&weights));
                     assert_eq!(r.to_bits(), residual.to_bits(), "noise {noise} shot {shot}: residual");
@@ -161,7 +166,7 @@ fn most_bands_projection_matches_dense_reference() {
 #[test]
 fn analysis_keeping_its_input_matches_dense_reference() {
     fn case<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>() {
-        let dict = random_dictionary::<PS, PT, PU, PV, B>(8);
+        let dict = random_dictionary::<PatchShape<PS, PT, PU, PV, B, N>>(8);
         let (kt, n) = dense_kronecker(dict.analysis());
         let mut r = rng(9);
         let x: Vec<f32> = (0..N).map(|_| r.random_range(-1.0f32..1.0)).collect();

@@ -13,8 +13,8 @@ use slf_firmware::schedule::{Schedule, Schedules, Weights};
 use slf_firmware::sl0::{solve_scheduled, solve_warm_scheduled};
 use slf_firmware::*;
 
-type W = Weights<3, 3, 2, 2, 4>;
-type S = Schedule<3, 3, 2, 2, 4>;
+type W = Weights<PatchShape<3, 3, 2, 2, 4, 144>>;
+type S = Schedule<PatchShape<3, 3, 2, 2, 4, 144>>;
 const N: usize = 144;
 
 fn weights() -> W {
@@ -35,8 +35,8 @@ fn problem(seed: u64) -> (Vec<f32>, Vec<bool>) {
     (truth, measured)
 }
 
-fn workspace(truth: &[f32], measured: &[bool]) -> Box<Workspace<3, 3, 2, 2, 4, N>> {
-    let mut ws = Box::new(Workspace::<3, 3, 2, 2, 4, N>::new());
+fn workspace(truth: &[f32], measured: &[bool]) -> Box<Workspace<PatchShape<3, 3, 2, 2, 4, N>>> {
+    let mut ws = Box::new(Workspace::<PatchShape<3, 3, 2, 2, 4, N>>::new());
     for (i, (&x, &k)) in truth.iter().zip(measured).enumerate() {
         if k {
             ws.measurements_mut().set(i, x).unwrap();
@@ -48,7 +48,7 @@ fn workspace(truth: &[f32], measured: &[bool]) -> Box<Workspace<3, 3, 2, 2, 4, N
 /// The steps from the definition, dense in f64: `S0 = K^T y0` (zeros unmeasured), `sigma_t =
 /// max(f_t max|S0|, sigma_min)`, `s <- s - mu s exp(-w s^2 / (2 sigma^2))`, then
 /// `x = K s`, measured entries set to `y`, `s = K^T x`; the patch is `K s` with `y` put back.
-fn reference(dict: &Dictionary<3, 3, 2, 2, 4>, s: &S, truth: &[f32], measured: &[bool]) -> Vec<f64> {
+fn reference(dict: &Dictionary<PatchShape<3, 3, 2, 2, 4, 144>>, s: &S, truth: &[f32], measured: &[bool]) -> Vec<f64> {
     let (k, n) = dense_kronecker(dict.synthesis());
     let apply_t = |x: &[f64]| -> Vec<f64> { (0..n).map(|j| (0..n).map(|i| k[i * n + j] * x[i]).sum()).collect() };
     let apply = |c: &[f64]| -> Vec<f64> { (0..n).map(|i| (0..n).map(|j| k[i * n + j] * c[j]).sum()).collect() };
@@ -73,7 +73,7 @@ fn reference(dict: &Dictionary<3, 3, 2, 2, 4>, s: &S, truth: &[f32], measured: &
 #[test]
 fn a_scheduled_solve_is_the_steps_it_names() {
     for seed in 1..4 {
-        let dict = random_dictionary::<3, 3, 2, 2, 4>(seed + 30);
+        let dict = random_dictionary::<PatchShape<3, 3, 2, 2, 4, 144>>(seed + 30);
         let (truth, measured) = problem(seed);
         let mut ws = workspace(&truth, &measured);
         let out = solve_scheduled(&dict, &Sl0Config::DEFAULT, &schedule(), &mut ws).unwrap();
@@ -95,7 +95,7 @@ fn a_scheduled_solve_is_the_steps_it_names() {
         solve_scheduled(&dict, &Sl0Config::DEFAULT, &filled, &mut cold).unwrap();
         let mut from_fill = workspace(&truth, &measured);
         let mut x = [0.0f32; N];
-        slf_firmware::solver::fill::fill_bands::<4, N>(from_fill.measurements(), &mut x);
+        slf_firmware::solver::fill::fill_bands::<PatchShape<3, 3, 2, 2, 4, N>>(from_fill.measurements(), &mut x);
         from_fill.patch_mut().copy_from_slice(&x);
         solve_warm_scheduled(&dict, &Sl0Config::DEFAULT, &filled, &mut from_fill).unwrap();
         assert!(max_abs_diff(cold.patch(), from_fill.patch()) < 1e-6);
@@ -105,7 +105,7 @@ fn a_scheduled_solve_is_the_steps_it_names() {
 
 #[test]
 fn a_scheduled_solve_stays_in_its_noise_ball_and_its_bound() {
-    let dict = random_dictionary::<3, 3, 2, 2, 4>(41);
+    let dict = random_dictionary::<PatchShape<3, 3, 2, 2, 4, 144>>(41);
     let (truth, measured) = problem(5);
     let mut ws = workspace(&truth, &measured);
     let cfg = Sl0Config { noise: 0.02, ..Sl0Config::DEFAULT };
@@ -127,12 +127,12 @@ fn a_scheduled_solve_stays_in_its_noise_ball_and_its_bound() {
 
 #[test]
 fn a_scheduled_solve_of_half_pixel_views_meets_their_interpolating_measurements() {
-    let dict = random_dictionary::<3, 3, 2, 2, 4>(43);
+    let dict = random_dictionary::<PatchShape<3, 3, 2, 2, 4, 144>>(43);
     let (truth, _) = problem(6);
     let shape = PatchShape::<3, 3, 2, 2, 4, N>::index;
     // View row 1 half: its entries measure the mean of lenslet rows s and s + 1.
     let half = HalfViews { rows: 0b10, cols: 0 };
-    let mut ws = Box::new(Workspace::<3, 3, 2, 2, 4, N>::new());
+    let mut ws = Box::new(Workspace::<PatchShape<3, 3, 2, 2, 4, N>>::new());
     ws.measurements_mut().set_half_views(half);
     let mut wanted = Vec::new();
     for s in 0..3 {
@@ -167,7 +167,10 @@ fn a_scheduled_solve_of_half_pixel_views_meets_their_interpolating_measurements(
     }
 }
 
-fn scheduled_blob(members: &[Dictionary<3, 3, 2, 2, 4>], s: &Schedules<3, 3, 2, 2, 4>) -> &'static [u8] {
+fn scheduled_blob(
+    members: &[Dictionary<PatchShape<3, 3, 2, 2, 4, 144>>],
+    s: &Schedules<PatchShape<3, 3, 2, 2, 4, 144>>,
+) -> &'static [u8] {
     let dims = [3, 3, 2, 2, 4];
     let mut out = vec![0u8; scheduled_blob_len(dims, members.len(), [s.cold.len(), s.warm.len(), s.alone.len()])];
     assert_eq!(write_blob_scheduled(members, Some(s), &mut out).unwrap(), out.len());
@@ -183,12 +186,12 @@ fn reseal(b: &mut [u8]) {
 
 #[test]
 fn a_blob_carries_its_schedules_and_refuses_bad_ones() {
-    let members = [random_dictionary::<3, 3, 2, 2, 4>(51), random_dictionary(52)];
+    let members = [random_dictionary::<PatchShape<3, 3, 2, 2, 4, 144>>(51), random_dictionary(52)];
     let warm = S::new(&[0.01, 0.001], &[2.0, 1.0], W::ONES).unwrap();
     let alone = S::new(&[0.5, 0.05, 0.005], &[1.0, 1.5, 2.0], weights()).unwrap().with_fill_start(true);
     let all = Schedules { cold: schedule(), warm, alone };
     let blob = scheduled_blob(&members, &all);
-    let e = Ensemble::<3, 3, 2, 2, 4>::new(blob).unwrap();
+    let e = Ensemble::<PatchShape<3, 3, 2, 2, 4, 144>>::new(blob).unwrap();
     assert_eq!(e.schedules(), Some(all));
     assert!(e.schedules().unwrap().alone.fill_start() && !e.schedules().unwrap().cold.fill_start());
     assert_eq!(u16::from_le_bytes([blob[4], blob[5]]), 2);
@@ -196,14 +199,14 @@ fn a_blob_carries_its_schedules_and_refuses_bad_ones() {
     let mut v1 = vec![0u8; blob::blob_len([3, 3, 2, 2, 4], 2)];
     blob::write_blob(&members, &mut v1).unwrap();
     assert_eq!(u16::from_le_bytes([v1[4], v1[5]]), 1);
-    assert_eq!(Ensemble::<3, 3, 2, 2, 4>::new(&v1).unwrap().schedules(), None);
+    assert_eq!(Ensemble::<PatchShape<3, 3, 2, 2, 4, 144>>::new(&v1).unwrap().schedules(), None);
     // The schedules start after the members: 2 x 4 * (9 + 9 + 4 + 4 + 16) bytes.
     let at = 24 + 2 * 4 * (9 + 9 + 4 + 4 + 16);
     let bad = |edit: &dyn Fn(&mut Vec<u8>)| {
         let mut b = blob.to_vec();
         edit(&mut b);
         reseal(&mut b);
-        Ensemble::<3, 3, 2, 2, 4>::new(&b).err()
+        Ensemble::<PatchShape<3, 3, 2, 2, 4, 144>>::new(&b).err()
     };
     let part = |part| Some(DictionaryError::BadSchedule { part });
     assert_eq!(bad(&|b| b[at..at + 2].copy_from_slice(&0u16.to_le_bytes())), part("steps"));
@@ -219,13 +222,13 @@ fn a_blob_carries_its_schedules_and_refuses_bad_ones() {
     let len = u32::from_le_bytes(short[20..24].try_into().unwrap()) - 8;
     short[20..24].copy_from_slice(&len.to_le_bytes());
     reseal(&mut short);
-    assert_eq!(Ensemble::<3, 3, 2, 2, 4>::new(&short).err(), part("steps"));
+    assert_eq!(Ensemble::<PatchShape<3, 3, 2, 2, 4, 144>>::new(&short).err(), part("steps"));
 }
 
 /// A frame of a smooth scene on the small sensor, its decoder and the truth per patch.
 struct Collect(Vec<(PatchOrigin, PatchReport, Vec<f32>)>);
 
-impl PatchSink<N> for Collect {
+impl PatchSink<PatchShape<3, 3, 2, 2, 4, N>> for Collect {
     type Error = ();
     fn accept(&mut self, o: PatchOrigin, p: &[f32; N], r: &PatchReport) -> Result<(), ()> {
         self.0.push((o, *r, p.to_vec()));
@@ -235,7 +238,7 @@ impl PatchSink<N> for Collect {
 
 #[test]
 fn an_ensemble_decodes_with_its_blobs_schedules_cold_sheared_and_seeded() {
-    let members = [Dictionary::<3, 3, 2, 2, 4>::dct(), random_dictionary(61)];
+    let members = [Dictionary::<PatchShape<3, 3, 2, 2, 4, 144>>::dct(), random_dictionary(61)];
     let warm = S::new(&[0.02, 0.005, 0.001], &[1.5, 1.5, 1.0], W::ONES).unwrap();
     // A cold schedule like the hand-set one: sigma from 1 to 1e-4 of the start in 24 steps.
     let fall: Vec<f32> = (0..24).map(|t| 10f32.powf(-4.0 * t as f32 / 23.0)).collect();
@@ -257,10 +260,10 @@ fn an_ensemble_decodes_with_its_blobs_schedules_cold_sheared_and_seeded() {
     };
     let frames: Vec<Vec<f32>> = (0..2).map(|_| (0..rows * cols).map(|i| value(i / cols, i % cols)).collect()).collect();
     let frames: Vec<RawFrame<f32>> = frames.iter().map(|f| RawFrame::new(f, rows, cols).unwrap()).collect();
-    let decode = |m: &EnsembleModel<3, 3, 2, 2, 4>, halves: bool| {
+    let decode = |m: &EnsembleModel<PatchShape<3, 3, 2, 2, 4, 144>>, halves: bool| {
         let dec = small_decoder(mask).with_disparities(DisparityRange::new(-1, 1).unwrap().with_halves(halves));
         let mut sink = Collect(Vec::new());
-        let mut ws = Box::new(Workspace::<3, 3, 2, 2, 4, N>::new());
+        let mut ws = Box::new(Workspace::<PatchShape<3, 3, 2, 2, 4, N>>::new());
         let report = dec.decode_frame(m, (2, 2), &mut FrameSource::new(&frames), &mut sink, &mut ws);
         (report, sink.0)
     };

@@ -17,7 +17,7 @@ use slf_firmware::*;
 
 const L5: LensletSize = LensletSize { rows: 5, cols: 5 };
 
-fn score(dict: &Dictionary<5, 5, 4, 4, 13>, patch: &[f32]) -> f64 {
+fn score(dict: &Dictionary<PaperShape>, patch: &[f32]) -> f64 {
     let mut c = Box::new([0.0f32; 5200]);
     analyze_preserving(dict, patch.try_into().unwrap(), &mut c);
     f64::from(ChoiceRule::DEFAULT.score(&c[..]))
@@ -36,13 +36,12 @@ fn estimate(truth: &[f32], amp: f32, seed: u64) -> Vec<f32> {
 #[test]
 fn a_seeded_decode_is_one_solve_from_the_seed_as_the_screened_choice_describes() {
     let members = vec![Dictionary::dct(), random_dictionary(21), random_dictionary(22)];
-    let e = Ensemble::<5, 5, 4, 4, 13>::new(blob(&members)).unwrap();
+    let e = Ensemble::<PaperShape>::new(blob(&members)).unwrap();
     let model = EnsembleModel::new(e, MemberChoice::Screened(ChoiceRule::DEFAULT));
     let mask = Mask::pixel(3, 3, 13, L5).unwrap();
     let mut outcomes = [0usize; 2];
-    for (case, truth) in [sparse_in(&members[2], 5), sparse_in(&members[0], 6), smooth_patch::<5, 5, 4, 4, 13, 5200>(7)]
-        .into_iter()
-        .enumerate()
+    for (case, truth) in
+        [sparse_in(&members[2], 5), sparse_in(&members[0], 6), smooth_patch::<PaperShape>(7)].into_iter().enumerate()
     {
         for noise in [0.0f32, 0.01] {
             let cfg = Sl0Config { noise, ..Sl0Config::DEFAULT };
@@ -92,7 +91,7 @@ fn a_seeded_decode_is_one_solve_from_the_seed_as_the_screened_choice_describes()
 /// starts too low to find the patch.
 #[test]
 fn a_seed_is_where_the_solve_starts() {
-    let dct = Dictionary::<5, 5, 4, 4, 13>::dct();
+    let dct = Dictionary::<PaperShape>::dct();
     let mask = Mask::pixel(3, 1, 13, L5).unwrap();
     for s in [11u64, 12, 13] {
         let truth: Vec<f32> = sparse_in(&dct, s).iter().map(|x| x + 0.5).collect();
@@ -118,7 +117,7 @@ fn a_seed_is_where_the_solve_starts() {
 /// A flat patch takes the short path from a seed too (no solve), whatever the seed holds.
 #[test]
 fn a_flat_patch_ignores_its_seed() {
-    let dct = Dictionary::<5, 5, 4, 4, 13>::dct();
+    let dct = Dictionary::<PaperShape>::dct();
     let mask = Mask::pixel(3, 3, 13, L5).unwrap();
     let truth: Vec<f32> = (0..5200).map(|i| 0.1 + 0.05 * (i % 13) as f32).collect();
     let mut ws = Box::new(PaperWorkspace::new());
@@ -134,7 +133,7 @@ fn a_flat_patch_ignores_its_seed() {
 /// has one neighbour: there half a step off). Whole views are left alone.
 #[test]
 fn from_sensor_interpolates_the_half_grid_back() {
-    type S = PatchShape<5, 5, 4, 4, 13, 5200>;
+    type S = PaperShape;
     for d in [Disparity::halves(1), Disparity::halves(-3)] {
         let half = HalfViews::of(d, (0, 0), (5, 5));
         assert!(!half.is_none());
@@ -146,8 +145,8 @@ fn from_sensor_interpolates_the_half_grid_back() {
             })
             .collect();
         let mut p: Box<[f32; 5200]> = truth.clone().try_into().unwrap();
-        to_sensor::<5, 5, 4, 4, 13, 5200>(half, &mut p);
-        from_sensor::<5, 5, 4, 4, 13, 5200>(half, &mut p);
+        to_sensor::<PaperShape>(half, &mut p);
+        from_sensor::<PaperShape>(half, &mut p);
         for (i, (&x, &y)) in p.iter().zip(&truth).enumerate() {
             let [s, t, u, v, _] = S::coordinates(i);
             let ends = (half.row(u) && (s == 0 || s == 4)) || (half.col(v) && (t == 0 || t == 4));

@@ -14,7 +14,9 @@ mod common;
 use common::*;
 use nalgebra::{DMatrix, DVector};
 use rand::Rng;
+use slf_firmware::Shape as _;
 use slf_firmware::ball::Ball;
+use slf_firmware::shape::ValueCount;
 use slf_firmware::shares::{RowSums, project_shares, to_sensor};
 use slf_firmware::workspace::{CellShares, MAX_SHARE_VIEWS, Measurements, PLACE_UNIT};
 use slf_firmware::*;
@@ -79,9 +81,14 @@ fn taps((s, t, u, v): (usize, usize, usize, usize), place: (f64, f64), shares: &
 type Rows = Vec<(usize, Vec<(usize, f64)>)>;
 
 /// (each row: the entry it was set at, and its taps)
-fn measure(shares: &CellShares, per_band: usize, seed: u64, place: Option<f64>) -> (Measurements<N>, Rows, Vec<f64>) {
+fn measure(
+    shares: &CellShares,
+    per_band: usize,
+    seed: u64,
+    place: Option<f64>,
+) -> (Measurements<ValueCount<N>>, Rows, Vec<f64>) {
     let mut r = rng(seed);
-    let mut m = Measurements::<N>::new();
+    let mut m = Measurements::<ValueCount<N>>::new();
     m.set_shares(Some(*shares)).unwrap();
     let pixels: Vec<(usize, usize, usize, usize)> = (0..PS)
         .flat_map(|s| (0..PT).flat_map(move |t| (0..PU).flat_map(move |u| (0..PV).map(move |v| (s, t, u, v)))))
@@ -134,7 +141,7 @@ fn dense(rows: &Rows, kd: &[f64], n: usize) -> (DMatrix<f64>, DVector<f64>) {
 
 #[test]
 fn the_projection_matches_the_dense_definition() {
-    let dict = random_dictionary::<PS, PT, PU, PV, B>(5);
+    let dict = random_dictionary::<PatchShape<PS, PT, PU, PV, B, N>>(5);
     let (kd, n) = dense_kronecker(dict.synthesis());
     for (case, shares, per_band) in [
         // Pixels narrower than a cell (pitch 3.06 px for 3 views), unsheared.
@@ -185,7 +192,7 @@ fn the_projection_matches_the_dense_definition() {
         // The prediction of every measurement from a patch: M x.
         let x: [f32; N] = core::array::from_fn(|_| r.random_range(-1.0f32..1.0));
         let mut predicted = x;
-        to_sensor::<PS, PT, PU, PV, B, N>(&m, &mut predicted, &mut scratch);
+        to_sensor::<PatchShape<PS, PT, PU, PV, B, N>>(&m, &mut predicted, &mut scratch);
         for (entry, row) in &rows {
             let want: f64 = row.iter().map(|&(e, w)| w * f64::from(x[e])).sum();
             assert!((f64::from(predicted[*entry]) - want).abs() < 1e-5, "case {case}: prediction at {entry}");
@@ -200,7 +207,7 @@ fn the_projection_matches_the_dense_definition() {
 /// steps grow it (checked on the dense definition, so the test shows why the sums).
 #[test]
 fn on_a_band_measured_everywhere_the_residual_shrinks() {
-    let dict = random_dictionary::<PS, PT, PU, PV, B>(6);
+    let dict = random_dictionary::<PatchShape<PS, PT, PU, PV, B, N>>(6);
     let (kd, n) = dense_kronecker(dict.synthesis());
     let shares = shares_of((1.0, 1.0), [0; 3], [0; 3]);
     let (m, rows, y) = measure(&shares, PS * PT * PU * PV, 21, Some(126.0 / f64::from(PLACE_UNIT)));

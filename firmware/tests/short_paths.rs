@@ -21,7 +21,7 @@ fn misfit(ws: &Ws) -> f32 {
     (0..5200).filter_map(|i| ws.measurements().get(i).map(|y| (ws.patch()[i] - y).abs())).fold(0.0, f32::max)
 }
 
-fn dct() -> Dictionary<5, 5, 4, 4, 13> {
+fn dct() -> Dictionary<PaperShape> {
     Dictionary::dct()
 }
 
@@ -29,7 +29,7 @@ fn dct() -> Dictionary<5, 5, 4, 4, 13> {
 /// `Converged`, still on the measurements and finite, at a bounded cost in error.
 #[test]
 fn early_stop_ends_when_the_patch_stops_moving() {
-    let truth = smooth_patch::<5, 5, 4, 4, 13, 5200>(3);
+    let truth = smooth_patch::<PaperShape>(3);
     let mut ws = measured(&truth, 3);
     let full = solve(&dct(), &Sl0Config::DEFAULT, &mut ws).unwrap();
     assert_eq!(full.ended, Ended::SigmaMin);
@@ -59,7 +59,7 @@ fn early_stop_ends_when_the_patch_stops_moving() {
 /// 2L, ...) and differencing the patches: the two agree where it matters, at the stop.
 #[test]
 fn early_stop_measures_movement_like_the_obvious_difference() {
-    let truth = smooth_patch::<5, 5, 4, 4, 13, 5200>(7);
+    let truth = smooth_patch::<PaperShape>(7);
     let mut ws = measured(&truth, 1);
     let base = Sl0Config::DEFAULT;
     // Patch after every level, by bounded solves (the schedule is deterministic).
@@ -95,10 +95,10 @@ fn early_stop_measures_movement_like_the_obvious_difference() {
 /// changes it little.
 #[test]
 fn warm_start_resumes_from_the_patch_in_the_workspace() {
-    let truth = smooth_patch::<5, 5, 4, 4, 13, 5200>(9);
+    let truth = smooth_patch::<PaperShape>(9);
     let mut ws = measured(&truth, 3);
     let cfg = Sl0Config::DEFAULT;
-    let cold = solve(&random_dictionary::<5, 5, 4, 4, 13>(3), &cfg, &mut ws).unwrap();
+    let cold = solve(&random_dictionary::<PaperShape>(3), &cfg, &mut ws).unwrap();
     let warm = solve_warm(&dct(), &cfg, &mut ws).unwrap();
     assert!(warm.iterations < cold.iterations, "{} vs {}", warm.iterations, cold.iterations);
     assert!(misfit(&ws) <= 1e-5);
@@ -150,7 +150,7 @@ fn flat_patches_take_the_short_path() {
     }
     // The ensemble stops after its first solve.
     let model = EnsembleModel::new(
-        Ensemble::<5, 5, 4, 4, 13>::new(DEFAULT_ENSEMBLE).unwrap(),
+        Ensemble::<PaperShape>::new(DEFAULT_ENSEMBLE).unwrap(),
         MemberChoice::Screened(ChoiceRule::DEFAULT),
     );
     let mut ws = measured(&truth, 3);
@@ -196,7 +196,7 @@ fn the_band_gain_fill_is_its_definition_and_exact_for_one_spectrum() {
     let truth: Vec<f32> = (0..5200).map(|i| 0.7 * spectrum[i % 13]).collect();
     let ws = measured(&truth, 1);
     let mut out = [0.0f32; 5200];
-    fill_bands::<13, 5200>(ws.measurements(), &mut out);
+    fill_bands::<PaperShape>(ws.measurements(), &mut out);
     let worst = out.iter().zip(&truth).map(|(a, b)| (a - b).abs() / b).fold(0.0f32, f32::max);
     assert!(worst < 1e-5, "one spectrum is filled to {worst} relative");
 
@@ -204,7 +204,7 @@ fn the_band_gain_fill_is_its_definition_and_exact_for_one_spectrum() {
     let noisy: Vec<f32> = (0..5200).map(|i| 0.1 + 0.8 * ((i * 7919 % 1009) as f32 / 1009.0)).collect();
     let ws = measured(&noisy, 1);
     let m = ws.measurements();
-    fill_bands::<13, 5200>(m, &mut out);
+    fill_bands::<PaperShape>(m, &mut out);
     let (mut sum, mut count) = ([0.0f64; 13], [0u32; 13]);
     for i in 0..5200 {
         if let Some(y) = m.get(i) {
@@ -239,7 +239,7 @@ fn the_band_gain_fill_is_its_definition_and_exact_for_one_spectrum() {
         .map(|i| if i % 13 == 12 { 0.3 } else { 0.004 * (((i / 13 * 7919) % 1009) as f32 / 1009.0 - 0.5) })
         .collect();
     let ws = measured(&dark, 1);
-    fill_bands::<13, 5200>(ws.measurements(), &mut out);
+    fill_bands::<PaperShape>(ws.measurements(), &mut out);
     let top = out.iter().fold(0.0f32, |a, &x| a.max(x.abs()));
     assert!(top <= 0.6, "the dark patch is filled up to {top}");
 }
@@ -251,7 +251,7 @@ fn the_band_gain_fill_is_its_definition_and_exact_for_one_spectrum() {
 /// outside (0, 1] is refused by name.
 #[test]
 fn a_cold_solve_from_the_fill_takes_fewer_steps_and_meets_the_measurements() {
-    let truth = smooth_patch::<5, 5, 4, 4, 13, 5200>(3);
+    let truth = smooth_patch::<PaperShape>(3);
     let mut ws = measured(&truth, 1);
     let full = solve(&dct(), &Sl0Config::DEFAULT, &mut ws).unwrap();
     let full_err = rel_err32(ws.patch(), &truth);

@@ -5,6 +5,9 @@ mod common;
 
 use common::*;
 use rand::Rng;
+use slf_firmware::Fixed;
+use slf_firmware::PaperShape;
+use slf_firmware::Shape as _;
 use slf_firmware::pinv::{PinvOperator, solve_pinv};
 use slf_firmware::{
     Dictionary, Ended, FullViewWorkspace, LensletSize, Mask, MaskFamily, PaperWorkspace, PatchShape, Sl0Config,
@@ -50,16 +53,20 @@ fn masks(k: u8) -> [Mask<'static>; 3] {
 /// The orthonormal fast path and the paper's pseudo-inverse path decode the same patch
 /// on kronecker masks (1e-4 relative), with the DCT and with a random orthonormal member.
 fn fast_equals_pinv<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const N: usize>() {
-    for (dseed, dict) in [(0, Dictionary::<PS, PT, PU, PV, 13>::dct()), (5, random_dictionary(5))] {
+    for (dseed, dict) in [(0, Dictionary::<PatchShape<PS, PT, PU, PV, 13, N>>::dct()), (5, random_dictionary(5))] {
         for k in [1u8, 3, 7] {
             let mask = Mask::kronecker(21 + u64::from(k), k, 13, L5, (PS as u8, PT as u8)).unwrap();
-            let truth = smooth_patch::<PS, PT, PU, PV, 13, N>(k.into());
-            let mut ws = Box::new(Workspace::<PS, PT, PU, PV, 13, N>::new());
+            let truth = smooth_patch::<PatchShape<PS, PT, PU, PV, 13, N>>(k.into());
+            let mut ws = Box::new(Workspace::<PatchShape<PS, PT, PU, PV, 13, N>>::new());
             measure(&mask, (0, 0), &truth, &mut ws);
             let cfg = Sl0Config::DEFAULT;
             let fast_out = solve(&dict, &cfg, &mut ws).unwrap();
             let fast = ws.patch().to_vec();
-            let op = PinvOperator::new(&dict, &mask.kronecker_phi::<PS, PT, PU, PV>(0, 0).unwrap()).unwrap();
+            let op = PinvOperator::new(
+                &dict,
+                &mask.kronecker_phi::<Fixed<PS>, Fixed<PT>, Fixed<PU>, Fixed<PV>>(0, 0).unwrap(),
+            )
+            .unwrap();
             let pinv_out = solve_pinv(&op, &cfg, &mut ws).unwrap();
             let e = rel_err32(ws.patch(), &fast);
             assert!(e <= 1e-4, "dict {dseed} k {k}: fast vs pinv rel diff {e}");
@@ -81,10 +88,11 @@ fn fast_path_equals_pinv_path_full_view_patch() {
 
 #[test]
 fn pinv_path_needs_the_kronecker_measurements() {
-    let dict = Dictionary::<5, 5, 4, 4, 13>::dct();
+    let dict = Dictionary::<PaperShape>::dct();
     let mask = Mask::kronecker(1, 2, 13, L5, (5, 5)).unwrap();
-    let op = PinvOperator::new(&dict, &mask.kronecker_phi::<5, 5, 4, 4>(0, 0).unwrap()).unwrap();
-    let truth = smooth_patch::<5, 5, 4, 4, 13, 5200>(1);
+    let op =
+        PinvOperator::new(&dict, &mask.kronecker_phi::<Fixed<5>, Fixed<5>, Fixed<4>, Fixed<4>>(0, 0).unwrap()).unwrap();
+    let truth = smooth_patch::<PaperShape>(1);
     let mut w = ws();
     // Measured with a pixel mask: not what this Phi selects.
     measure(&Mask::pixel(1, 2, 13, L5).unwrap(), (0, 0), &truth, &mut w);
@@ -104,15 +112,15 @@ fn pinv_path_needs_the_kronecker_measurements() {
 
 /// k = 13 measures every band of every pixel: the decode is the patch itself.
 fn all_bands_reproduce<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const N: usize>() {
-    let dict = Dictionary::<PS, PT, PU, PV, 13>::dct();
-    let truth = smooth_patch::<PS, PT, PU, PV, 13, N>(9);
+    let dict = Dictionary::<PatchShape<PS, PT, PU, PV, 13, N>>::dct();
+    let truth = smooth_patch::<PatchShape<PS, PT, PU, PV, 13, N>>(9);
     let all = [
         Mask::kronecker(1, 13, 13, L5, (PS as u8, PT as u8)).unwrap(),
         Mask::lenslet(2, 13, 13, L5).unwrap(),
         Mask::pixel(3, 13, 13, L5).unwrap(),
     ];
     for mask in all {
-        let mut w = Box::new(Workspace::<PS, PT, PU, PV, 13, N>::new());
+        let mut w = Box::new(Workspace::<PatchShape<PS, PT, PU, PV, 13, N>>::new());
         measure(&mask, (5, 10), &truth, &mut w);
         assert_eq!(w.measurements().count(), N);
         let out = solve(&dict, &Sl0Config::DEFAULT, &mut w).unwrap();
@@ -130,7 +138,7 @@ fn all_thirteen_bands_reproduce_the_patch() {
 
 #[test]
 fn bad_config_is_a_typed_error() {
-    let dict = Dictionary::<5, 5, 4, 4, 13>::dct();
+    let dict = Dictionary::<PaperShape>::dct();
     let mut w = ws();
     w.measurements_mut().set(0, 0.5).unwrap();
     let d = Sl0Config::DEFAULT;
@@ -172,9 +180,9 @@ macro_rules! shape_suite {
             const PV: usize = $pv;
             const N: usize = $n;
             type Shape = PatchShape<5, 5, PU, PV, 13, N>;
-            type Dict = Dictionary<5, 5, PU, PV, 13>;
+            type Dict = Dictionary<PatchShape<5, 5, PU, PV, 13, N>>;
 
-            fn wsn() -> Box<Workspace<5, 5, PU, PV, 13, N>> {
+            fn wsn() -> Box<Workspace<PatchShape<5, 5, PU, PV, 13, N>>> {
                 Box::new(Workspace::new())
             }
 
@@ -214,7 +222,7 @@ macro_rules! shape_suite {
                 let dict = Dict::dct();
                 let mut errs = [0.0; 3];
                 for seed in 0..3 {
-                    let truth = smooth_patch::<5, 5, PU, PV, 13, N>(40 + seed);
+                    let truth = smooth_patch::<PatchShape<5, 5, PU, PV, 13, N>>(40 + seed);
                     for (e, mask) in errs.iter_mut().zip(masks(3)) {
                         let mut w = wsn();
                         measure(&mask, (0, 0), &truth, &mut w);
@@ -233,7 +241,7 @@ macro_rules! shape_suite {
                 let noise = 0.02f32;
                 let mut err = [0.0f64; 2];
                 for seed in 0..3u64 {
-                    let truth = smooth_patch::<5, 5, PU, PV, 13, N>(60 + seed);
+                    let truth = smooth_patch::<PatchShape<5, 5, PU, PV, 13, N>>(60 + seed);
                     let mut w = wsn();
                     measure(&mask, (0, 0), &truth, &mut w);
                     let mut r = rng(seed);
@@ -266,7 +274,7 @@ macro_rules! shape_suite {
             #[test]
             fn the_iteration_bound_is_honoured_and_reported() {
                 let dict = Dict::dct();
-                let truth = smooth_patch::<5, 5, PU, PV, 13, N>(3);
+                let truth = smooth_patch::<PatchShape<5, 5, PU, PV, 13, N>>(3);
                 let mut w = wsn();
                 measure(&masks(1)[2], (0, 0), &truth, &mut w);
                 let cfg = Sl0Config { max_iterations: 7, ..Sl0Config::DEFAULT };
@@ -384,7 +392,7 @@ macro_rules! shape_suite {
 
             #[test]
             fn hard_sigma_min_below_f32_resolution() {
-                let truth = smooth_patch::<5, 5, PU, PV, 13, N>(8);
+                let truth = smooth_patch::<PatchShape<5, 5, PU, PV, 13, N>>(8);
                 for sigma_min in [1e-30f32, f32::MIN_POSITIVE, 1e-45] {
                     for max_iterations in [100_000, 50] {
                         let cfg = Sl0Config { sigma_min, max_iterations, ..Sl0Config::DEFAULT };
@@ -432,13 +440,13 @@ shape_suite!(full_view_patch, 5, 5, 8125);
 /// snapshots; at one snapshot the ball is `p / 16`.
 #[test]
 fn weighted_noise_ball_holds_the_solution_and_fits_less_noise() {
-    let dict = Dictionary::<5, 5, 4, 4, 13>::dct();
+    let dict = Dictionary::<PaperShape>::dct();
     let (noise, shot) = (0.002f32, 1.0 / 500.0); // a dim sensor: 500 electrons at white
     for k in [1u8, 3] {
         let mask = Mask::pixel(31, k, 13, L5).unwrap();
         let mut err = [0.0f64; 2];
         for seed in 0..3u64 {
-            let truth = smooth_patch::<5, 5, 4, 4, 13, 5200>(70 + seed);
+            let truth = smooth_patch::<PaperShape>(70 + seed);
             let mut w = ws();
             measure(&mask, (0, 0), &truth, &mut w);
             let mut r = rng(seed);

@@ -103,7 +103,7 @@ fn chip(frames: &[Vec<u16>], bus_error: core::ops::Range<usize>, short: core::op
 #[derive(Default)]
 struct Collect(Vec<(PatchOrigin, Vec<f32>)>);
 
-impl PatchSink<5200> for Collect {
+impl PatchSink<PaperShape> for Collect {
     type Error = ();
     fn accept(&mut self, o: PatchOrigin, p: &[f32; 5200], _: &PatchReport) -> Result<(), ()> {
         self.0.push((o, p.to_vec()));
@@ -111,7 +111,7 @@ impl PatchSink<5200> for Collect {
     }
 }
 
-fn decoder(mask: Mask<'static>) -> TileDecoder<'static, 5, 5, 4, 4, 13, 5200> {
+fn decoder(mask: Mask<'static>) -> TileDecoder<'static, PaperShape> {
     let raw = RawFormat::bits(12, 64.0);
     TileDecoder::new(DecoderConfig { sensor: SENSOR, mask, raw, defects: DefectList::EMPTY, sl0: Sl0Config::DEFAULT })
         .unwrap()

@@ -10,7 +10,7 @@ use slf_firmware::*;
 const L5: LensletSize = LensletSize { rows: 5, cols: 5 };
 /// 10 x 15 lenslets of 5 x 5 views: 2 x 3 blocks of the paper's patch, 50 x 75 pixels.
 const SENSOR: SensorGeometry = SensorGeometry { lenslets: (10, 15), lenslet: L5 };
-type Decoder<'a> = TileDecoder<'a, 5, 5, 4, 4, 13, 5200>;
+type Decoder<'a> = TileDecoder<'a, PaperShape>;
 
 /// A smooth 5D light field over the whole sensor, `[s][t][u][v][b]`.
 fn light_field() -> Vec<f32> {
@@ -73,7 +73,7 @@ struct Collect {
     rejected: Vec<(PatchOrigin, SolveError)>,
 }
 
-impl PatchSink<5200> for Collect {
+impl PatchSink<PaperShape> for Collect {
     type Error = ();
     fn accept(&mut self, origin: PatchOrigin, patch: &[f32; 5200], report: &PatchReport) -> Result<(), ()> {
         self.accepted.push((origin, patch.to_vec(), *report));
@@ -98,7 +98,7 @@ fn config(mask: Mask<'static>) -> DecoderConfig<'static> {
     }
 }
 
-fn decode_all(dec: &Decoder, frames: &[Vec<f32>], dict: &Dictionary<5, 5, 4, 4, 13>) -> (Collect, TileReport) {
+fn decode_all(dec: &Decoder, frames: &[Vec<f32>], dict: &Dictionary<PaperShape>) -> (Collect, TileReport) {
     let raw: Vec<RawFrame<f32>> = frames.iter().map(|f| RawFrame::new(f, 50, 75).unwrap()).collect();
     let mut src = FrameSource::new(&raw);
     let mut sink = Collect::default();
@@ -338,10 +338,10 @@ fn full_view_patches_need_one_window() {
     let mask = Mask::pixel(2, 3, 13, L5).unwrap();
     let frames = capture(&l, &mask);
     let raw: Vec<RawFrame<f32>> = frames.iter().map(|f| RawFrame::new(f, 50, 75).unwrap()).collect();
-    let dec = TileDecoder::<5, 5, 5, 5, 13, 8125>::new(config(mask)).unwrap();
+    let dec = TileDecoder::<FullViewShape>::new(config(mask)).unwrap();
     assert_eq!(dec.windows().count(), 1);
     struct Count(usize, f64);
-    impl PatchSink<8125> for Count {
+    impl PatchSink<FullViewShape> for Count {
         type Error = ();
         fn accept(&mut self, _: PatchOrigin, p: &[f32; 8125], _: &PatchReport) -> Result<(), ()> {
             self.0 += 1;
@@ -350,7 +350,7 @@ fn full_view_patches_need_one_window() {
         }
     }
     let mut sink = Count(0, 0.0);
-    let mut ws = Box::new(Workspace::<5, 5, 5, 5, 13, 8125>::new());
+    let mut ws = Box::new(Workspace::<FullViewShape>::new());
     let r = dec.decode_frame(&Dictionary::dct(), (2, 3), &mut FrameSource::new(&raw), &mut sink, &mut ws);
     assert_eq!((r.patches.decoded, sink.0), (6, 6));
     let mean = sink.1 / (6.0 * 8125.0);
@@ -390,7 +390,7 @@ fn tiles_cover_every_lenslet_of_any_sensor() {
 /// Seeds from the truth, as a frame's first pass would give them (sensor units).
 struct TruthSeed<'a>(&'a [f32], bool);
 
-impl PatchSeed<5200> for TruthSeed<'_> {
+impl PatchSeed<PaperShape> for TruthSeed<'_> {
     fn seed(&mut self, origin: PatchOrigin, patch: &mut [f32; 5200]) -> bool {
         patch.copy_from_slice(&truth_patch(self.0, origin));
         if self.1 {
@@ -415,7 +415,7 @@ fn a_seeded_tile_decode_starts_each_patch_from_its_balanced_seed() {
     let tile = Tile { lenslet_row: 0, lenslet_col: 5, lenslet_rows: 5, lenslet_cols: 5 };
     let mut ws = Box::new(PaperWorkspace::new());
     // One tile into a sink of its own, from nothing (`None`) or seeded by `seed`.
-    let run = |seed: Option<&mut dyn PatchSeed<5200>>| {
+    let run = |seed: Option<&mut dyn PatchSeed<PaperShape>>| {
         let (mut sink, mut ws) = (Collect::default(), Box::new(PaperWorkspace::new()));
         let mut src = FrameSource::new(&raw);
         match seed {

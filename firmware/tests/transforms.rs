@@ -6,6 +6,8 @@ use common::*;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
 use slf_firmware::Dictionary;
+use slf_firmware::PaperShape;
+use slf_firmware::PatchShape;
 use slf_firmware::transform::{analyze, synthesize};
 
 /// Synthesis and analysis of random patches with a random orthonormal dictionary and with
@@ -18,7 +20,7 @@ fn check_against_dense<
     const B: usize,
     const N: usize,
 >() {
-    for (dseed, dict) in [(0u64, Dictionary::<PS, PT, PU, PV, B>::dct()), (7, random_dictionary(7))] {
+    for (dseed, dict) in [(0u64, Dictionary::<PatchShape<PS, PT, PU, PV, B, N>>::dct()), (7, random_dictionary(7))] {
         let (k, n) = dense_kronecker(dict.synthesis());
         assert_eq!(n, N);
         let (kt, _) = dense_kronecker(dict.analysis());
@@ -51,7 +53,7 @@ fn full_view_patch_transforms_match_dense_kronecker() {
 
 #[test]
 fn synthesis_then_analysis_is_identity() {
-    let dict = random_dictionary::<5, 5, 4, 4, 13>(3);
+    let dict = random_dictionary::<PaperShape>(3);
     let mut r = rng(4);
     let s: Vec<f32> = (0..5200).map(|_| rand::Rng::random_range(&mut r, -1.0f32..1.0)).collect();
     let mut a: Box<[f32; 5200]> = Box::new(s.clone().try_into().unwrap());
@@ -72,7 +74,7 @@ fn adjoint_case<const PS: usize, const PT: usize, const PU: usize, const PV: usi
     x: &[f32],
     y: &[f32],
 ) -> Result<(), TestCaseError> {
-    let dict = random_dictionary::<PS, PT, PU, PV, B>(dict_seed);
+    let dict = random_dictionary::<PatchShape<PS, PT, PU, PV, B, N>>(dict_seed);
     let mut xa: Box<[f32; N]> = Box::new(x.try_into().unwrap());
     let mut ax = Box::new([0.0f32; N]);
     synthesize(&dict, &mut xa, &mut ax);

@@ -6,8 +6,8 @@ mod common;
 use common::*;
 use slf_firmware::*;
 
-type Ws = Workspace<5, 5, 4, 4, 13, 5200>;
-type Decoder = TileDecoder<'static, 5, 5, 4, 4, 13, 5200>;
+type Ws = Workspace<PaperShape>;
+type Decoder = TileDecoder<'static, PaperShape>;
 
 const L5: LensletSize = LensletSize { rows: 5, cols: 5 };
 
@@ -18,7 +18,7 @@ fn frames(l: &[f32], mask: &Mask) -> Vec<RawFrame<'static, f32>> {
         .collect()
 }
 
-fn decode<M: PatchModel<5, 5, 4, 4, 13, 5200>>(dec: &Decoder, raw: &[RawFrame<f32>], model: &M) -> Patches {
+fn decode<M: PatchModel<PaperShape>>(dec: &Decoder, raw: &[RawFrame<f32>], model: &M) -> Patches {
     let mut sink = Patches::default();
     let mut ws = Box::new(Ws::new());
     let r = dec.decode_frame(model, (2, 3), &mut FrameSource::new(raw), &mut sink, &mut ws);
@@ -37,9 +37,9 @@ fn a_pilots_errors_are_the_held_out_estimates_of_each_model() {
     let mask = Mask::pixel(4, 3, 13, L5).unwrap();
     let raw = frames(&l, &mask);
     let dec = Decoder::new(decoder_config((10, 15), mask)).unwrap();
-    let dct = Dictionary::<5, 5, 4, 4, 13>::dct();
-    let other = random_dictionary::<5, 5, 4, 4, 13>(7);
-    let estimated = |model: &Dictionary<5, 5, 4, 4, 13>| {
+    let dct = Dictionary::<PaperShape>::dct();
+    let other = random_dictionary::<PaperShape>(7);
+    let estimated = |model: &Dictionary<PaperShape>| {
         let dec = dec.with_error_estimate(Some(HoldOut::DEFAULT)).unwrap();
         decode(&dec, &raw, model).0
     };
@@ -83,9 +83,9 @@ fn the_trial_picks_the_model_nearer_the_truth_in_either_order() {
         let l = rough_light_field(seed);
         let raw = frames(&l, &mask);
         let dec = Decoder::new(decoder_config((10, 15), mask)).unwrap();
-        let dct = Dictionary::<5, 5, 4, 4, 13>::dct();
+        let dct = Dictionary::<PaperShape>::dct();
         // A member the scene is not sparse in: the DCT's neighbour in a random rotation.
-        let other = random_dictionary::<5, 5, 4, 4, 13>(seed + 10);
+        let other = random_dictionary::<PaperShape>(seed + 10);
         let truth = [true_rms(&decode(&dec, &raw, &dct), &l), true_rms(&decode(&dec, &raw, &other), &l)];
         let nearer = if truth[0] < truth[1] { Pick::First } else { Pick::Second };
         let mut ws = Box::new(Ws::new());
@@ -108,8 +108,8 @@ fn the_picked_model_decodes_as_it_does_alone() {
     let mask = Mask::pixel(4, 3, 13, L5).unwrap();
     let raw = frames(&l, &mask);
     let dec = Decoder::new(decoder_config((10, 15), mask)).unwrap();
-    let dct = Dictionary::<5, 5, 4, 4, 13>::dct();
-    let other = random_dictionary::<5, 5, 4, 4, 13>(9);
+    let dct = Dictionary::<PaperShape>::dct();
+    let other = random_dictionary::<PaperShape>(9);
     let (by_dct, by_other) = (decode(&dec, &raw, &dct), decode(&dec, &raw, &other));
     let first = decode(&dec, &raw, &Picked { first: &dct, second: &other, pick: Pick::First });
     let second = decode(&dec, &raw, &Picked { first: &dct, second: &other, pick: Pick::Second });
@@ -256,7 +256,7 @@ fn sheared_light_field(d: f32) -> Vec<f32> {
 #[test]
 fn the_shear_trial_pilots_half_pixel_blocks_and_finds_a_true_half_disparity_better() {
     let mask = Mask::pixel(4, 1, 13, L5).unwrap();
-    let dct = Dictionary::<5, 5, 4, 4, 13>::dct();
+    let dct = Dictionary::<PaperShape>::dct();
     let mut ws = Box::new(Ws::new());
     let halves = DisparityRange::DEFAULT.with_halves(true);
     // At a whole disparity (0: every view alike) no block is a pilot.
@@ -296,7 +296,7 @@ struct Counting<'m, M> {
     solves: std::cell::Cell<u32>,
 }
 
-impl<M: PatchModel<5, 5, 4, 4, 13, 5200>> PatchModel<5, 5, 4, 4, 13, 5200> for Counting<'_, M> {
+impl<M: PatchModel<PaperShape>> PatchModel<PaperShape> for Counting<'_, M> {
     fn decode(&self, cfg: &Sl0Config, ws: &mut Ws) -> Result<ModelOutcome, SolveError> {
         let out = self.model.decode(cfg, ws);
         // A failed solve ran too: one, as the trial counts it.
@@ -313,10 +313,10 @@ impl<M: PatchModel<5, 5, 4, 4, 13, 5200>> PatchModel<5, 5, 4, 4, 13, 5200> for C
 
 #[test]
 fn a_trial_counts_the_solves_its_pilots_ran() {
-    let dct = Dictionary::<5, 5, 4, 4, 13>::dct();
+    let dct = Dictionary::<PaperShape>::dct();
     let blob = slf_firmware::DEFAULT_ENSEMBLE;
     let ensemble =
-        EnsembleModel::new(Ensemble::<5, 5, 4, 4, 13>::new(blob).unwrap(), MemberChoice::Screened(ChoiceRule::DEFAULT));
+        EnsembleModel::new(Ensemble::<PaperShape>::new(blob).unwrap(), MemberChoice::Screened(ChoiceRule::DEFAULT));
     let mut ws = Box::new(Ws::new());
     // The model trial: the DCT's solve and the screened ensemble's two or three a pilot.
     let mask = Mask::pixel(4, 3, 13, L5).unwrap();

@@ -25,6 +25,7 @@
 //!
 //! Prints `key value` lines for `scripts/roofline.sh` and nothing else.
 
+use slf_firmware::Shape;
 use std::hint::black_box;
 use std::time::Instant;
 
@@ -37,7 +38,7 @@ use slf_firmware::transform::{analyze, synthesize};
 use slf_firmware::{DEFAULT_FULL_VIEW_ENSEMBLE, Dictionary, Ensemble, FullViewShape, Measurements};
 
 const N: usize = FullViewShape::N;
-type Full = Dictionary<5, 5, 5, 5, 13>;
+type Full = Dictionary<FullViewShape>;
 
 /// Peak multiply-adds a cycle of one AVX2 core: 2 pipes x 8 lanes.
 const PEAK_MACS_PER_CYCLE: f64 = 16.0;
@@ -98,17 +99,17 @@ fn main() -> anyhow::Result<()> {
     println!("peak_macs_per_cycle {PEAK_MACS_PER_CYCLE}");
     println!("peak_gmacs {:.2}", ghz * PEAK_MACS_PER_CYCLE);
     let mut rng = ChaCha8Rng::seed_from_u64(62);
-    let ensemble = Ensemble::<5, 5, 5, 5, 13>::new(DEFAULT_FULL_VIEW_ENSEMBLE).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let ensemble = Ensemble::<FullViewShape>::new(DEFAULT_FULL_VIEW_ENSEMBLE).map_err(|e| anyhow::anyhow!("{e}"))?;
     let member = ensemble.member(0).map_err(|e| anyhow::anyhow!("{e}"))?;
     // Pixel k = 1: one band a pixel, the band of a 3 x 3 periodic mask.
-    let mut m = Box::new(Measurements::<N>::new());
+    let mut m = Box::new(Measurements::<slf_firmware::shape::ValueCount<N>>::new());
     for p in 0..N / 13 {
         let b = (p * 7 + p / 25) % 13;
         m.set(p * 13 + b, rng.random_range(0.0f32..1.0)).map_err(|e| anyhow::anyhow!("{e:?}"))?;
     }
     let ball = Ball::new(0.0, 0.0, m.count() as u32, 0);
     let transform = FullViewShape::TRANSFORM_MACS as f64;
-    let projection = projection_macs::<5, 5, 5, 5, 13>(m.count()) as f64;
+    let projection = projection_macs::<FullViewShape>(m.count()) as f64;
     println!("transform_macs {transform}");
     println!("projection_macs {projection}");
     println!("measurements {}", m.count());

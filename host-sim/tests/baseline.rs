@@ -11,6 +11,7 @@
 //! config against 1e-4. The f64 comparison uses the DCT computed in f64 (the f32 tables are
 //! orthonormal only to about 1e-7), and the 1D method accumulates its dense products in f64.
 
+use slf_firmware::Shape;
 use slf_host::decode::paper_1d::{Dense1D, Factors, solve_5d};
 use slf_host::firmware::{Dictionary, LensletSize, Mask, PaperShape, PaperWorkspace, Sl0Config, solve};
 use slf_host::sim::scene::{self, SceneSize};
@@ -21,7 +22,7 @@ fn max_diff<T: Copy + Into<f64>>(a: &[T], b: &[T]) -> f64 {
 
 #[test]
 fn five_d_equals_one_d_for_every_mask_family() {
-    let dict = Dictionary::<5, 5, 4, 4, 13>::dct();
+    let dict = Dictionary::<PaperShape>::dct();
     let lf = scene::named("depth").unwrap().render(SceneSize { views: (4, 4), rows: 20, cols: 20 });
     let l4 = LensletSize { rows: 4, cols: 4 };
     for k in [1u8, 3] {
@@ -78,7 +79,7 @@ fn five_d_equals_one_d_for_every_mask_family() {
 /// movement directly as the distance between successive patches.
 #[test]
 fn early_stop_matches_the_directly_measured_f64_stop() {
-    let dict = Dictionary::<5, 5, 4, 4, 13>::dct();
+    let dict = Dictionary::<PaperShape>::dct();
     let lf = scene::named("texture").unwrap().render(SceneSize { views: (4, 4), rows: 20, cols: 20 });
     let l4 = LensletSize { rows: 4, cols: 4 };
     let f64_dct = Factors::dct_f64();

@@ -4,6 +4,7 @@
 //! overlap ring, and the command line.
 
 use assert_cmd::Command;
+use slf_firmware::PatchShape;
 use slf_host::decode::cs::{Basis, DecodeOptions, PatchViews, decode_with, disparity_per_lenslet, tile_decoder};
 use slf_host::eval::metrics::psnr;
 use slf_host::firmware::disparity::Disparity;
@@ -124,8 +125,8 @@ fn ring_matches_the_host<const PU: usize, const PV: usize, const N: usize>(views
     let mut strip = vec![0.0f32; od.strip_len(6)];
     let mut rows = Rows(LightField::zeros(truth.views, truth.rows, truth.cols, 13));
     let raw = capture.raw_frames().unwrap();
-    let mut ws = Box::new(Workspace::<5, 5, PU, PV, 13, N>::new());
-    let dct = common::DctModel::<PU, PV>::shipped();
+    let mut ws = Box::new(Workspace::<PatchShape<5, 5, PU, PV, 13, N>>::new());
+    let dct = common::DctModel::<PU, PV, N>::shipped();
     let r = od.decode_frame(&dct, &mut FrameSource::new(&raw), &mut strip, &mut rows, &mut ws).unwrap();
     assert_eq!((r.bands, r.uncovered, r.filled as usize), (3, 0, report.filled), "{views} views");
     let worst = host.data.iter().zip(&rows.0.data).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);

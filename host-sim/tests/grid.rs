@@ -6,6 +6,7 @@
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use slf_firmware::FullViewShape;
 use slf_host::io::capture::VERSION_SENSOR;
 use slf_host::io::lightfield::LightField;
 use slf_host::io::sensor::SensorDescription;
@@ -241,7 +242,7 @@ fn the_decode_reads_each_view_where_the_grid_puts_it() {
     let g = slf_host::io::grid::GridDescription::aligned([30, 30], [5, 5]).firmware([5, 5]).unwrap();
     let gridded = plain.decoder::<5, 5, 8125>(slf_firmware::Sl0Config::DEFAULT).unwrap().with_grid(Some(g)).unwrap();
     let raw = plain.raw_frames().unwrap();
-    let dct = Box::new(slf_firmware::Dictionary::<5, 5, 5, 5, 13>::dct());
+    let dct = Box::new(slf_firmware::Dictionary::<FullViewShape>::dct());
     let mut outs = Vec::new();
     for d in [&dec, &gridded] {
         let mut got = Vec::new();
@@ -331,7 +332,7 @@ fn behind_a_grid_the_default_disparities_are_whole() {
 /// Every accepted patch's values, in order.
 struct Collect<'a>(&'a mut Vec<Vec<u32>>);
 
-impl slf_firmware::PatchSink<8125> for Collect<'_> {
+impl slf_firmware::PatchSink<FullViewShape> for Collect<'_> {
     type Error = ();
     fn accept(
         &mut self,

@@ -2,6 +2,8 @@
 //! (a one-patch tile each), then averaged with the window's weights in f64; for the paper's
 //! patch (four angular windows a block) and the full-view patch (one).
 
+use slf_firmware::Shape;
+use slf_firmware::shape::PerValue;
 use slf_host::decode::cs::{Basis, DecodeOptions, PatchViews, SolveSchedule, Window, decode_with, tile_decoder};
 use slf_host::firmware::tile::PatchSeed;
 use slf_host::firmware::{
@@ -17,10 +19,10 @@ use common::Rows;
 /// Keeps the patches a one-patch tile sends (one per angular window).
 struct Kept(Vec<(PatchOrigin, Vec<f32>)>);
 
-impl<const N: usize> PatchSink<N> for Kept {
+impl<S: Shape> PatchSink<S> for Kept {
     type Error = core::convert::Infallible;
-    fn accept(&mut self, o: PatchOrigin, patch: &[f32; N], _: &PatchReport) -> Result<(), Self::Error> {
-        self.0.push((o, patch.to_vec()));
+    fn accept(&mut self, o: PatchOrigin, patch: &PerValue<S, f32>, _: &PatchReport) -> Result<(), Self::Error> {
+        self.0.push((o, patch.as_ref().to_vec()));
         Ok(())
     }
     fn reject(&mut self, _: PatchOrigin, _: SolveError) -> Result<(), Self::Error> {
@@ -48,7 +50,9 @@ fn unsheared() -> DecodeOptions {
 /// lenslets and views (unsheared), as the decode's sink receives a patch.
 struct FirstPass<'a, const PU: usize, const PV: usize>(&'a LightField, &'a [f32]);
 
-impl<const PU: usize, const PV: usize, const N: usize> PatchSeed<N> for FirstPass<'_, PU, PV> {
+impl<const PU: usize, const PV: usize, const N: usize> PatchSeed<PatchShape<5, 5, PU, PV, 13, N>>
+    for FirstPass<'_, PU, PV>
+{
     fn seed(&mut self, o: PatchOrigin, patch: &mut [f32; N]) -> bool {
         for (i, x) in patch.iter_mut().enumerate() {
             let [s, t, u, v, b] = PatchShape::<5, 5, PU, PV, 13, N>::coordinates(i);
@@ -74,8 +78,8 @@ fn reference<const PU: usize, const PV: usize, const N: usize>(
     let opts = unsheared();
     let decoder = tile_decoder::<PU, PV, N>(&capture, &opts).unwrap();
     let raw = capture.raw_frames().unwrap();
-    let dct = common::DctModel::<PU, PV>::shipped();
-    let mut ws = Box::new(Workspace::<5, 5, PU, PV, 13, N>::new());
+    let dct = common::DctModel::<PU, PV, N>::shipped();
+    let mut ws = Box::new(Workspace::<PatchShape<5, 5, PU, PV, 13, N>>::new());
     let (rows, cols) = (truth.rows, truth.cols);
     let mut sum = vec![0.0f64; truth.data.len()];
     let mut weight = vec![0.0f64; truth.data.len()];
@@ -161,8 +165,8 @@ fn overlap_matches_the_reference<const PU: usize, const PV: usize, const N: usiz
         let mut strip = vec![0.0f32; od.strip_len(4)];
         let mut rows = Rows(LightField::zeros(truth.views, truth.rows, truth.cols, 13));
         let raw = capture.raw_frames().unwrap();
-        let mut ws = Box::new(Workspace::<5, 5, PU, PV, 13, N>::new());
-        let dct = common::DctModel::<PU, PV>::shipped();
+        let mut ws = Box::new(Workspace::<PatchShape<5, 5, PU, PV, 13, N>>::new());
+        let dct = common::DctModel::<PU, PV, N>::shipped();
         let r = od.decode_frame(&dct, &mut FrameSource::new(&raw), &mut strip, &mut rows, &mut ws).unwrap();
         assert_eq!((r.bands, r.uncovered), (3, 0));
         let worst = fast.data.iter().zip(&rows.0.data).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
@@ -200,11 +204,11 @@ fn seeded_matches_the_reference<const PU: usize, const PV: usize, const N: usize
         let overlap = Overlap { stride: (stride as u8, stride as u8), window, seeded: true };
         let od = OverlapDecoder::new(tile_decoder::<PU, PV, N>(&capture, &opts).unwrap(), overlap).unwrap();
         let raw = capture.raw_frames().unwrap();
-        let dct = common::DctModel::<PU, PV>::shipped();
+        let dct = common::DctModel::<PU, PV, N>::shipped();
         for width in [11, 4] {
             let mut strip = vec![0.0f32; od.strip_len(width)];
             let mut rows = Rows(LightField::zeros(truth.views, truth.rows, truth.cols, 13));
-            let mut ws = Box::new(Workspace::<5, 5, PU, PV, 13, N>::new());
+            let mut ws = Box::new(Workspace::<PatchShape<5, 5, PU, PV, 13, N>>::new());
             let r = od.decode_frame(&dct, &mut FrameSource::new(&raw), &mut strip, &mut rows, &mut ws).unwrap();
             assert_eq!(r.uncovered, 0);
             let scale = fast.data.iter().fold(0.0f32, |m, x| m.max(x.abs()));

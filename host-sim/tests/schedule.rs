@@ -4,6 +4,7 @@
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use slf_firmware::Dictionary;
+use slf_firmware::FullViewShape;
 use slf_host::train::schedule::{self, Params, Problem, ScheduleConfig};
 use slf_host::train::{self, Generator};
 
@@ -17,14 +18,14 @@ fn problems(count: usize, seed: u64) -> Vec<Problem<N>> {
     patches.chunks_exact(N).map(|t| Problem::new(t, &schedule::random_pattern::<5, 5, N>(&mut rng))).collect()
 }
 
-fn loss(dict: &Dictionary<5, 5, 5, 5, 13>, params: &Params<5, 5>, p: &Problem<N>, start: &[f32]) -> f64 {
+fn loss(dict: &Dictionary<FullViewShape>, params: &Params<5, 5>, p: &Problem<N>, start: &[f32]) -> f64 {
     let s = params.schedule().unwrap();
     schedule::loss_and_gradient(dict, params, &s, p, start).0
 }
 
 #[test]
 fn gradients_match_finite_differences() {
-    let dict = Dictionary::<5, 5, 5, 5, 13>::dct();
+    let dict = Dictionary::<FullViewShape>::dct();
     let p = &problems(1, 7)[0];
     let zero_filled: Vec<f32> = (0..N).map(|i| p.measurements.get(i).unwrap_or(0.0)).collect();
     let start = schedule::start(&dict, p, &zero_filled);
@@ -75,7 +76,7 @@ fn training_lowers_the_error_on_held_out_patches() {
     let patches: Vec<f32> = train_set.iter().flat_map(|p| p.truth.clone()).collect();
     let cfg =
         ScheduleConfig { cold_steps: 8, warm_steps: 4, patches: 48, iterations: 30, batch: 16, ..Default::default() };
-    let dct = Dictionary::<5, 5, 5, 5, 13>::dct();
+    let dct = Dictionary::<FullViewShape>::dct();
     let dicts = [dct];
     let (trained, report) = schedule::train::<5, 5, N>(&dicts, Some(0), &patches, &cfg).unwrap();
     assert!(report.cold.last < report.cold.first, "{report:?}");

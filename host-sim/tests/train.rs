@@ -1,6 +1,9 @@
 //! Ensemble training: monotone at fixed assignments, orthonormal members, better than the
 //! DCT on held-out patches, reproducible to the byte; and the shipped ensemble.
 
+use slf_firmware::FullViewShape;
+use slf_firmware::PaperShape;
+use slf_firmware::PatchShape;
 use slf_host::firmware::{
     ChoiceRule, DEFAULT_ENSEMBLE, DEFAULT_FULL_VIEW_ENSEMBLE, Dictionary, Ensemble, EnsembleModel, MemberChoice, blob,
 };
@@ -24,7 +27,7 @@ fn one_update_never_increases_the_coding_error_at_fixed_assignments() {
     let data = patches(2000, 4, 240);
     let cfg = small();
     let members = train::init_members::<4, 4, 5200>(&data, &cfg);
-    let dicts: Vec<Dictionary<5, 5, 4, 4, 13>> = members.iter().map(|m| m.dictionary()).collect();
+    let dicts: Vec<Dictionary<PaperShape>> = members.iter().map(|m| m.dictionary()).collect();
     let assignment = train::assign::<4, 4, 5200>(&data, &dicts, cfg.tau);
     let mut updated = 0;
     for (k, m) in members.iter().enumerate().skip(1) {
@@ -37,7 +40,7 @@ fn one_update_never_increases_the_coding_error_at_fixed_assignments() {
         let after = train::member_error::<4, 4, 5200>(&data, &next, &group, cfg.tau);
         assert!(after <= before * (1.0 + 1e-9) + 1e-12, "member {k}: {before} -> {after}");
         // Learned matrices stay orthonormal to 1e-5 (in f32, as shipped).
-        let errs = next.dictionary::<4, 4>().synthesis().orthonormality_errors();
+        let errs = next.dictionary::<4, 4, 5200>().synthesis().orthonormality_errors();
         assert!(errs.iter().all(|&e| e <= 1e-5), "member {k}: {errs:?}");
         updated += 1;
     }
@@ -96,8 +99,8 @@ fn training_is_reproducible_to_the_byte() {
 
 #[test]
 fn the_shipped_ensembles_load_and_validate() {
-    fn check<const PU: usize, const PV: usize>(bytes: &[u8]) {
-        let e = Ensemble::<5, 5, PU, PV, 13>::new(bytes).unwrap();
+    fn check<const PU: usize, const PV: usize, const N: usize>(bytes: &[u8]) {
+        let e = Ensemble::<PatchShape<5, 5, PU, PV, 13, N>>::new(bytes).unwrap();
         assert_eq!(e.len(), 8, "{PU} views");
         let model = EnsembleModel::new(e, MemberChoice::Screened(ChoiceRule::DEFAULT));
         assert_eq!(model.dct_member(), Some(0), "{PU} views: member 0 is the fixed DCT");
@@ -106,9 +109,9 @@ fn the_shipped_ensembles_load_and_validate() {
             assert!(errs.iter().all(|&x| x <= 1e-5), "{PU} views, member {k}: {errs:?}");
         }
     }
-    check::<4, 4>(DEFAULT_ENSEMBLE);
-    check::<5, 5>(DEFAULT_FULL_VIEW_ENSEMBLE);
+    check::<4, 4, 5200>(DEFAULT_ENSEMBLE);
+    check::<5, 5, 8125>(DEFAULT_FULL_VIEW_ENSEMBLE);
     // Each is refused as the other patch's.
-    assert!(Ensemble::<5, 5, 5, 5, 13>::new(DEFAULT_ENSEMBLE).is_err());
-    assert!(Ensemble::<5, 5, 4, 4, 13>::new(DEFAULT_FULL_VIEW_ENSEMBLE).is_err());
+    assert!(Ensemble::<FullViewShape>::new(DEFAULT_ENSEMBLE).is_err());
+    assert!(Ensemble::<PaperShape>::new(DEFAULT_FULL_VIEW_ENSEMBLE).is_err());
 }

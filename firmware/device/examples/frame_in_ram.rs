@@ -23,7 +23,7 @@ struct Summary {
     sum: f32,
 }
 
-impl PatchSink<PAPER_N> for Summary {
+impl PatchSink<PaperShape> for Summary {
     type Error = core::convert::Infallible;
     fn accept(&mut self, _: PatchOrigin, patch: &PaperPatch, _: &PatchReport) -> Result<(), Self::Error> {
         self.patches += 1;

@@ -47,6 +47,7 @@ mod device {
     #[cfg(feature = "defmt")]
     use defmt_semihosting as _;
     use panic_semihosting as _;
+    use slf_firmware::Shape as _;
     use slf_firmware::{
         ChoiceRule, DEFAULT_FULL_VIEW_ENSEMBLE, DecoderConfig, DefectList, Dictionary, Disparity, DisparityRange,
         Ensemble, EnsembleModel, FrameSource, FullViewShape, FullViewWorkspace, HoldOut, LeU16Frame, LensletGrid,
@@ -107,7 +108,7 @@ mod device {
     #[inline(never)]
     fn calibrated(
         config: &DecoderConfig<'static>,
-        model: &EnsembleModel<'static, 5, 5, 5, 5, 13>,
+        model: &EnsembleModel<'static, FullViewShape>,
         ws: &mut FullViewWorkspace,
     ) -> u32 {
         static DEFECTS: [Pixel; SENSOR_DEFECTS.len()] = SENSOR_DEFECTS;
@@ -128,7 +129,7 @@ mod device {
             return 1;
         };
         let frames = [f0, f1, f2];
-        let plain = TileDecoder::<5, 5, 5, 5, 13, 8125>::new(*config)
+        let plain = TileDecoder::<FullViewShape>::new(*config)
             .ok()
             .and_then(|d| d.with_grid(Some(grid)).ok())
             .and_then(|d| d.estimate_gains(&mut FrameSource::new(&frames)).ok().and_then(|g| d.with_gains(&g).ok()));
@@ -137,7 +138,7 @@ mod device {
             return 1;
         };
         let raw = RawFormat { black: SENSOR_BLACK, white: SENSOR_WHITE, max_valid: MAX_VALID };
-        let calibrated = TileDecoder::<5, 5, 5, 5, 13, 8125>::new(DecoderConfig { raw, defects, ..*config })
+        let calibrated = TileDecoder::<FullViewShape>::new(DecoderConfig { raw, defects, ..*config })
             .ok()
             .and_then(|d| d.with_response(&response, ResponseModel::Unmix).ok())
             .and_then(|d| d.with_view_gains(Some((&VIEW_GAINS, SENSOR_REGIONS))).ok())
@@ -188,7 +189,7 @@ mod device {
         print: bool,
     }
 
-    impl PatchSink<8125> for Print {
+    impl PatchSink<FullViewShape> for Print {
         type Error = core::convert::Infallible;
         fn accept(&mut self, o: PatchOrigin, p: &[f32; 8125], r: &PatchReport) -> Result<(), Self::Error> {
             self.patches += 1;
@@ -240,8 +241,8 @@ mod device {
     /// dictionaries `EnsembleModel::new` compares (2 KB each) leave the stack with it
     /// instead of staying in `run`'s frame for the whole decode.
     #[inline(never)]
-    fn model() -> Option<EnsembleModel<'static, 5, 5, 5, 5, 13>> {
-        let ensemble = Ensemble::<5, 5, 5, 5, 13>::new(DEFAULT_FULL_VIEW_ENSEMBLE).ok()?;
+    fn model() -> Option<EnsembleModel<'static, FullViewShape>> {
+        let ensemble = Ensemble::<FullViewShape>::new(DEFAULT_FULL_VIEW_ENSEMBLE).ok()?;
         Some(EnsembleModel::new(ensemble, MemberChoice::Screened(ChoiceRule::DEFAULT)))
     }
 
@@ -279,7 +280,7 @@ mod device {
             defects: DefectList::EMPTY,
             sl0: Sl0Config { noise: NOISE, shot: SHOT, ..Sl0Config::DEFAULT },
         };
-        let Ok(decoder) = TileDecoder::<5, 5, 5, 5, 13, 8125>::new(config) else {
+        let Ok(decoder) = TileDecoder::<FullViewShape>::new(config) else {
             hprintln!("error: decoder config rejected");
             return debug::EXIT_FAILURE;
         };
@@ -301,7 +302,7 @@ mod device {
             return debug::EXIT_FAILURE;
         };
         // In flash: a `const` table, not 2 KB of the stack.
-        static DCT: Dictionary<5, 5, 5, 5, 13> = Dictionary::dct();
+        static DCT: Dictionary<FullViewShape> = Dictionary::dct();
         let dct = &DCT;
 
         // Window 0: one synthesis (FullViewShape::TRANSFORM_MACS multiply-adds).
@@ -347,7 +348,7 @@ mod device {
         // Built in the singleton, not by `EnsembleModel::scheduled_screen`: its value, moved
         // in, took 3.9 KB more peak stack (33,796 B against 29,900, `scripts/budgets.sh`).
         let Some(scheduled) = model.schedules().copied().and_then(|schedules| {
-            cortex_m::singleton!(: ScheduledDictionary<5, 5, 5, 5, 13> = ScheduledDictionary { dictionary: Dictionary::dct(), schedules })
+            cortex_m::singleton!(: ScheduledDictionary<FullViewShape> = ScheduledDictionary { dictionary: Dictionary::dct(), schedules })
         }) else {
             hprintln!("error: the shipped ensemble has no trained schedules");
             return debug::EXIT_FAILURE;
@@ -428,7 +429,7 @@ mod device {
         let camera = SensorGeometry { lenslets: (100, 100), lenslet };
         let ram_left = RAM_BYTES.saturating_sub(core::mem::size_of::<FullViewWorkspace>());
         for overlap in [Overlap::DEFAULT, Overlap { seeded: false, ..Overlap::DEFAULT }] {
-            if let Ok(camera) = TileDecoder::<5, 5, 5, 5, 13, 8125>::new(DecoderConfig { sensor: camera, ..config })
+            if let Ok(camera) = TileDecoder::<FullViewShape>::new(DecoderConfig { sensor: camera, ..config })
                 .map(|d| d.with_disparities(search))
                 .and_then(|d| OverlapDecoder::new(d, overlap))
             {

@@ -24,6 +24,7 @@ use crate::decode::engine::schedule::{Needs, Next, Schedule};
 use crate::decode::engine::strip::{SeedPatches, Strip, StripShape};
 pub use crate::decode::engine::window::Window;
 use crate::decode::tile::{ConfigError, TileDecoder, TileReport};
+use crate::operators::shape::Shape;
 use crate::sensor::source::TileSource;
 use crate::solver::choice::PatchModel;
 use crate::solver::workspace::Workspace;
@@ -86,41 +87,31 @@ impl<K: fmt::Debug> core::error::Error for OverlapError<K> {}
 
 /// The tile decoder with patches at a stride: checked config, stateless.
 #[derive(Clone, Copy, Debug)]
-pub struct OverlapDecoder<
-    'a,
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
-> {
-    tiles: TileDecoder<'a, PS, PT, PU, PV, B, N>,
+pub struct OverlapDecoder<'a, S: Shape> {
+    tiles: TileDecoder<'a, S>,
     overlap: Overlap,
     grids: Grids,
     /// Lenslet rows the strip holds: the schedule of the whole width run dry.
     needs: Needs,
 }
 
-impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
-    OverlapDecoder<'a, PS, PT, PU, PV, B, N>
-{
+impl<'a, S: Shape> OverlapDecoder<'a, S> {
     /// Checks the stride against the patch.
     ///
     /// # Errors
     /// [`ConfigError::Stride`] for a stride axis outside `1..=` the patch's size.
-    pub fn new(tiles: TileDecoder<'a, PS, PT, PU, PV, B, N>, overlap: Overlap) -> Result<Self, ConfigError> {
+    pub fn new(tiles: TileDecoder<'a, S>, overlap: Overlap) -> Result<Self, ConfigError> {
         let c = tiles.config().sensor;
         let (vu, vv) = (usize::from(c.lenslet.rows), usize::from(c.lenslet.cols));
         let halo = tiles.disparities().halo(vu.max(vv));
-        let grids =
-            Grids::new(c.lenslets, (PS, PT), overlap.stride, (1, 1), (1, 1), halo).map_err(|_| ConfigError::Stride)?;
+        let grids = Grids::new(c.lenslets, (S::PS, S::PT), overlap.stride, (1, 1), (1, 1), halo)
+            .map_err(|_| ConfigError::Stride)?;
         let needs = Schedule::new(grids, grids.disjoint(), grids.shifted()).needs(1);
         Ok(Self { tiles, overlap, grids, needs })
     }
 
     /// The tile decoder underneath.
-    pub fn tiles(&self) -> &TileDecoder<'a, PS, PT, PU, PV, B, N> {
+    pub fn tiles(&self) -> &TileDecoder<'a, S> {
         &self.tiles
     }
 
@@ -131,7 +122,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
 
     /// Whether the decode seeds: asked, and a stride below the patch's size.
     fn seeded(&self) -> bool {
-        self.overlap.seeded && self.overlap.stride != (PS as u8, PT as u8)
+        self.overlap.seeded && self.overlap.stride != (S::PS as u8, S::PT as u8)
     }
 
     /// Lenslet views (rows, cols) of the sensor.
@@ -148,14 +139,14 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     /// Columns a band holds beyond its own on each side, at most: a seeded band reads the
     /// seeds of every shifted patch that reaches it.
     fn margin(&self) -> usize {
-        if self.seeded() { PT + 2 * self.grids.halo() } else { 0 }
+        if self.seeded() { S::PT + 2 * self.grids.halo() } else { 0 }
     }
 
     /// `f32`s of a strip that decodes bands of `width` lenslet columns (the whole width in
     /// one band at the sensor's columns).
     pub fn strip_len(&self, width: usize) -> usize {
         let held = (width + 2 * self.margin()).min(self.grids.lenslets().1);
-        self.strip_shape(0..held, 0..held).buffer_len::<B>()
+        self.strip_shape(0..held, 0..held).buffer_len::<S::Bands>()
     }
 
     /// The strip of a band holding columns `held` and putting `out`.
@@ -193,13 +184,13 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     /// # Errors
     /// [`OverlapError::Strip`] before anything is read; [`OverlapError::Sink`] stops the
     /// decode (the rows sent stay sent).
-    pub fn decode_frame<M: PatchModel<PS, PT, PU, PV, B, N>, S: TileSource, K: RowSink>(
+    pub fn decode_frame<M: PatchModel<S>, Src: TileSource, K: RowSink>(
         &self,
         model: &M,
-        source: &mut S,
+        source: &mut Src,
         strip: &mut [f32],
         sink: &mut K,
-        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+        ws: &mut Workspace<S>,
     ) -> Result<OverlapReport, OverlapError<K::Error>> {
         let width = self.band_width(strip.len()).ok_or(OverlapError::Strip)?;
         let (grids, seeded, needs) = (self.grids, self.seeded(), self.needs);
@@ -209,8 +200,8 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         for band in Band::across(&grids, width, seeded) {
             report.bands += 1;
             let shape = self.strip_shape(band.held.clone(), band.out.clone());
-            let mut rows_held =
-                Strip::<B>::new(&mut *strip, shape, range, self.overlap.window).map_err(|_| OverlapError::Strip)?;
+            let mut rows_held = Strip::<S::Bands>::new(&mut *strip, shape, range, self.overlap.window)
+                .map_err(|_| OverlapError::Strip)?;
             let mut schedule = Schedule::new(grids, band.disjoint(&grids), band.shifted(&grids));
             let (mut fill, mut unused) = (Fill::default(), Fill::default());
             loop {
@@ -221,9 +212,9 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                     Next::Stalled => return Err(OverlapError::Strip),
                 };
                 if let Some(p) = planned {
-                    let (mut into, seeds) = rows_held.sink::<PS, PT, PU, PV>();
+                    let (mut into, seeds) = rows_held.sink::<S>();
                     let r = if seed {
-                        let mut q = SeedPatches::<PS, PT, PU, PV, B> { seeds, lenslets: (rows, cols) };
+                        let mut q = SeedPatches::<S> { seeds, lenslets: (rows, cols) };
                         self.tiles.decode_tile_seeded(model, p.tile, source, &mut q, &mut into, ws)
                     } else {
                         self.tiles.decode_tile(model, p.tile, source, &mut into, ws)

@@ -14,6 +14,7 @@
 use core::ops::AddAssign;
 
 use crate::decode::tile::{PatchOrigin, SHEAR_MARGIN, TileDecoder, TileSource};
+use crate::operators::shape::Shape;
 use crate::sensor::mask::MaskFamily;
 use crate::solver::choice::PatchModel;
 use crate::solver::holdout::HoldOut;
@@ -204,9 +205,7 @@ impl PairedErrors {
     }
 }
 
-impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
-    TileDecoder<'_, PS, PT, PU, PV, B, N>
-{
+impl<S: Shape> TileDecoder<'_, S> {
     /// The model trial on the block at lenslet `(row, col)`: its first window's patch,
     /// sheared as the decode shears it, decoded by `first` and by `second` from
     /// [`HoldOut::DEFAULT`]'s measurements; their held-out errors as one pilot (no pilot
@@ -215,25 +214,25 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
     ///
     /// # Errors
     /// The source's error.
-    pub fn trial<A, Z, S>(
+    pub fn trial<A, Z, Src>(
         &self,
         first: &A,
         second: &Z,
         (row, col): (u16, u16),
-        source: &mut S,
-        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
-    ) -> Result<ModelTrial, S::Error>
+        source: &mut Src,
+        ws: &mut Workspace<S>,
+    ) -> Result<ModelTrial, Src::Error>
     where
-        A: PatchModel<PS, PT, PU, PV, B, N>,
-        Z: PatchModel<PS, PT, PU, PV, B, N>,
-        S: TileSource,
+        A: PatchModel<S>,
+        Z: PatchModel<S>,
+        Src: TileSource,
     {
         let none = ModelTrial::default();
         let Some((view_row, view_col)) = self.windows().next() else { return Ok(none) };
         let disparity = self.choose_disparity(row as usize, col as usize, source)?;
         let origin = PatchOrigin { lenslet_row: row, lenslet_col: col, view_row, view_col, disparity };
         self.read_patch(origin, source, ws)?;
-        if bands_measured::<B, N>(ws.measurements()) < u32::from(self.config().sl0.min_bands) {
+        if bands_measured::<S>(ws.measurements()) < u32::from(self.config().sl0.min_bands) {
             return Ok(none);
         }
         let (a, solves_a) = self.estimate_error(first, &HoldOut::DEFAULT, origin, source, ws, true)?;
@@ -256,13 +255,13 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
     ///
     /// # Errors
     /// The source's error.
-    pub fn shear_trial<M: PatchModel<PS, PT, PU, PV, B, N>, S: TileSource>(
+    pub fn shear_trial<M: PatchModel<S>, Src: TileSource>(
         &self,
         model: &M,
         (row, col): (u16, u16),
-        source: &mut S,
-        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
-    ) -> Result<ShearTrial, S::Error> {
+        source: &mut Src,
+        ws: &mut Workspace<S>,
+    ) -> Result<ShearTrial, Src::Error> {
         let half = self.choose_disparity(row as usize, col as usize, source)?;
         if half.is_whole() {
             return Ok(ShearTrial::default());

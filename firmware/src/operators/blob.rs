@@ -22,17 +22,22 @@
 //! only copies one member's 1 KiB out of flash. A version 1 blob is read as before: its
 //! solves take the hand-set schedule.
 
+use core::marker::PhantomData;
+
 use crc::{CRC_32_ISO_HDLC, Crc};
 
-use crate::operators::dictionary::{Dictionary, DictionaryError, Factors, Matrix};
+use crate::operators::dictionary::{Dictionary, DictionaryError, Factors};
+use crate::operators::mode::{Mode, ModeMatrix};
 use crate::operators::schedule::{MAX_STEPS, Schedule, Schedules, Weights};
+use crate::operators::shape::Shape;
+use crate::sensor::extent::Array;
 
 /// The shipped default ensemble for the paper's patch (5 x 5 x 4 x 4 x 13): 8 members
 /// trained by `cargo run --release -p slf-host -- train -o firmware/dictionaries/ensemble8.slfd`
 /// (all defaults: 48 realistic training scenes of 60 x 60 lenslets, white-balanced as the
 /// decoder balances a capture, 20,000 patches, tau 100, 10 iterations, seed 1; member 0 is
 /// the fixed 5D DCT) on rendered scenes only, never the named test scenes or real data.
-/// `Ensemble::<5, 5, 4, 4, 13>::new(DEFAULT_ENSEMBLE)` validates it.
+/// `Ensemble::<PaperShape>::new(DEFAULT_ENSEMBLE)` validates it.
 pub static DEFAULT_ENSEMBLE: &[u8] = include_bytes!("../../dictionaries/ensemble8.slfd");
 
 /// The shipped default ensemble for the full-view patch (5 x 5 x 5 x 5 x 13), with its
@@ -41,7 +46,7 @@ pub static DEFAULT_ENSEMBLE: &[u8] = include_bytes!("../../dictionaries/ensemble
 /// training scenes as [`DEFAULT_ENSEMBLE`]), then its schedules by `slf train-schedule
 /// fullview8-ensemble.slfd -o firmware/dictionaries/fullview8.slfd` (all defaults: a cold
 /// schedule of 24 steps and a warm one of 16, on 1,024 patches of 24 realistic training
-/// scenes). `Ensemble::<5, 5, 5, 5, 13>::new(DEFAULT_FULL_VIEW_ENSEMBLE)` validates it.
+/// scenes). `Ensemble::<FullViewShape>::new(DEFAULT_FULL_VIEW_ENSEMBLE)` validates it.
 pub static DEFAULT_FULL_VIEW_ENSEMBLE: &[u8] = include_bytes!("../../dictionaries/fullview8.slfd");
 
 /// The magic bytes at the start of a blob.
@@ -120,21 +125,25 @@ fn put(buf: &mut [u8], at: usize, bytes: &[u8]) {
     }
 }
 
-fn read_matrix<const D: usize>(bytes: &[u8]) -> Matrix<D> {
-    let mut m = [[0.0f32; D]; D];
-    let (words, _) = bytes.as_chunks::<4>();
-    for (x, w) in m.as_flattened_mut().iter_mut().zip(words) {
-        *x = f32::from_le_bytes(*w);
+fn read_matrix<E: Mode>(bytes: &[u8]) -> ModeMatrix<E> {
+    let mut m = E::ZERO_MATRIX;
+    let mut words = bytes.as_chunks::<4>().0.iter();
+    for row in m.iter_mut() {
+        for (x, w) in row.iter_mut().zip(words.by_ref()) {
+            *x = f32::from_le_bytes(*w);
+        }
     }
     m
 }
 
-fn write_matrix<const D: usize>(m: &Matrix<D>, out: &mut [u8]) -> usize {
-    let (words, _) = out.as_chunks_mut::<4>();
-    for (w, x) in words.iter_mut().zip(m.as_flattened()) {
-        *w = x.to_le_bytes();
+fn write_matrix<E: Mode>(m: &ModeMatrix<E>, out: &mut [u8]) -> usize {
+    let mut words = out.as_chunks_mut::<4>().0.iter_mut();
+    for row in m.iter() {
+        for (x, w) in row.iter().zip(words.by_ref()) {
+            *w = x.to_le_bytes();
+        }
     }
-    4 * D * D
+    4 * E::D * E::D
 }
 
 fn f32_at(b: &[u8], at: usize) -> f32 {
@@ -142,11 +151,9 @@ fn f32_at(b: &[u8], at: usize) -> f32 {
 }
 
 /// One schedule from `bytes`; returns it and its length in bytes.
-fn read_schedule<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
-    bytes: &[u8],
-) -> Result<(Schedule<PS, PT, PU, PV, B>, usize), DictionaryError> {
+fn read_schedule<S: Shape>(bytes: &[u8]) -> Result<(Schedule<S>, usize), DictionaryError> {
     let steps = usize::from(u16_at(bytes, 0));
-    let len = schedule_len([PS, PT, PU, PV, B], steps);
+    let len = schedule_len([S::PS, S::PT, S::PU, S::PV, S::B], steps);
     if bytes.len() < 4 || steps == 0 || steps > MAX_STEPS || bytes.len() < len {
         return Err(DictionaryError::BadSchedule { part: "steps" });
     }
@@ -172,9 +179,7 @@ fn read_schedule<const PS: usize, const PT: usize, const PU: usize, const PV: us
 }
 
 /// The cold, the warm and the alone schedule, which must fill `bytes` exactly.
-fn read_schedules<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
-    bytes: &[u8],
-) -> Result<Schedules<PS, PT, PU, PV, B>, DictionaryError> {
+fn read_schedules<S: Shape>(bytes: &[u8]) -> Result<Schedules<S>, DictionaryError> {
     let (cold, a) = read_schedule(bytes)?;
     let (warm, b) = read_schedule(bytes.get(a..).unwrap_or(&[]))?;
     let (alone, c) = read_schedule(bytes.get(a + b..).unwrap_or(&[]))?;
@@ -185,10 +190,7 @@ fn read_schedules<const PS: usize, const PT: usize, const PU: usize, const PV: u
 }
 
 /// Writes one schedule at the start of `out`; returns its length.
-fn write_schedule<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
-    s: &Schedule<PS, PT, PU, PV, B>,
-    out: &mut [u8],
-) -> usize {
+fn write_schedule<S: Shape>(s: &Schedule<S>, out: &mut [u8]) -> usize {
     put(out, 0, &(s.len() as u16).to_le_bytes());
     put(out, 2, &u16::from(s.fill_start()).to_le_bytes());
     let mut at = 4;
@@ -202,17 +204,16 @@ fn write_schedule<const PS: usize, const PT: usize, const PU: usize, const PV: u
 
 /// A validated blob of K >= 1 members, read in place from flash.
 #[derive(Clone, Copy, Debug)]
-pub struct Ensemble<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> {
+pub struct Ensemble<'a, S: Shape> {
+    shape: PhantomData<S>,
     payload: &'a [u8],
     members: u16,
     /// The schedules' bytes (version 2), validated.
     schedules: Option<&'a [u8]>,
 }
 
-impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>
-    Ensemble<'a, PS, PT, PU, PV, B>
-{
-    const DIMS: [usize; 5] = [PS, PT, PU, PV, B];
+impl<'a, S: Shape> Ensemble<'a, S> {
+    const DIMS: [usize; 5] = [S::PS, S::PT, S::PU, S::PV, S::B];
     const MEMBER_LEN: usize = member_len(Self::DIMS);
 
     /// Checks a blob completely (see the module docs for the order of checks).
@@ -262,21 +263,25 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             return Err(DictionaryError::Checksum { stored, computed });
         }
         let schedules = (version == BLOB_VERSION).then(|| blob.get(HEADER_LEN + members_len..body_len).unwrap_or(&[]));
-        let ensemble =
-            Self { payload: blob.get(HEADER_LEN..HEADER_LEN + members_len).unwrap_or(&[]), members, schedules };
+        let ensemble = Self {
+            shape: PhantomData,
+            payload: blob.get(HEADER_LEN..HEADER_LEN + members_len).unwrap_or(&[]),
+            members,
+            schedules,
+        };
         for m in 0..members {
             ensemble.factors(m).validate(m)?;
         }
         if let Some(bytes) = schedules {
-            read_schedules::<PS, PT, PU, PV, B>(bytes)?;
+            read_schedules::<S>(bytes)?;
         }
         Ok(ensemble)
     }
 
     /// The trained schedules of a version 2 blob (validated by [`new`](Self::new)); `None`
     /// for a version 1 blob, whose solves take the hand-set schedule.
-    pub fn schedules(&self) -> Option<Schedules<PS, PT, PU, PV, B>> {
-        self.schedules.and_then(|b| read_schedules(b).ok())
+    pub fn schedules(&self) -> Option<Schedules<S>> {
+        self.schedules.and_then(|b| read_schedules::<S>(b).ok())
     }
 
     /// Number of members K.
@@ -289,7 +294,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         self.members == 0
     }
 
-    fn factors(&self, member: u16) -> Factors<PS, PT, PU, PV, B> {
+    fn factors(&self, member: u16) -> Factors<S> {
         let start = member as usize * Self::MEMBER_LEN;
         let bytes = self.payload.get(start..start + Self::MEMBER_LEN).unwrap_or(&[]);
         let mut at = 0;
@@ -299,11 +304,11 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             s
         };
         Factors {
-            m1: read_matrix::<PS>(next(PS)),
-            m2: read_matrix::<PT>(next(PT)),
-            m3: read_matrix::<PU>(next(PU)),
-            m4: read_matrix::<PV>(next(PV)),
-            m5: read_matrix::<B>(next(B)),
+            m1: read_matrix::<S::S>(next(S::PS)),
+            m2: read_matrix::<S::T>(next(S::PT)),
+            m3: read_matrix::<S::U>(next(S::PU)),
+            m4: read_matrix::<S::V>(next(S::PV)),
+            m5: read_matrix::<S::Bands>(next(S::B)),
         }
     }
 
@@ -311,7 +316,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     ///
     /// # Errors
     /// [`DictionaryError::NoSuchMember`] past the end.
-    pub fn member(&self, index: usize) -> Result<Dictionary<PS, PT, PU, PV, B>, DictionaryError> {
+    pub fn member(&self, index: usize) -> Result<Dictionary<S>, DictionaryError> {
         if index >= self.len() {
             return Err(DictionaryError::NoSuchMember {
                 index: index.min(u16::MAX as usize) as u16,
@@ -322,13 +327,13 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     }
 }
 
-impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> Dictionary<PS, PT, PU, PV, B> {
+impl<S: Shape> Dictionary<S> {
     /// Reads a blob that holds exactly one member.
     ///
     /// # Errors
     /// Any [`Ensemble::new`] error, or [`DictionaryError::MemberCount`] for K != 1.
     pub fn from_blob(blob: &[u8]) -> Result<Self, DictionaryError> {
-        let e = Ensemble::<PS, PT, PU, PV, B>::new(blob)?;
+        let e = Ensemble::<S>::new(blob)?;
         if e.len() != 1 {
             return Err(DictionaryError::MemberCount { found: e.members });
         }
@@ -341,10 +346,7 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
 /// # Errors
 /// [`DictionaryError::MemberCount`] for no members (or more than 65535),
 /// [`DictionaryError::BufferTooSmall`] when `out` is shorter than [`blob_len`].
-pub fn write_blob<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
-    members: &[Dictionary<PS, PT, PU, PV, B>],
-    out: &mut [u8],
-) -> Result<usize, DictionaryError> {
+pub fn write_blob<S: Shape>(members: &[Dictionary<S>], out: &mut [u8]) -> Result<usize, DictionaryError> {
     write_blob_scheduled(members, None, out)
 }
 
@@ -354,12 +356,12 @@ pub fn write_blob<const PS: usize, const PT: usize, const PU: usize, const PV: u
 ///
 /// # Errors
 /// As [`write_blob`].
-pub fn write_blob_scheduled<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
-    members: &[Dictionary<PS, PT, PU, PV, B>],
-    schedules: Option<&Schedules<PS, PT, PU, PV, B>>,
+pub fn write_blob_scheduled<S: Shape>(
+    members: &[Dictionary<S>],
+    schedules: Option<&Schedules<S>>,
     out: &mut [u8],
 ) -> Result<usize, DictionaryError> {
-    let dims = [PS, PT, PU, PV, B];
+    let dims = [S::PS, S::PT, S::PU, S::PV, S::B];
     if members.is_empty() || members.len() > u16::MAX as usize {
         return Err(DictionaryError::MemberCount { found: members.len().min(u16::MAX as usize) as u16 });
     }
@@ -386,11 +388,11 @@ pub fn write_blob_scheduled<const PS: usize, const PT: usize, const PU: usize, c
     let mut at = 0;
     for m in members {
         let d = &m.d;
-        at += write_matrix(&d.m1, rest.get_mut(at..).unwrap_or_default());
-        at += write_matrix(&d.m2, rest.get_mut(at..).unwrap_or_default());
-        at += write_matrix(&d.m3, rest.get_mut(at..).unwrap_or_default());
-        at += write_matrix(&d.m4, rest.get_mut(at..).unwrap_or_default());
-        at += write_matrix(&d.m5, rest.get_mut(at..).unwrap_or_default());
+        at += write_matrix::<S::S>(&d.m1, rest.get_mut(at..).unwrap_or_default());
+        at += write_matrix::<S::T>(&d.m2, rest.get_mut(at..).unwrap_or_default());
+        at += write_matrix::<S::U>(&d.m3, rest.get_mut(at..).unwrap_or_default());
+        at += write_matrix::<S::V>(&d.m4, rest.get_mut(at..).unwrap_or_default());
+        at += write_matrix::<S::Bands>(&d.m5, rest.get_mut(at..).unwrap_or_default());
     }
     if let Some(s) = schedules {
         for schedule in [&s.cold, &s.warm, &s.alone] {

@@ -12,27 +12,12 @@
 
 use core::fmt;
 
-use crate::operators::dct::dct_matrix;
+use crate::operators::mode::{Fold, Mode, ModeMatrix};
+use crate::operators::shape::Shape;
 
-/// Which symmetry of a mode's matrix a mode product uses; found when its dictionary is
-/// built ([`Dictionary::dct`], or checked in [`Dictionary::new`]).
-///
-/// The DCT-II's rows are even or odd about their middle, `C[a][D-1-c] = (-1)^a C[a][c]`.
-/// A product by such a matrix first adds and subtracts the input's mirrored rows and then
-/// needs about half the multiplies (13 instead of 25 for `D = 5`, 8 instead of 16 for
-/// `D = 4`); on a core whose multiplier is the bottleneck that is about half the time.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Fold {
-    /// No symmetry used: `D^2` multiply-adds per column.
-    Plain,
-    /// Rows even or odd, `M[a][D-1-c] = (-1)^a M[a][c]` (the DCT-II: analysis).
-    Rows,
-    /// Columns even or odd, `M[D-1-n][k] = (-1)^k M[n][k]` (its transpose: synthesis).
-    Columns,
-}
-
-/// A `D x D` matrix, row-major.
-pub type Matrix<const D: usize> = [[f32; D]; D];
+/// A mode's matrix and its checks, where integrators found them before the modes had a
+/// file of their own.
+pub use crate::operators::mode::{Matrix, PARITY_TOLERANCE, has_parity, orthonormality_error, transpose};
 
 /// How far from orthonormal a matrix may be: every entry of `M M^T - I` within this.
 pub const ORTHONORMAL_TOLERANCE: f32 = 1e-4;
@@ -112,35 +97,37 @@ impl core::error::Error for DictionaryError {}
 
 /// Five matrices, one per mode: the dimensions of a patch in the types.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Factors<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> {
-    pub m1: Matrix<PS>,
-    pub m2: Matrix<PT>,
-    pub m3: Matrix<PU>,
-    pub m4: Matrix<PV>,
-    pub m5: Matrix<B>,
+pub struct Factors<S: Shape> {
+    pub m1: ModeMatrix<S::S>,
+    pub m2: ModeMatrix<S::T>,
+    pub m3: ModeMatrix<S::U>,
+    pub m4: ModeMatrix<S::V>,
+    pub m5: ModeMatrix<S::Bands>,
 }
 
-impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> Factors<PS, PT, PU, PV, B> {
+impl<S: Shape> Factors<S> {
     /// Every matrix transposed.
-    pub const fn transposed(&self) -> Self {
+    pub fn transposed(&self) -> Self {
         Self {
-            m1: transpose(&self.m1),
-            m2: transpose(&self.m2),
-            m3: transpose(&self.m3),
-            m4: transpose(&self.m4),
-            m5: transpose(&self.m5),
+            m1: S::S::transpose(&self.m1),
+            m2: S::T::transpose(&self.m2),
+            m3: S::U::transpose(&self.m3),
+            m4: S::V::transpose(&self.m4),
+            m5: S::Bands::transpose(&self.m5),
         }
     }
 
     /// The first mode (1..=5) whose matrix holds a non-finite value.
     pub fn first_non_finite(&self) -> Option<u8> {
-        let finite = |m: &[f32]| m.iter().all(|x| x.is_finite());
+        fn finite<E: Mode>(m: &ModeMatrix<E>) -> bool {
+            m.as_ref().iter().all(|row| row.as_ref().iter().all(|x| x.is_finite()))
+        }
         [
-            finite(self.m1.as_flattened()),
-            finite(self.m2.as_flattened()),
-            finite(self.m3.as_flattened()),
-            finite(self.m4.as_flattened()),
-            finite(self.m5.as_flattened()),
+            finite::<S::S>(&self.m1),
+            finite::<S::T>(&self.m2),
+            finite::<S::U>(&self.m3),
+            finite::<S::V>(&self.m4),
+            finite::<S::Bands>(&self.m5),
         ]
         .iter()
         .position(|ok| !ok)
@@ -150,11 +137,11 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
     /// Per mode, the largest entry of `|M M^T - I|`.
     pub fn orthonormality_errors(&self) -> [f32; 5] {
         [
-            orthonormality_error(&self.m1),
-            orthonormality_error(&self.m2),
-            orthonormality_error(&self.m3),
-            orthonormality_error(&self.m4),
-            orthonormality_error(&self.m5),
+            S::S::orthonormality_error(&self.m1),
+            S::T::orthonormality_error(&self.m2),
+            S::U::orthonormality_error(&self.m3),
+            S::V::orthonormality_error(&self.m4),
+            S::Bands::orthonormality_error(&self.m5),
         ]
     }
 
@@ -170,89 +157,42 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
     }
 }
 
-/// How far from even / odd a row may be for the transforms to use the symmetry: the
-/// symmetric half of the row is what they read, so this bounds what they change.
-pub const PARITY_TOLERANCE: f32 = 1e-6;
-
-/// Whether every row `a` of `m` is even (`a` even) or odd about its middle to
-/// [`PARITY_TOLERANCE`]: `m[a][D-1-c] = (-1)^a m[a][c]`, and so the middle entry of an odd
-/// row of odd length is 0.
-pub fn has_parity<const D: usize>(m: &Matrix<D>) -> bool {
-    m.iter().enumerate().all(|(a, row)| {
-        let sign = if a % 2 == 0 { 1.0 } else { -1.0 };
-        (0..D).all(|c| (row[D - 1 - c] - sign * row[c]).abs() <= PARITY_TOLERANCE)
-    })
-}
-
-/// The transpose of a square matrix.
-pub const fn transpose<const D: usize>(m: &Matrix<D>) -> Matrix<D> {
-    let mut t = [[0.0f32; D]; D];
-    let mut i = 0;
-    while i < D {
-        let mut j = 0;
-        while j < D {
-            t[j][i] = m[i][j];
-            j += 1;
-        }
-        i += 1;
-    }
-    t
-}
-
-/// The largest entry of `|M M^T - I|` (NaN if `M` holds NaN).
-pub fn orthonormality_error<const D: usize>(m: &Matrix<D>) -> f32 {
-    let mut worst = 0.0f32;
-    for (i, ri) in m.iter().enumerate() {
-        for (j, rj) in m.iter().enumerate() {
-            let dot: f32 = ri.iter().zip(rj).map(|(a, b)| a * b).sum();
-            let target = if i == j { 1.0 } else { 0.0 };
-            let e = (dot - target).abs();
-            if e.is_nan() || e > worst {
-                worst = e; // also carries NaN out
-            }
-        }
-    }
-    worst
-}
-
 /// One member of the signal model: an orthonormal matrix per mode, with its transposes.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Dictionary<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> {
+pub struct Dictionary<S: Shape> {
     /// `D_i`: synthesis matrices (columns are atoms).
-    pub(crate) d: Factors<PS, PT, PU, PV, B>,
+    pub(crate) d: Factors<S>,
     /// `D_i^T`: analysis matrices.
-    pub(crate) t: Factors<PS, PT, PU, PV, B>,
+    pub(crate) t: Factors<S>,
     /// Per mode 1..=4, whether `D_i^T`'s rows are even or odd about their middle (the
     /// DCT-II's symmetry), which the transforms use to halve their multiplies.
     pub(crate) parity: [bool; 4],
 }
 
-impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> Dictionary<PS, PT, PU, PV, B> {
+impl<S: Shape> Dictionary<S> {
     /// The separable orthonormal 5D DCT; a `const fn`, so a `static` of it is a flash table.
     pub const fn dct() -> Self {
+        const { S::CHECK };
         // Synthesis is the inverse DCT: D_i = C^T (columns of D_i are the cosine atoms).
-        let c = Factors {
-            m1: dct_matrix::<PS>(),
-            m2: dct_matrix::<PT>(),
-            m3: dct_matrix::<PU>(),
-            m4: dct_matrix::<PV>(),
-            m5: dct_matrix::<B>(),
-        };
-        Self { d: c.transposed(), t: c, parity: [true; 4] }
+        let d = Factors { m1: S::S::DCT_T, m2: S::T::DCT_T, m3: S::U::DCT_T, m4: S::V::DCT_T, m5: S::Bands::DCT_T };
+        let t = Factors { m1: S::S::DCT, m2: S::T::DCT, m3: S::U::DCT, m4: S::V::DCT, m5: S::Bands::DCT };
+        Self { d, t, parity: [true; 4] }
     }
 
     /// A dictionary from its synthesis matrices `D_1..D_5`.
     ///
     /// # Errors
     /// [`DictionaryError::NonFinite`] or [`DictionaryError::NotOrthonormal`] (member 0).
-    pub fn new(d: Factors<PS, PT, PU, PV, B>) -> Result<Self, DictionaryError> {
+    pub fn new(d: Factors<S>) -> Result<Self, DictionaryError> {
         d.validate(0)?;
         Ok(Self::from_validated(d))
     }
 
-    pub(crate) fn from_validated(d: Factors<PS, PT, PU, PV, B>) -> Self {
+    pub(crate) fn from_validated(d: Factors<S>) -> Self {
+        const { S::CHECK };
         let t = d.transposed();
-        let parity = [has_parity(&t.m1), has_parity(&t.m2), has_parity(&t.m3), has_parity(&t.m4)];
+        let parity =
+            [S::S::has_parity(&t.m1), S::T::has_parity(&t.m2), S::U::has_parity(&t.m3), S::V::has_parity(&t.m4)];
         Self { d, t, parity }
     }
 
@@ -274,12 +214,12 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
     }
 
     /// The synthesis matrices `D_1..D_5`.
-    pub fn synthesis(&self) -> &Factors<PS, PT, PU, PV, B> {
+    pub fn synthesis(&self) -> &Factors<S> {
         &self.d
     }
 
     /// The analysis matrices `D_1^T..D_5^T`.
-    pub fn analysis(&self) -> &Factors<PS, PT, PU, PV, B> {
+    pub fn analysis(&self) -> &Factors<S> {
         &self.t
     }
 }

@@ -27,6 +27,8 @@
 //! the neighbours' decode), and a dictionary decoding alone.
 
 use crate::operators::dictionary::DictionaryError;
+use crate::operators::shape::{PerBand, Shape};
+use crate::sensor::extent::{Extent, Per};
 
 /// The most steps a schedule may hold: bounds every trained solve.
 pub const MAX_STEPS: usize = 64;
@@ -35,32 +37,36 @@ pub const MAX_STEPS: usize = 64;
 /// at `[s, t, u, v, b]` weighs `s[s] * t[t] * u[u] * v[v] * b[b]`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Weights<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> {
-    pub s: [f32; PS],
-    pub t: [f32; PT],
-    pub u: [f32; PU],
-    pub v: [f32; PV],
-    pub b: [f32; B],
+pub struct Weights<S: Shape> {
+    pub s: Per<S::S, f32>,
+    pub t: Per<S::T, f32>,
+    pub u: Per<S::U, f32>,
+    pub v: Per<S::V, f32>,
+    pub b: PerBand<S, f32>,
 }
 
-impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> Weights<PS, PT, PU, PV, B> {
+impl<S: Shape> Weights<S> {
     /// Every weight 1: SL0's own penalty.
-    pub const ONES: Self = Self { s: [1.0; PS], t: [1.0; PT], u: [1.0; PU], v: [1.0; PV], b: [1.0; B] };
+    pub const ONES: Self = Self { s: S::S::ONES, t: S::T::ONES, u: S::U::ONES, v: S::V::ONES, b: S::Bands::ONES };
 
     /// The weights mode by mode (`s`, `t`, `u`, `v`, `b`).
     pub fn modes(&self) -> [&[f32]; 5] {
-        [&self.s, &self.t, &self.u, &self.v, &self.b]
+        [self.s.as_ref(), self.t.as_ref(), self.u.as_ref(), self.v.as_ref(), self.b.as_ref()]
     }
 
     /// The weights mode by mode, to write.
     pub fn modes_mut(&mut self) -> [&mut [f32]; 5] {
-        [&mut self.s, &mut self.t, &mut self.u, &mut self.v, &mut self.b]
+        [self.s.as_mut(), self.t.as_mut(), self.u.as_mut(), self.v.as_mut(), self.b.as_mut()]
     }
 
     /// The weight of the coefficient at `[s, t, u, v, b]` (0 outside the patch).
     pub fn at(&self, [s, t, u, v, b]: [usize; 5]) -> f32 {
         let get = |w: &[f32], i: usize| w.get(i).copied().unwrap_or(0.0);
-        get(&self.s, s) * get(&self.t, t) * get(&self.u, u) * get(&self.v, v) * get(&self.b, b)
+        get(self.s.as_ref(), s)
+            * get(self.t.as_ref(), t)
+            * get(self.u.as_ref(), u)
+            * get(self.v.as_ref(), v)
+            * get(self.b.as_ref(), b)
     }
 }
 
@@ -68,17 +74,17 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
 /// and the penalty's group weights.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Schedule<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> {
+pub struct Schedule<S: Shape> {
     len: u8,
     /// A cold solve's start: the band-gain fill (each unmeasured value from its pixel's
     /// measured bands and the patch's band means) instead of the minimum-norm solution.
     fill_start: bool,
     sigma: [f32; MAX_STEPS],
     mu: [f32; MAX_STEPS],
-    weights: Weights<PS, PT, PU, PV, B>,
+    weights: Weights<S>,
 }
 
-impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> Schedule<PS, PT, PU, PV, B> {
+impl<S: Shape> Schedule<S> {
     /// A checked schedule: 1 to [`MAX_STEPS`] steps (`sigma` and `mu` of the same length),
     /// every `sigma` in (0, 1], every `mu` in (0, 2] (above 2 the ascent grows a small
     /// coefficient: see the solver's `Sl0Config::mu`), every weight finite in
@@ -87,7 +93,7 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
     /// # Errors
     /// [`DictionaryError::BadSchedule`] naming the first bad part (`steps`, `sigma`, `mu`,
     /// `weights`).
-    pub fn new(sigma: &[f32], mu: &[f32], weights: Weights<PS, PT, PU, PV, B>) -> Result<Self, DictionaryError> {
+    pub fn new(sigma: &[f32], mu: &[f32], weights: Weights<S>) -> Result<Self, DictionaryError> {
         let bad = |part| Err(DictionaryError::BadSchedule { part });
         if sigma.is_empty() || sigma.len() > MAX_STEPS || sigma.len() != mu.len() {
             return bad("steps");
@@ -140,7 +146,7 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
     }
 
     /// The penalty's group weights.
-    pub fn weights(&self) -> &Weights<PS, PT, PU, PV, B> {
+    pub fn weights(&self) -> &Weights<S> {
         &self.weights
     }
 }
@@ -148,18 +154,18 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
 /// The three schedules a blob carries.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Schedules<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> {
+pub struct Schedules<S: Shape> {
     /// The screened choice's first solve, the DCT's from the measurements alone: its
     /// solution is scored in every member and starts the member's warm solve.
-    pub cold: Schedule<PS, PT, PU, PV, B>,
+    pub cold: Schedule<S>,
     /// A warm solve: from another member's solution or a seed.
-    pub warm: Schedule<PS, PT, PU, PV, B>,
+    pub warm: Schedule<S>,
     /// A dictionary decoding alone from the measurements (the DCT of the preview): its
     /// solution is the decode, with no member's solve after it. Trained apart from the cold
     /// one because the two ends differ: measured, the band-gain fill start made this
     /// solve 1.2-2.8 dB better on the realistic set and the screened choice after the cold
     /// one 0.2-1.8 dB worse.
-    pub alone: Schedule<PS, PT, PU, PV, B>,
+    pub alone: Schedule<S>,
 }
 
 #[cfg(test)]
@@ -168,11 +174,12 @@ mod tests {
 
     #[test]
     fn a_schedule_out_of_range_is_refused_by_name() {
-        let w = Weights::<5, 5, 5, 5, 13>::ONES;
-        let field = |r: Result<Schedule<5, 5, 5, 5, 13>, DictionaryError>| match r {
-            Err(DictionaryError::BadSchedule { part }) => part,
-            _ => "accepted",
-        };
+        let w = Weights::<crate::operators::shape::PatchShape<5, 5, 5, 5, 13, 8125>>::ONES;
+        let field =
+            |r: Result<Schedule<crate::operators::shape::PatchShape<5, 5, 5, 5, 13, 8125>>, DictionaryError>| match r {
+                Err(DictionaryError::BadSchedule { part }) => part,
+                _ => "accepted",
+            };
         assert_eq!(field(Schedule::new(&[], &[], w)), "steps");
         assert_eq!(field(Schedule::new(&[0.5; 65], &[1.0; 65], w)), "steps");
         assert_eq!(field(Schedule::new(&[0.5, 0.2], &[1.0], w)), "steps");
@@ -190,7 +197,7 @@ mod tests {
 
     #[test]
     fn a_weight_is_the_product_of_its_indices_weights() {
-        let mut w = Weights::<2, 2, 2, 2, 3>::ONES;
+        let mut w = Weights::<crate::operators::shape::PatchShape<2, 2, 2, 2, 3, 48>>::ONES;
         (w.s[1], w.t[0], w.u[1], w.v[1], w.b[2]) = (2.0, 3.0, 0.5, 4.0, 0.25);
         assert_eq!(w.at([1, 0, 1, 1, 2]), 2.0 * 3.0 * 0.5 * 4.0 * 0.25);
         assert_eq!(w.at([0, 1, 0, 0, 0]), 1.0);

@@ -25,15 +25,17 @@
 /// blown up without bound.
 pub const MAX_RATIO: f32 = 64.0;
 
+use crate::sensor::extent::Array;
+
 /// Gains from each band's sum of measurements and their count: each band's mean (at least
 /// the brightest mean over [`MAX_RATIO`]), scaled so the gains average 1 (the decode's
 /// values keep their overall size, so the solver's thresholds in normalised units keep
 /// their meaning). A band with no measurement gets the measured bands' mean gain; no
 /// positive mean at all (a black frame) gives gains of 1.
-pub fn gains_from_sums<const B: usize>(sums: &[f32; B], counts: &[u32; B]) -> [f32; B] {
-    let mut means = [0.0f32; B];
+pub fn gains_from_sums<G: Array<f32>, K: Array<u32>>(sums: &G, counts: &K) -> G {
+    let mut means = G::splat(0.0);
     let mut top = 0.0f32;
-    for ((m, &s), &c) in means.iter_mut().zip(sums).zip(counts) {
+    for ((m, &s), &c) in means.iter_mut().zip(sums.iter()).zip(counts.iter()) {
         if c > 0 {
             *m = s / c as f32;
             if *m > top {
@@ -42,11 +44,11 @@ pub fn gains_from_sums<const B: usize>(sums: &[f32; B], counts: &[u32; B]) -> [f
         }
     }
     if !(top > 0.0 && top.is_finite()) {
-        return [1.0; B];
+        return G::splat(1.0);
     }
     let floor = top / MAX_RATIO;
     let (mut total, mut measured) = (0.0f32, 0u32);
-    for (m, &c) in means.iter_mut().zip(counts) {
+    for (m, &c) in means.iter_mut().zip(counts.iter()) {
         if c > 0 {
             *m = if *m > floor { *m } else { floor };
             total += *m;
@@ -55,13 +57,13 @@ pub fn gains_from_sums<const B: usize>(sums: &[f32; B], counts: &[u32; B]) -> [f
     }
     // `measured >= 1`: `top > 0` came from a measured band.
     let fill = total / measured.max(1) as f32;
-    for (m, &c) in means.iter_mut().zip(counts) {
+    for (m, &c) in means.iter_mut().zip(counts.iter()) {
         if c == 0 {
             *m = fill;
         }
     }
     // The gains' mean is `fill` now (every band has a value): divide it out.
-    let mean = means.iter().sum::<f32>() / B.max(1) as f32;
+    let mean = means.iter().sum::<f32>() / means.len().max(1) as f32;
     for m in means.iter_mut() {
         *m /= mean;
     }

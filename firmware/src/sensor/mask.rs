@@ -24,6 +24,8 @@
 
 use core::fmt;
 
+use crate::sensor::extent::{Array, Extent};
+
 /// The largest number of bands (filter types) the decoder handles. It lives with the masks,
 /// the lowest layer that counts bands; the patch shape names it too.
 pub const MAX_BANDS: usize = 32;
@@ -391,40 +393,40 @@ impl<'a> Mask<'a> {
     /// # Errors
     /// [`SensingError::NotKronecker`] on another family, [`SensingError::BlockMismatch`] if
     /// `(PS, PT)` is not the mask's block.
-    pub fn kronecker_phi<const PS: usize, const PT: usize, const PU: usize, const PV: usize>(
+    pub fn kronecker_phi<S: Extent, T: Extent, U: Extent, V: Extent>(
         &self,
         row: usize,
         col: usize,
-    ) -> Result<KroneckerPhi<PS, PT, PU, PV>, SensingError> {
+    ) -> Result<KroneckerPhi<S, T, U, V>, SensingError> {
         let Pattern::Seeded(seed) = self.pattern else {
             return Err(SensingError::NotKronecker);
         };
         if self.family != MaskFamily::Kronecker {
             return Err(SensingError::NotKronecker);
         }
-        if (self.block.0 as usize, self.block.1 as usize) != (PS, PT) {
+        if (self.block.0 as usize, self.block.1 as usize) != (S::D, T::D) {
             return Err(SensingError::BlockMismatch);
         }
         Ok(KroneckerPhi {
-            shuffle1: shuffle(seed, 1),
-            shuffle2: shuffle(seed, 2),
-            shuffle3: shuffle(seed, 3),
-            shuffle4: shuffle(seed, 4),
+            shuffle1: shuffle::<S>(seed, 1),
+            shuffle2: shuffle::<T>(seed, 2),
+            shuffle3: shuffle::<U>(seed, 3),
+            shuffle4: shuffle::<V>(seed, 4),
             bands: self.bands_at(row, col),
         })
     }
 }
 
 /// A seeded permutation of `0..D`: the row shuffle of `Phi_mode`, the same for every block.
-fn shuffle<const D: usize>(seed: u64, mode: usize) -> [u8; D] {
-    let mut p = [0u8; D];
-    for (i, x) in p.iter_mut().enumerate() {
+fn shuffle<E: Extent>(seed: u64, mode: usize) -> E::Per<u8> {
+    let mut p = E::Per::<u8>::splat(0);
+    for (i, x) in p.as_mut().iter_mut().enumerate() {
         *x = i as u8;
     }
-    let mut stream = Stream::new(seed, TAG_SHUFFLE, mode, D);
-    for i in (1..D).rev() {
+    let mut stream = Stream::new(seed, TAG_SHUFFLE, mode, E::D);
+    for i in (1..E::D).rev() {
         let j = stream.below(i + 1);
-        p.swap(i, j);
+        p.as_mut().swap(i, j);
     }
     p
 }
@@ -435,11 +437,11 @@ fn shuffle<const D: usize>(seed: u64, mode: usize) -> [u8; D] {
 /// column `shuffle_i[r]`. `Phi5` is `k x B`: row `j` is one-hot at `bands[j]`. So
 /// `I[s, t, u, v, j] = L[shuffle1[s], shuffle2[t], shuffle3[u], shuffle4[v], bands[j]]`.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct KroneckerPhi<const PS: usize, const PT: usize, const PU: usize, const PV: usize> {
-    pub shuffle1: [u8; PS],
-    pub shuffle2: [u8; PT],
-    pub shuffle3: [u8; PU],
-    pub shuffle4: [u8; PV],
+pub struct KroneckerPhi<S: Extent, T: Extent, U: Extent, V: Extent> {
+    pub shuffle1: S::Per<u8>,
+    pub shuffle2: T::Per<u8>,
+    pub shuffle3: U::Per<u8>,
+    pub shuffle4: V::Per<u8>,
     pub bands: BandList,
 }
 

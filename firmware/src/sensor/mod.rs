@@ -1,5 +1,8 @@
 //! The sensor layer: raw frames and what the camera's filters make of them.
 //!
+//! - [`extent`]: an extent (the bands, or the views or lenslets along an axis) as a type
+//!   ([`Extent`](extent::Extent), [`Fixed`](extent::Fixed)), which containers sized by it
+//!   are generic over;
 //! - [`raw`]: samples and which of them are measurements (finite, not negative, not
 //!   saturated), frames in RAM or flash, one [`FrameSource`](raw::FrameSource) per capture;
 //! - [`source`]: the [`TileSource`](source::TileSource) trait every frame source implements;
@@ -16,6 +19,7 @@
 //! decode) may use it.
 
 pub mod defects;
+pub mod extent;
 pub mod gains;
 pub mod grid;
 pub mod mask;

@@ -18,6 +18,7 @@
 //! and decodes `x_b / g_b`: in those units the response is `G^-1 R G`
 //! ([`Response::balanced`]).
 
+use crate::sensor::extent::{Array, BandCount, Bands, Fixed, Square};
 use crate::sensor::mask::SensingError;
 
 /// The largest condition number (1-norm) a response may have: beyond it the filters do not
@@ -26,7 +27,7 @@ use crate::sensor::mask::SensingError;
 pub const MAX_CONDITION: f32 = 1e3;
 
 /// A checked `B x B` response matrix (row `f`: filter `f`'s transmission of each band) with
-/// its inverse.
+/// its inverse, over the bands `C` ([`crate::sensor::extent::BandCount`]).
 ///
 /// Both are held as their difference from the identity, so that the identity is all
 /// zeros: a [`crate::solver::workspace::Workspace`] holding one stays zero-initialised,
@@ -34,36 +35,35 @@ pub const MAX_CONDITION: f32 = 1e3;
 /// stored as ones on the diagonal, the emulated Cortex-M7 built the 107 KB workspace on the
 /// stack and copied it: the painted stack peak went from 27 to 104 KB).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Response<const B: usize> {
+pub struct Response<C: Bands> {
     /// `R - I`.
-    leak: [[f32; B]; B],
+    leak: Square<C, f32>,
     /// `R^-1 - I`.
-    unleak: [[f32; B]; B],
+    unleak: Square<C, f32>,
     mixed: bool,
 }
 
-impl<const B: usize> Response<B> {
+impl<C: Bands> Response<C> {
     /// The ideal filters: each pixel sees its band alone.
-    pub const IDENTITY: Self = Self { leak: [[0.0; B]; B], unleak: [[0.0; B]; B], mixed: false };
+    pub const IDENTITY: Self = Self { leak: C::ZERO_MATRIX, unleak: C::ZERO_MATRIX, mixed: false };
 
-    /// A checked response.
-    ///
-    /// # Errors
-    /// [`SensingError::Response`] for a matrix with an entry that is not finite, a row
-    /// whose sum is not positive, or a condition number above [`MAX_CONDITION`] (singular
-    /// included).
-    pub fn new(r: &[[f32; B]; B]) -> Result<Self, SensingError> {
-        if !r.iter().all(|row| row.iter().all(|x| x.is_finite()) && row.iter().sum::<f32>() > 0.0) {
+    /// A checked response ([`Response::new`]).
+    fn checked(r: &Square<C, f32>) -> Result<Self, SensingError> {
+        let rows = r.as_ref();
+        if !rows.iter().all(|row| row.as_ref().iter().all(|x| x.is_finite()) && row.as_ref().iter().sum::<f32>() > 0.0)
+        {
             return Err(SensingError::Response);
         }
-        let inverse = invert(r).ok_or(SensingError::Response)?;
-        let condition = norm1(r) * norm1(&inverse);
+        let inverse = invert::<C>(r).ok_or(SensingError::Response)?;
+        let condition = norm1::<C>(r) * norm1::<C>(&inverse);
         // (`is_finite` first: a NaN condition is refused too.)
-        if !condition.is_finite() || condition > MAX_CONDITION || !inverse.iter().flatten().all(|x| x.is_finite()) {
+        let finite = inverse.as_ref().iter().all(|row| row.as_ref().iter().all(|x| x.is_finite()));
+        if !condition.is_finite() || condition > MAX_CONDITION || !finite {
             return Err(SensingError::Response);
         }
-        let less = |m: &[[f32; B]; B]| map(m, |i, j, x| x - id(i, j));
-        let mixed = (0..B).any(|i| (0..B).any(|j| r[i][j] != id(i, j)));
+        let less = |m: &Square<C, f32>| map::<C, f32, f32>(m, |i, j, x| x - id(i, j));
+        let mixed =
+            rows.iter().enumerate().any(|(i, row)| row.as_ref().iter().enumerate().any(|(j, &x)| x != id(i, j)));
         Ok(Self { leak: less(r), unleak: less(&inverse), mixed })
     }
 
@@ -73,13 +73,13 @@ impl<const B: usize> Response<B> {
     }
 
     /// The matrix, row `f` for filter `f`.
-    pub fn matrix(&self) -> [[f32; B]; B] {
-        map(&self.leak, |i, j, x| x + id(i, j))
+    pub fn matrix(&self) -> Square<C, f32> {
+        map::<C, f32, f32>(&self.leak, |i, j, x| x + id(i, j))
     }
 
     /// Its inverse: `x = R^-1 z` for `z` one value per filter.
-    pub fn inverse(&self) -> [[f32; B]; B] {
-        map(&self.unleak, |i, j, x| x + id(i, j))
+    pub fn inverse(&self) -> Square<C, f32> {
+        map::<C, f32, f32>(&self.unleak, |i, j, x| x + id(i, j))
     }
 
     /// The response in white-balanced units, for band gains `g` (each positive, as
@@ -90,40 +90,56 @@ impl<const B: usize> Response<B> {
             return *self;
         }
         let gain = |b: usize| g.get(b).copied().unwrap_or(1.0);
-        let scale = |m: &[[f32; B]; B]| map(m, |f, b, x| x * gain(b) / gain(f));
+        let scale = |m: &Square<C, f32>| map::<C, f32, f32>(m, |f, b, x| x * gain(b) / gain(f));
         Self { leak: scale(&self.leak), unleak: scale(&self.unleak), mixed: true }
     }
 
     /// One pixel's spectrum as its filters see it, in place: `z = R x`.
-    pub fn mix(&self, x: &mut [f32; B]) {
+    pub fn mix(&self, x: &mut C::Per<f32>) {
         if self.mixed {
-            *x = apply(&self.leak, x);
+            *x = apply::<C>(&self.leak, x);
         }
     }
 
     /// One pixel's values, one per filter, unmixed in place: `x = R^-1 z`.
-    pub fn unmix(&self, z: &mut [f32; B]) {
+    pub fn unmix(&self, z: &mut C::Per<f32>) {
         if self.mixed {
-            *z = apply(&self.unleak, z);
+            *z = apply::<C>(&self.unleak, z);
         }
     }
 }
 
+impl<const B: usize> Response<BandCount<B>> {
+    /// A checked response of `B` bands.
+    ///
+    /// # Errors
+    /// [`SensingError::Response`] for a matrix with an entry that is not finite, a row
+    /// whose sum is not positive, or a condition number above [`MAX_CONDITION`] (singular
+    /// included).
+    pub fn new(r: &[[f32; B]; B]) -> Result<Self, SensingError> {
+        Self::checked(r)
+    }
+}
+
 /// `(I + d) x`.
-fn apply<const B: usize>(d: &[[f32; B]; B], x: &[f32; B]) -> [f32; B] {
+fn apply<C: Bands>(d: &Square<C, f32>, x: &C::Per<f32>) -> C::Per<f32> {
     let mut out = *x;
-    for (o, row) in out.iter_mut().zip(d) {
-        *o += row.iter().zip(x).map(|(a, v)| a * v).sum::<f32>();
+    for (o, row) in out.as_mut().iter_mut().zip(d.as_ref()) {
+        *o += row.as_ref().iter().zip(x.as_ref()).map(|(a, v)| a * v).sum::<f32>();
     }
     out
 }
 
 /// `f(i, j, m[i][j])` for every entry, by iterators: indexing inside `array::from_fn`
 /// left bounds checks (panic call sites) in the device's release build.
-fn map<const B: usize, T: Copy, U: Copy + Default>(m: &[[T; B]; B], f: impl Fn(usize, usize, T) -> U) -> [[U; B]; B] {
-    let mut out = [[U::default(); B]; B];
-    for (i, (o, row)) in out.iter_mut().zip(m).enumerate() {
-        for (j, (x, &v)) in o.iter_mut().zip(row).enumerate() {
+fn map<C: Bands, T, U>(m: &Square<C, T>, f: impl Fn(usize, usize, T) -> U) -> Square<C, U>
+where
+    T: Copy + core::fmt::Debug + PartialEq,
+    U: Copy + core::fmt::Debug + PartialEq + Default,
+{
+    let mut out = Square::<C, U>::splat(C::Per::<U>::splat(U::default()));
+    for (i, (o, row)) in out.as_mut().iter_mut().zip(m.as_ref()).enumerate() {
+        for (j, (x, &v)) in o.as_mut().iter_mut().zip(row.as_ref()).enumerate() {
             *x = f(i, j, v);
         }
     }
@@ -136,21 +152,23 @@ fn id(i: usize, j: usize) -> f32 {
 }
 
 /// The 1-norm (largest column sum of magnitudes).
-fn norm1<const B: usize>(m: &[[f32; B]; B]) -> f32 {
-    (0..B).map(|c| m.iter().map(|row| row[c].abs()).sum::<f32>()).fold(0.0, |a, s| if s > a { s } else { a })
+fn norm1<C: Bands>(m: &Square<C, f32>) -> f32 {
+    (0..C::D)
+        .map(|c| m.as_ref().iter().map(|row| row[c].abs()).sum::<f32>())
+        .fold(0.0, |a, s| if s > a { s } else { a })
 }
 
 /// `m^-1` by Gauss-Jordan elimination with partial pivoting in f64 (a one-off at set-up:
 /// f64 keeps the inverse's rounding far below the condition bound's), or `None` for a
 /// pivot below `1e-12` of the matrix's largest entry.
-#[allow(clippy::needless_range_loop)] // elimination reads best with its indices
-fn invert<const B: usize>(m: &[[f32; B]; B]) -> Option<[[f32; B]; B]> {
-    let mut a: [[f64; B]; B] = map(m, |_, _, x| f64::from(x));
-    let mut inv: [[f64; B]; B] = map(m, |i, j, _| if i == j { 1.0 } else { 0.0 });
-    let top = a.iter().flatten().fold(0.0f64, |t, x| if x.abs() > t { x.abs() } else { t });
-    for c in 0..B {
+fn invert<C: Bands>(m: &Square<C, f32>) -> Option<Square<C, f32>> {
+    let mut a: Square<C, f64> = map::<C, f32, f64>(m, |_, _, x| f64::from(x));
+    let mut inv: Square<C, f64> = map::<C, f32, f64>(m, |i, j, _| if i == j { 1.0 } else { 0.0 });
+    let top = a.as_ref().iter().flat_map(|row| row.as_ref()).fold(0.0f64, |t, x| if x.abs() > t { x.abs() } else { t });
+    let b = C::D;
+    for c in 0..b {
         let mut p = c;
-        for r in c + 1..B {
+        for r in c + 1..b {
             if a[r][c].abs() > a[p][c].abs() {
                 p = r;
             }
@@ -158,24 +176,38 @@ fn invert<const B: usize>(m: &[[f32; B]; B]) -> Option<[[f32; B]; B]> {
         if a[p][c].is_nan() || a[p][c].abs() <= 1e-12 * top {
             return None;
         }
-        a.swap(c, p);
-        inv.swap(c, p);
+        a.as_mut().swap(c, p);
+        inv.as_mut().swap(c, p);
         let pivot = 1.0 / a[c][c];
-        for j in 0..B {
+        for j in 0..b {
             a[c][j] *= pivot;
             inv[c][j] *= pivot;
         }
-        for r in 0..B {
+        for r in 0..b {
             if r != c {
                 let f = a[r][c];
                 if f != 0.0 {
-                    for j in 0..B {
-                        a[r][j] -= f * a[c][j];
-                        inv[r][j] -= f * inv[c][j];
+                    for j in 0..b {
+                        let (ac, ic) = (a[c][j], inv[c][j]);
+                        a[r][j] -= f * ac;
+                        inv[r][j] -= f * ic;
                     }
                 }
             }
         }
     }
-    Some(map(&inv, |_, _, x| x as f32))
+    Some(map::<C, f64, f32>(&inv, |_, _, x| x as f32))
+}
+
+/// A band count whose ideal response lives in static memory: what a decoder borrows when
+/// no response is given. (A constant of a type generic over `C` is not promoted to a
+/// static where it is borrowed, as the compiler cannot see that the type holds no cell;
+/// for [`Fixed`] counts it can.)
+pub trait StaticIdentity: Bands {
+    /// [`Response::IDENTITY`], in static memory.
+    const IDENTITY_REF: &'static Response<Self>;
+}
+
+impl<const B: usize> StaticIdentity for Fixed<B> {
+    const IDENTITY_REF: &'static Response<Self> = &Response::IDENTITY;
 }

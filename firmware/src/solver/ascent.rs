@@ -20,6 +20,8 @@
 //! range; the step within 3e-7 of the `libm::expf` step's size.
 
 use crate::operators::schedule::Weights;
+use crate::operators::shape::{Scratch, Shape};
+use crate::sensor::extent::{Array, Extent};
 
 /// `t` is clamped here: `2^-115` is a normal f32, and beyond it `mu * 2^t` is below
 /// `2^-25` for any `mu < 1e27`, so the step would leave `s` unchanged after rounding (the
@@ -151,31 +153,29 @@ pub fn ascend(coeffs: &mut [f32], mu: f32, inv: f32) -> f32 {
 /// band's once per step, so a coefficient costs one multiply more than in [`ascend`].
 ///
 /// Returns the squared length of the step, as [`ascend`] does.
-pub fn ascend_weighted<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
-    coeffs: &mut [f32],
-    mu: f32,
-    inv: f32,
-    weights: &Weights<PS, PT, PU, PV, B>,
-) -> f32 {
+pub fn ascend_weighted<S: Shape>(coeffs: &mut [f32], mu: f32, inv: f32, weights: &Weights<S>) -> f32 {
     let (c, skip) = exponents(mu, inv);
     let k = scaled(mu);
     // The exponent's factor of every (view, band) of a lenslet, `c w_u w_v w_b`, on the
     // stack ([u, v, b] is a contiguous run of the patch layout): each lenslet's run is
     // then one loop over contiguous values with a per-lenslet factor, which vectorises as
     // `ascend` does (a loop per 13-band fibre stayed 4 times slower).
-    let mut views = [[[0.0f32; B]; PV]; PU];
-    for (row, wu) in views.iter_mut().zip(&weights.u) {
-        for (fibre, wv) in row.iter_mut().zip(&weights.v) {
-            for (x, wb) in fibre.iter_mut().zip(&weights.b) {
+    let mut views = S::Lenslet::ZERO;
+    let views = views.values();
+    let mut fibres = S::Bands::chunks_mut(views).iter_mut();
+    for wu in weights.u.iter() {
+        for wv in weights.v.iter() {
+            let Some(fibre) = fibres.next() else { break };
+            for (x, wb) in fibre.iter_mut().zip(weights.b.iter()) {
                 *x = c * wu * wv * wb;
             }
         }
     }
-    let views = views.as_flattened().as_flattened();
+    let views = &*views;
     let mut sums = [0.0f32; 8];
-    let mut lenslets = coeffs.chunks_exact_mut(PU * PV * B);
-    for ws in &weights.s {
-        for wt in &weights.t {
+    let mut lenslets = coeffs.chunks_exact_mut(S::PU * S::PV * S::B);
+    for ws in weights.s.iter() {
+        for wt in weights.t.iter() {
             let Some(run) = lenslets.next() else { return sums.iter().sum() };
             lenslet_step(run, views, ws * wt, &k, skip, &mut sums);
         }

@@ -40,9 +40,11 @@
 
 use crate::operators::blob::Ensemble;
 use crate::operators::dictionary::Dictionary;
+use crate::operators::mode::{Mode, ModeMatrix};
 use crate::operators::schedule::Schedules;
-use crate::operators::shape::PatchShape;
+use crate::operators::shape::Shape;
 use crate::operators::transform::analyze_preserving;
+use crate::sensor::extent::Array;
 use crate::solver::sl0::{
     Ended, Outcome, Sl0Config, SolveError, max_abs, put_back, seed, solve, solve_scheduled, solve_seeded, solve_warm,
     solve_warm_scheduled,
@@ -201,13 +203,12 @@ pub struct ModelOutcome {
 /// Something that decodes the patch in a workspace: a single [`Dictionary`] (with the
 /// hand-set schedule, or trained ones: [`ScheduledDictionary`]) or an [`EnsembleModel`].
 /// The tile decoder takes any.
-pub trait PatchModel<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
-{
+pub trait PatchModel<S: Shape> {
     /// Decodes the patch whose measurements are in `ws` into `ws.patch()`.
     ///
     /// # Errors
     /// As [`solve`].
-    fn decode(&self, cfg: &Sl0Config, ws: &mut Workspace<PS, PT, PU, PV, B, N>) -> Result<ModelOutcome, SolveError>;
+    fn decode(&self, cfg: &Sl0Config, ws: &mut Workspace<S>) -> Result<ModelOutcome, SolveError>;
 
     /// Decodes the patch whose measurements are in `ws`, starting from the estimate of it
     /// in `ws.patch()` (its overlapping neighbours' decode, in the solve's balanced units):
@@ -216,11 +217,7 @@ pub trait PatchModel<const PS: usize, const PT: usize, const PU: usize, const PV
     ///
     /// # Errors
     /// As [`solve`].
-    fn decode_seeded(
-        &self,
-        cfg: &Sl0Config,
-        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
-    ) -> Result<ModelOutcome, SolveError> {
+    fn decode_seeded(&self, cfg: &Sl0Config, ws: &mut Workspace<S>) -> Result<ModelOutcome, SolveError> {
         self.decode(cfg, ws)
     }
 
@@ -231,24 +228,18 @@ pub trait PatchModel<const PS: usize, const PT: usize, const PU: usize, const PV
     ///
     /// # Errors
     /// As [`solve`].
-    fn estimating_solve(&self, cfg: &Sl0Config, ws: &mut Workspace<PS, PT, PU, PV, B, N>) -> Result<u16, SolveError> {
+    fn estimating_solve(&self, cfg: &Sl0Config, ws: &mut Workspace<S>) -> Result<u16, SolveError> {
         self.decode(cfg, ws).map(|d| d.solves)
     }
 }
 
-impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
-    PatchModel<PS, PT, PU, PV, B, N> for Dictionary<PS, PT, PU, PV, B>
-{
-    fn decode(&self, cfg: &Sl0Config, ws: &mut Workspace<PS, PT, PU, PV, B, N>) -> Result<ModelOutcome, SolveError> {
+impl<S: Shape> PatchModel<S> for Dictionary<S> {
+    fn decode(&self, cfg: &Sl0Config, ws: &mut Workspace<S>) -> Result<ModelOutcome, SolveError> {
         let outcome = solve(self, cfg, ws)?;
         Ok(ModelOutcome { outcome, member: None, solves: 1 })
     }
 
-    fn decode_seeded(
-        &self,
-        cfg: &Sl0Config,
-        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
-    ) -> Result<ModelOutcome, SolveError> {
+    fn decode_seeded(&self, cfg: &Sl0Config, ws: &mut Workspace<S>) -> Result<ModelOutcome, SolveError> {
         if let Some(outcome) = seed(self, cfg, ws)? {
             return Ok(ModelOutcome { outcome, member: None, solves: 0 });
         }
@@ -261,24 +252,18 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
 /// warm one from a seed. The DCT with the schedules of a blob that screens with it (its
 /// alone schedule is trained on the DCT's solves).
 #[derive(Clone, Debug)]
-pub struct ScheduledDictionary<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> {
-    pub dictionary: Dictionary<PS, PT, PU, PV, B>,
-    pub schedules: Schedules<PS, PT, PU, PV, B>,
+pub struct ScheduledDictionary<S: Shape> {
+    pub dictionary: Dictionary<S>,
+    pub schedules: Schedules<S>,
 }
 
-impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
-    PatchModel<PS, PT, PU, PV, B, N> for ScheduledDictionary<PS, PT, PU, PV, B>
-{
-    fn decode(&self, cfg: &Sl0Config, ws: &mut Workspace<PS, PT, PU, PV, B, N>) -> Result<ModelOutcome, SolveError> {
+impl<S: Shape> PatchModel<S> for ScheduledDictionary<S> {
+    fn decode(&self, cfg: &Sl0Config, ws: &mut Workspace<S>) -> Result<ModelOutcome, SolveError> {
         let outcome = solve_scheduled(&self.dictionary, cfg, &self.schedules.alone, ws)?;
         Ok(ModelOutcome { outcome, member: None, solves: 1 })
     }
 
-    fn decode_seeded(
-        &self,
-        cfg: &Sl0Config,
-        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
-    ) -> Result<ModelOutcome, SolveError> {
+    fn decode_seeded(&self, cfg: &Sl0Config, ws: &mut Workspace<S>) -> Result<ModelOutcome, SolveError> {
         if let Some(outcome) = seed(&self.dictionary, cfg, ws)? {
             return Ok(ModelOutcome { outcome, member: None, solves: 0 });
         }
@@ -300,39 +285,35 @@ enum Start {
 
 /// An ensemble with its member choice. Config: immutable, the blob stays in flash.
 #[derive(Clone, Debug)]
-pub struct EnsembleModel<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> {
-    ensemble: Ensemble<'a, PS, PT, PU, PV, B>,
-    screen: Dictionary<PS, PT, PU, PV, B>,
+pub struct EnsembleModel<'a, S: Shape> {
+    ensemble: Ensemble<'a, S>,
+    screen: Dictionary<S>,
     /// The member that is the screening DCT, if one is (to f32 rounding).
     screen_member: Option<u16>,
     choice: MemberChoice,
     /// The trained schedules its solves take; `None`: the hand-set schedule.
-    schedules: Option<Schedules<PS, PT, PU, PV, B>>,
+    schedules: Option<Schedules<S>>,
 }
 
 /// Whether two dictionaries hold the same matrices to `1e-6`.
-fn same<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
-    a: &Dictionary<PS, PT, PU, PV, B>,
-    b: &Dictionary<PS, PT, PU, PV, B>,
-) -> bool {
+fn same<S: Shape>(a: &Dictionary<S>, b: &Dictionary<S>) -> bool {
+    fn close<E: Mode>(x: &ModeMatrix<E>, y: &ModeMatrix<E>) -> bool {
+        x.iter().zip(y.iter()).all(|(x, y)| x.iter().zip(y.iter()).all(|(p, q)| (p - q).abs() <= 1e-6))
+    }
     let (a, b) = (a.synthesis(), b.synthesis());
-    let close = |x: &[f32], y: &[f32]| x.iter().zip(y).all(|(p, q)| (p - q).abs() <= 1e-6);
-    close(a.m1.as_flattened(), b.m1.as_flattened())
-        && close(a.m2.as_flattened(), b.m2.as_flattened())
-        && close(a.m3.as_flattened(), b.m3.as_flattened())
-        && close(a.m4.as_flattened(), b.m4.as_flattened())
-        && close(a.m5.as_flattened(), b.m5.as_flattened())
+    close::<S::S>(&a.m1, &b.m1)
+        && close::<S::T>(&a.m2, &b.m2)
+        && close::<S::U>(&a.m3, &b.m3)
+        && close::<S::V>(&a.m4, &b.m4)
+        && close::<S::Bands>(&a.m5, &b.m5)
 }
 
-type Ws<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize> =
-    Workspace<PS, PT, PU, PV, B, N>;
+type Ws<S> = Workspace<S>;
 
-impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>
-    EnsembleModel<'a, PS, PT, PU, PV, B>
-{
+impl<'a, S: Shape> EnsembleModel<'a, S> {
     /// An ensemble that screens with the 5D DCT, solving with the blob's trained schedules
     /// if it has them ([`Ensemble::schedules`]), else with the hand-set schedule.
-    pub fn new(ensemble: Ensemble<'a, PS, PT, PU, PV, B>, choice: MemberChoice) -> Self {
+    pub fn new(ensemble: Ensemble<'a, S>, choice: MemberChoice) -> Self {
         let screen = Dictionary::dct();
         let screen_member =
             (0..ensemble.len()).find(|&k| ensemble.member(k).is_ok_and(|m| same(&m, &screen))).map(|k| k as u16);
@@ -340,30 +321,30 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     }
 
     /// The model with these schedules for its solves (`None`: the hand-set schedule).
-    pub fn with_schedules(self, schedules: Option<Schedules<PS, PT, PU, PV, B>>) -> Self {
+    pub fn with_schedules(self, schedules: Option<Schedules<S>>) -> Self {
         Self { schedules, ..self }
     }
 
     /// The trained schedules its solves take, if any.
-    pub fn schedules(&self) -> Option<&Schedules<PS, PT, PU, PV, B>> {
+    pub fn schedules(&self) -> Option<&Schedules<S>> {
         self.schedules.as_ref()
     }
 
     /// The DCT it screens with, on its trained schedules (`None` without them): the model
     /// trial's other model ([`crate::decode::trial`]), which decodes as the DCT alone does.
-    pub fn scheduled_screen(&self) -> Option<ScheduledDictionary<PS, PT, PU, PV, B>> {
+    pub fn scheduled_screen(&self) -> Option<ScheduledDictionary<S>> {
         self.schedules.map(|schedules| ScheduledDictionary { dictionary: self.screen.clone(), schedules })
     }
 
     /// A solve of `ws` by `dict` from `start`: the trained schedule for it ([`Start::Cold`]:
     /// the cold one; otherwise the warm one), or without schedules the hand-set solve
     /// ([`solve`], [`solve_warm`], [`solve_seeded`]).
-    fn solve_from<const N: usize>(
+    fn solve_from(
         &self,
         start: Start,
-        dict: &Dictionary<PS, PT, PU, PV, B>,
+        dict: &Dictionary<S>,
         cfg: &Sl0Config,
-        ws: &mut Ws<PS, PT, PU, PV, B, N>,
+        ws: &mut Ws<S>,
     ) -> Result<Outcome, SolveError> {
         match (&self.schedules, start) {
             (Some(s), Start::Cold) => solve_scheduled(dict, cfg, &s.cold, ws),
@@ -375,7 +356,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     }
 
     /// The ensemble.
-    pub fn ensemble(&self) -> &Ensemble<'a, PS, PT, PU, PV, B> {
+    pub fn ensemble(&self) -> &Ensemble<'a, S> {
         &self.ensemble
     }
 
@@ -391,24 +372,14 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
 
     /// Scores the solution in `ws.patch()` in `member` by `rule`, analysing a copy in the
     /// coefficient buffer (the solution is only read).
-    fn score<const N: usize>(
-        &self,
-        member: &Dictionary<PS, PT, PU, PV, B>,
-        rule: &ChoiceRule,
-        ws: &mut Ws<PS, PT, PU, PV, B, N>,
-    ) -> f32 {
-        const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
+    fn score(&self, member: &Dictionary<S>, rule: &ChoiceRule, ws: &mut Ws<S>) -> f32 {
         analyze_preserving(member, &ws.signal, &mut ws.coeffs);
-        rule.score(&ws.coeffs)
+        rule.score(ws.coeffs.as_ref())
     }
 
     /// The member other than the DCT whose analysis of `ws.patch()` scores sparsest by
     /// `rule`, with its score (`None`: the ensemble has no other member).
-    fn screen_members<const N: usize>(
-        &self,
-        rule: &ChoiceRule,
-        ws: &mut Ws<PS, PT, PU, PV, B, N>,
-    ) -> Result<(f32, Option<u16>), SolveError> {
+    fn screen_members(&self, rule: &ChoiceRule, ws: &mut Ws<S>) -> Result<(f32, Option<u16>), SolveError> {
         let mut best = (f32::INFINITY, None);
         for k in (0..self.ensemble.len() as u16).filter(|&k| Some(k) != self.screen_member) {
             let s = self.score(&self.member(k)?, rule, ws);
@@ -419,17 +390,12 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         Ok(best)
     }
 
-    fn member(&self, k: u16) -> Result<Dictionary<PS, PT, PU, PV, B>, SolveError> {
+    fn member(&self, k: u16) -> Result<Dictionary<S>, SolveError> {
         self.ensemble.member(k as usize).map_err(|_| SolveError::NoSuchMember)
     }
 
     /// Exhaustive: every member solved and scored; the best solved again.
-    fn exhaustive<const N: usize>(
-        &self,
-        rule: &ChoiceRule,
-        cfg: &Sl0Config,
-        ws: &mut Ws<PS, PT, PU, PV, B, N>,
-    ) -> Result<ModelOutcome, SolveError> {
+    fn exhaustive(&self, rule: &ChoiceRule, cfg: &Sl0Config, ws: &mut Ws<S>) -> Result<ModelOutcome, SolveError> {
         let mut best = (f32::INFINITY, 0u16);
         for k in 0..self.ensemble.len() as u16 {
             let member = self.member(k)?;
@@ -451,11 +417,11 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     /// the ensemble holds the DCT and the member's solution does not score [`DCT_MARGIN`]
     /// times sparser than the DCT's own, the patch becomes the two solutions' mean, each weighted by the other's
     /// score, or (`resolve`) the DCT solves again from the member's.
-    fn screened<const N: usize>(
+    fn screened(
         &self,
         rule: &ChoiceRule,
         cfg: &Sl0Config,
-        ws: &mut Ws<PS, PT, PU, PV, B, N>,
+        ws: &mut Ws<S>,
         resolve: bool,
     ) -> Result<ModelOutcome, SolveError> {
         let first = self.solve_from(Start::Cold, &self.screen, cfg, ws)?;
@@ -504,12 +470,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     /// in the screened choice. One solve where the screened choice takes two, the first
     /// cold. Interpolating measurements (half-pixel shears) keep the member's solution:
     /// the stash holds unmeasured entries only.
-    fn seeded<const N: usize>(
-        &self,
-        rule: &ChoiceRule,
-        cfg: &Sl0Config,
-        ws: &mut Ws<PS, PT, PU, PV, B, N>,
-    ) -> Result<ModelOutcome, SolveError> {
+    fn seeded(&self, rule: &ChoiceRule, cfg: &Sl0Config, ws: &mut Ws<S>) -> Result<ModelOutcome, SolveError> {
         if let Some(outcome) = seed(&self.screen, cfg, ws)? {
             return Ok(ModelOutcome { outcome, member: self.screen_member, solves: 0 });
         }
@@ -541,10 +502,8 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     }
 }
 
-impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
-    PatchModel<PS, PT, PU, PV, B, N> for EnsembleModel<'_, PS, PT, PU, PV, B>
-{
-    fn decode(&self, cfg: &Sl0Config, ws: &mut Workspace<PS, PT, PU, PV, B, N>) -> Result<ModelOutcome, SolveError> {
+impl<S: Shape> PatchModel<S> for EnsembleModel<'_, S> {
+    fn decode(&self, cfg: &Sl0Config, ws: &mut Workspace<S>) -> Result<ModelOutcome, SolveError> {
         // One call site for both screened choices: two kept `screened` out of line, and its
         // frame on top of the caller's took 4 KiB more stack on the device.
         let (rule, resolve) = match self.choice {
@@ -555,7 +514,7 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
         self.screened(&rule, cfg, ws, resolve)
     }
 
-    fn estimating_solve(&self, cfg: &Sl0Config, ws: &mut Workspace<PS, PT, PU, PV, B, N>) -> Result<u16, SolveError> {
+    fn estimating_solve(&self, cfg: &Sl0Config, ws: &mut Workspace<S>) -> Result<u16, SolveError> {
         match &self.schedules {
             Some(s) => solve_scheduled(&self.screen, cfg, &s.alone, ws),
             None => solve(&self.screen, cfg, ws),
@@ -563,11 +522,7 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
         .map(|_| 1)
     }
 
-    fn decode_seeded(
-        &self,
-        cfg: &Sl0Config,
-        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
-    ) -> Result<ModelOutcome, SolveError> {
+    fn decode_seeded(&self, cfg: &Sl0Config, ws: &mut Workspace<S>) -> Result<ModelOutcome, SolveError> {
         let rule = match self.choice {
             MemberChoice::Exhaustive(rule) => return self.exhaustive(&rule, cfg, ws),
             MemberChoice::Screened(rule) | MemberChoice::ScreenedResolve(rule) => rule,

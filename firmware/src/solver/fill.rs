@@ -17,6 +17,8 @@
 //! edges, occlusions or narrow spectra (the `depth` and `led` scenes), where SL0 at small
 //! sigma only refines what the fill got wrong.
 
+use crate::operators::shape::{PerBand, PerValue, Shape};
+use crate::sensor::extent::{Array, Bands};
 use crate::solver::workspace::Measurements;
 
 /// What a pixel's gain adds to its own measurements and to its bands' means, per measured
@@ -28,11 +30,11 @@ pub const FLOOR: f32 = 0.01;
 /// measured values as they are, every other value its pixel's gain times its band's mean.
 /// A band no pixel measures takes the mean of all measurements; a pixel with no
 /// measurement (or whose bands' means are not positive) has gain 1.
-pub fn fill_bands<const B: usize, const N: usize>(m: &Measurements<N>, signal: &mut [f32; N]) {
-    let (mut sum, mut count) = ([0.0f32; B], [0u32; B]);
-    let pixels = || m.values.as_chunks::<B>().0.iter().zip(m.measured.as_chunks::<B>().0);
+pub fn fill_bands<S: Shape>(m: &Measurements<S::Values>, signal: &mut PerValue<S, f32>) {
+    let (mut sum, mut count) = (<PerBand<S, f32>>::splat(0.0), <PerBand<S, u32>>::splat(0));
+    let pixels = || S::Bands::chunks(m.values.as_ref()).iter().zip(S::Bands::chunks(m.measured.as_ref()));
     for (values, measured) in pixels() {
-        for b in 0..B {
+        for b in 0..S::B {
             if measured[b] {
                 sum[b] += values[b];
                 count[b] += 1;
@@ -40,10 +42,13 @@ pub fn fill_bands<const B: usize, const N: usize>(m: &Measurements<N>, signal: &
         }
     }
     let all = sum.iter().sum::<f32>() / count.iter().sum::<u32>().max(1) as f32;
-    let mean: [f32; B] = core::array::from_fn(|b| if count[b] > 0 { sum[b] / count[b] as f32 } else { all });
-    for (x, (values, measured)) in signal.as_chunks_mut::<B>().0.iter_mut().zip(pixels()) {
+    let mut mean = <PerBand<S, f32>>::splat(0.0);
+    for (b, m) in mean.iter_mut().enumerate() {
+        *m = if count[b] > 0 { sum[b] / count[b] as f32 } else { all };
+    }
+    for (x, (values, measured)) in S::Bands::chunks_mut(signal.as_mut()).iter_mut().zip(pixels()) {
         let (mut own, mut expected) = (0.0f32, 0.0f32);
-        for b in 0..B {
+        for b in 0..S::B {
             if measured[b] {
                 own += values[b];
                 expected += mean[b];
@@ -57,7 +62,7 @@ pub fn fill_bands<const B: usize, const N: usize>(m: &Measurements<N>, signal: &
         let floor = FLOOR * measured.iter().filter(|&&k| k).count() as f32;
         let ratio = (own + floor) / (expected + floor);
         let gain = if expected + floor > f32::MIN_POSITIVE && ratio.is_finite() && ratio > 0.0 { ratio } else { 1.0 };
-        for b in 0..B {
+        for b in 0..S::B {
             x[b] = if measured[b] { values[b] } else { gain * mean[b] };
         }
     }

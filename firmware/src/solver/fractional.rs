@@ -21,7 +21,9 @@
 //! view a band is measured in: measured, about 1.5 times the fast path's projection.
 
 use crate::operators::dictionary::Dictionary;
-use crate::operators::shape::PatchShape;
+use crate::operators::mode::ModeMatrix;
+use crate::operators::shape::{PerBand, PerValue, Shape};
+use crate::sensor::extent::{Array, Extent};
 use crate::solver::ball::Ball;
 use crate::solver::projection::{band_bits, dot, project_whole};
 use crate::solver::workspace::Measurements;
@@ -35,28 +37,20 @@ pub const MAX_GRID: usize = 25;
 /// (exactly, or onto the noise [`Ball`]); `scratch` is clobbered. Returns the residual
 /// norm before the move. [`crate::solver::projection::project_coefficients`] for patches with
 /// half views ([`Measurements::half_views`]).
-pub fn project_fractional<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
->(
-    dict: &Dictionary<PS, PT, PU, PV, B>,
-    coeffs: &mut [f32; N],
-    scratch: &mut [f32; N],
-    m: &Measurements<N>,
+pub fn project_fractional<S: Shape>(
+    dict: &Dictionary<S>,
+    coeffs: &mut PerValue<S, f32>,
+    scratch: &mut PerValue<S, f32>,
+    m: &Measurements<S::Values>,
     ball: &Ball,
 ) -> f32 {
-    const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
     // The pixel modes' synthesis (the fast path's), every slice back in place: each
     // pixel's band coefficients; then the band step view by view.
-    let mut step = |scratch: &mut [f32; N]| {
+    let mut step = |scratch: &mut PerValue<S, f32>| {
         let (mut r2, mut w2) = (0.0f32, 0.0f32);
-        for u in 0..PU {
-            for v in 0..PV {
-                let (r, w) = view_step::<PS, PT, PU, PV, B, N>(&dict.d.m5, scratch, m, ball, (u, v));
+        for u in 0..S::PU {
+            for v in 0..S::PV {
+                let (r, w) = view_step::<S>(&dict.d.m5, scratch, m, ball, (u, v));
                 (r2, w2) = (r2 + r, w2 + w);
             }
         }
@@ -76,28 +70,28 @@ pub fn project_fractional<
 /// `weight * z` times its band's row of `D5` to the pixels it read, about 1,000
 /// multiply-adds a view each way at one measurement per pixel.
 #[inline(never)]
-fn view_step<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
-    m5: &[[f32; B]; B],
-    scratch: &mut [f32; N],
-    m: &Measurements<N>,
+fn view_step<S: Shape>(
+    m5: &ModeMatrix<S::Bands>,
+    scratch: &mut PerValue<S, f32>,
+    m: &Measurements<S::Values>,
     ball: &Ball,
     (u, v): (usize, usize),
 ) -> (f32, f32) {
     let (hs, ht) = (usize::from(m.half.row(u)), usize::from(m.half.col(v)));
-    let fibres = scratch.as_chunks_mut::<B>().0;
-    let pixel = |s: usize, t: usize| ((s * PT + t) * PU + u) * PV + v;
+    let fibres = S::Bands::chunks_mut(scratch.as_mut());
+    let pixel = |s: usize, t: usize| ((s * S::PT + t) * S::PU + u) * S::PV + v;
     // The diagonal of M M^T: a measurement's own overlap.
     let weight = overlap(hs, 0) * overlap(ht, 0);
     // Per band: its measured grid positions (`s * PT + t`) and their residuals.
-    let mut count = [0usize; B];
-    let mut at = [[0u8; MAX_GRID]; B];
-    let mut r = [[0.0f32; MAX_GRID]; B];
+    let mut count = <PerBand<S, usize>>::splat(0);
+    let mut at = <PerBand<S, [u8; MAX_GRID]>>::splat([0; MAX_GRID]);
+    let mut r = <PerBand<S, [f32; MAX_GRID]>>::splat([0.0; MAX_GRID]);
     let (mut r2, mut w2) = (0.0f32, 0.0f32);
     let weighted = ball.is_weighted();
-    for s in 0..PS - hs {
-        for t in 0..PT - ht {
-            let base = pixel(s, t) * B;
-            let (Some(flags), Some(ys)) = (m.measured.get(base..base + B), m.values.get(base..base + B)) else {
+    for s in 0..S::PS - hs {
+        for t in 0..S::PT - ht {
+            let base = pixel(s, t) * S::B;
+            let (Some(flags), Some(ys)) = (m.measured.get(base..base + S::B), m.values.get(base..base + S::B)) else {
                 continue;
             };
             let mut bits = band_bits(flags);
@@ -105,11 +99,11 @@ fn view_step<const PS: usize, const PT: usize, const PU: usize, const PV: usize,
                 continue;
             }
             // The values this position's measurements interpolate, summed.
-            let mut sum = [0.0f32; B];
+            let mut sum = <PerBand<S, f32>>::splat(0.0);
             for a in 0..=hs {
                 for c in 0..=ht {
                     if let Some(f) = fibres.get(pixel(s + a, t + c)) {
-                        for (o, &x) in sum.iter_mut().zip(f) {
+                        for (o, &x) in sum.iter_mut().zip(f.iter()) {
                             *o += x;
                         }
                     }
@@ -119,7 +113,7 @@ fn view_step<const PS: usize, const PT: usize, const PU: usize, const PV: usize,
                 let b = bits.trailing_zeros() as usize;
                 bits &= bits - 1;
                 let (Some(row), Some(&y), Some(n)) = (m5.get(b), ys.get(b), count.get_mut(b)) else { continue };
-                let res = y - weight * dot(row, &sum);
+                let res = y - weight * dot(row.as_ref(), sum.as_ref());
                 r2 += res * res;
                 if weighted {
                     w2 += res * res * ball.weight(y, m.gains.get(b).copied().unwrap_or(1.0));
@@ -127,7 +121,7 @@ fn view_step<const PS: usize, const PT: usize, const PU: usize, const PV: usize,
                 let (Some(p), Some(q), Ok(pos)) = (
                     at.get_mut(b).and_then(|x| x.get_mut(*n)),
                     r.get_mut(b).and_then(|x| x.get_mut(*n)),
-                    u8::try_from(s * PT + t),
+                    u8::try_from(s * S::PT + t),
                 ) else {
                     continue;
                 };
@@ -137,23 +131,23 @@ fn view_step<const PS: usize, const PT: usize, const PU: usize, const PV: usize,
         }
     }
     // The view's pixels become the correction, built from each band's solved block.
-    for s in 0..PS {
-        for t in 0..PT {
+    for s in 0..S::PS {
+        for t in 0..S::PT {
             if let Some(f) = fibres.get_mut(pixel(s, t)) {
-                *f = [0.0; B];
+                *f = <PerBand<S, f32>>::splat(0.0);
             }
         }
     }
-    for (b, ((&n, at), r)) in count.iter().zip(&at).zip(&mut r).enumerate() {
+    for (b, ((&n, at), r)) in count.iter().zip(at.iter()).zip(r.iter_mut()).enumerate() {
         let (Some(at), Some(row)) = (at.get(..n), m5.get(b)) else { continue };
-        solve_block(at, r, (hs, ht), PT);
+        solve_block(at, r, (hs, ht), S::PT);
         for (&p, &z) in at.iter().zip(r.iter()) {
-            let (s, t) = grid_position(p, PT);
+            let (s, t) = grid_position(p, S::PT);
             let z = weight * z;
             for a in 0..=hs {
                 for c in 0..=ht {
                     if let Some(f) = fibres.get_mut(pixel(s + a, t + c)) {
-                        for (o, &w) in f.iter_mut().zip(row) {
+                        for (o, &w) in f.iter_mut().zip(row.iter()) {
                             *o += z * w;
                         }
                     }
@@ -267,19 +261,15 @@ fn cholesky<const L: usize>(at: &[u8], r: &mut [f32; MAX_GRID], (hs, ht): (usize
 /// A decoded half-pixel patch at the sensor pixels its grid positions name: along every
 /// half axis, position `s` becomes the mean of `s` and `s + 1`, the value the pixel it
 /// read measured (the last position keeps its value; it names no pixel). In place.
-pub fn to_sensor<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
-    half: crate::operators::disparity::HalfViews,
-    patch: &mut [f32; N],
-) {
-    const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
-    let index = PatchShape::<PS, PT, PU, PV, B, N>::index;
-    for u in 0..PU {
-        for v in 0..PV {
+pub fn to_sensor<S: Shape>(half: crate::operators::disparity::HalfViews, patch: &mut PerValue<S, f32>) {
+    let index = S::index;
+    for u in 0..S::PU {
+        for v in 0..S::PV {
             let (hs, ht) = (half.row(u), half.col(v));
-            for b in 0..B {
+            for b in 0..S::B {
                 if hs {
-                    for t in 0..PT {
-                        for s in 0..PS - 1 {
+                    for t in 0..S::PT {
+                        for s in 0..S::PS - 1 {
                             let next = patch.get(index(s + 1, t, u, v, b)).copied().unwrap_or(0.0);
                             if let Some(x) = patch.get_mut(index(s, t, u, v, b)) {
                                 *x = 0.5 * (*x + next);
@@ -288,8 +278,8 @@ pub fn to_sensor<const PS: usize, const PT: usize, const PU: usize, const PV: us
                     }
                 }
                 if ht {
-                    for s in 0..PS {
-                        for t in 0..PT - 1 {
+                    for s in 0..S::PS {
+                        for t in 0..S::PT - 1 {
                             let next = patch.get(index(s, t + 1, u, v, b)).copied().unwrap_or(0.0);
                             if let Some(x) = patch.get_mut(index(s, t, u, v, b)) {
                                 *x = 0.5 * (*x + next);
@@ -307,31 +297,20 @@ pub fn to_sensor<const PS: usize, const PT: usize, const PU: usize, const PV: us
 /// a half axis names no pixel and is not read). Along every half axis, position `s`
 /// between pixels `s - 1` and `s` becomes their mean, and the end positions their one
 /// neighbour: linear interpolation, exact for a patch linear along the axis. In place.
-pub fn from_sensor<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
->(
-    half: crate::operators::disparity::HalfViews,
-    patch: &mut [f32; N],
-) {
-    const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
-    let index = PatchShape::<PS, PT, PU, PV, B, N>::index;
-    for u in 0..PU {
-        for v in 0..PV {
+pub fn from_sensor<S: Shape>(half: crate::operators::disparity::HalfViews, patch: &mut PerValue<S, f32>) {
+    let index = S::index;
+    for u in 0..S::PU {
+        for v in 0..S::PV {
             let (hs, ht) = (half.row(u), half.col(v));
-            for b in 0..B {
+            for b in 0..S::B {
                 if hs {
-                    for t in 0..PT {
-                        back_along(patch, PS, |s| index(s, t, u, v, b));
+                    for t in 0..S::PT {
+                        back_along::<S>(patch, S::PS, |s| index(s, t, u, v, b));
                     }
                 }
                 if ht {
-                    for s in 0..PS {
-                        back_along(patch, PT, |t| index(s, t, u, v, b));
+                    for s in 0..S::PS {
+                        back_along::<S>(patch, S::PT, |t| index(s, t, u, v, b));
                     }
                 }
             }
@@ -343,11 +322,11 @@ pub fn from_sensor<
 /// the far end, each position the mean of its two pixels before they change, the last
 /// position its one neighbour's (the first keeps its pixel).
 #[inline(always)]
-fn back_along<const N: usize>(patch: &mut [f32; N], len: usize, at: impl Fn(usize) -> usize) {
+fn back_along<S: Shape>(patch: &mut PerValue<S, f32>, len: usize, at: impl Fn(usize) -> usize) {
     if len < 2 {
         return;
     }
-    let get = |p: &[f32; N], i: usize| p.get(at(i)).copied().unwrap_or(0.0);
+    let get = |p: &PerValue<S, f32>, i: usize| p.get(at(i)).copied().unwrap_or(0.0);
     let last = get(patch, len - 2);
     for i in (1..len - 1).rev() {
         let x = 0.5 * (get(patch, i - 1) + get(patch, i));

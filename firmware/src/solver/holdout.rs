@@ -18,7 +18,8 @@
 //! as an RMS per value over the whole patch): the unmeasured values at the held-out
 //! prediction error, the measured ones at the noise's level.
 
-use crate::operators::shape::PatchShape;
+use crate::operators::shape::{PerBand, PerValue, Shape};
+use crate::sensor::extent::{Array, Bands};
 use crate::solver::workspace::Measurements;
 
 /// Which measurements are held out (config).
@@ -48,12 +49,12 @@ impl HoldOut {
     /// Whether entry `index` of a patch of `PU x PV` views and `B` bands is held out when
     /// the patch's measurements are held out by `unit`.
     #[inline(always)]
-    pub fn held<const PU: usize, const PV: usize, const B: usize>(&self, unit: Unit, index: usize) -> bool {
+    pub fn held<S: Shape>(&self, unit: Unit, index: usize) -> bool {
         match unit {
             Unit::Measurement => self.holds(index),
             // The lenslet and the band: every view of it.
-            Unit::LensletBand => match (index.checked_div(PU * PV * B), index.checked_rem(B)) {
-                (Some(lenslet), Some(band)) => self.holds(lenslet * B + band),
+            Unit::LensletBand => match (index.checked_div(S::PU * S::PV * S::B), index.checked_rem(S::B)) {
+                (Some(lenslet), Some(band)) => self.holds(lenslet * S::B + band),
                 _ => false,
             },
         }
@@ -83,21 +84,18 @@ pub enum Unit {
 impl Unit {
     /// [`Unit::LensletBand`] if most (lenslet, band) groups the patch measures at all are
     /// measured in at least three quarters of the patch's views, else [`Unit::Measurement`].
-    pub fn of<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
-        m: &Measurements<N>,
-    ) -> Self {
-        const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
+    pub fn of<S: Shape>(m: &Measurements<S::Values>) -> Self {
         let (mut groups, mut whole) = (0u32, 0u32);
-        for lenslet in m.measured.chunks_exact(PU * PV * B) {
-            let mut views = [0u32; B];
-            for pixel in lenslet.as_chunks::<B>().0 {
-                for (n, &k) in views.iter_mut().zip(pixel) {
+        for lenslet in m.measured.chunks_exact(S::PU * S::PV * S::B) {
+            let mut views = <PerBand<S, _>>::splat(0u32);
+            for pixel in S::Bands::chunks(lenslet) {
+                for (n, &k) in views.iter_mut().zip(pixel.iter()) {
                     *n += u32::from(k);
                 }
             }
-            for &n in &views {
+            for &n in views.iter() {
                 groups += u32::from(n > 0);
-                whole += u32::from(4 * n as usize >= 3 * PU * PV);
+                whole += u32::from(4 * n as usize >= 3 * S::PU * S::PV);
             }
         }
         if 2 * whole > groups { Self::LensletBand } else { Self::Measurement }
@@ -112,18 +110,14 @@ impl Default for HoldOut {
 
 /// Leaves the held-out entries of `m` out (not measured, value 0); returns how many.
 /// Nothing is left out if that would leave no measurement.
-pub fn hold_out<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
-    hold: &HoldOut,
-    m: &mut Measurements<N>,
-) -> u32 {
-    const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
-    let unit = Unit::of::<PS, PT, PU, PV, B, N>(m);
-    let held = (0..N).filter(|&i| m.measured.get(i) == Some(&true) && hold.held::<PU, PV, B>(unit, i)).count() as u32;
+pub fn hold_out<S: Shape>(hold: &HoldOut, m: &mut Measurements<S::Values>) -> u32 {
+    let unit = Unit::of::<S>(m);
+    let held = (0..S::N).filter(|&i| m.measured.get(i) == Some(&true) && hold.held::<S>(unit, i)).count() as u32;
     if held == 0 || held >= m.count {
         return 0;
     }
     for (i, (v, k)) in m.values.iter_mut().zip(m.measured.iter_mut()).enumerate() {
-        if *k && hold.held::<PU, PV, B>(unit, i) {
+        if *k && hold.held::<S>(unit, i) {
             *k = false;
             *v = 0.0;
         }
@@ -138,21 +132,20 @@ pub fn hold_out<const PS: usize, const PT: usize, const PU: usize, const PV: usi
 /// `m` (all its measurements, read again). `noise` and `shot` are the capture's noise model
 /// (normalised units, as [`crate::Sl0Config`]'s); each band's values are divided by its
 /// gain in `m` and multiplied back here. `None` if `m` holds no held-out measurement.
-pub fn estimate<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
+pub fn estimate<S: Shape>(
     hold: &HoldOut,
-    m: &Measurements<N>,
-    predicted: &[f32; N],
+    m: &Measurements<S::Values>,
+    predicted: &PerValue<S, f32>,
     noise: f32,
     shot: f32,
 ) -> Option<f32> {
-    const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
-    let unit = Unit::of::<PS, PT, PU, PV, B, N>(m);
+    let unit = Unit::of::<S>(m);
     let (mut r2, mut var, mut held) = (0.0f32, 0.0f32, 0u32);
-    for (i, ((&y, &k), &x)) in m.values.iter().zip(&m.measured).zip(predicted).enumerate() {
-        if !(k && hold.held::<PU, PV, B>(unit, i)) {
+    for (i, ((&y, &k), &x)) in m.values.iter().zip(m.measured.iter()).zip(predicted.iter()).enumerate() {
+        if !(k && hold.held::<S>(unit, i)) {
             continue;
         }
-        let g = m.gains.get(i % B).copied().unwrap_or(1.0);
+        let g = m.gains.get(i % S::B).copied().unwrap_or(1.0);
         let (seen, d) = (y * g, (x - y) * g);
         r2 += d * d;
         var += noise * noise + shot * if seen > 0.0 { seen } else { 0.0 };
@@ -164,6 +157,6 @@ pub fn estimate<const PS: usize, const PT: usize, const PU: usize, const PV: usi
     let (r2, var) = (r2 / held as f32, var / held as f32);
     // The unmeasured values' error, the noise taken off (not below nothing).
     let unmeasured = if r2 > var { r2 - var } else { 0.0 };
-    let measured = m.count as f32 / N as f32;
+    let measured = m.count as f32 / S::N as f32;
     Some(libm::sqrtf(unmeasured * (1.0 - measured) + var * measured))
 }

@@ -15,14 +15,16 @@
 //! the first and last; a pixel with no measurement takes the mean spectrum of those with
 //! one. The patch meets its measurements exactly.
 
+use crate::operators::shape::{PerBand, PerValue, Shape};
+use crate::sensor::extent::{Array, Bands};
 use crate::solver::workspace::Measurements;
 
 /// How many distinct bands the patch measures anywhere (`B` bands per pixel, the last
 /// axis).
-pub fn bands_measured<const B: usize, const N: usize>(m: &Measurements<N>) -> u32 {
-    let mut any = [false; B];
-    for flags in m.measured.as_chunks::<B>().0 {
-        for (a, &f) in any.iter_mut().zip(flags) {
+pub fn bands_measured<S: Shape>(m: &Measurements<S::Values>) -> u32 {
+    let mut any = <PerBand<S, bool>>::splat(false);
+    for flags in S::Bands::chunks(m.measured.as_ref()) {
+        for (a, &f) in any.iter_mut().zip(flags.iter()) {
             *a |= f;
         }
     }
@@ -32,13 +34,15 @@ pub fn bands_measured<const B: usize, const N: usize>(m: &Measurements<N>) -> u3
 /// Writes into `out` each pixel's measurements interpolated along the band axis (see the
 /// module docs). Returns the number of pixels without a measurement, filled with the mean
 /// spectrum (0 if no pixel is measured).
-pub fn interpolate_bands<const B: usize, const N: usize>(m: &Measurements<N>, out: &mut [f32; N]) -> usize {
-    let mut sum = [0.0f32; B];
+pub fn interpolate_bands<S: Shape>(m: &Measurements<S::Values>, out: &mut PerValue<S, f32>) -> usize {
+    let mut sum = <PerBand<S, f32>>::splat(0.0);
     let (mut measured, mut missing) = (0u32, 0usize);
-    let pixels =
-        out.as_chunks_mut::<B>().0.iter_mut().zip(m.values.as_chunks::<B>().0).zip(m.measured.as_chunks::<B>().0);
+    let pixels = S::Bands::chunks_mut(out.as_mut())
+        .iter_mut()
+        .zip(S::Bands::chunks(m.values.as_ref()))
+        .zip(S::Bands::chunks(m.measured.as_ref()));
     for ((spectrum, values), flags) in pixels {
-        if through(values, flags, spectrum) {
+        if through::<S>(values, flags, spectrum) {
             measured += 1;
             for (s, &x) in sum.iter_mut().zip(spectrum.iter()) {
                 *s += x;
@@ -48,8 +52,13 @@ pub fn interpolate_bands<const B: usize, const N: usize>(m: &Measurements<N>, ou
         }
     }
     if missing > 0 {
-        let mean = sum.map(|s| if measured > 0 { s / measured as f32 } else { 0.0 });
-        for (spectrum, flags) in out.as_chunks_mut::<B>().0.iter_mut().zip(m.measured.as_chunks::<B>().0) {
+        let mut mean = sum;
+        for s in mean.iter_mut() {
+            *s = if measured > 0 { *s / measured as f32 } else { 0.0 };
+        }
+        for (spectrum, flags) in
+            S::Bands::chunks_mut(out.as_mut()).iter_mut().zip(S::Bands::chunks(m.measured.as_ref()))
+        {
             if !flags.contains(&true) {
                 *spectrum = mean;
             }
@@ -60,15 +69,16 @@ pub fn interpolate_bands<const B: usize, const N: usize>(m: &Measurements<N>, ou
 
 /// One pixel: linear in band index between measured bands, flat beyond the outer ones.
 /// `false` (and `out` untouched) if no band is measured.
-fn through<const B: usize>(values: &[f32; B], flags: &[bool; B], out: &mut [f32; B]) -> bool {
+fn through<S: Shape>(values: &PerBand<S, f32>, flags: &PerBand<S, bool>, out: &mut PerBand<S, f32>) -> bool {
     // The measured band (index, value) at or below `b`, and the next one above it.
-    let measured_after =
-        |b: usize| flags.iter().zip(values).enumerate().skip(b + 1).find(|(_, (f, _))| **f).map(|(j, (_, &v))| (j, v));
+    let measured_after = |b: usize| {
+        flags.iter().zip(values.iter()).enumerate().skip(b + 1).find(|(_, (f, _))| **f).map(|(j, (_, &v))| (j, v))
+    };
     if !flags.contains(&true) {
         return false;
     }
     let mut below: Option<(usize, f32)> = None;
-    for (b, ((o, &f), &y)) in out.iter_mut().zip(flags).zip(values).enumerate() {
+    for (b, ((o, &f), &y)) in out.iter_mut().zip(flags.iter()).zip(values.iter()).enumerate() {
         if f {
             below = Some((b, y));
             *o = y;

@@ -19,39 +19,42 @@
 //! projection ([`project_signal`]), since a measured entry is no longer the measurement.
 
 use crate::operators::dictionary::Dictionary;
+use crate::operators::shape::{PerBand, PerValue, Shape};
+use crate::sensor::extent::{Array, Bands, Square};
 use crate::sensor::response::Response;
 use crate::solver::ball::{Ball, Move};
 use crate::solver::projection::{band_bits, dot, project_slices};
 use crate::solver::workspace::Measurements;
 
 /// What one solve needs of a response in the decode's (white-balanced) units: the response
-/// itself, its rows through the dictionary's band mode, and its Gram matrix.
-pub struct BandModel<const B: usize> {
+/// itself, its rows through the dictionary's band mode, and its Gram matrix, over the bands
+/// `C`.
+pub struct BandModel<C: Bands> {
     /// `R`: filter `f`'s transmission of each band (signal space).
-    r: [[f32; B]; B],
+    r: Square<C, f32>,
     /// `R D5`: filter `f`'s measurement of the band coefficients (coefficient space).
-    rows: [[f32; B]; B],
+    rows: Square<C, f32>,
     /// `R R^T`.
-    gram: [[f32; B]; B],
+    gram: Square<C, f32>,
 }
 
-impl<const B: usize> BandModel<B> {
+impl<C: Bands> BandModel<C> {
     /// The model of `response` (already balanced, [`Response::balanced`]) for a
     /// dictionary whose band mode's synthesis rows are `m5` (value `b` = `m5[b] . c`).
-    pub fn new(response: &Response<B>, m5: &[[f32; B]; B]) -> Self {
+    pub fn new(response: &Response<C>, m5: &Square<C, f32>) -> Self {
         let r = response.matrix();
-        let mut rows = [[0.0f32; B]; B];
-        for (row, rf) in rows.iter_mut().zip(&r) {
-            for (&w, m) in rf.iter().zip(m5) {
-                for (o, &x) in row.iter_mut().zip(m) {
+        let mut rows = Square::<C, f32>::splat(C::Per::<f32>::splat(0.0));
+        for (row, rf) in rows.as_mut().iter_mut().zip(r.as_ref()) {
+            for (&w, m) in rf.as_ref().iter().zip(m5.as_ref()) {
+                for (o, &x) in row.as_mut().iter_mut().zip(m.as_ref()) {
                     *o += w * x;
                 }
             }
         }
-        let mut gram = [[0.0f32; B]; B];
-        for (g, ri) in gram.iter_mut().zip(&r) {
-            for (o, rj) in g.iter_mut().zip(&r) {
-                *o = dot(ri, rj);
+        let mut gram = Square::<C, f32>::splat(C::Per::<f32>::splat(0.0));
+        for (g, ri) in gram.as_mut().iter_mut().zip(r.as_ref()) {
+            for (o, rj) in g.as_mut().iter_mut().zip(r.as_ref()) {
+                *o = dot(ri.as_ref(), rj.as_ref());
             }
         }
         Self { r, rows, gram }
@@ -61,12 +64,16 @@ impl<const B: usize> BandModel<B> {
     /// `res`): a division at `k = 1`, an `L D L^T` factorisation on the stack above. A
     /// pivot that is not positive (it cannot be for distinct filters of a checked response;
     /// rounding could only make one tiny) zeroes its unknown.
-    #[allow(clippy::needless_range_loop)] // the factorisation reads best with its indices
     pub fn solve(&self, filters: &[u8], res: &mut [f32]) {
-        let n = filters.len().min(res.len()).min(B);
+        let n = filters.len().min(res.len()).min(C::D);
         let g = |i: usize, j: usize| {
             let (Some(&a), Some(&b)) = (filters.get(i), filters.get(j)) else { return 0.0 };
-            self.gram.get(usize::from(a)).and_then(|row| row.get(usize::from(b))).copied().unwrap_or(0.0)
+            self.gram
+                .as_ref()
+                .get(usize::from(a))
+                .and_then(|row| row.as_ref().get(usize::from(b)))
+                .copied()
+                .unwrap_or(0.0)
         };
         if n == 1 {
             let d = g(0, 0);
@@ -75,8 +82,8 @@ impl<const B: usize> BandModel<B> {
             }
             return;
         }
-        let mut l = [[0.0f32; B]; B];
-        let (mut d, mut inv) = ([0.0f32; B], [0.0f32; B]);
+        let mut l = Square::<C, f32>::splat(C::Per::<f32>::splat(0.0));
+        let (mut d, mut inv) = (C::Per::<f32>::splat(0.0), C::Per::<f32>::splat(0.0));
         for j in 0..n {
             let mut pivot = g(j, j);
             for k in 0..j {
@@ -113,33 +120,34 @@ impl<const B: usize> BandModel<B> {
     /// One pixel's residuals `y - rows_F x` in filter order, with the filters; returns how
     /// many. `rows` is `R` for a spectrum `x`, `R D5` for its band coefficients.
     fn residuals(
-        rows: &[[f32; B]; B],
-        x: &[f32; B],
+        rows: &Square<C, f32>,
+        x: &C::Per<f32>,
         ys: &[f32],
         bits: u64,
-        filters: &mut [u8; B],
-        res: &mut [f32; B],
+        filters: &mut C::Per<u8>,
+        res: &mut C::Per<f32>,
     ) -> usize {
         let mut bits = bits;
         let mut k = 0;
         while bits != 0 {
             let f = bits.trailing_zeros() as usize;
             bits &= bits - 1;
-            let (Some(row), Some(&y), Some(o), Some(r)) = (rows.get(f), ys.get(f), filters.get_mut(k), res.get_mut(k))
+            let (Some(row), Some(&y), Some(o), Some(r)) =
+                (rows.as_ref().get(f), ys.get(f), filters.as_mut().get_mut(k), res.as_mut().get_mut(k))
             else {
                 break;
             };
-            (*o, *r) = (f as u8, y - dot(row, x));
+            (*o, *r) = (f as u8, y - dot(row.as_ref(), x.as_ref()));
             k += 1;
         }
         k
     }
 
     /// `x += scale R_F^T w` for solved residuals `w` of `filters`.
-    fn add_rows(rows: &[[f32; B]; B], x: &mut [f32; B], filters: &[u8], w: &[f32], scale: f32) {
-        for (&f, &w) in filters.iter().zip(w) {
-            if let Some(row) = rows.get(usize::from(f)) {
-                for (o, &a) in x.iter_mut().zip(row) {
+    fn add_rows(rows: &Square<C, f32>, x: &mut C::Per<f32>, filters: &[u8], w: &[f32], scale: f32) {
+        for (&f, &w) in filters.iter().zip(w.iter()) {
+            if let Some(row) = rows.as_ref().get(usize::from(f)) {
+                for (o, &a) in x.as_mut().iter_mut().zip(row.as_ref()) {
                     *o += scale * w * a;
                 }
             }
@@ -149,30 +157,37 @@ impl<const B: usize> BandModel<B> {
 
 /// The minimum-norm start in signal space: each pixel `R_F^T (R_F R_F^T)^-1 y`, zero where
 /// nothing is measured.
-pub fn min_norm<const B: usize, const N: usize>(model: &BandModel<B>, m: &Measurements<N>, signal: &mut [f32; N]) {
-    let pixels = signal.as_chunks_mut::<B>().0.iter_mut().zip(m.values.as_chunks::<B>().0);
-    for ((x, ys), measured) in pixels.zip(m.measured.as_chunks::<B>().0) {
-        *x = [0.0; B];
-        let (mut filters, mut res) = ([0u8; B], [0.0f32; B]);
-        let k = BandModel::residuals(&model.r, x, ys, band_bits(measured), &mut filters, &mut res);
+pub fn min_norm<S: Shape>(model: &BandModel<S::Bands>, m: &Measurements<S::Values>, signal: &mut PerValue<S, f32>) {
+    let pixels = S::Bands::chunks_mut(signal.as_mut()).iter_mut().zip(S::Bands::chunks(m.values.as_ref()));
+    for ((x, ys), measured) in pixels.zip(S::Bands::chunks(m.measured.as_ref())) {
+        *x = <PerBand<S, _>>::splat(0.0);
+        let (mut filters, mut res) = (<PerBand<S, _>>::splat(0u8), <PerBand<S, _>>::splat(0.0f32));
+        let k = BandModel::<S::Bands>::residuals(
+            &model.r,
+            x,
+            ys.as_ref(),
+            band_bits(measured.as_ref()),
+            &mut filters,
+            &mut res,
+        );
         let (Some(filters), Some(res)) = (filters.get(..k), res.get_mut(..k)) else { continue };
         model.solve(filters, res);
-        BandModel::add_rows(&model.r, x, filters, res, 1.0);
+        BandModel::<S::Bands>::add_rows(&model.r, x, filters, res, 1.0);
     }
 }
 
 /// Every pixel's `B` values unmixed by `response` (balanced): an estimate of `R x` (the
 /// band-gain fill, a flat patch's band means) made an estimate of `x`.
-pub fn unmix_all<const B: usize, const N: usize>(response: &Response<B>, signal: &mut [f32; N]) {
-    for x in signal.as_chunks_mut::<B>().0 {
+pub fn unmix_all<S: Shape>(response: &Response<S::Bands>, signal: &mut PerValue<S, f32>) {
+    for x in S::Bands::chunks_mut(signal.as_mut()) {
         response.unmix(x);
     }
 }
 
 /// Every pixel's spectrum as its filters see it ([`Response::mix`]): an estimate of `x` (a
 /// seed from decoded neighbours) made one of `R x`, for a decode of `R x`.
-pub fn mix_all<const B: usize, const N: usize>(response: &Response<B>, signal: &mut [f32; N]) {
-    for x in signal.as_chunks_mut::<B>().0 {
+pub fn mix_all<S: Shape>(response: &Response<S::Bands>, signal: &mut PerValue<S, f32>) {
+    for x in S::Bands::chunks_mut(signal.as_mut()) {
         response.mix(x);
     }
 }
@@ -180,19 +195,31 @@ pub fn mix_all<const B: usize, const N: usize>(response: &Response<B>, signal: &
 /// The projection of a patch in signal space onto its mixed measurements (exactly, or onto
 /// the noise [`Ball`]): per pixel `x += scale R_F^T (R_F R_F^T)^-1 (y - R_F x)`. Returns
 /// the residual norm before the move. The put-back after a solve and before a seeded one.
-pub fn project_signal<const B: usize, const N: usize>(
-    model: &BandModel<B>,
-    x: &mut [f32; N],
-    m: &Measurements<N>,
+pub fn project_signal<S: Shape>(
+    model: &BandModel<S::Bands>,
+    x: &mut PerValue<S, f32>,
+    m: &Measurements<S::Values>,
     ball: &Ball,
 ) -> f32 {
     let (mut r2, mut w2) = (0.0f32, 0.0f32);
     let weighted = ball.is_weighted();
-    let pixels = || x.as_chunks::<B>().0.iter().zip(m.values.as_chunks::<B>().0).zip(m.measured.as_chunks::<B>().0);
+    let pixels = || {
+        S::Bands::chunks(x.as_ref())
+            .iter()
+            .zip(S::Bands::chunks(m.values.as_ref()))
+            .zip(S::Bands::chunks(m.measured.as_ref()))
+    };
     for ((x, ys), measured) in pixels() {
-        let (mut filters, mut res) = ([0u8; B], [0.0f32; B]);
-        let k = BandModel::residuals(&model.r, x, ys, band_bits(measured), &mut filters, &mut res);
-        for (&f, &r) in filters.iter().zip(&res).take(k) {
+        let (mut filters, mut res) = (<PerBand<S, _>>::splat(0u8), <PerBand<S, _>>::splat(0.0f32));
+        let k = BandModel::<S::Bands>::residuals(
+            &model.r,
+            x,
+            ys.as_ref(),
+            band_bits(measured.as_ref()),
+            &mut filters,
+            &mut res,
+        );
+        for (&f, &r) in filters.iter().zip(res.iter()).take(k) {
             r2 += r * r;
             if weighted {
                 let f = usize::from(f);
@@ -204,13 +231,20 @@ pub fn project_signal<const B: usize, const N: usize>(
         Move::Scale(scale) => scale,
         Move::Stay => return libm::sqrtf(r2),
     };
-    let pixels = x.as_chunks_mut::<B>().0.iter_mut().zip(m.values.as_chunks::<B>().0);
-    for ((x, ys), measured) in pixels.zip(m.measured.as_chunks::<B>().0) {
-        let (mut filters, mut res) = ([0u8; B], [0.0f32; B]);
-        let k = BandModel::residuals(&model.r, x, ys, band_bits(measured), &mut filters, &mut res);
+    let pixels = S::Bands::chunks_mut(x.as_mut()).iter_mut().zip(S::Bands::chunks(m.values.as_ref()));
+    for ((x, ys), measured) in pixels.zip(S::Bands::chunks(m.measured.as_ref())) {
+        let (mut filters, mut res) = (<PerBand<S, _>>::splat(0u8), <PerBand<S, _>>::splat(0.0f32));
+        let k = BandModel::<S::Bands>::residuals(
+            &model.r,
+            x,
+            ys.as_ref(),
+            band_bits(measured.as_ref()),
+            &mut filters,
+            &mut res,
+        );
         let (Some(filters), Some(res)) = (filters.get(..k), res.get_mut(..k)) else { continue };
         model.solve(filters, res);
-        BandModel::add_rows(&model.r, x, filters, res, scale);
+        BandModel::<S::Bands>::add_rows(&model.r, x, filters, res, scale);
     }
     libm::sqrtf(r2)
 }
@@ -221,29 +255,28 @@ pub fn project_signal<const B: usize, const N: usize>(
 /// move. The pixel modes' transforms are the fast path's (one frame shared with it); the band
 /// step reads each measurement through a row of `R D5` and solves the pixel's `k x k`
 /// Gram system.
-pub fn project_mixed<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
->(
-    dict: &Dictionary<PS, PT, PU, PV, B>,
-    model: &BandModel<B>,
-    coeffs: &mut [f32; N],
-    scratch: &mut [f32; N],
-    m: &Measurements<N>,
+pub fn project_mixed<S: Shape>(
+    dict: &Dictionary<S>,
+    model: &BandModel<S::Bands>,
+    coeffs: &mut PerValue<S, f32>,
+    scratch: &mut PerValue<S, f32>,
+    m: &Measurements<S::Values>,
     ball: &Ball,
 ) -> f32 {
     let weighted = ball.is_weighted();
-    let mut step = |fibres: &mut [[f32; B]], values: &[f32], measured: &[bool]| {
+    let mut step = |fibres: &mut [PerBand<S, f32>], values: &[f32], measured: &[bool]| {
         let (mut r2, mut w2) = (0.0f32, 0.0f32);
-        for ((fibre, ys), measured) in fibres.iter_mut().zip(values.as_chunks::<B>().0).zip(measured.as_chunks::<B>().0)
-        {
-            let (mut filters, mut res) = ([0u8; B], [0.0f32; B]);
-            let k = BandModel::residuals(&model.rows, fibre, ys, band_bits(measured), &mut filters, &mut res);
-            for (&f, &e) in filters.iter().zip(&res).take(k) {
+        for ((fibre, ys), measured) in fibres.iter_mut().zip(S::Bands::chunks(values)).zip(S::Bands::chunks(measured)) {
+            let (mut filters, mut res) = (<PerBand<S, _>>::splat(0u8), <PerBand<S, _>>::splat(0.0f32));
+            let k = BandModel::<S::Bands>::residuals(
+                &model.rows,
+                fibre,
+                ys.as_ref(),
+                band_bits(measured.as_ref()),
+                &mut filters,
+                &mut res,
+            );
+            for (&f, &e) in filters.iter().zip(res.iter()).take(k) {
                 r2 += e * e;
                 if weighted {
                     let f = usize::from(f);
@@ -251,10 +284,10 @@ pub fn project_mixed<
                         e * e * ball.weight(ys.get(f).copied().unwrap_or(0.0), m.gains.get(f).copied().unwrap_or(1.0));
                 }
             }
-            *fibre = [0.0; B];
+            *fibre = <PerBand<S, _>>::splat(0.0);
             let (Some(filters), Some(res)) = (filters.get(..k), res.get_mut(..k)) else { continue };
             model.solve(filters, res);
-            BandModel::add_rows(&model.rows, fibre, filters, res, 1.0);
+            BandModel::<S::Bands>::add_rows(&model.rows, fibre, filters, res, 1.0);
         }
         (r2, w2)
     };

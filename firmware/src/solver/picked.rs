@@ -5,6 +5,7 @@
 //! is decoded by the picked model alone: no patch pays for both. [`Picked`] borrows both
 //! models, so a pick per tile costs nothing but the flag.
 
+use crate::operators::shape::Shape;
 use crate::solver::choice::{ModelOutcome, PatchModel};
 use crate::solver::sl0::{Sl0Config, SolveError};
 use crate::solver::workspace::Workspace;
@@ -28,31 +29,26 @@ pub struct Picked<'m, A, Z> {
     pub pick: Pick,
 }
 
-impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize, A, Z>
-    PatchModel<PS, PT, PU, PV, B, N> for Picked<'_, A, Z>
+impl<S: Shape, A, Z> PatchModel<S> for Picked<'_, A, Z>
 where
-    A: PatchModel<PS, PT, PU, PV, B, N>,
-    Z: PatchModel<PS, PT, PU, PV, B, N>,
+    A: PatchModel<S>,
+    Z: PatchModel<S>,
 {
-    fn decode(&self, cfg: &Sl0Config, ws: &mut Workspace<PS, PT, PU, PV, B, N>) -> Result<ModelOutcome, SolveError> {
+    fn decode(&self, cfg: &Sl0Config, ws: &mut Workspace<S>) -> Result<ModelOutcome, SolveError> {
         match self.pick {
             Pick::First => self.first.decode(cfg, ws),
             Pick::Second => self.second.decode(cfg, ws),
         }
     }
 
-    fn decode_seeded(
-        &self,
-        cfg: &Sl0Config,
-        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
-    ) -> Result<ModelOutcome, SolveError> {
+    fn decode_seeded(&self, cfg: &Sl0Config, ws: &mut Workspace<S>) -> Result<ModelOutcome, SolveError> {
         match self.pick {
             Pick::First => self.first.decode_seeded(cfg, ws),
             Pick::Second => self.second.decode_seeded(cfg, ws),
         }
     }
 
-    fn estimating_solve(&self, cfg: &Sl0Config, ws: &mut Workspace<PS, PT, PU, PV, B, N>) -> Result<u16, SolveError> {
+    fn estimating_solve(&self, cfg: &Sl0Config, ws: &mut Workspace<S>) -> Result<u16, SolveError> {
         match self.pick {
             Pick::First => self.first.estimating_solve(cfg, ws),
             Pick::Second => self.second.estimating_solve(cfg, ws),

@@ -14,9 +14,11 @@
 
 use nalgebra::{SMatrix, SVD};
 
-use crate::operators::dictionary::{Dictionary, Factors, Matrix};
-use crate::operators::shape::PatchShape;
+use crate::operators::dictionary::{Dictionary, Factors};
+use crate::operators::mode::{Mode, ModeMatrix};
+use crate::operators::shape::{PerValue, Shape};
 use crate::operators::transform::{apply_in_place, synthesize};
+use crate::sensor::extent::{Array, Bands};
 use crate::sensor::mask::KroneckerPhi;
 use crate::solver::ascent::ascend;
 use crate::solver::ball::Move;
@@ -29,8 +31,8 @@ pub const PINV_MAX_DIM: usize = 16;
 type Padded = SMatrix<f64, PINV_MAX_DIM, PINV_MAX_DIM>;
 
 /// The Moore-Penrose pseudo-inverse of a `D x D` matrix, via an f64 SVD.
-fn pseudo_inverse<const D: usize>(a: &Matrix<D>, mode: u8) -> Result<Matrix<D>, SolveError> {
-    const { assert!(D <= PINV_MAX_DIM, "mode larger than PINV_MAX_DIM") };
+fn pseudo_inverse<E: Mode>(a: &ModeMatrix<E>, mode: u8) -> Result<ModeMatrix<E>, SolveError> {
+    const { assert!(E::D <= PINV_MAX_DIM, "mode larger than PINV_MAX_DIM") };
     let fail = SolveError::PseudoInverse { mode };
     // Zero padding: pinv(diag(A, 0)) = diag(pinv(A), 0).
     let mut m = Padded::zeros();
@@ -50,7 +52,7 @@ fn pseudo_inverse<const D: usize>(a: &Matrix<D>, mode: u8) -> Result<Matrix<D>, 
     let svd = SVD::try_new_unordered(m, true, true, f64::EPSILON, 10_000).ok_or(fail)?;
     let tol = svd.singular_values.max() * 1e-9;
     let p = svd.pseudo_inverse(tol).map_err(|_| fail)?;
-    let mut out = [[0.0f32; D]; D];
+    let mut out = E::ZERO_MATRIX;
     for (i, row) in out.iter_mut().enumerate() {
         for (j, x) in row.iter_mut().enumerate() {
             *x = p[(i, j)] as f32;
@@ -60,10 +62,10 @@ fn pseudo_inverse<const D: usize>(a: &Matrix<D>, mode: u8) -> Result<Matrix<D>, 
 }
 
 /// `Phi D` for a row-shuffled identity `Phi`: row `r` is row `shuffle[r]` of `D`.
-fn shuffled_rows<const D: usize>(d: &Matrix<D>, shuffle: &[u8; D]) -> Matrix<D> {
-    let mut a = [[0.0f32; D]; D];
-    for (row, &p) in a.iter_mut().zip(shuffle) {
-        *row = d[p as usize % D];
+fn shuffled_rows<E: Mode>(d: &ModeMatrix<E>, shuffle: &E::Per<u8>) -> ModeMatrix<E> {
+    let mut a = E::ZERO_MATRIX;
+    for (row, &p) in a.iter_mut().zip(shuffle.iter()) {
+        *row = d[p as usize % E::D];
     }
     a
 }
@@ -71,16 +73,14 @@ fn shuffled_rows<const D: usize>(d: &Matrix<D>, shuffle: &[u8; D]) -> Matrix<D> 
 /// The operators `A_i = Phi_i D_i` and their pseudo-inverses for one kronecker block.
 /// Config: built once, used for every patch the block's `Phi` describes.
 #[derive(Clone, Debug)]
-pub struct PinvOperator<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> {
-    a: Factors<PS, PT, PU, PV, B>,
-    a_pinv: Factors<PS, PT, PU, PV, B>,
-    phi: KroneckerPhi<PS, PT, PU, PV>,
-    dict: Dictionary<PS, PT, PU, PV, B>,
+pub struct PinvOperator<S: Shape> {
+    a: Factors<S>,
+    a_pinv: Factors<S>,
+    phi: KroneckerPhi<S::S, S::T, S::U, S::V>,
+    dict: Dictionary<S>,
 }
 
-impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>
-    PinvOperator<PS, PT, PU, PV, B>
-{
+impl<S: Shape> PinvOperator<S> {
     /// Forms `A_i = Phi_i D_i` and computes each `A_i^+` once.
     ///
     /// Set-up only: call it once per kronecker block, before decoding, never per patch. It
@@ -93,32 +93,32 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
     ///
     /// # Errors
     /// [`SolveError::PseudoInverse`] if an SVD does not converge or an input is not finite.
-    pub fn new(dict: &Dictionary<PS, PT, PU, PV, B>, phi: &KroneckerPhi<PS, PT, PU, PV>) -> Result<Self, SolveError> {
+    pub fn new(dict: &Dictionary<S>, phi: &KroneckerPhi<S::S, S::T, S::U, S::V>) -> Result<Self, SolveError> {
         let d = &dict.d;
-        let mut a5 = [[0.0f32; B]; B];
-        for (row, &band) in a5.iter_mut().zip(&phi.bands) {
-            *row = d.m5[band as usize % B];
+        let mut a5 = S::Bands::ZERO_MATRIX;
+        for (row, &band) in a5.iter_mut().zip(phi.bands.iter()) {
+            *row = d.m5[band as usize % S::B];
         }
         let a = Factors {
-            m1: shuffled_rows(&d.m1, &phi.shuffle1),
-            m2: shuffled_rows(&d.m2, &phi.shuffle2),
-            m3: shuffled_rows(&d.m3, &phi.shuffle3),
-            m4: shuffled_rows(&d.m4, &phi.shuffle4),
+            m1: shuffled_rows::<S::S>(&d.m1, &phi.shuffle1),
+            m2: shuffled_rows::<S::T>(&d.m2, &phi.shuffle2),
+            m3: shuffled_rows::<S::U>(&d.m3, &phi.shuffle3),
+            m4: shuffled_rows::<S::V>(&d.m4, &phi.shuffle4),
             m5: a5,
         };
         let a_pinv = Factors {
-            m1: pseudo_inverse(&a.m1, 1)?,
-            m2: pseudo_inverse(&a.m2, 2)?,
-            m3: pseudo_inverse(&a.m3, 3)?,
-            m4: pseudo_inverse(&a.m4, 4)?,
-            m5: pseudo_inverse(&a.m5, 5)?,
+            m1: pseudo_inverse::<S::S>(&a.m1, 1)?,
+            m2: pseudo_inverse::<S::T>(&a.m2, 2)?,
+            m3: pseudo_inverse::<S::U>(&a.m3, 3)?,
+            m4: pseudo_inverse::<S::V>(&a.m4, 4)?,
+            m5: pseudo_inverse::<S::Bands>(&a.m5, 5)?,
         };
         Ok(Self { a, a_pinv, phi: phi.clone(), dict: dict.clone() })
     }
 
     /// [`PatchShape::index`] (which does not depend on `N`).
-    const fn index(s: usize, t: usize, u: usize, v: usize, b: usize) -> usize {
-        PatchShape::<PS, PT, PU, PV, B, 0>::index(s, t, u, v, b)
+    fn index(s: usize, t: usize, u: usize, v: usize, b: usize) -> usize {
+        S::index(s, t, u, v, b)
     }
 
     /// For every entry of the padded measurement tensor `I` (in the patch layout, with the
@@ -140,7 +140,7 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
     }
 
     /// `t -= I` (or `t = I` with `assign`); `I` read from the measurements.
-    fn subtract_measurements<const N: usize>(&self, m: &Measurements<N>, t: &mut [f32; N], assign: bool) {
+    fn subtract_measurements(&self, m: &Measurements<S::Values>, t: &mut PerValue<S, f32>, assign: bool) {
         self.for_each_selected(|i, e| {
             let y = m.values.get(e).copied().unwrap_or(0.0);
             if let Some(x) = t.get_mut(i) {
@@ -161,27 +161,20 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
 /// # Errors
 /// [`SolveError::InvalidConfig`], [`SolveError::NoMeasurements`],
 /// [`SolveError::IncompleteKronecker`], [`SolveError::NonFiniteResult`].
-pub fn solve_pinv<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
->(
-    op: &PinvOperator<PS, PT, PU, PV, B>,
+pub fn solve_pinv<S: Shape>(
+    op: &PinvOperator<S>,
     cfg: &Sl0Config,
-    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ws: &mut Workspace<S>,
 ) -> Result<Outcome, SolveError> {
     let Workspace { coeffs, signal, measurements: m, response, .. } = ws;
     if !response.is_identity() {
         // The paper's operator is a selection of the patch's entries: no mixed filters.
         return Err(SolveError::InvalidConfig { field: "response" });
     }
-    let ball = start::<B, N>(cfg, m)?;
+    let ball = start::<S>(cfg, m)?;
     let mut complete = true;
     op.for_each_selected(|_, e| complete &= m.measured.get(e).copied().unwrap_or(false));
-    if !complete || m.count() != PatchShape::<PS, PT, PU, PV, B, N>::PIXELS * op.phi.bands.len() {
+    if !complete || m.count() != S::PIXELS * op.phi.bands.len() {
         return Err(SolveError::IncompleteKronecker);
     }
 
@@ -189,13 +182,13 @@ pub fn solve_pinv<
     coeffs.fill(0.0);
     op.subtract_measurements(m, coeffs, true);
     apply_in_place(&op.a_pinv, coeffs);
-    let sigma0 = max_abs(coeffs);
+    let sigma0 = max_abs(coeffs.as_ref());
 
-    let outcome = run_schedule(cfg, sigma0, N, |inv| {
+    let outcome = run_schedule(cfg, sigma0, S::N, |inv| {
         // The step's own length bounds how far the projected step moves the patch.
-        let moved = libm::sqrtf(ascend(coeffs, cfg.mu, inv));
+        let moved = libm::sqrtf(ascend(coeffs.as_mut(), cfg.mu, inv));
         // R = S x_i A_i - I
-        signal.copy_from_slice(coeffs);
+        signal.copy_from_slice(coeffs.as_ref());
         apply_in_place(&op.a, signal);
         op.subtract_measurements(m, signal, false);
         let r2: f32 = signal.iter().map(|r| r * r).sum();
@@ -204,7 +197,7 @@ pub fn solve_pinv<
         if ball.is_weighted() {
             op.for_each_selected(|i, e| {
                 let (r, y) = (signal.get(i).copied().unwrap_or(0.0), m.values.get(e).copied().unwrap_or(0.0));
-                w2 += r * r * ball.weight(y, m.gains.get(e % B).copied().unwrap_or(1.0));
+                w2 += r * r * ball.weight(y, m.gains.get(e % S::B).copied().unwrap_or(1.0));
             });
         }
         let norm = libm::sqrtf(r2);

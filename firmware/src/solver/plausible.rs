@@ -29,7 +29,8 @@
 //! ([`crate::decode::tile`]): it decodes it again by a safer path and, if values are still
 //! above their bounds, [`clip`]s them; both are counted in its report.
 
-use crate::operators::shape::PatchShape;
+use crate::operators::shape::{PerBand, PerValue, Pixels, Shape};
+use crate::sensor::extent::{Array, Bands};
 use crate::solver::workspace::Measurements;
 
 /// The bound's parameters (config: immutable, set once on the tile decoder).
@@ -70,35 +71,24 @@ impl Plausibility {
 
     /// The bounds of the patch measured by `m` (values in the solve's units, as `m` holds
     /// them).
-    pub fn bounds<
-        const PS: usize,
-        const PT: usize,
-        const PU: usize,
-        const PV: usize,
-        const B: usize,
-        const N: usize,
-    >(
-        &self,
-        m: &Measurements<N>,
-    ) -> Bounds<PS, PT, PU, PV> {
-        const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
+    pub fn bounds<S: Shape>(&self, m: &Measurements<S::Values>) -> Bounds<S> {
         let mut b = Bounds {
-            local: [[[[f32::NEG_INFINITY; PV]; PU]; PT]; PS],
-            seen: [[[[0u32; PV]; PU]; PT]; PS],
+            local: S::PerPixel::<f32>::splat(f32::NEG_INFINITY),
+            seen: S::PerPixel::<u32>::splat(0),
             wide: f32::INFINITY,
         };
         if self.is_off() {
-            b.local = [[[[f32::INFINITY; PV]; PU]; PT]; PS];
-            b.seen = [[[[u32::MAX; PV]; PU]; PT]; PS];
+            b.local = S::PerPixel::<f32>::splat(f32::INFINITY);
+            b.seen = S::PerPixel::<u32>::splat(u32::MAX);
             return b;
         }
         let mut widest = f32::NEG_INFINITY;
         {
-            let local = b.local.as_flattened_mut().as_flattened_mut().as_flattened_mut();
-            let seen = b.seen.as_flattened_mut().as_flattened_mut().as_flattened_mut();
-            let pixels = m.values.as_chunks::<B>().0.iter().zip(m.measured.as_chunks::<B>().0);
+            let local = b.local.flat_mut();
+            let seen = b.seen.flat_mut();
+            let pixels = S::Bands::chunks(m.values.as_ref()).iter().zip(S::Bands::chunks(m.measured.as_ref()));
             for ((most, bits), (values, measured)) in local.iter_mut().zip(seen.iter_mut()).zip(pixels) {
-                for (band, (&y, &k)) in values.iter().zip(measured).enumerate() {
+                for (band, (&y, &k)) in values.iter().zip(measured.iter()).enumerate() {
                     if k {
                         *most = if y > *most { y } else { *most };
                         *bits |= 1 << (band & 31);
@@ -109,13 +99,11 @@ impl Plausibility {
         }
         // The neighbourhood's maximum and bands, one axis at a time (a 3 x 3 x 3 x 3
         // neighbourhood is four 3-tap ones), in place.
-        for (len, stride) in [(PS, PT * PU * PV), (PT, PU * PV), (PU, PV), (PV, 1)] {
-            let local = b.local.as_flattened_mut().as_flattened_mut().as_flattened_mut();
-            along(local, len, stride, f32::NEG_INFINITY, |a, c| if a > c { a } else { c });
-            let seen = b.seen.as_flattened_mut().as_flattened_mut().as_flattened_mut();
-            along(seen, len, stride, 0, |a, c| a | c);
+        for (len, stride) in [(S::PS, S::PT * S::PU * S::PV), (S::PT, S::PU * S::PV), (S::PU, S::PV), (S::PV, 1)] {
+            along(b.local.flat_mut(), len, stride, f32::NEG_INFINITY, |a, c| if a > c { a } else { c });
+            along(b.seen.flat_mut(), len, stride, 0, |a, c| a | c);
         }
-        for most in b.local.as_flattened_mut().as_flattened_mut().as_flattened_mut() {
+        for most in b.local.flat_mut() {
             *most = self.bound(*most);
         }
         b.wide = self.bound(widest);
@@ -138,22 +126,26 @@ impl Plausibility {
 /// bands, and a saturated colour's unseen band can be many times its seen ones: bounded by
 /// the neighbourhood's, the saturated test scene lost 1.3 dB at lenslet k = 3).
 #[derive(Clone, Debug)]
-pub struct Bounds<const PS: usize, const PT: usize, const PU: usize, const PV: usize> {
+pub struct Bounds<S: Shape> {
     /// The neighbourhood's bound of each pixel.
-    pub local: [[[[f32; PV]; PU]; PT]; PS],
+    pub local: S::PerPixel<f32>,
     /// The bands (bit `b`: band `b`) measured in each pixel's neighbourhood.
-    pub seen: [[[[u32; PV]; PU]; PT]; PS],
+    pub seen: S::PerPixel<u32>,
     /// The patch's bound, for the bands a neighbourhood did not measure.
     pub wide: f32,
 }
 
-impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize> Bounds<PS, PT, PU, PV> {
+impl<S: Shape> Bounds<S> {
     /// Each pixel's `B` bounds, in the patch's pixel order.
-    fn per_pixel<const B: usize>(&self) -> impl Iterator<Item = [f32; B]> + '_ {
-        let local = self.local.as_flattened().as_flattened().as_flattened();
-        let seen = self.seen.as_flattened().as_flattened().as_flattened();
-        local.iter().zip(seen).map(move |(&near, &bits)| {
-            core::array::from_fn(|b| if bits & (1 << (b & 31)) != 0 { near } else { self.wide })
+    fn per_pixel(&self) -> impl Iterator<Item = PerBand<S, f32>> + '_ {
+        self.local.flat().iter().zip(self.seen.flat()).map(move |(&near, &bits)| {
+            let mut bounds = <PerBand<S, f32>>::splat(self.wide);
+            for (b, x) in bounds.iter_mut().enumerate() {
+                if bits & (1 << (b & 31)) != 0 {
+                    *x = near;
+                }
+            }
+            bounds
         })
     }
 }
@@ -189,21 +181,10 @@ impl Default for Plausibility {
 
 /// How many values of `patch` lie above their bound (`bounds`, from
 /// [`Plausibility::bounds`]); a NaN counts as above.
-pub fn implausible<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
->(
-    bounds: &Bounds<PS, PT, PU, PV>,
-    patch: &[f32; N],
-) -> u32 {
-    const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
+pub fn implausible<S: Shape>(bounds: &Bounds<S>, patch: &PerValue<S, f32>) -> u32 {
     let mut above = 0u32;
-    for (run, bound) in patch.as_chunks::<B>().0.iter().zip(bounds.per_pixel::<B>()) {
-        for (&x, &bound) in run.iter().zip(&bound) {
+    for (run, bound) in S::Bands::chunks(patch.as_ref()).iter().zip(bounds.per_pixel()) {
+        for (&x, &bound) in run.iter().zip(bound.iter()) {
             // Above, or NaN (which no bound holds).
             above += u32::from(x > bound || x.is_nan());
         }
@@ -214,13 +195,9 @@ pub fn implausible<
 /// Every value of `patch` above its bound set to the bound (a NaN too). Measured values lie
 /// within their own bound (`factor >= 1`, `margin >= 0`), so a patch that met its
 /// measurements still does.
-pub fn clip<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
-    bounds: &Bounds<PS, PT, PU, PV>,
-    patch: &mut [f32; N],
-) {
-    const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
-    for (run, bound) in patch.as_chunks_mut::<B>().0.iter_mut().zip(bounds.per_pixel::<B>()) {
-        for (x, &bound) in run.iter_mut().zip(&bound) {
+pub fn clip<S: Shape>(bounds: &Bounds<S>, patch: &mut PerValue<S, f32>) {
+    for (run, bound) in S::Bands::chunks_mut(patch.as_mut()).iter_mut().zip(bounds.per_pixel()) {
+        for (x, &bound) in run.iter_mut().zip(bound.iter()) {
             *x = if *x <= bound { *x } else { bound };
         }
     }

@@ -24,18 +24,17 @@
 //! in the L1 cache from the synthesis to the analysis.
 
 use crate::operators::dictionary::Dictionary;
-use crate::operators::shape::PatchShape;
-use crate::operators::transform::{Slice, flat, mode_pixel, mode_rows, mode_rows_add, slice};
+use crate::operators::mode::{Mode, ModeMatrix};
+use crate::operators::shape::{PerBand, PerValue, Scratch, Shape};
+use crate::sensor::extent::{Array, Extent};
 use crate::solver::ball::{Ball, Move};
 use crate::solver::workspace::Measurements;
 
 /// Multiply-adds of one projection with `measured` measurements: the pixel-mode synthesis
 /// and analysis, and `2 B` per measurement on the band axis.
-pub const fn projection_macs<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
-    measured: usize,
-) -> usize {
-    let pixels = PS * PT * PU * PV;
-    2 * pixels * B * (PS + PT + PU + PV) + 2 * B * measured
+pub const fn projection_macs<S: Shape>(measured: usize) -> usize {
+    let pixels = S::PS * S::PT * S::PU * S::PV;
+    2 * pixels * S::B * (S::PS + S::PT + S::PU + S::PV) + 2 * S::B * measured
 }
 
 /// Moves the coefficients `coeffs` (of `dict`) onto the measurements `m`: exactly, or onto
@@ -51,29 +50,22 @@ pub const fn projection_macs<const PS: usize, const PT: usize, const PU: usize, 
 /// Kept out of line: inlined into the solver's step loop, the band step ran about twice
 /// as slow as in this function alone (`perf annotate` of `slf bench`), and a decode with
 /// the DCT took 0.80 against 0.68 ms a patch at pixel k = 3 (0.49 against 0.47 at k = 1).
-pub fn project_coefficients<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
->(
-    dict: &Dictionary<PS, PT, PU, PV, B>,
-    coeffs: &mut [f32; N],
-    scratch: &mut [f32; N],
-    m: &Measurements<N>,
+pub fn project_coefficients<S: Shape>(
+    dict: &Dictionary<S>,
+    coeffs: &mut PerValue<S, f32>,
+    scratch: &mut PerValue<S, f32>,
+    m: &Measurements<S::Values>,
     ball: &Ball,
-    weights: Option<&[f32; N]>,
+    weights: Option<&PerValue<S, f32>>,
 ) -> f32 {
     let weighted = ball.is_weighted();
-    let mut parts = weights.map(|w| w.chunks_exact(PT * PU * PV * B));
-    let mut step = |fibres: &mut [[f32; B]], values: &[f32], measured: &[bool]| {
+    let mut parts = weights.map(|w| w.as_ref().chunks_exact(S::PT * S::PU * S::PV * S::B));
+    let mut step = |fibres: &mut [PerBand<S, f32>], values: &[f32], measured: &[bool]| {
         let (m5, gains) = (&dict.d.m5, &m.gains);
         match parts.as_mut().and_then(Iterator::next) {
-            Some(w) if weighted => band_step::<B, TABLE>(m5, fibres, values, measured, ball, gains, w),
-            _ if weighted => band_step::<B, COMPUTED>(m5, fibres, values, measured, ball, gains, values),
-            _ => band_step::<B, PLAIN>(m5, fibres, values, measured, ball, gains, values),
+            Some(w) if weighted => band_step::<S, TABLE>(m5, fibres, values, measured, ball, gains, w),
+            _ if weighted => band_step::<S, COMPUTED>(m5, fibres, values, measured, ball, gains, values),
+            _ => band_step::<S, PLAIN>(m5, fibres, values, measured, ball, gains, values),
         }
     };
     project_slices(dict, coeffs, scratch, m, ball, &mut step)
@@ -81,10 +73,10 @@ pub fn project_coefficients<
 
 /// Each measured entry's weight in `ball` ([`Ball::weight`]) into `weights`, in patch
 /// order (the other entries are left as they are): what [`project_coefficients`] reads.
-pub fn weigh<const B: usize, const N: usize>(m: &Measurements<N>, ball: &Ball, weights: &mut [f32; N]) {
-    let measured = m.values.as_chunks::<B>().0.iter().zip(m.measured.as_chunks::<B>().0);
-    for (ws, (ys, flags)) in weights.as_chunks_mut::<B>().0.iter_mut().zip(measured) {
-        for b in set_flags(flags) {
+pub fn weigh<S: Shape>(m: &Measurements<S::Values>, ball: &Ball, weights: &mut PerValue<S, f32>) {
+    let measured = S::Bands::chunks(m.values.as_ref()).iter().zip(S::Bands::chunks(m.measured.as_ref()));
+    for (ws, (ys, flags)) in S::Bands::chunks_mut(weights.as_mut()).iter_mut().zip(measured) {
+        for b in set_flags(flags.as_ref()) {
             let (Some(w), Some(&y)) = (ws.get_mut(b), ys.get(b)) else { continue };
             *w = ball.weight(y, m.gains.get(b).copied().unwrap_or(1.0));
         }
@@ -95,7 +87,7 @@ pub fn weigh<const B: usize, const N: usize>(m: &Measurements<N>, ball: &Ball, w
 /// pixel modes' synthesis), become the correction's; `values` / `measured` are the
 /// slice's measurements in patch order. Returns the sums of squared residuals, plain and
 /// weighted ([`Ball::weight`]).
-pub(crate) type BandStep<'s, const B: usize> = dyn FnMut(&mut [[f32; B]], &[f32], &[bool]) -> (f32, f32) + 's;
+pub(crate) type BandStep<'s, S> = dyn FnMut(&mut [PerBand<S, f32>], &[f32], &[bool]) -> (f32, f32) + 's;
 
 /// The projection's frame shared by the one-hot band step ([`project_coefficients`]) and
 /// the mixed one ([`crate::solver::mixing::project_mixed`]): the pixel modes' synthesis,
@@ -103,41 +95,33 @@ pub(crate) type BandStep<'s, const B: usize> = dyn FnMut(&mut [[f32; B]], &[f32]
 /// through a pointer (five calls a projection), so the transforms are compiled once: with
 /// a copy per band step the mixed projection added 20 KB of flash to the device image.
 #[inline(never)]
-pub(crate) fn project_slices<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
->(
-    dict: &Dictionary<PS, PT, PU, PV, B>,
-    coeffs: &mut [f32; N],
-    scratch: &mut [f32; N],
-    m: &Measurements<N>,
+pub(crate) fn project_slices<S: Shape>(
+    dict: &Dictionary<S>,
+    coeffs: &mut PerValue<S, f32>,
+    scratch: &mut PerValue<S, f32>,
+    m: &Measurements<S::Values>,
     ball: &Ball,
-    step: &mut BandStep<'_, B>,
+    step: &mut BandStep<'_, S>,
 ) -> f32 {
-    const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
-    let part_len = PT * PU * PV * B;
-    mode_rows(&dict.d.m1, dict.synthesis_folds()[0], coeffs, scratch, part_len);
+    let part_len = S::PT * S::PU * S::PV * S::B;
+    S::S::rows(&dict.d.m1, dict.synthesis_folds()[0], coeffs.as_ref(), scratch.as_mut(), part_len);
     let (mut r2, mut w2) = (0.0f32, 0.0f32);
-    let mut tmp: Slice<PT, PU, PV, B> = slice();
-    let parts = scratch.chunks_exact_mut(part_len).zip(m.values.chunks_exact(part_len));
-    for ((part, values), measured) in parts.zip(m.measured.chunks_exact(part_len)) {
-        let tmp = flat(&mut tmp);
+    let mut tmp = S::Slice::ZERO;
+    let parts = scratch.as_mut().chunks_exact_mut(part_len).zip(m.values.as_ref().chunks_exact(part_len));
+    for ((part, values), measured) in parts.zip(m.measured.as_ref().chunks_exact(part_len)) {
+        let tmp = tmp.values();
         slice_synthesis(dict, part, tmp);
-        let (r, w) = step(tmp.as_chunks_mut::<B>().0, values, measured);
+        let (r, w) = step(S::Bands::chunks_mut(tmp), values, measured);
         (r2, w2) = (r2 + r, w2 + w);
         slice_analysis(dict, tmp, part);
     }
-    apply_move(dict, ball, (r2, w2), scratch, coeffs)
+    apply_move(dict, ball, (r2, w2), scratch.as_ref(), coeffs.as_mut())
 }
 
 /// A step on the whole patch's band coefficients: `scratch` (every pixel's band
 /// coefficients after the pixel modes' synthesis) becomes the correction's. Returns the sums
 /// of squared residuals, plain and weighted.
-pub(crate) type PatchStep<'s, const N: usize> = dyn FnMut(&mut [f32; N]) -> (f32, f32) + 's;
+pub(crate) type PatchStep<'s, S> = dyn FnMut(&mut PerValue<S, f32>) -> (f32, f32) + 's;
 
 /// The frame of the interpolating projections ([`crate::solver::fractional`],
 /// [`crate::solver::shares`]), whose measurements read values of several spatial slices:
@@ -145,74 +129,58 @@ pub(crate) type PatchStep<'s, const N: usize> = dyn FnMut(&mut [f32; N]) -> (f32
 /// analysis and the ball's move. One copy for both (through a pointer, as
 /// [`project_slices`]): a copy each took 19 KB more flash on the device.
 #[inline(never)]
-pub(crate) fn project_whole<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
->(
-    dict: &Dictionary<PS, PT, PU, PV, B>,
-    coeffs: &mut [f32; N],
-    scratch: &mut [f32; N],
+pub(crate) fn project_whole<S: Shape>(
+    dict: &Dictionary<S>,
+    coeffs: &mut PerValue<S, f32>,
+    scratch: &mut PerValue<S, f32>,
     ball: &Ball,
-    step: &mut PatchStep<'_, N>,
+    step: &mut PatchStep<'_, S>,
 ) -> f32 {
-    const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
-    let part_len = PT * PU * PV * B;
-    mode_rows(&dict.d.m1, dict.synthesis_folds()[0], coeffs, scratch, part_len);
-    let mut tmp: Slice<PT, PU, PV, B> = slice();
-    for part in scratch.chunks_exact_mut(part_len) {
-        let tmp = flat(&mut tmp);
+    let part_len = S::PT * S::PU * S::PV * S::B;
+    S::S::rows(&dict.d.m1, dict.synthesis_folds()[0], coeffs.as_ref(), scratch.as_mut(), part_len);
+    let mut tmp = S::Slice::ZERO;
+    for part in scratch.as_mut().chunks_exact_mut(part_len) {
+        let tmp = tmp.values();
         slice_synthesis(dict, part, tmp);
-        part.copy_from_slice(tmp);
+        part.copy_from_slice(tmp.as_ref());
     }
     let moved = step(scratch);
-    for part in scratch.chunks_exact_mut(part_len) {
-        let tmp = flat(&mut tmp);
-        tmp.copy_from_slice(part);
+    for part in scratch.as_mut().chunks_exact_mut(part_len) {
+        let tmp = tmp.values();
+        tmp.copy_from_slice(part.as_ref());
         slice_analysis(dict, tmp, part);
     }
-    apply_move(dict, ball, moved, scratch, coeffs)
+    apply_move(dict, ball, moved, scratch.as_ref(), coeffs.as_mut())
 }
 
 /// The synthesis of one spatial slice over the pixel modes after the first: `part` (its
 /// first mode already synthesised) to each pixel's band coefficients in `fibres`; `part`
 /// is clobbered. Shared by both projections ([`crate::solver::fractional`]).
 #[inline(always)]
-pub(crate) fn slice_synthesis<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
-    dict: &Dictionary<PS, PT, PU, PV, B>,
-    part: &mut [f32],
-    fibres: &mut [f32],
-) {
+pub(crate) fn slice_synthesis<S: Shape>(dict: &Dictionary<S>, part: &mut [f32], fibres: &mut [f32]) {
     let (d, fd) = (&dict.d, dict.synthesis_folds());
-    mode_rows(&d.m2, fd[1], part, fibres, PU * PV * B);
-    mode_rows(&d.m3, fd[2], fibres, part, PV * B);
-    mode_pixel(&d.m4, fd[3], part.as_chunks::<B>().0, fibres.as_chunks_mut::<B>().0);
+    S::T::rows(&d.m2, fd[1], part, fibres, S::PU * S::PV * S::B);
+    S::U::rows(&d.m3, fd[2], fibres, part, S::PV * S::B);
+    S::pixel(&d.m4, fd[3], part, fibres);
 }
 
 /// The inverse of [`slice_synthesis`]: a slice's corrections as band coefficients in
 /// `fibres` analysed over the pixel modes after the first into `part`; `fibres` is
 /// clobbered.
 #[inline(always)]
-pub(crate) fn slice_analysis<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
-    dict: &Dictionary<PS, PT, PU, PV, B>,
-    fibres: &mut [f32],
-    part: &mut [f32],
-) {
+pub(crate) fn slice_analysis<S: Shape>(dict: &Dictionary<S>, fibres: &mut [f32], part: &mut [f32]) {
     let (t, ft) = (&dict.t, dict.analysis_folds());
-    mode_pixel(&t.m4, ft[3], fibres.as_chunks::<B>().0, part.as_chunks_mut::<B>().0);
-    mode_rows(&t.m3, ft[2], part, fibres, PV * B);
-    mode_rows(&t.m2, ft[1], fibres, part, PU * PV * B);
+    S::pixel(&t.m4, ft[3], fibres, part);
+    S::U::rows(&t.m3, ft[2], part, fibres, S::PV * S::B);
+    S::T::rows(&t.m2, ft[1], fibres, part, S::PU * S::PV * S::B);
 }
 
 /// The end of a projection: the ball's move for squared residual norms `(r2, w2)` (plain,
 /// weighted), and the correction in `scratch` (all but the first mode analysed) added to
 /// `coeffs` at that scale through the first mode's analysis. Returns the residual norm.
 #[inline(always)]
-pub(crate) fn apply_move<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
-    dict: &Dictionary<PS, PT, PU, PV, B>,
+pub(crate) fn apply_move<S: Shape>(
+    dict: &Dictionary<S>,
     ball: &Ball,
     (r2, w2): (f32, f32),
     scratch: &[f32],
@@ -222,7 +190,7 @@ pub(crate) fn apply_move<const PS: usize, const PT: usize, const PU: usize, cons
     let Move::Scale(scale) = ball.move_for(r2, w2) else {
         return norm; // inside the ball: no move
     };
-    mode_rows_add(&dict.t.m1, dict.analysis_folds()[0], scale, scratch, coeffs, PT * PU * PV * B);
+    S::S::rows_add(&dict.t.m1, dict.analysis_folds()[0], scale, scratch, coeffs, S::PT * S::PU * S::PV * S::B);
     norm
 }
 
@@ -248,33 +216,33 @@ const TABLE: u8 = 2;
 /// of 128-bit arithmetic a band) took the projection from 5.98 to 5.75 us at one.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)] // the band step's inputs, inlined into its one caller
-fn band_step<const B: usize, const WEIGH: u8>(
-    m5: &[[f32; B]; B],
-    fibres: &mut [[f32; B]],
+fn band_step<S: Shape, const WEIGH: u8>(
+    m5: &ModeMatrix<S::Bands>,
+    fibres: &mut [PerBand<S, f32>],
     values: &[f32],
     measured: &[bool],
     ball: &Ball,
     gains: &[f32],
     weights: &[f32],
 ) -> (f32, f32) {
-    const { assert!(B <= 64, "a pixel's flags fit one mask (B <= MAX_BANDS)") };
+    const { assert!(S::B <= 64, "a pixel's flags fit one mask (S::B <= MAX_BANDS)") };
     let (mut r2, mut w2) = (0.0f32, 0.0f32);
-    let pixels = fibres.iter_mut().zip(values.as_chunks::<B>().0).zip(measured.as_chunks::<B>().0);
-    for (((fibre, values), measured), weights) in pixels.zip(weights.as_chunks::<B>().0) {
-        let mut correction = [0.0f32; B];
-        let mut bits = band_bits(measured);
+    let pixels = fibres.iter_mut().zip(S::Bands::chunks(values)).zip(S::Bands::chunks(measured));
+    for (((fibre, values), measured), weights) in pixels.zip(S::Bands::chunks(weights)) {
+        let mut correction = <PerBand<S, f32>>::splat(0.0);
+        let mut bits = band_bits(measured.as_ref());
         while bits != 0 {
             let b = bits.trailing_zeros() as usize;
             bits &= bits - 1;
             let (Some(row), Some(&y)) = (m5.get(b), values.get(b)) else { break };
-            let r = y - dot(row, fibre);
+            let r = y - dot(row.as_ref(), fibre.as_ref());
             r2 += r * r;
             if WEIGH == COMPUTED {
                 w2 += r * r * ball.weight(y, gains.get(b).copied().unwrap_or(1.0));
             } else if WEIGH == TABLE {
                 w2 += r * r * weights.get(b).copied().unwrap_or(0.0);
             }
-            for (c, &w) in correction.iter_mut().zip(row) {
+            for (c, &w) in correction.iter_mut().zip(row.iter()) {
                 *c += r * w;
             }
         }
@@ -319,7 +287,7 @@ pub(crate) fn band_bits(flags: &[bool]) -> u64 {
 /// `sum a[j] b[j]` as eight running sums added pairwise: a chain of `B / 8 + 3` additions
 /// instead of `B`, so the pixels' band steps overlap.
 #[inline(always)]
-pub(crate) fn dot<const B: usize>(a: &[f32; B], b: &[f32; B]) -> f32 {
+pub(crate) fn dot(a: &[f32], b: &[f32]) -> f32 {
     let mut acc = [0.0f32; 8];
     for (j, (x, y)) in a.iter().zip(b).enumerate() {
         acc[j % 8] += x * y;

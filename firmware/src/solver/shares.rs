@@ -46,7 +46,9 @@
 //! faster: 2.6 s both).
 
 use crate::operators::dictionary::Dictionary;
-use crate::operators::shape::PatchShape;
+use crate::operators::mode::ModeMatrix;
+use crate::operators::shape::{PerBand, PerValue, Shape, Values};
+use crate::sensor::extent::{Array, Bands};
 use crate::solver::ball::Ball;
 use crate::solver::projection::{band_bits, dot, project_whole};
 use crate::solver::workspace::{CellShares, MAX_SHARE_VIEWS, Measurements, PLACE_UNIT};
@@ -80,7 +82,7 @@ impl Footprint {
 
     /// Band `b` of the cells covered, each by its share, summed (`cells` by patch pixel).
     #[inline(always)]
-    fn band_sum<const B: usize>(&self, cells: &[[f32; B]], b: usize) -> f32 {
+    fn band_sum<C: Bands>(&self, cells: &[C::Per<f32>], b: usize) -> f32 {
         let mut sum = 0.0f32;
         self.each(|c, w| sum += w * cells.get(c).and_then(|f| f.get(b)).copied().unwrap_or(0.0));
         sum
@@ -112,7 +114,8 @@ const OUTSIDE: u16 = u16::MAX;
 /// before and after it on the sensor, found through the shear's whole-lenslet shifts
 /// ([`OUTSIDE`] beyond the patch); likewise for columns. Built once a projection: the
 /// lookups cost more than the shares.
-struct Layout<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> {
+struct Layout<S: Shape> {
+    shape: core::marker::PhantomData<S>,
     rows: [[u16; 2]; MAX_AXIS],
     cols: [[u16; 2]; MAX_AXIS],
     /// One over a pixel's side in cells, rows and columns; the side over 2.
@@ -120,27 +123,28 @@ struct Layout<const PS: usize, const PT: usize, const PU: usize, const PV: usize
     half: (f32, f32),
 }
 
-impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> Layout<PS, PT, PU, PV, B> {
+impl<S: Shape> Layout<S> {
     fn new(shares: &CellShares) -> Self {
         let mut layout = Self {
+            shape: core::marker::PhantomData,
             rows: [[OUTSIDE; 2]; MAX_AXIS],
             cols: [[OUTSIDE; 2]; MAX_AXIS],
             inv: (1.0 / shares.width.0, 1.0 / shares.width.1),
             half: (0.5 * shares.width.0, 0.5 * shares.width.1),
         };
         let part = |x: Option<usize>| x.and_then(|x| u16::try_from(x).ok()).unwrap_or(OUTSIDE);
-        for (i, o) in layout.rows.iter_mut().enumerate().take(PS * PU) {
-            let (s, u) = (i / PU, i % PU);
-            let p = (s as isize + shares.shift.0.get(u).copied().unwrap_or(0) as isize) * PU as isize + u as isize;
+        for (i, o) in layout.rows.iter_mut().enumerate().take(S::PS * S::PU) {
+            let (s, u) = (i / S::PU, i % S::PU);
+            let p = (s as isize + shares.shift.0.get(u).copied().unwrap_or(0) as isize) * S::PU as isize + u as isize;
             for (d, x) in [-1isize, 1].into_iter().zip(o.iter_mut()) {
-                *x = part(along(p + d, PU, PS, &shares.shift.0).map(|(s, u)| (s * PT * PU + u) * PV));
+                *x = part(along(p + d, S::PU, S::PS, &shares.shift.0).map(|(s, u)| (s * S::PT * S::PU + u) * S::PV));
             }
         }
-        for (i, o) in layout.cols.iter_mut().enumerate().take(PT * PV) {
-            let (t, v) = (i / PV, i % PV);
-            let q = (t as isize + shares.shift.1.get(v).copied().unwrap_or(0) as isize) * PV as isize + v as isize;
+        for (i, o) in layout.cols.iter_mut().enumerate().take(S::PT * S::PV) {
+            let (t, v) = (i / S::PV, i % S::PV);
+            let q = (t as isize + shares.shift.1.get(v).copied().unwrap_or(0) as isize) * S::PV as isize + v as isize;
             for (d, x) in [-1isize, 1].into_iter().zip(o.iter_mut()) {
-                *x = part(along(q + d, PV, PT, &shares.shift.1).map(|(t, v)| t * PU * PV + v));
+                *x = part(along(q + d, S::PV, S::PT, &shares.shift.1).map(|(t, v)| t * S::PU * S::PV + v));
             }
         }
         layout
@@ -148,24 +152,24 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
 
     /// The footprint of the measurements of patch pixel `(s, t, u, v)` (index `pixel`).
     #[inline(always)]
-    fn footprint<const N: usize>(
+    fn footprint(
         &self,
-        m: &Measurements<N>,
+        m: &Measurements<S::Values>,
         (s, t, u, v): (usize, usize, usize, usize),
         pixel: usize,
     ) -> Footprint {
         let [pr, pc] = m.place.get(pixel).copied().unwrap_or([0, 0]);
         let place = |x: i8| f32::from(x) * (1.0 / PLACE_UNIT);
-        let (before, after) = match self.rows.get(s * PU + u) {
+        let (before, after) = match self.rows.get(s * S::PU + u) {
             Some(&[b, a]) => (b, a),
             None => (OUTSIDE, OUTSIDE),
         };
-        let row_parts = [before, ((s * PT * PU + u) * PV) as u16, after];
-        let (before, after) = match self.cols.get(t * PV + v) {
+        let row_parts = [before, ((s * S::PT * S::PU + u) * S::PV) as u16, after];
+        let (before, after) = match self.cols.get(t * S::PV + v) {
             Some(&[b, a]) => (b, a),
             None => (OUTSIDE, OUTSIDE),
         };
-        let col_parts = [before, (t * PU * PV + v) as u16, after];
+        let col_parts = [before, (t * S::PU * S::PV + v) as u16, after];
         Footprint {
             rows: axis(place(pr), self.half.0, self.inv.0, row_parts),
             cols: axis(place(pc), self.half.1, self.inv.1, col_parts),
@@ -210,19 +214,19 @@ fn axis(delta: f32, half: f32, inv: f32, parts: [u16; 3]) -> ([u16; 3], [f32; 3]
 /// which entries are measured and where their pixels sit, not on the iterate: a solve's
 /// first projection finds them and its other projections reuse them (half of a step's
 /// passes). A fresh one for each solve: the measurements must not change while it is kept.
-pub struct RowSums<const N: usize> {
-    inv: [f32; N],
+pub struct RowSums<S: Shape> {
+    inv: PerValue<S, f32>,
     ready: bool,
 }
 
-impl<const N: usize> RowSums<N> {
+impl<S: Shape> RowSums<S> {
     /// Not yet found: the next projection finds them.
     pub const fn new() -> Self {
-        Self { inv: [0.0; N], ready: false }
+        Self { inv: <S::Values as Values>::ZEROS, ready: false }
     }
 }
 
-impl<const N: usize> Default for RowSums<N> {
+impl<S: Shape> Default for RowSums<S> {
     fn default() -> Self {
         Self::new()
     }
@@ -234,26 +238,18 @@ impl<const N: usize> Default for RowSums<N> {
 /// before the move. [`crate::solver::projection::project_coefficients`] behind a lenslet
 /// grid. `rows` is found by the first
 /// projection of a solve and kept for its others ([`RowSums`]).
-pub fn project_shares<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
->(
-    dict: &Dictionary<PS, PT, PU, PV, B>,
-    coeffs: &mut [f32; N],
-    scratch: &mut [f32; N],
-    m: &Measurements<N>,
+pub fn project_shares<S: Shape>(
+    dict: &Dictionary<S>,
+    coeffs: &mut PerValue<S, f32>,
+    scratch: &mut PerValue<S, f32>,
+    m: &Measurements<S::Values>,
     ball: &Ball,
-    rows: &mut RowSums<N>,
+    rows: &mut RowSums<S>,
 ) -> f32 {
-    const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
     // The pixel modes' synthesis, every slice back in place (the half-pixel projection's
     // frame, `crate::solver::fractional`): each pixel's band coefficients.
-    let mut step = |scratch: &mut [f32; N]| match &m.shares {
-        Some(shares) => share_step::<PS, PT, PU, PV, B, N>(&dict.d.m5, scratch, m, ball, shares, rows),
+    let mut step = |scratch: &mut PerValue<S, f32>| match &m.shares {
+        Some(shares) => share_step::<S>(&dict.d.m5, scratch, m, ball, shares, rows),
         None => (0.0, 0.0),
     };
     project_whole(dict, coeffs, scratch, ball, &mut step)
@@ -261,16 +257,13 @@ pub fn project_shares<
 
 /// Calls `f((s, t, u, v), pixel, band bits)` for every patch pixel with a measurement.
 #[inline(always)]
-fn each_measured<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
-    m: &Measurements<N>,
-    mut f: impl FnMut((usize, usize, usize, usize), usize, u64),
-) {
-    for s in 0..PS {
-        for t in 0..PT {
-            for u in 0..PU {
-                for v in 0..PV {
-                    let pixel = ((s * PT + t) * PU + u) * PV + v;
-                    let Some(flags) = m.measured.get(pixel * B..pixel * B + B) else { continue };
+fn each_measured<S: Shape>(m: &Measurements<S::Values>, mut f: impl FnMut((usize, usize, usize, usize), usize, u64)) {
+    for s in 0..S::PS {
+        for t in 0..S::PT {
+            for u in 0..S::PU {
+                for v in 0..S::PV {
+                    let pixel = ((s * S::PT + t) * S::PU + u) * S::PV + v;
+                    let Some(flags) = m.measured.get(pixel * S::B..pixel * S::B + S::B) else { continue };
                     let bits = band_bits(flags);
                     if bits != 0 {
                         f((s, t, u, v), pixel, bits);
@@ -290,34 +283,34 @@ fn each_measured<const PS: usize, const PT: usize, const PU: usize, const PV: us
 /// `rows` (each band's coverage of each cell in `scratch`, the shares its measurements put
 /// there, then each measurement's row sum).
 #[inline(never)]
-fn share_step<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
-    m5: &[[f32; B]; B],
-    scratch: &mut [f32; N],
-    m: &Measurements<N>,
+fn share_step<S: Shape>(
+    m5: &ModeMatrix<S::Bands>,
+    scratch: &mut PerValue<S, f32>,
+    m: &Measurements<S::Values>,
     ball: &Ball,
     shares: &CellShares,
-    rows: &mut RowSums<N>,
+    rows: &mut RowSums<S>,
 ) -> (f32, f32) {
-    let layout = Layout::<PS, PT, PU, PV, B>::new(shares);
-    let fibres = scratch.as_chunks_mut::<B>().0;
+    let layout = Layout::<S>::new(shares);
+    let fibres = S::Bands::chunks_mut(scratch.as_mut());
     // Each measurement's residual, in its patch entry.
-    let mut res = [0.0f32; N];
+    let mut res = <PerValue<S, f32>>::splat(0.0);
     let (mut r2, mut w2) = (0.0f32, 0.0f32);
     let weighted = ball.is_weighted();
-    each_measured::<PS, PT, PU, PV, B, N>(m, |at, pixel, bits| {
+    each_measured::<S>(m, |at, pixel, bits| {
         let fp = layout.footprint(m, at, pixel);
-        let mut sum = [0.0f32; B];
+        let mut sum = <PerBand<S, f32>>::splat(0.0);
         fp.each(|c, w| {
             if let Some(f) = fibres.get(c) {
-                for (o, &x) in sum.iter_mut().zip(f) {
+                for (o, &x) in sum.iter_mut().zip(f.iter()) {
                     *o += w * x;
                 }
             }
         });
         for b in bands(bits) {
-            let i = pixel * B + b;
+            let i = pixel * S::B + b;
             let (Some(row), Some(&y), Some(r)) = (m5.get(b), m.values.get(i), res.get_mut(i)) else { continue };
-            *r = y - dot(row, &sum);
+            *r = y - dot(row.as_ref(), sum.as_ref());
             r2 += *r * *r;
             if weighted {
                 w2 += *r * *r * ball.weight(y, m.gains.get(b).copied().unwrap_or(1.0));
@@ -325,28 +318,28 @@ fn share_step<const PS: usize, const PT: usize, const PU: usize, const PV: usize
         }
     });
     if !rows.ready {
-        row_sums::<PS, PT, PU, PV, B, N>(fibres, m, &layout, &mut rows.inv);
+        row_sums::<S>(fibres, m, &layout, &mut rows.inv);
         rows.ready = true;
     }
     // The correction: each measurement's step (its residual over its row sum) times its
     // band's row of `D5`, spread over the cells it covers by their shares.
     for f in fibres.iter_mut() {
-        *f = [0.0; B];
+        *f = <PerBand<S, f32>>::splat(0.0);
     }
-    each_measured::<PS, PT, PU, PV, B, N>(m, |at, pixel, bits| {
-        let mut correction = [0.0f32; B];
+    each_measured::<S>(m, |at, pixel, bits| {
+        let mut correction = <PerBand<S, f32>>::splat(0.0);
         for b in bands(bits) {
-            let i = pixel * B + b;
+            let i = pixel * S::B + b;
             let (Some(row), Some(&r), Some(&inv)) = (m5.get(b), res.get(i), rows.inv.get(i)) else { continue };
             let z = r * inv;
-            for (o, &w) in correction.iter_mut().zip(row) {
+            for (o, &w) in correction.iter_mut().zip(row.iter()) {
                 *o += z * w;
             }
         }
         let fp = layout.footprint(m, at, pixel);
         fp.each(|c, w| {
             if let Some(f) = fibres.get_mut(c) {
-                for (o, &x) in f.iter_mut().zip(&correction) {
+                for (o, &x) in f.iter_mut().zip(correction.iter()) {
                     *o += w * x;
                 }
             }
@@ -359,16 +352,16 @@ fn share_step<const PS: usize, const PT: usize, const PU: usize, const PV: usize
 /// nothing is covered): each band's coverage of each cell first (in `fibres`, clobbered),
 /// then each measurement's shares of its cells' coverage.
 #[inline(never)]
-fn row_sums<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
-    fibres: &mut [[f32; B]],
-    m: &Measurements<N>,
-    layout: &Layout<PS, PT, PU, PV, B>,
-    inv: &mut [f32; N],
+fn row_sums<S: Shape>(
+    fibres: &mut [PerBand<S, f32>],
+    m: &Measurements<S::Values>,
+    layout: &Layout<S>,
+    inv: &mut PerValue<S, f32>,
 ) {
     for f in fibres.iter_mut() {
-        *f = [0.0; B];
+        *f = <PerBand<S, f32>>::splat(0.0);
     }
-    each_measured::<PS, PT, PU, PV, B, N>(m, |at, pixel, bits| {
+    each_measured::<S>(m, |at, pixel, bits| {
         let fp = layout.footprint(m, at, pixel);
         fp.each(|c, w| {
             if let Some(f) = fibres.get_mut(c) {
@@ -380,11 +373,11 @@ fn row_sums<const PS: usize, const PT: usize, const PU: usize, const PV: usize, 
             }
         });
     });
-    each_measured::<PS, PT, PU, PV, B, N>(m, |at, pixel, bits| {
+    each_measured::<S>(m, |at, pixel, bits| {
         let fp = layout.footprint(m, at, pixel);
         for b in bands(bits) {
-            let row = fp.band_sum(fibres, b);
-            if let Some(x) = inv.get_mut(pixel * B + b) {
+            let row = fp.band_sum::<S::Bands>(fibres, b);
+            if let Some(x) = inv.get_mut(pixel * S::B + b) {
                 *x = if row > f32::MIN_POSITIVE { 1.0 / row } else { 0.0 };
             }
         }
@@ -395,21 +388,16 @@ fn row_sums<const PS: usize, const PT: usize, const PU: usize, const PV: usize, 
 /// the cells its pixel covers (the model's prediction of the measurement, for the
 /// held-out error estimate). Unmeasured entries are left as they are; `scratch` is
 /// clobbered (a copy of the patch).
-pub fn to_sensor<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
-    m: &Measurements<N>,
-    patch: &mut [f32; N],
-    scratch: &mut [f32; N],
-) {
-    const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
+pub fn to_sensor<S: Shape>(m: &Measurements<S::Values>, patch: &mut PerValue<S, f32>, scratch: &mut PerValue<S, f32>) {
     let Some(shares) = &m.shares else { return };
-    let layout = Layout::<PS, PT, PU, PV, B>::new(shares);
-    scratch.copy_from_slice(patch);
-    let cells = scratch.as_chunks::<B>().0;
-    each_measured::<PS, PT, PU, PV, B, N>(m, |at, pixel, bits| {
+    let layout = Layout::<S>::new(shares);
+    scratch.copy_from_slice(patch.as_ref());
+    let cells = S::Bands::chunks(scratch.as_ref());
+    each_measured::<S>(m, |at, pixel, bits| {
         let fp = layout.footprint(m, at, pixel);
         for b in bands(bits) {
-            let x = fp.band_sum(cells, b);
-            if let Some(y) = patch.get_mut(pixel * B + b) {
+            let x = fp.band_sum::<S::Bands>(cells, b);
+            if let Some(y) = patch.get_mut(pixel * S::B + b) {
                 *y = x;
             }
         }

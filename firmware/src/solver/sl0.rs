@@ -37,6 +37,8 @@ use crate::solver::projection::{project_coefficients, set_flags, weigh};
 use crate::solver::shares::{RowSums, project_shares};
 use crate::solver::workspace::{Measurements, Workspace};
 
+use crate::operators::shape::{PerBand, PerValue, Shape};
+use crate::sensor::extent::{Array, Bands};
 /// Every solver path returns it; it lives below the workspace that checks measurements.
 pub use crate::solver::error::SolveError;
 /// SL0's parameters and how a solve ended, in their own file; named here, with the solve.
@@ -67,12 +69,12 @@ pub(crate) fn max_abs(x: &[f32]) -> f32 {
 /// where a pass over every entry made one chain of `N` dependent additions and a branch an
 /// entry on the mask's random pattern (3.8 % of a one-thread default decode at pixel k = 3,
 /// `perf record`, for one call a solve).
-fn project<const B: usize, const N: usize>(x: &mut [f32; N], m: &Measurements<N>, ball: &Ball) -> f32 {
+fn project<S: Shape>(x: &mut PerValue<S, f32>, m: &Measurements<S::Values>, ball: &Ball) -> f32 {
     let (mut r2, mut w2) = (0.0f32, 0.0f32);
     let weighted = ball.is_weighted();
-    let measured = m.values.as_chunks::<B>().0.iter().zip(m.measured.as_chunks::<B>().0);
-    for (xs, (ys, flags)) in x.as_chunks::<B>().0.iter().zip(measured) {
-        for b in set_flags(flags) {
+    let measured = S::Bands::chunks(m.values.as_ref()).iter().zip(S::Bands::chunks(m.measured.as_ref()));
+    for (xs, (ys, flags)) in S::Bands::chunks(x.as_ref()).iter().zip(measured) {
+        for b in set_flags(flags.as_ref()) {
             let (Some(&x), Some(&y)) = (xs.get(b), ys.get(b)) else { continue };
             let r = y - x;
             r2 += r * r;
@@ -85,9 +87,12 @@ fn project<const B: usize, const N: usize>(x: &mut [f32; N], m: &Measurements<N>
         Move::Scale(scale) => scale,
         Move::Stay => return libm::sqrtf(r2),
     };
-    let (xs, _) = x.as_chunks_mut::<B>();
-    for ((xs, ys), flags) in xs.iter_mut().zip(m.values.as_chunks::<B>().0).zip(m.measured.as_chunks::<B>().0) {
-        for b in set_flags(flags) {
+    for ((xs, ys), flags) in S::Bands::chunks_mut(x.as_mut())
+        .iter_mut()
+        .zip(S::Bands::chunks(m.values.as_ref()))
+        .zip(S::Bands::chunks(m.measured.as_ref()))
+    {
+        for b in set_flags(flags.as_ref()) {
             let (Some(x), Some(&y)) = (xs.get_mut(b), ys.get(b)) else { continue };
             // The exact projection (scale 1) puts the measured values back as they are.
             *x = if scale == 1.0 { y } else { *x + scale * (y - *x) };
@@ -98,7 +103,7 @@ fn project<const B: usize, const N: usize>(x: &mut [f32; N], m: &Measurements<N>
 
 /// The checks both projection paths start with; returns the noise ball (exact projection
 /// without a noise description).
-pub(crate) fn start<const B: usize, const N: usize>(cfg: &Sl0Config, m: &Measurements<N>) -> Result<Ball, SolveError> {
+pub(crate) fn start<S: Shape>(cfg: &Sl0Config, m: &Measurements<S::Values>) -> Result<Ball, SolveError> {
     cfg.validate()?;
     if m.count == 0 {
         return Err(SolveError::NoMeasurements);
@@ -107,7 +112,7 @@ pub(crate) fn start<const B: usize, const N: usize>(cfg: &Sl0Config, m: &Measure
         return Ok(Ball::new(0.0, 0.0, m.count, 0));
     }
     // Pixels with at least one measured band (the band is the last axis).
-    let pixels = m.measured.as_chunks::<B>().0.iter().filter(|p| p.contains(&true)).count();
+    let pixels = S::Bands::chunks(m.measured.as_ref()).iter().filter(|p| p.contains(&true)).count();
     Ok(Ball::new(cfg.noise, cfg.shot, m.count, pixels as u32).balanced(m.balanced))
 }
 
@@ -158,9 +163,9 @@ pub(crate) fn run_schedule(cfg: &Sl0Config, sigma0: f32, values: usize, mut step
 /// A trained schedule's steps, shared by both projection paths: `step(inv, mu)` for each
 /// step, `sigma = max(schedule.sigma[t] * sigma0, cfg.sigma_min)`, until the schedule's
 /// end, the iteration bound or sigma underflow.
-pub(crate) fn run_trained<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
+pub(crate) fn run_trained<S: Shape>(
     cfg: &Sl0Config,
-    schedule: &Schedule<PS, PT, PU, PV, B>,
+    schedule: &Schedule<S>,
     sigma0: f32,
     mut step: impl FnMut(f32, f32) -> Step,
 ) -> Outcome {
@@ -193,24 +198,20 @@ pub(crate) fn run_trained<const PS: usize, const PT: usize, const PU: usize, con
 /// # Errors
 /// [`SolveError::InvalidConfig`], [`SolveError::NoMeasurements`], or
 /// [`SolveError::NonFiniteResult`] (then `ws.patch()` is not a decode).
-pub fn solve<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
-    dict: &Dictionary<PS, PT, PU, PV, B>,
-    cfg: &Sl0Config,
-    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
-) -> Result<Outcome, SolveError> {
+pub fn solve<S: Shape>(dict: &Dictionary<S>, cfg: &Sl0Config, ws: &mut Workspace<S>) -> Result<Outcome, SolveError> {
     cold(dict, cfg, ws, cfg.cold_start < 1.0, Plan::Annealed { scale: cfg.cold_start })
 }
 
 /// A solve from the measurements alone ([`solve`], [`solve_scheduled`]): from the band-gain
 /// fill (`fill`) or the minimum-norm start, down `plan`'s sigmas.
-fn cold<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
-    dict: &Dictionary<PS, PT, PU, PV, B>,
+fn cold<S: Shape>(
+    dict: &Dictionary<S>,
     cfg: &Sl0Config,
-    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ws: &mut Workspace<S>,
     fill: bool,
-    plan: Plan<'_, PS, PT, PU, PV, B>,
+    plan: Plan<'_, S>,
 ) -> Result<Outcome, SolveError> {
-    let ball = start::<B, N>(cfg, &ws.measurements)?;
+    let ball = start::<S>(cfg, &ws.measurements)?;
     let mixed = !ws.response.is_identity();
     if ws.measurements.interpolates() {
         if mixed {
@@ -220,7 +221,7 @@ fn cold<const PS: usize, const PT: usize, const PU: usize, const PV: usize, cons
         // projection of zero; the fill's start is the exact projection of the fill.
         let Workspace { coeffs, signal, measurements: m, .. } = ws;
         if fill {
-            fill_bands::<B, N>(m, signal);
+            fill_bands::<S>(m, signal);
             analyze(dict, signal, coeffs);
         } else {
             coeffs.fill(0.0);
@@ -236,10 +237,10 @@ fn cold<const PS: usize, const PT: usize, const PU: usize, const PV: usize, cons
     if mixed {
         mixed_start(dict, response, m, signal, fill);
     } else if fill {
-        fill_bands::<B, N>(m, signal);
+        fill_bands::<S>(m, signal);
     } else {
         // Minimum-norm start: S0 = analysis of the measurements, zeros elsewhere.
-        for ((x, &y), &k) in signal.iter_mut().zip(&m.values).zip(&m.measured) {
+        for ((x, &y), &k) in signal.iter_mut().zip(m.values.iter()).zip(m.measured.iter()) {
             *x = if k { y } else { 0.0 };
         }
     }
@@ -250,19 +251,21 @@ fn cold<const PS: usize, const PT: usize, const PU: usize, const PV: usize, cons
 /// measurements lie within `cfg.flat` of each other, `ws.patch()` becomes each band's
 /// mean (measured entries keep their values, so the patch meets the measurements).
 /// Otherwise `ws.patch()` is left as it was.
-fn short_path<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
-    cfg: &Sl0Config,
-    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
-) -> Option<Outcome> {
+fn short_path<S: Shape>(cfg: &Sl0Config, ws: &mut Workspace<S>) -> Option<Outcome> {
     let Workspace { signal, measurements: m, response, .. } = ws;
-    let (mut lo, mut hi, mut sum, mut count) = ([f32::INFINITY; B], [f32::NEG_INFINITY; B], [0.0f32; B], [0u32; B]);
+    let (mut lo, mut hi, mut sum, mut count) = (
+        <PerBand<S, _>>::splat(f32::INFINITY),
+        <PerBand<S, _>>::splat(f32::NEG_INFINITY),
+        <PerBand<S, _>>::splat(0.0f32),
+        <PerBand<S, _>>::splat(0u32),
+    );
     // The band is the last (contiguous) axis of the patch layout. Pixel by pixel, each
     // measured band from the pixel's flags as bits (each band's sum in the same order as a
     // pass over every entry), and out at the first band whose spread passes `flat`: a
     // spread only grows, so the answer is already no (on a noisy patch within a few pixels;
     // the whole pass was 2 % of a one-thread default decode, `perf record`).
-    for (values, measured) in m.values.as_chunks::<B>().0.iter().zip(m.measured.as_chunks::<B>().0) {
-        for b in set_flags(measured) {
+    for (values, measured) in S::Bands::chunks(m.values.as_ref()).iter().zip(S::Bands::chunks(m.measured.as_ref())) {
+        for b in set_flags(measured.as_ref()) {
             let (Some(&y), Some(l), Some(h), Some(s), Some(n)) =
                 (values.get(b), lo.get_mut(b), hi.get_mut(b), sum.get_mut(b), count.get_mut(b))
             else {
@@ -274,25 +277,30 @@ fn short_path<const PS: usize, const PT: usize, const PU: usize, const PV: usize
             }
         }
     }
-    if (0..B).any(|b| count[b] == 0 || hi[b] - lo[b] > cfg.flat) {
+    if (0..S::B).any(|b| count[b] == 0 || hi[b] - lo[b] > cfg.flat) {
         return None;
     }
-    let mut mean: [f32; B] = core::array::from_fn(|b| sum[b] / count[b] as f32);
+    let mut mean = sum;
+    for (m, &n) in mean.iter_mut().zip(count.iter()) {
+        *m /= n as f32;
+    }
     if mean.iter().any(|v| !v.is_finite()) {
         return None; // a sum past f32's range: the solve reports it
     }
     if !response.is_identity() {
         // The means are `R x` of the patch's one spectrum: every value is `R^-1` of them.
         response.balanced(&m.gains).unmix(&mut mean);
-        for x in signal.as_chunks_mut::<B>().0 {
+        for x in S::Bands::chunks_mut(signal.as_mut()) {
             *x = mean;
         }
         return Some(Outcome { iterations: 0, levels: 0, sigma0: 0.0, residual: 0.0, ended: Ended::Flat });
     }
-    for ((x, values), measured) in
-        signal.as_chunks_mut::<B>().0.iter_mut().zip(m.values.as_chunks::<B>().0).zip(m.measured.as_chunks::<B>().0)
+    for ((x, values), measured) in S::Bands::chunks_mut(signal.as_mut())
+        .iter_mut()
+        .zip(S::Bands::chunks(m.values.as_ref()))
+        .zip(S::Bands::chunks(m.measured.as_ref()))
     {
-        for b in 0..B {
+        for b in 0..S::B {
             x[b] = if measured[b] { values[b] } else { mean[b] };
         }
     }
@@ -313,30 +321,23 @@ fn short_path<const PS: usize, const PT: usize, const PU: usize, const PV: usize
 ///
 /// # Errors
 /// As [`solve`].
-pub fn solve_warm<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
->(
-    dict: &Dictionary<PS, PT, PU, PV, B>,
+pub fn solve_warm<S: Shape>(
+    dict: &Dictionary<S>,
     cfg: &Sl0Config,
-    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ws: &mut Workspace<S>,
 ) -> Result<Outcome, SolveError> {
     descend_from(dict, cfg, cfg.warm_sigma_f, ws)
 }
 
 /// The schedule from the patch in `ws.patch()` at `cfg.warm_start * max |S|`, falling by
 /// `sigma_f` with `cfg.warm_steps` steps a level: [`solve_warm`] and [`solve_seeded`].
-fn descend_from<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
-    dict: &Dictionary<PS, PT, PU, PV, B>,
+fn descend_from<S: Shape>(
+    dict: &Dictionary<S>,
     cfg: &Sl0Config,
     sigma_f: f32,
-    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ws: &mut Workspace<S>,
 ) -> Result<Outcome, SolveError> {
-    let ball = start::<B, N>(cfg, &ws.measurements)?;
+    let ball = start::<S>(cfg, &ws.measurements)?;
     let from = Sl0Config { sigma_f, steps: cfg.warm_steps, ..*cfg };
     descend(dict, &from, ws, &ball, Plan::Annealed { scale: cfg.warm_start })
 }
@@ -347,17 +348,10 @@ fn descend_from<const PS: usize, const PT: usize, const PU: usize, const PV: usi
 ///
 /// # Errors
 /// As [`solve`].
-pub fn solve_seeded<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
->(
-    dict: &Dictionary<PS, PT, PU, PV, B>,
+pub fn solve_seeded<S: Shape>(
+    dict: &Dictionary<S>,
     cfg: &Sl0Config,
-    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ws: &mut Workspace<S>,
 ) -> Result<Outcome, SolveError> {
     descend_from(dict, cfg, cfg.seed_sigma_f, ws)
 }
@@ -371,12 +365,12 @@ pub fn solve_seeded<
 ///
 /// # Errors
 /// As [`solve`].
-pub fn seed<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
-    dict: &Dictionary<PS, PT, PU, PV, B>,
+pub fn seed<S: Shape>(
+    dict: &Dictionary<S>,
     cfg: &Sl0Config,
-    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ws: &mut Workspace<S>,
 ) -> Result<Option<Outcome>, SolveError> {
-    start::<B, N>(cfg, &ws.measurements)?;
+    start::<S>(cfg, &ws.measurements)?;
     let exact = Ball::new(0.0, 0.0, ws.measurements.count, 0);
     let mixed = !ws.response.is_identity();
     if ws.measurements.interpolates() {
@@ -395,27 +389,20 @@ pub fn seed<const PS: usize, const PT: usize, const PU: usize, const PV: usize, 
     if mixed {
         put_back_onto(dict, ws, &exact);
     } else {
-        project::<B, N>(&mut ws.signal, &ws.measurements, &exact);
+        project::<S>(&mut ws.signal, &ws.measurements, &exact);
     }
     Ok(None)
 }
 
 /// The projection onto measurements that interpolate the patch: shares of view cells
 /// behind a lenslet grid ([`project_shares`]) or a half-pixel shear ([`project_fractional`]).
-fn project_interpolating<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
->(
-    dict: &Dictionary<PS, PT, PU, PV, B>,
-    coeffs: &mut [f32; N],
-    scratch: &mut [f32; N],
-    m: &Measurements<N>,
+fn project_interpolating<S: Shape>(
+    dict: &Dictionary<S>,
+    coeffs: &mut PerValue<S, f32>,
+    scratch: &mut PerValue<S, f32>,
+    m: &Measurements<S::Values>,
     ball: &Ball,
-    rows: Option<&mut RowSums<N>>,
+    rows: Option<&mut RowSums<S>>,
 ) -> f32 {
     if m.shares.is_none() {
         return project_fractional(dict, coeffs, scratch, m, ball);
@@ -429,18 +416,11 @@ fn project_interpolating<
 /// One projection behind a lenslet grid outside a descent (a start, a seed): its
 /// [`RowSums`] (32 KB for the full-view patch) in a frame of its own, only behind a grid.
 #[inline(never)]
-fn project_shares_once<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
->(
-    dict: &Dictionary<PS, PT, PU, PV, B>,
-    coeffs: &mut [f32; N],
-    scratch: &mut [f32; N],
-    m: &Measurements<N>,
+fn project_shares_once<S: Shape>(
+    dict: &Dictionary<S>,
+    coeffs: &mut PerValue<S, f32>,
+    scratch: &mut PerValue<S, f32>,
+    m: &Measurements<S::Values>,
     ball: &Ball,
 ) -> f32 {
     project_shares(dict, coeffs, scratch, m, ball, &mut RowSums::new())
@@ -449,9 +429,9 @@ fn project_shares_once<
 /// How a descent walks sigma down: the hand-set schedule of the config from `scale` times
 /// the start's largest coefficient, or a trained [`Schedule`].
 #[derive(Clone, Copy)]
-enum Plan<'s, const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> {
+enum Plan<'s, S: Shape> {
     Annealed { scale: f32 },
-    Trained(&'s Schedule<PS, PT, PU, PV, B>),
+    Trained(&'s Schedule<S>),
 }
 
 /// Decodes the patch whose measurements are in `ws` with a trained schedule's steps
@@ -461,18 +441,11 @@ enum Plan<'s, const PS: usize, const PT: usize, const PU: usize, const PV: usize
 ///
 /// # Errors
 /// As [`solve`].
-pub fn solve_scheduled<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
->(
-    dict: &Dictionary<PS, PT, PU, PV, B>,
+pub fn solve_scheduled<S: Shape>(
+    dict: &Dictionary<S>,
     cfg: &Sl0Config,
-    schedule: &Schedule<PS, PT, PU, PV, B>,
-    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    schedule: &Schedule<S>,
+    ws: &mut Workspace<S>,
 ) -> Result<Outcome, SolveError> {
     cold(dict, cfg, ws, schedule.fill_start(), Plan::Trained(schedule))
 }
@@ -483,30 +456,23 @@ pub fn solve_scheduled<
 ///
 /// # Errors
 /// As [`solve`].
-pub fn solve_warm_scheduled<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
->(
-    dict: &Dictionary<PS, PT, PU, PV, B>,
+pub fn solve_warm_scheduled<S: Shape>(
+    dict: &Dictionary<S>,
     cfg: &Sl0Config,
-    schedule: &Schedule<PS, PT, PU, PV, B>,
-    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    schedule: &Schedule<S>,
+    ws: &mut Workspace<S>,
 ) -> Result<Outcome, SolveError> {
-    let ball = start::<B, N>(cfg, &ws.measurements)?;
+    let ball = start::<S>(cfg, &ws.measurements)?;
     descend(dict, cfg, ws, &ball, Plan::Trained(schedule))
 }
 
 /// The schedule from the patch in `ws.signal` (`plan`), projecting onto `ball`.
-fn descend<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
-    dict: &Dictionary<PS, PT, PU, PV, B>,
+fn descend<S: Shape>(
+    dict: &Dictionary<S>,
     cfg: &Sl0Config,
-    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ws: &mut Workspace<S>,
     ball: &Ball,
-    plan: Plan<'_, PS, PT, PU, PV, B>,
+    plan: Plan<'_, S>,
 ) -> Result<Outcome, SolveError> {
     if !ws.response.is_identity() {
         return descend_mixed(dict, cfg, ws, ball, plan);
@@ -520,19 +486,12 @@ fn descend<const PS: usize, const PT: usize, const PU: usize, const PV: usize, c
 /// [`descend`] behind a lenslet grid: the solve's [`RowSums`] (32 KB for the full-view
 /// patch) in a frame of its own, so the other solves' stacks do not carry them.
 #[inline(never)]
-fn descend_shared<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
->(
-    dict: &Dictionary<PS, PT, PU, PV, B>,
+fn descend_shared<S: Shape>(
+    dict: &Dictionary<S>,
     cfg: &Sl0Config,
-    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ws: &mut Workspace<S>,
     ball: &Ball,
-    plan: Plan<'_, PS, PT, PU, PV, B>,
+    plan: Plan<'_, S>,
 ) -> Result<Outcome, SolveError> {
     let mut rows = RowSums::new();
     descend_with(dict, cfg, ws, ball, plan, None, Some(&mut rows))
@@ -541,12 +500,12 @@ fn descend_shared<
 /// [`descend`] with a response that mixes bands: its [`BandModel`] (2 KB) in a frame of its
 /// own, so the one-hot solve's stack does not carry it.
 #[inline(never)]
-fn descend_mixed<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
-    dict: &Dictionary<PS, PT, PU, PV, B>,
+fn descend_mixed<S: Shape>(
+    dict: &Dictionary<S>,
     cfg: &Sl0Config,
-    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ws: &mut Workspace<S>,
     ball: &Ball,
-    plan: Plan<'_, PS, PT, PU, PV, B>,
+    plan: Plan<'_, S>,
 ) -> Result<Outcome, SolveError> {
     if ws.measurements.interpolates() {
         return Err(SolveError::MixedHalfViews);
@@ -557,30 +516,30 @@ fn descend_mixed<const PS: usize, const PT: usize, const PU: usize, const PV: us
 
 /// [`descend`]'s body: projections onto the mixed measurements of `mixing` if given, and
 /// behind a lenslet grid with the solve's `rows`.
-fn descend_with<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
-    dict: &Dictionary<PS, PT, PU, PV, B>,
+fn descend_with<S: Shape>(
+    dict: &Dictionary<S>,
     cfg: &Sl0Config,
-    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ws: &mut Workspace<S>,
     ball: &Ball,
-    plan: Plan<'_, PS, PT, PU, PV, B>,
-    mixing: Option<&BandModel<B>>,
-    mut rows: Option<&mut RowSums<N>>,
+    plan: Plan<'_, S>,
+    mixing: Option<&BandModel<S::Bands>>,
+    mut rows: Option<&mut RowSums<S>>,
 ) -> Result<Outcome, SolveError> {
     let Workspace { coeffs, signal, measurements: m, weights, .. } = ws;
     let selection = !m.interpolates();
     analyze(dict, signal, coeffs);
-    let top = max_abs(coeffs);
+    let top = max_abs(coeffs.as_ref());
     // The measurements' weights once a solve, not once a step (one-hot measurements only).
     let table = if selection && mixing.is_none() && ball.is_weighted() {
-        weigh::<B, N>(m, ball, weights);
+        weigh::<S>(m, ball, weights);
         Some(&*weights)
     } else {
         None
     };
-    let mut step = |inv: f32, mu: f32, weights: Option<&Weights<PS, PT, PU, PV, B>>| {
+    let mut step = |inv: f32, mu: f32, weights: Option<&Weights<S>>| {
         let step2 = match weights {
-            Some(w) => ascend_weighted(coeffs, mu, inv, w),
-            None => ascend(coeffs, mu, inv),
+            Some(w) => ascend_weighted(coeffs.as_mut(), mu, inv, w),
+            None => ascend(coeffs.as_mut(), mu, inv),
         };
         let residual = if let Some(model) = mixing {
             project_mixed(dict, model, coeffs, signal, m, ball)
@@ -599,18 +558,18 @@ fn descend_with<const PS: usize, const PT: usize, const PU: usize, const PV: usi
         Step { residual, moved: libm::sqrtf(moved2.max(0.0)) }
     };
     let outcome = match plan {
-        Plan::Annealed { scale } => run_schedule(cfg, scale * top, N, |inv| step(inv, cfg.mu, None)),
+        Plan::Annealed { scale } => run_schedule(cfg, scale * top, S::N, |inv| step(inv, cfg.mu, None)),
         Plan::Trained(schedule) => run_trained(cfg, schedule, top, |inv, mu| step(inv, mu, Some(schedule.weights()))),
     };
 
     synthesize(dict, coeffs, signal);
     if let Some(model) = mixing {
         // A measured entry is not its measurement: the per-pixel projection puts them back.
-        project_signal(model, signal, m, ball);
+        project_signal::<S>(model, signal, m, ball);
     } else if selection {
         // Rounding of the transforms aside the patch meets the measurements; put them back
         // exactly (interpolating ones: the last step's projection is the last word).
-        project::<B, N>(signal, m, ball);
+        project::<S>(signal, m, ball);
     }
     if signal.iter().any(|x| !x.is_finite()) {
         return Err(SolveError::NonFiniteResult);
@@ -624,19 +583,19 @@ fn descend_with<const PS: usize, const PT: usize, const PU: usize, const PV: usi
 /// by the bands' gain ratios). Out of line: its [`BandModel`] stays off the one-hot
 /// solve's stack.
 #[inline(never)]
-fn mixed_start<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
-    dict: &Dictionary<PS, PT, PU, PV, B>,
-    response: &Response<B>,
-    m: &Measurements<N>,
-    signal: &mut [f32; N],
+fn mixed_start<S: Shape>(
+    dict: &Dictionary<S>,
+    response: &Response<S::Bands>,
+    m: &Measurements<S::Values>,
+    signal: &mut PerValue<S, f32>,
     fill: bool,
 ) {
     let model = BandModel::new(&response.balanced(&m.gains), &dict.d.m5);
     if fill {
-        fill_bands::<B, N>(m, signal);
-        project_signal(&model, signal, m, &Ball::new(0.0, 0.0, m.count, 0));
+        fill_bands::<S>(m, signal);
+        project_signal::<S>(&model, signal, m, &Ball::new(0.0, 0.0, m.count, 0));
     } else {
-        min_norm(&model, m, signal);
+        min_norm::<S>(&model, m, signal);
     }
 }
 
@@ -644,22 +603,15 @@ fn mixed_start<const PS: usize, const PT: usize, const PU: usize, const PV: usiz
 /// mean): with mixed measurements the measured entries are the second solution's, not the
 /// measurements, so the blend is moved back onto them (onto `cfg`'s ball) by the per-pixel
 /// projection. With one-hot filters the blend meets them already and nothing is done.
-pub(crate) fn put_back<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
->(
-    dict: &Dictionary<PS, PT, PU, PV, B>,
+pub(crate) fn put_back<S: Shape>(
+    dict: &Dictionary<S>,
     cfg: &Sl0Config,
-    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ws: &mut Workspace<S>,
 ) -> Result<(), SolveError> {
     if ws.response.is_identity() {
         return Ok(());
     }
-    let ball = start::<B, N>(cfg, &ws.measurements)?;
+    let ball = start::<S>(cfg, &ws.measurements)?;
     put_back_onto(dict, ws, &ball);
     Ok(())
 }
@@ -667,11 +619,7 @@ pub(crate) fn put_back<
 /// The patch in `ws.signal` moved onto its mixed measurements (onto `ball`) by the
 /// per-pixel projection. Out of line: its [`BandModel`] stays off the callers' stack.
 #[inline(never)]
-fn put_back_onto<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
-    dict: &Dictionary<PS, PT, PU, PV, B>,
-    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
-    ball: &Ball,
-) {
+fn put_back_onto<S: Shape>(dict: &Dictionary<S>, ws: &mut Workspace<S>, ball: &Ball) {
     let model = BandModel::new(&ws.response.balanced(&ws.measurements.gains), &dict.d.m5);
-    project_signal(&model, &mut ws.signal, &ws.measurements, ball);
+    project_signal::<S>(&model, &mut ws.signal, &ws.measurements, ball);
 }

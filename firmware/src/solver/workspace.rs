@@ -7,7 +7,9 @@
 //! `const fn`, so a device can place it in a `static`.
 
 use crate::operators::disparity::HalfViews;
-use crate::operators::shape::{MAX_BANDS, PatchShape};
+use crate::operators::shape::{MAX_BANDS, Values};
+use crate::operators::shape::{PerBand, PerValue, Shape};
+use crate::sensor::extent::{Array, Bands};
 use crate::sensor::response::Response;
 use crate::solver::error::SolveError;
 
@@ -26,9 +28,9 @@ use crate::solver::error::SolveError;
 /// Gains are 1 unless set, and [`clear`](Self::clear) keeps them (they are the unit of
 /// the values, not a measurement).
 #[derive(Clone, Debug)]
-pub struct Measurements<const N: usize> {
-    pub(crate) values: [f32; N],
-    pub(crate) measured: [bool; N],
+pub struct Measurements<V: Values> {
+    pub(crate) values: V::PerValue<f32>,
+    pub(crate) measured: V::PerValue<bool>,
     pub(crate) count: u32,
     /// Gain of each band (the first `B` entries; 1 beyond them).
     pub(crate) gains: [f32; MAX_BANDS],
@@ -84,12 +86,12 @@ impl CellShares {
     }
 }
 
-impl<const N: usize> Measurements<N> {
+impl<V: Values> Measurements<V> {
     /// Nothing measured.
     pub const fn new() -> Self {
         Self {
-            values: [0.0; N],
-            measured: [false; N],
+            values: V::ZEROS,
+            measured: V::NONE,
             count: 0,
             gains: [1.0; MAX_BANDS],
             balanced: false,
@@ -177,7 +179,7 @@ impl<const N: usize> Measurements<N> {
             return Err(SolveError::BadGains);
         }
         self.gains = [1.0; MAX_BANDS];
-        for (o, g) in self.gains.iter_mut().zip(gains) {
+        for (o, g) in self.gains.iter_mut().zip(gains.iter()) {
             *o = *g;
         }
         self.balanced = gains.iter().any(|&g| g != 1.0);
@@ -191,8 +193,8 @@ impl<const N: usize> Measurements<N> {
 
     /// Forgets every measurement.
     pub fn clear(&mut self) {
-        self.values.fill(0.0);
-        self.measured.fill(false);
+        self.values.as_mut().fill(0.0);
+        self.measured.as_mut().fill(false);
         self.count = 0;
         self.half = HalfViews::NONE;
         self.shares = None;
@@ -207,7 +209,7 @@ impl<const N: usize> Measurements<N> {
         if !value.is_finite() {
             return Err(SolveError::NonFiniteMeasurement);
         }
-        let (Some(v), Some(m)) = (self.values.get_mut(index), self.measured.get_mut(index)) else {
+        let (Some(v), Some(m)) = (self.values.as_mut().get_mut(index), self.measured.as_mut().get_mut(index)) else {
             return Err(SolveError::IndexOutOfRange);
         };
         *v = value;
@@ -220,8 +222,8 @@ impl<const N: usize> Measurements<N> {
 
     /// The value measured at `index`, if any.
     pub fn get(&self, index: usize) -> Option<f32> {
-        match self.measured.get(index) {
-            Some(true) => self.values.get(index).copied(),
+        match self.measured.as_ref().get(index) {
+            Some(true) => self.values.as_ref().get(index).copied(),
             _ => None,
         }
     }
@@ -232,8 +234,8 @@ impl<const N: usize> Measurements<N> {
     }
 
     /// Keeps the unmeasured entries of `patch` in the unmeasured slots of the values.
-    pub(crate) fn stash(&mut self, patch: &[f32; N]) {
-        for ((v, &k), &x) in self.values.iter_mut().zip(&self.measured).zip(patch) {
+    pub(crate) fn stash(&mut self, patch: &V::PerValue<f32>) {
+        for ((v, &k), &x) in self.values.as_mut().iter_mut().zip(self.measured.as_ref()).zip(patch.as_ref()) {
             if !k {
                 *v = x;
             }
@@ -242,8 +244,8 @@ impl<const N: usize> Measurements<N> {
 
     /// Makes each unmeasured entry `x` of `patch` the weighted mean `w s + (1 - w) x` with
     /// its stashed value `s`, and forgets the stash. Measured entries are left as they are.
-    pub(crate) fn blend_stash(&mut self, patch: &mut [f32; N], w: f32) {
-        for ((v, &k), x) in self.values.iter_mut().zip(&self.measured).zip(patch) {
+    pub(crate) fn blend_stash(&mut self, patch: &mut V::PerValue<f32>, w: f32) {
+        for ((v, &k), x) in self.values.as_mut().iter_mut().zip(self.measured.as_ref()).zip(patch.as_mut()) {
             if !k {
                 *x = w * *v + (1.0 - w) * *x;
                 *v = 0.0;
@@ -253,7 +255,7 @@ impl<const N: usize> Measurements<N> {
 
     /// Forgets the stash: the unmeasured values are zero again.
     pub(crate) fn drop_stash(&mut self) {
-        for (v, &k) in self.values.iter_mut().zip(&self.measured) {
+        for (v, &k) in self.values.as_mut().iter_mut().zip(self.measured.as_ref()) {
             if !k {
                 *v = 0.0;
             }
@@ -261,7 +263,7 @@ impl<const N: usize> Measurements<N> {
     }
 }
 
-impl<const N: usize> Default for Measurements<N> {
+impl<V: Values> Default for Measurements<V> {
     fn default() -> Self {
         Self::new()
     }
@@ -269,35 +271,32 @@ impl<const N: usize> Default for Measurements<N> {
 
 /// Every buffer of one patch decode. Mutable state, apart from the immutable config.
 #[derive(Clone, Debug)]
-pub struct Workspace<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
-{
-    pub(crate) coeffs: [f32; N],
-    pub(crate) signal: [f32; N],
-    pub(crate) measurements: Measurements<N>,
+pub struct Workspace<S: Shape> {
+    pub(crate) coeffs: PerValue<S, f32>,
+    pub(crate) signal: PerValue<S, f32>,
+    pub(crate) measurements: Measurements<S::Values>,
     /// Each measurement's weight in a noise ball that weighs them
     /// ([`crate::solver::ball::Ball::weight`], in patch order; other entries are stale):
     /// made once a solve, read by every step's
     /// projection. Computed in each step instead, its two divisions a measurement held the
     /// projection's band step up (`perf annotate`: a fifth of a default decode's samples in
     /// the step stood on the division's result at pixel k = 3).
-    pub(crate) weights: [f32; N],
+    pub(crate) weights: PerValue<S, f32>,
     /// The filters' response matrix the measurements are taken through (in the sensor's
     /// units; the solve balances it by the measurements' gains): the identity for one-hot
     /// filters ([`crate::solver::mixing`]).
-    pub(crate) response: Response<B>,
+    pub(crate) response: Response<S::Bands>,
 }
 
-impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
-    Workspace<PS, PT, PU, PV, B, N>
-{
+impl<S: Shape> Workspace<S> {
     /// A zeroed workspace.
     pub const fn new() -> Self {
-        const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
+        const { S::CHECK };
         Self {
-            coeffs: [0.0; N],
-            signal: [0.0; N],
+            coeffs: S::Values::ZEROS,
+            signal: S::Values::ZEROS,
             measurements: Measurements::new(),
-            weights: [0.0; N],
+            weights: S::Values::ZEROS,
             response: Response::IDENTITY,
         }
     }
@@ -306,69 +305,69 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
     /// [`Measurements::clear`]: a property of the sensor, not of a patch). The identity, as
     /// new, is the one-hot model. Half-pixel shears ([`Measurements::set_half_views`]) need
     /// the identity: a solve with both is [`SolveError::MixedHalfViews`].
-    pub fn set_response(&mut self, response: &Response<B>) {
+    pub fn set_response(&mut self, response: &Response<S::Bands>) {
         self.response = *response;
     }
 
     /// The response matrix the solves take the measurements through.
-    pub fn response(&self) -> &Response<B> {
+    pub fn response(&self) -> &Response<S::Bands> {
         &self.response
     }
 
     /// The measurements the next solve uses.
-    pub fn measurements(&self) -> &Measurements<N> {
+    pub fn measurements(&self) -> &Measurements<S::Values> {
         &self.measurements
     }
 
     /// The measurements, to fill before a solve.
-    pub fn measurements_mut(&mut self) -> &mut Measurements<N> {
+    pub fn measurements_mut(&mut self) -> &mut Measurements<S::Values> {
         &mut self.measurements
     }
 
     /// The coefficient buffer, e.g. to synthesise a patch from chosen coefficients.
-    pub fn coefficients_mut(&mut self) -> &mut [f32; N] {
+    pub fn coefficients_mut(&mut self) -> &mut PerValue<S, f32> {
         &mut self.coeffs
     }
 
     /// `patch = coefficients x_i D_i`, in place in the workspace (the coefficients are the
     /// scratch and are clobbered): one transform with no buffer outside the workspace.
-    pub fn synthesize(&mut self, dict: &crate::operators::dictionary::Dictionary<PS, PT, PU, PV, B>) {
+    pub fn synthesize(&mut self, dict: &crate::operators::dictionary::Dictionary<S>) {
         crate::operators::transform::synthesize(dict, &mut self.coeffs, &mut self.signal);
     }
 
-    /// The decoded patch after a successful solve (layout of [`PatchShape::index`]).
-    pub fn patch(&self) -> &[f32; N] {
+    /// The decoded patch after a successful solve (layout of [`Shape::index`]).
+    pub fn patch(&self) -> &PerValue<S, f32> {
         &self.signal
     }
 
     /// The patch buffer, to write an estimate of the patch into before a seeded decode
     /// ([`crate::solver::choice::PatchModel::decode_seeded`], in the solve's units: divided
     /// by the band gains). The tile decoder fills it from its seed.
-    pub fn patch_mut(&mut self) -> &mut [f32; N] {
+    pub fn patch_mut(&mut self) -> &mut PerValue<S, f32> {
         &mut self.signal
     }
 
     /// Multiplies each band of the decoded patch by its gain: a white-balanced decode back
     /// in the sensor's units. Gains of 1 leave it as it is (and cost nothing).
-    pub(crate) fn unbalance_patch(&mut self, gains: &[f32; B]) {
+    pub(crate) fn unbalance_patch(&mut self, gains: &PerBand<S, f32>) {
         self.per_band(gains, |x, g| x * g);
     }
 
     /// Divides each band of the patch by its gain: an estimate in the sensor's units into
     /// the white-balanced units the solve works in ([`Self::unbalance_patch`]'s reverse).
-    pub(crate) fn balance_patch(&mut self, gains: &[f32; B]) {
+    pub(crate) fn balance_patch(&mut self, gains: &PerBand<S, f32>) {
         self.per_band(gains, |x, g| x / g);
     }
 
     /// Each value `x` of the patch becomes `f(x, its band's gain)`; nothing at all when
     /// every gain is 1.
     #[inline(always)]
-    fn per_band(&mut self, gains: &[f32; B], f: impl Fn(f32, f32) -> f32) {
+    fn per_band(&mut self, gains: &PerBand<S, f32>, f: impl Fn(f32, f32) -> f32) {
         if gains.iter().all(|&g| g == 1.0) {
             return;
         }
-        for pixel in self.signal.as_chunks_mut::<B>().0 {
-            for (x, &g) in pixel.iter_mut().zip(gains) {
+        for pixel in S::Bands::chunks_mut(self.signal.as_mut()) {
+            for (x, &g) in pixel.iter_mut().zip(gains.iter()) {
                 *x = f(*x, g);
             }
         }
@@ -390,16 +389,14 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
     }
 }
 
-impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize> Default
-    for Workspace<PS, PT, PU, PV, B, N>
-{
+impl<S: Shape> Default for Workspace<S> {
     fn default() -> Self {
         Self::new()
     }
 }
 
 /// The workspace of the paper's patch.
-pub type PaperWorkspace = Workspace<5, 5, 4, 4, 13, 5200>;
+pub type PaperWorkspace = Workspace<crate::operators::shape::PaperShape>;
 
 /// The workspace of the full-view patch ([`crate::FullViewShape`], 5 x 5 x 5 x 5 x 13).
-pub type FullViewWorkspace = Workspace<5, 5, 5, 5, 13, 8125>;
+pub type FullViewWorkspace = Workspace<crate::operators::shape::FullViewShape>;

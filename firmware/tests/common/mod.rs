@@ -3,35 +3,51 @@
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use slf_firmware::PaperShape;
+use slf_firmware::Shape;
 use slf_firmware::dictionary::{Factors, Matrix};
+use slf_firmware::mode::{Mode, ModeMatrix};
+use slf_firmware::{Array, Fixed};
 use slf_firmware::{Dictionary, Mask, PatchShape, Workspace};
 
 pub fn rng(seed: u64) -> ChaCha8Rng {
     ChaCha8Rng::seed_from_u64(seed)
 }
 
-/// A random orthonormal `D x D` matrix: Gram-Schmidt in f64 on a Gaussian-ish matrix.
-pub fn random_orthonormal<const D: usize>(rng: &mut ChaCha8Rng) -> Matrix<D> {
-    let mut rows: Vec<[f64; D]> = Vec::new();
-    while rows.len() < D {
-        let mut v = [0.0f64; D];
+/// The rows of a random orthonormal `d x d` matrix: Gram-Schmidt in f64 on a Gaussian-ish
+/// matrix.
+fn gram_schmidt(d: usize, rng: &mut ChaCha8Rng) -> Vec<Vec<f64>> {
+    let mut rows: Vec<Vec<f64>> = Vec::new();
+    while rows.len() < d {
+        let mut v = vec![0.0f64; d];
         for x in v.iter_mut() {
             *x = rng.random_range(-1.0..1.0);
         }
         for _ in 0..2 {
             for r in &rows {
-                let d: f64 = r.iter().zip(&v).map(|(a, b)| a * b).sum();
+                let dot: f64 = r.iter().zip(&v).map(|(a, b)| a * b).sum();
                 for (x, a) in v.iter_mut().zip(r) {
-                    *x -= d * a;
+                    *x -= dot * a;
                 }
             }
         }
         let n = v.iter().map(|x| x * x).sum::<f64>().sqrt();
         if n > 1e-3 {
-            rows.push(v.map(|x| x / n));
+            rows.push(v.iter().map(|x| x / n).collect());
         }
     }
-    let mut m = [[0.0f32; D]; D];
+    rows
+}
+
+/// A random orthonormal `D x D` matrix ([`gram_schmidt`]).
+pub fn random_orthonormal<const D: usize>(rng: &mut ChaCha8Rng) -> Matrix<D> {
+    random_mode::<Fixed<D>>(rng)
+}
+
+/// A random orthonormal matrix of mode `E` ([`gram_schmidt`]).
+pub fn random_mode<E: Mode>(rng: &mut ChaCha8Rng) -> ModeMatrix<E> {
+    let rows = gram_schmidt(E::D, rng);
+    let mut m = E::ZERO_MATRIX;
     for (mr, r) in m.iter_mut().zip(&rows) {
         for (a, b) in mr.iter_mut().zip(r) {
             *a = *b as f32;
@@ -40,29 +56,25 @@ pub fn random_orthonormal<const D: usize>(rng: &mut ChaCha8Rng) -> Matrix<D> {
     m
 }
 
-pub fn random_dictionary<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
-    seed: u64,
-) -> Dictionary<PS, PT, PU, PV, B> {
+pub fn random_dictionary<S: Shape>(seed: u64) -> Dictionary<S> {
     let mut r = rng(seed);
     Dictionary::new(Factors {
-        m1: random_orthonormal(&mut r),
-        m2: random_orthonormal(&mut r),
-        m3: random_orthonormal(&mut r),
-        m4: random_orthonormal(&mut r),
-        m5: random_orthonormal(&mut r),
+        m1: random_mode::<S::S>(&mut r),
+        m2: random_mode::<S::T>(&mut r),
+        m3: random_mode::<S::U>(&mut r),
+        m4: random_mode::<S::V>(&mut r),
+        m5: random_mode::<S::Bands>(&mut r),
     })
     .expect("Gram-Schmidt output is orthonormal")
 }
 
-fn flat<const D: usize>(m: &Matrix<D>) -> Vec<f64> {
-    m.iter().flatten().map(|&x| f64::from(x)).collect()
+fn flat<E: Mode>(m: &ModeMatrix<E>) -> Vec<f64> {
+    m.iter().flat_map(|r| r.iter()).map(|&x| f64::from(x)).collect()
 }
 
 /// The dense N x N matrix of a separable operator, in f64: row-major vec of the patch layout
 /// (band fastest), so `K = M1 (x) M2 (x) M3 (x) M4 (x) M5` by the Kronecker product.
-pub fn dense_kronecker<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
-    f: &Factors<PS, PT, PU, PV, B>,
-) -> (Vec<f64>, usize) {
+pub fn dense_kronecker<S: Shape>(f: &Factors<S>) -> (Vec<f64>, usize) {
     fn kron(a: &[f64], ad: usize, b: &[f64], bd: usize) -> Vec<f64> {
         let d = ad * bd;
         let mut k = vec![0.0; d * d];
@@ -78,11 +90,11 @@ pub fn dense_kronecker<const PS: usize, const PT: usize, const PU: usize, const 
         }
         k
     }
-    let k = kron(&flat(&f.m1), PS, &flat(&f.m2), PT);
-    let k = kron(&k, PS * PT, &flat(&f.m3), PU);
-    let k = kron(&k, PS * PT * PU, &flat(&f.m4), PV);
-    let k = kron(&k, PS * PT * PU * PV, &flat(&f.m5), B);
-    (k, PS * PT * PU * PV * B)
+    let k = kron(&flat::<S::S>(&f.m1), S::PS, &flat::<S::T>(&f.m2), S::PT);
+    let k = kron(&k, S::PS * S::PT, &flat::<S::U>(&f.m3), S::PU);
+    let k = kron(&k, S::PS * S::PT * S::PU, &flat::<S::V>(&f.m4), S::PV);
+    let k = kron(&k, S::PS * S::PT * S::PU * S::PV, &flat::<S::Bands>(&f.m5), S::B);
+    (k, S::PS * S::PT * S::PU * S::PV * S::B)
 }
 
 /// `y = K x` in f64.
@@ -107,27 +119,18 @@ pub fn max_abs_diff(a: &[f32], b: &[f32]) -> f32 {
 
 /// A smooth, positive, natural-ish patch: low-order trends in every dimension plus a
 /// little texture, in [0.05, 0.95].
-pub fn smooth_patch<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
->(
-    seed: u64,
-) -> Vec<f32> {
+pub fn smooth_patch<S: Shape>(seed: u64) -> Vec<f32> {
     let mut r = rng(seed);
     let c: [f32; 8] = core::array::from_fn(|_| r.random_range(-1.0..1.0));
-    let mut x = vec![0.0f32; N];
+    let mut x = vec![0.0f32; S::N];
     for (i, v) in x.iter_mut().enumerate() {
-        let [s, t, u, v_, b] = PatchShape::<PS, PT, PU, PV, B, N>::coordinates(i);
+        let [s, t, u, v_, b] = S::coordinates(i);
         let (s, t, u, vv, b) = (
-            s as f32 / PS as f32,
-            t as f32 / PT as f32,
-            u as f32 / PU as f32,
-            v_ as f32 / PV as f32,
-            b as f32 / B as f32,
+            s as f32 / S::PS as f32,
+            t as f32 / S::PT as f32,
+            u as f32 / S::PU as f32,
+            v_ as f32 / S::PV as f32,
+            b as f32 / S::B as f32,
         );
         let val = 0.5
             + 0.15 * c[0] * s
@@ -144,42 +147,30 @@ pub fn smooth_patch<
 
 /// Fills `ws`'s measurements as the camera would: patch pixel `(s, t, u, v)` of the patch
 /// whose first lenslet is `lenslet_origin` sees `mask`'s bands at its sensor pixel.
-pub fn measure<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>(
-    mask: &Mask,
-    lenslet_origin: (usize, usize),
-    truth: &[f32],
-    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
-) {
+pub fn measure<S: Shape>(mask: &Mask, lenslet_origin: (usize, usize), truth: &[f32], ws: &mut Workspace<S>) {
     measure_window(mask, lenslet_origin, (0, 0), truth, ws);
 }
 
 /// [`measure`] for the angular window whose first view is `view_origin`.
-pub fn measure_window<
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
->(
+pub fn measure_window<S: Shape>(
     mask: &Mask,
     lenslet_origin: (usize, usize),
     view_origin: (usize, usize),
     truth: &[f32],
-    ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+    ws: &mut Workspace<S>,
 ) {
     let l = mask.lenslet_size();
     let (lu, lv) = (l.rows as usize, l.cols as usize);
     let m = ws.measurements_mut();
     m.clear();
-    for s in 0..PS {
-        for t in 0..PT {
-            for u in 0..PU {
-                for v in 0..PV {
+    for s in 0..S::PS {
+        for t in 0..S::PT {
+            for u in 0..S::PU {
+                for v in 0..S::PV {
                     let row = (lenslet_origin.0 + s) * lu + view_origin.0 + u;
                     let col = (lenslet_origin.1 + t) * lv + view_origin.1 + v;
                     for &band in mask.bands_at(row, col).iter() {
-                        let i = PatchShape::<PS, PT, PU, PV, B, N>::index(s, t, u, v, band as usize);
+                        let i = S::index(s, t, u, v, band as usize);
                         m.set(i, truth[i]).expect("finite truth");
                     }
                 }
@@ -192,7 +183,7 @@ pub fn measure_window<
 /// bands on lenslets of 3 x 3 views (centre view 1), so a dense 144 x 144 basis is cheap.
 pub const L3: slf_firmware::LensletSize = slf_firmware::LensletSize { rows: 3, cols: 3 };
 pub const SMALL: slf_firmware::SensorGeometry = slf_firmware::SensorGeometry { lenslets: (10, 11), lenslet: L3 };
-pub type Small<'a> = slf_firmware::TileDecoder<'a, 3, 3, 2, 2, 4, 144>;
+pub type Small<'a> = slf_firmware::TileDecoder<'a, PatchShape<3, 3, 2, 2, 4, 144>>;
 pub type SmallShape = PatchShape<3, 3, 2, 2, 4, 144>;
 
 /// Raw samples `x + 10` read back as `x` (any sign), up to f32 rounding near 10.
@@ -212,14 +203,14 @@ pub fn small_decoder(mask: Mask<'static>) -> Small<'static> {
 
 /// An ensemble blob of `members`, leaked for the `'static` an [`slf_firmware::Ensemble`]
 /// borrows.
-pub fn blob(members: &[Dictionary<5, 5, 4, 4, 13>]) -> &'static [u8] {
+pub fn blob(members: &[Dictionary<PaperShape>]) -> &'static [u8] {
     let mut out = vec![0u8; slf_firmware::blob::blob_len([5, 5, 4, 4, 13], members.len())];
     slf_firmware::blob::write_blob(members, &mut out).unwrap();
     Box::leak(out.into_boxed_slice())
 }
 
 /// A patch of 15 atoms of `dict` (a member's exactly sparse patch).
-pub fn sparse_in(dict: &Dictionary<5, 5, 4, 4, 13>, seed: u64) -> Vec<f32> {
+pub fn sparse_in(dict: &Dictionary<PaperShape>, seed: u64) -> Vec<f32> {
     let mut r = rng(seed);
     let mut s = Box::new([0.0f32; 5200]);
     for _ in 0..15 {
@@ -246,7 +237,7 @@ pub fn decoder_config(lenslets: (u16, u16), mask: Mask<'static>) -> slf_firmware
 #[derive(Default)]
 pub struct Patches(pub Vec<(slf_firmware::PatchOrigin, Vec<f32>, slf_firmware::PatchReport)>);
 
-impl slf_firmware::PatchSink<5200> for Patches {
+impl slf_firmware::PatchSink<PaperShape> for Patches {
     type Error = ();
     fn accept(
         &mut self,

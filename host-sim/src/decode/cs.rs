@@ -42,9 +42,9 @@ use crate::io::patch::{BANDS, HostDictionary, HostEnsemble, HostModel};
 use crate::io::rows::{RowShape, Rows};
 
 /// A dictionary of the paper's patch: 5 x 5 lenslets x 4 x 4 views x 13 bands.
-pub type PaperDictionary = HostDictionary<4, 4>;
+pub type PaperDictionary = HostDictionary<4, 4, 5200>;
 /// A dictionary of the full-view patch: 5 x 5 lenslets x 5 x 5 views x 13 bands.
-pub type FullViewDictionary = HostDictionary<5, 5>;
+pub type FullViewDictionary = HostDictionary<5, 5, 8125>;
 
 /// Decodes `capture` with `basis` (see [`decode`]).
 ///
@@ -112,10 +112,10 @@ fn decode_basis<const PU: usize, const PV: usize, const N: usize>(
             )
         }
         Basis::Dct => {
-            let dictionary = HostDictionary::<PU, PV>::dct();
+            let dictionary = HostDictionary::<PU, PV, N>::dct();
             // The DCT takes the schedules of the shipped blob, whose cold one is trained on
             // the DCT's solves (the screen's).
-            match ensemble::<PU, PV>(None)?.schedules().filter(|_| trained) {
+            match ensemble::<PU, PV, N>(None)?.schedules().filter(|_| trained) {
                 Some(schedules) => {
                     let model = slf_firmware::ScheduledDictionary { dictionary, schedules };
                     decode_observed_into::<PU, PV, N, _>(capture, &model, opts, observer, sink)
@@ -132,7 +132,7 @@ fn decode_basis<const PU: usize, const PV: usize, const N: usize>(
             trial_decode::<PU, PV, N>(capture, blob.as_deref(), *choice, prior, opts, observer, sink)
         }
         Basis::Ensemble { blob, choice } => {
-            let ensemble = ensemble::<PU, PV>(blob.as_deref())?;
+            let ensemble = ensemble::<PU, PV, N>(blob.as_deref())?;
             let model = slf_firmware::EnsembleModel::new(ensemble, *choice);
             let model = if trained { model } else { model.with_schedules(None) };
             decode_observed_into::<PU, PV, N, _>(capture, &model, opts, observer, sink)
@@ -151,13 +151,13 @@ fn trial_decode<const PU: usize, const PV: usize, const N: usize>(
     observer: &(dyn Fn(usize, usize) + Sync),
     sink: &mut Rows<'_>,
 ) -> Result<DecodeReport> {
-    let model = slf_firmware::EnsembleModel::new(ensemble::<PU, PV>(blob)?, choice);
+    let model = slf_firmware::EnsembleModel::new(ensemble::<PU, PV, N>(blob)?, choice);
     let model = if opts.schedule == SolveSchedule::Trained { model } else { model.with_schedules(None) };
     // The trial's other model: the DCT the ensemble screens with, on its schedules.
     match model.scheduled_screen() {
         Some(dct) => decode_picked_into::<PU, PV, N, _, _>(capture, &dct, &model, pick, opts, observer, sink),
         None => {
-            let dct = HostDictionary::<PU, PV>::dct();
+            let dct = HostDictionary::<PU, PV, N>::dct();
             decode_picked_into::<PU, PV, N, _, _>(capture, &dct, &model, pick, opts, observer, sink)
         }
     }
@@ -168,7 +168,9 @@ fn trial_decode<const PU: usize, const PV: usize, const N: usize>(
 ///
 /// # Errors
 /// A blob that does not validate, or of the other patch (named, with the flag to change).
-pub fn ensemble<const PU: usize, const PV: usize>(blob: Option<&[u8]>) -> Result<HostEnsemble<'_, PU, PV>> {
+pub fn ensemble<const PU: usize, const PV: usize, const N: usize>(
+    blob: Option<&[u8]>,
+) -> Result<HostEnsemble<'_, PU, PV, N>> {
     let views = PatchViews::of_views(PU, PV).ok_or_else(|| anyhow!("no patch of {PU} x {PV} views"))?;
     let bytes = blob.unwrap_or(views.shipped_ensemble());
     if let Some(made) = PatchViews::of_blob(bytes).filter(|&m| m != views) {
@@ -179,7 +181,7 @@ pub fn ensemble<const PU: usize, const PV: usize>(blob: Option<&[u8]>) -> Result
             views.shape_name()
         );
     }
-    HostEnsemble::<PU, PV>::new(bytes).map_err(|e| anyhow!("ensemble blob: {e}"))
+    HostEnsemble::<PU, PV, N>::new(bytes).map_err(|e| anyhow!("ensemble blob: {e}"))
 }
 
 /// Patches the CS decoder decodes in `capture` with `views`-view patches (every tile's

@@ -375,7 +375,7 @@ fn parse(log: &str) -> Result<DeviceLog> {
 
 struct Collect(HashMap<PatchOrigin, (u16, Vec<f32>)>);
 
-impl PatchSink<8125> for Collect {
+impl PatchSink<slf_firmware::FullViewShape> for Collect {
     type Error = core::convert::Infallible;
     fn accept(&mut self, o: PatchOrigin, p: &[f32; 8125], r: &PatchReport) -> Result<(), Self::Error> {
         self.0.insert(o, (r.member.unwrap_or(u16::MAX), p.to_vec()));
@@ -408,7 +408,7 @@ pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
     let DeviceLog { patches: device, rows, count, gains, calibrated, calibrated_gains, trial } = parse(&text)?;
     let capture = Capture::load(capture_dir)?;
     // The device decodes full-view patches with the shipped full-view ensemble.
-    let ensemble = HostEnsemble::<5, 5>::new(DEFAULT_FULL_VIEW_ENSEMBLE).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let ensemble = HostEnsemble::<5, 5, 8125>::new(DEFAULT_FULL_VIEW_ENSEMBLE).map_err(|e| anyhow::anyhow!("{e}"))?;
     let model = EnsembleModel::new(ensemble, MemberChoice::Screened(ChoiceRule::DEFAULT));
     // The config the device takes from `capture.rs` (the capture's noise ball) and its white
     // balance: the host's default. The device's tiles are its per-patch benchmark, unsheared;
@@ -490,7 +490,7 @@ fn check_calibrated(
     gains: &[f32],
     capture_dir: &Path,
     calibration: &Path,
-    model: &HostEnsembleModel<'_, 5, 5>,
+    model: &HostEnsembleModel<'_, 5, 5, 8125>,
 ) -> Result<()> {
     let capture = Capture::load(capture_dir)?;
     let cal = Calibration::load(calibration)?;
@@ -559,8 +559,8 @@ fn check_calibrated(
 fn check_rows(
     rows: &HashMap<(usize, usize), Vec<f32>>,
     capture: &Capture,
-    dct: &HostScheduledDictionary<5, 5>,
-    model: &HostEnsembleModel<'_, 5, 5>,
+    dct: &HostScheduledDictionary<5, 5, 8125>,
+    model: &HostEnsembleModel<'_, 5, 5, 8125>,
     pick: Pick,
 ) -> Result<()> {
     // The host's default, full-view patches (the device's), no flags; without the baseline

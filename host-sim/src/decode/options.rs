@@ -3,6 +3,8 @@
 //! [`crate::decode::settings`] and named by [`crate::decode::preset`].
 
 use anyhow::{Result, anyhow, bail, ensure};
+use slf_firmware::BandCount;
+use slf_firmware::Shape;
 use slf_firmware::{DisparityRange, Plausibility, Response, ResponseModel, Sl0Config};
 
 use crate::io::capture::Capture;
@@ -140,9 +142,9 @@ pub fn read_blob(path: &std::path::Path) -> Result<Vec<u8>> {
     )?;
     let blob = std::fs::read(path).map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
     let checked = match PatchViews::of_blob(&blob) {
-        Some(PatchViews::Five) => HostEnsemble::<5, 5>::new(&blob).map(|_| ()),
+        Some(PatchViews::Five) => HostEnsemble::<5, 5, 8125>::new(&blob).map(|_| ()),
         // The paper's patch also reports a blob of neither shape (its dimension check).
-        _ => HostEnsemble::<4, 4>::new(&blob).map(|_| ()),
+        _ => HostEnsemble::<4, 4, 5200>::new(&blob).map(|_| ()),
     };
     checked.map_err(|e| anyhow!("{}: {e}", path.display()))?;
     Ok(blob)
@@ -250,7 +252,7 @@ pub struct DecodeOptions {
     /// The filters' response matrix (row-major, filter x band) and where the decode puts
     /// it ([`slf_firmware::response`], [`ResponseModel`]): a calibration's, whose leaked
     /// light the decode then separates. `None`: one-hot filters.
-    pub response: Option<(Response<BANDS>, ResponseModel)>,
+    pub response: Option<(Response<BandCount<BANDS>>, ResponseModel)>,
     /// The plausibility check of every solved patch ([`slf_firmware::TileDecoder::with_plausibility`]):
     /// [`Plausibility::DEFAULT`] unless set.
     pub plausibility: Plausibility,

@@ -6,6 +6,7 @@
 //! firmware is f32 only, as the device is.
 
 use nalgebra::{DMatrix, RealField};
+use slf_firmware::Shape;
 use std::time::Instant;
 
 use anyhow::Context;
@@ -60,7 +61,7 @@ pub struct Factors<T: Real>(pub Vec<(usize, Vec<T>)>);
 
 impl<T: Real> Factors<T> {
     /// A firmware dictionary's matrices (f32 values, widened to `T`).
-    pub fn from_dictionary<const PU: usize, const PV: usize>(dict: &HostDictionary<PU, PV>) -> Self {
+    pub fn from_dictionary<const PU: usize, const PV: usize, const N: usize>(dict: &HostDictionary<PU, PV, N>) -> Self {
         let d = dict.synthesis();
         let conv = |m: &[f32], n: usize| (n, m.iter().map(|&x| T::from(x)).collect());
         Self(vec![

@@ -7,6 +7,7 @@
 
 use anyhow::{Result, bail, ensure};
 use clap::ValueEnum;
+use slf_firmware::BandCount;
 use slf_firmware::{Response, ResponseModel};
 
 use crate::decode::baselines::BaselineReport;
@@ -172,7 +173,7 @@ impl DecodeSettings {
     fn run_corrected(
         &self,
         capture: &Capture,
-        response: Option<(Response<BANDS>, ResponseModel)>,
+        response: Option<(Response<BandCount<BANDS>>, ResponseModel)>,
         progress: bool,
         observer: &(dyn Fn(usize, usize) + Sync),
         sink: &mut Rows<'_>,

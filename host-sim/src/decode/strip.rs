@@ -26,7 +26,7 @@ use crate::decode::plan::FramePlan;
 use crate::decode::report::DecodeReport;
 use crate::decode::seams::{Spectra, seam_score};
 use crate::decode::tile_sums::TileSums;
-use crate::io::patch::{BANDS, HostModel, HostWorkspace, LENSLETS};
+use crate::io::patch::{HostBands, HostModel, HostShape, HostWorkspace};
 use crate::io::rows::{RowShape, Rows};
 
 /// Tiles a batch holds by default, per worker thread: enough that the threads rarely wait
@@ -35,7 +35,7 @@ pub const BATCH_TILES_PER_THREAD: usize = 8;
 
 /// The engine's seeds as the spectra the adaptive rule scores.
 struct SeedRows<'r> {
-    seeds: Seeds<'r, BANDS>,
+    seeds: Seeds<'r, HostBands>,
     shape: RowShape,
 }
 
@@ -98,7 +98,7 @@ where
         }
     };
     let lenslets = (shape.rows, shape.cols);
-    let run = |tiles: &[Planned], seeds: Option<Seeds<'_, BANDS>>| -> Decoded<PU, PV> {
+    let run = |tiles: &[Planned], seeds: Option<Seeds<'_, HostBands>>| -> Decoded<PU, PV> {
         tiles
             .par_iter()
             .map_init(
@@ -111,7 +111,7 @@ where
                             model,
                             planned.tile,
                             &mut source,
-                            &mut SeedPatches::<LENSLETS, LENSLETS, PU, PV, BANDS> { seeds, lenslets },
+                            &mut SeedPatches::<HostShape<PU, PV, N>> { seeds, lenslets },
                             &mut sums,
                             ws,
                         ),
@@ -126,7 +126,7 @@ where
     };
     let mut report = DecodeReport::default();
     let mut maps = Vec::new();
-    let mut account = |decoded: Decoded<PU, PV>, into: &mut Strip<'_, BANDS>, report: &mut DecodeReport| {
+    let mut account = |decoded: Decoded<PU, PV>, into: &mut Strip<'_, HostBands>, report: &mut DecodeReport| {
         for (planned, mut sums, r) in decoded {
             into.join(&sums.sums());
             match r {
@@ -154,8 +154,8 @@ where
         seed_slots: needs.seed_rows,
         seeded: seeds_needed,
     };
-    let mut buf = vec![0.0f32; held.buffer_len::<BANDS>()];
-    let mut strip = Strip::<BANDS>::new(&mut buf, held, plan.range, plan.window)
+    let mut buf = vec![0.0f32; held.buffer_len::<HostBands>()];
+    let mut strip = Strip::<HostBands>::new(&mut buf, held, plan.range, plan.window)
         .map_err(|e| anyhow::anyhow!("{e} ({slots} rows of {} x {} lenslets)", shape.rows, shape.cols))?;
     let (mut fill, mut unused) = (Fill::default(), Fill::default());
     loop {

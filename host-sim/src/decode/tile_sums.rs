@@ -8,7 +8,7 @@ use slf_firmware::overlap::Window;
 use slf_firmware::{PatchOrigin, PatchReport, PatchSink, SolveError, Tile};
 
 use crate::decode::report::PatchDecoder;
-use crate::io::patch::BANDS;
+use crate::io::patch::{HostBands, HostShape};
 
 /// A tile's weighted sums and report: the [`PatchSink`] a tile decodes into before its
 /// sums join the frame's rows.
@@ -28,7 +28,7 @@ pub(crate) struct TileSums<const PU: usize, const PV: usize> {
 
 impl<const PU: usize, const PV: usize> TileSums<PU, PV> {
     pub fn new(tile: Tile, views: (usize, usize), window: Window, halo: usize) -> Self {
-        let (sums, pixels) = Sums::<BANDS>::lens(&tile, views, halo);
+        let (sums, pixels) = Sums::<HostBands>::lens(&tile, views, halo);
         Self {
             tile,
             views,
@@ -45,8 +45,9 @@ impl<const PU: usize, const PV: usize> TileSums<PU, PV> {
     }
 
     /// The sums, as the engine reads and adds them.
-    pub fn sums(&mut self) -> Sums<'_, BANDS> {
+    pub fn sums(&mut self) -> Sums<'_, HostBands> {
         Sums {
+            bands: core::marker::PhantomData,
             tile: self.tile,
             views: self.views,
             window: self.window,
@@ -57,7 +58,7 @@ impl<const PU: usize, const PV: usize> TileSums<PU, PV> {
     }
 }
 
-impl<const PU: usize, const PV: usize, const N: usize> PatchSink<N> for TileSums<PU, PV> {
+impl<const PU: usize, const PV: usize, const N: usize> PatchSink<HostShape<PU, PV, N>> for TileSums<PU, PV> {
     type Error = core::convert::Infallible;
 
     fn accept(&mut self, o: PatchOrigin, patch: &[f32; N], report: &PatchReport) -> Result<(), Self::Error> {
@@ -70,7 +71,7 @@ impl<const PU: usize, const PV: usize, const N: usize> PatchSink<N> for TileSums
         if let (Some(e), false) = (report.error, report.fallback) {
             self.errors.push((o, e));
         }
-        self.sums().add::<5, 5, PU, PV>(o, patch, report.fallback);
+        self.sums().add::<HostShape<PU, PV, N>>(o, patch, report.fallback);
         Ok(())
     }
 

@@ -30,6 +30,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use slf_firmware::Dictionary;
+use slf_firmware::Shape;
 use slf_firmware::dictionary::Factors;
 use slf_firmware::transform::analyze;
 
@@ -103,7 +104,7 @@ pub struct Member(pub [Vec<f64>; 5]);
 
 impl Member {
     /// The f32 dictionary (checked orthonormal by the firmware).
-    pub fn dictionary<const PU: usize, const PV: usize>(&self) -> HostDictionary<PU, PV> {
+    pub fn dictionary<const PU: usize, const PV: usize, const N: usize>(&self) -> HostDictionary<PU, PV, N> {
         fn m<const D: usize>(v: &[f64]) -> [[f32; D]; D] {
             core::array::from_fn(|i| core::array::from_fn(|j| v[i * D + j] as f32))
         }
@@ -197,7 +198,7 @@ pub fn top_tau(s: &[f32], tau: usize) -> (f64, Vec<u16>) {
 fn coefficients<const PU: usize, const PV: usize, const N: usize>(
     patches: &[f32],
     p: usize,
-    dict: &HostDictionary<PU, PV>,
+    dict: &HostDictionary<PU, PV, N>,
 ) -> Box<[f32; N]> {
     let mut x: Box<[f32; N]> = Box::new([0.0; N]);
     x.copy_from_slice(&patches[p * N..(p + 1) * N]);
@@ -209,7 +210,7 @@ fn coefficients<const PU: usize, const PV: usize, const N: usize>(
 /// Mean relative coding error of every patch in `dict` at `tau`.
 pub fn coding_error<const PU: usize, const PV: usize, const N: usize>(
     patches: &[f32],
-    dict: &HostDictionary<PU, PV>,
+    dict: &HostDictionary<PU, PV, N>,
     tau: usize,
 ) -> f64 {
     let count = patches.len() / N;
@@ -221,7 +222,7 @@ pub fn coding_error<const PU: usize, const PV: usize, const N: usize>(
 /// Mean relative coding error with each patch in its best member: the ensemble's error.
 pub fn ensemble_error<const PU: usize, const PV: usize, const N: usize>(
     patches: &[f32],
-    members: &[HostDictionary<PU, PV>],
+    members: &[HostDictionary<PU, PV, N>],
     tau: usize,
 ) -> f64 {
     let count = patches.len() / N;
@@ -240,7 +241,7 @@ pub fn ensemble_error<const PU: usize, const PV: usize, const N: usize>(
 /// Each patch's best member and its error.
 pub fn assign<const PU: usize, const PV: usize, const N: usize>(
     patches: &[f32],
-    members: &[HostDictionary<PU, PV>],
+    members: &[HostDictionary<PU, PV, N>],
     tau: usize,
 ) -> Vec<(usize, f64)> {
     (0..patches.len() / N)
@@ -262,7 +263,7 @@ pub fn member_error<const PU: usize, const PV: usize, const N: usize>(
     which: &[usize],
     tau: usize,
 ) -> f64 {
-    let d = member.dictionary::<PU, PV>();
+    let d = member.dictionary::<PU, PV, N>();
     which.iter().map(|&p| top_tau(&coefficients::<PU, PV, N>(patches, p, &d)[..], tau).0).sum::<f64>()
         / which.len().max(1) as f64
 }
@@ -278,7 +279,7 @@ pub fn update_member<const PU: usize, const PV: usize, const N: usize>(
     which: &[usize],
     tau: usize,
 ) -> Member {
-    let dict = member.dictionary::<PU, PV>();
+    let dict = member.dictionary::<PU, PV, N>();
     // Per patch: the full coefficients (kept current as modes change) and the fixed code.
     let mut state: Vec<PatchCode<N>> = which
         .par_iter()
@@ -360,7 +361,7 @@ pub fn init_members<const PU: usize, const PV: usize, const N: usize>(
 pub fn train<const PU: usize, const PV: usize, const N: usize>(
     patches: &[f32],
     cfg: &TrainConfig,
-) -> (Vec<HostDictionary<PU, PV>>, Vec<IterationReport>) {
+) -> (Vec<HostDictionary<PU, PV, N>>, Vec<IterationReport>) {
     let count = patches.len() / N;
     let fixed = usize::from(cfg.dct_member && cfg.members > 0);
     let mut members = init_members::<PU, PV, N>(patches, cfg);
@@ -368,7 +369,7 @@ pub fn train<const PU: usize, const PV: usize, const N: usize>(
     let bar = progress_bar(cfg.iterations as u64, cfg.progress);
     let mut reports = Vec::new();
     for _ in 0..cfg.iterations {
-        let dicts: Vec<HostDictionary<PU, PV>> = members.iter().map(Member::dictionary).collect();
+        let dicts: Vec<HostDictionary<PU, PV, N>> = members.iter().map(Member::dictionary).collect();
         let assignment = assign::<PU, PV, N>(patches, &dicts, cfg.tau);
         let ensemble_error = assignment.iter().map(|a| a.1).sum::<f64>() / count as f64;
         let groups: Vec<Vec<usize>> =

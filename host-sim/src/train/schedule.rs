@@ -40,11 +40,13 @@ use crate::io::patch::{
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
+use slf_firmware::Shape;
 use slf_firmware::ascent::ascend_weighted;
 use slf_firmware::ball::Ball;
 use slf_firmware::choice::ChoiceRule;
 use slf_firmware::projection::project_coefficients;
 use slf_firmware::schedule::{MAX_STEPS, Schedule, Schedules, Weights};
+use slf_firmware::shape::ValueCount;
 use slf_firmware::transform::{analyze, analyze_preserving, synthesize};
 use slf_firmware::workspace::Measurements;
 use slf_firmware::{LensletSize, Mask};
@@ -105,8 +107,8 @@ impl Default for ScheduleConfig {
 pub struct Problem<const N: usize> {
     /// The patch, in the patch layout.
     pub truth: Vec<f32>,
-    pub measurements: Box<Measurements<N>>,
-    zero: Box<Measurements<N>>,
+    pub measurements: Box<Measurements<ValueCount<N>>>,
+    zero: Box<Measurements<ValueCount<N>>>,
 }
 
 impl<const N: usize> Problem<N> {
@@ -217,7 +219,7 @@ impl<const PU: usize, const PV: usize> Params<PU, PV> {
     }
 
     /// The group weights, in [1/64, 64].
-    pub fn weights(&self) -> HostWeights<PU, PV> {
+    pub fn weights<const N: usize>(&self) -> HostWeights<PU, PV, N> {
         let mut w = Weights::ONES;
         for (mode, logs) in w.modes_mut().into_iter().zip(&self.log_weights) {
             for (x, l) in mode.iter_mut().zip(logs) {
@@ -231,7 +233,7 @@ impl<const PU: usize, const PV: usize> Params<PU, PV> {
     ///
     /// # Errors
     /// More than [`MAX_STEPS`] steps.
-    pub fn schedule(&self) -> anyhow::Result<HostSchedule<PU, PV>> {
+    pub fn schedule<const N: usize>(&self) -> anyhow::Result<HostSchedule<PU, PV, N>> {
         Schedule::new(&self.sigma(), &self.mu(), self.weights()).map_err(|e| anyhow::anyhow!("{e}"))
     }
 }
@@ -246,7 +248,7 @@ pub struct Trajectory {
 /// The start of a solve from `signal` (a patch estimate; zeros in the unmeasured entries
 /// for the cold start): analysed in `dict`, projected onto the measurements.
 pub fn start<const PU: usize, const PV: usize, const N: usize>(
-    dict: &HostDictionary<PU, PV>,
+    dict: &HostDictionary<PU, PV, N>,
     problem: &Problem<N>,
     signal: &[f32],
 ) -> Vec<f32> {
@@ -261,10 +263,10 @@ pub fn start<const PU: usize, const PV: usize, const N: usize>(
 
 /// A cold solve's start as a patch: the band-gain fill ([`slf_firmware::solver::fill`]), or
 /// the measurements with zeros elsewhere.
-pub fn cold_start<const N: usize>(problem: &Problem<N>, fill: bool) -> Vec<f32> {
+pub fn cold_start<const PU: usize, const PV: usize, const N: usize>(problem: &Problem<N>, fill: bool) -> Vec<f32> {
     if fill {
         let mut x: Box<[f32; N]> = Box::new([0.0; N]);
-        slf_firmware::solver::fill::fill_bands::<13, N>(&problem.measurements, &mut x);
+        slf_firmware::solver::fill::fill_bands::<HostShape<PU, PV, N>>(&problem.measurements, &mut x);
         x.to_vec()
     } else {
         (0..N).map(|i| problem.measurements.get(i).unwrap_or(0.0)).collect()
@@ -273,8 +275,8 @@ pub fn cold_start<const N: usize>(problem: &Problem<N>, fill: bool) -> Vec<f32> 
 
 /// The solve from `start` (coefficients in `dict`), keeping every step's coefficients.
 pub fn unroll<const PU: usize, const PV: usize, const N: usize>(
-    dict: &HostDictionary<PU, PV>,
-    schedule: &HostSchedule<PU, PV>,
+    dict: &HostDictionary<PU, PV, N>,
+    schedule: &HostSchedule<PU, PV, N>,
     problem: &Problem<N>,
     start: &[f32],
 ) -> Trajectory {
@@ -299,7 +301,7 @@ pub fn unroll<const PU: usize, const PV: usize, const N: usize>(
 
 /// The decoded patch of a solve's last coefficients.
 pub fn patch_of<const PU: usize, const PV: usize, const N: usize>(
-    dict: &HostDictionary<PU, PV>,
+    dict: &HostDictionary<PU, PV, N>,
     coeffs: &[f32],
 ) -> Vec<f32> {
     let mut c: Box<[f32; N]> = Box::new([0.0; N]);
@@ -313,9 +315,9 @@ pub fn patch_of<const PU: usize, const PV: usize, const N: usize>(
 /// [`LOSS_FLOOR`]), and its gradient with respect to every parameter (in [`Params::flat`]'s
 /// order).
 pub fn loss_and_gradient<const PU: usize, const PV: usize, const N: usize>(
-    dict: &HostDictionary<PU, PV>,
+    dict: &HostDictionary<PU, PV, N>,
     params: &Params<PU, PV>,
-    schedule: &HostSchedule<PU, PV>,
+    schedule: &HostSchedule<PU, PV, N>,
     problem: &Problem<N>,
     start: &[f32],
 ) -> (f64, Vec<f64>) {
@@ -420,7 +422,7 @@ impl Fit {
 /// Trains `params` on `problems`, each with its dictionary index into `dicts` and its start.
 fn fit<const PU: usize, const PV: usize, const N: usize>(
     params: &mut Params<PU, PV>,
-    dicts: &[HostDictionary<PU, PV>],
+    dicts: &[HostDictionary<PU, PV, N>],
     problems: &[(usize, Problem<N>, Vec<f32>)],
     cfg: &ScheduleConfig,
     seed: u64,
@@ -463,8 +465,8 @@ fn fit<const PU: usize, const PV: usize, const N: usize>(
 
 /// Mean squared error per value of solving every problem with `schedule`.
 pub fn mean_error<const PU: usize, const PV: usize, const N: usize>(
-    dicts: &[HostDictionary<PU, PV>],
-    schedule: &HostSchedule<PU, PV>,
+    dicts: &[HostDictionary<PU, PV, N>],
+    schedule: &HostSchedule<PU, PV, N>,
     problems: &[(usize, Problem<N>, Vec<f32>)],
 ) -> f64 {
     let errors: Vec<f64> = problems
@@ -493,11 +495,11 @@ pub struct ScheduleReport {
 /// # Errors
 /// More steps than [`MAX_STEPS`], or no patch.
 pub fn train<const PU: usize, const PV: usize, const N: usize>(
-    members: &[HostDictionary<PU, PV>],
+    members: &[HostDictionary<PU, PV, N>],
     dct: Option<usize>,
     patches: &[f32],
     cfg: &ScheduleConfig,
-) -> anyhow::Result<(HostSchedules<PU, PV>, ScheduleReport)> {
+) -> anyhow::Result<(HostSchedules<PU, PV, N>, ScheduleReport)> {
     anyhow::ensure!(
         [cfg.cold_steps, cfg.warm_steps, cfg.alone_steps].iter().all(|s| (1..=MAX_STEPS).contains(s)),
         "schedule steps: 1 to {MAX_STEPS} each (cold {}, warm {}, alone {})",
@@ -507,7 +509,7 @@ pub fn train<const PU: usize, const PV: usize, const N: usize>(
     );
     anyhow::ensure!(patches.len() >= N, "no training patch");
     let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed);
-    let screen = HostDictionary::<PU, PV>::dct();
+    let screen = HostDictionary::<PU, PV, N>::dct();
     let mut dicts = vec![screen];
     dicts.extend_from_slice(members);
     let problems: Vec<Problem<N>> = patches
@@ -522,7 +524,7 @@ pub fn train<const PU: usize, const PV: usize, const N: usize>(
     let cold_problems: Vec<(usize, Problem<N>, Vec<f32>)> = problems
         .into_par_iter()
         .map(|p| {
-            let s = start(&dicts[0], &p, &cold_start::<N>(&p, false));
+            let s = start(&dicts[0], &p, &cold_start::<PU, PV, N>(&p, false));
             (0, p, s)
         })
         .collect();
@@ -559,7 +561,7 @@ pub fn train<const PU: usize, const PV: usize, const N: usize>(
     // dB over the minimum-norm start on the realistic set with nothing solved after it).
     for (d, p, s) in &mut warm_problems {
         *d = 0;
-        *s = start(&dicts[0], p, &cold_start::<N>(p, true));
+        *s = start(&dicts[0], p, &cold_start::<PU, PV, N>(p, true));
     }
     let mut alone = Params::<PU, PV>::geometric(cfg.alone_steps, 1.0, 1e-4);
     let alone_fit = fit(&mut alone, &dicts, &warm_problems, cfg, cfg.seed + 3)?;
@@ -596,7 +598,7 @@ fn train_schedule_blob_of<const PU: usize, const PV: usize, const N: usize>(
     output: &std::path::Path,
 ) -> anyhow::Result<()> {
     let start_time = std::time::Instant::now();
-    let ensemble = HostEnsemble::<PU, PV>::new(blob).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let ensemble = HostEnsemble::<PU, PV, N>::new(blob).map_err(|e| anyhow::anyhow!("{e}"))?;
     let members: Vec<_> = (0..ensemble.len())
         .map(|k| ensemble.member(k).map_err(|e| anyhow::anyhow!("{e}")))
         .collect::<anyhow::Result<_>>()?;

@@ -68,15 +68,15 @@ pub fn png_claiming(w: u32, h: u32) -> Vec<u8> {
 
 /// The DCT as the host's `Basis::Dct` decodes with it: with the shipped blob's trained
 /// schedules where the patch's blob has them (the full-view one), bare otherwise.
-pub enum DctModel<const PU: usize, const PV: usize> {
-    Bare(Box<slf_host::firmware::Dictionary<5, 5, PU, PV, 13>>),
-    Scheduled(Box<slf_host::firmware::ScheduledDictionary<5, 5, PU, PV, 13>>),
+pub enum DctModel<const PU: usize, const PV: usize, const N: usize> {
+    Bare(Box<slf_host::firmware::Dictionary<slf_host::firmware::PatchShape<5, 5, PU, PV, 13, N>>>),
+    Scheduled(Box<slf_host::firmware::ScheduledDictionary<slf_host::firmware::PatchShape<5, 5, PU, PV, 13, N>>>),
 }
 
-impl<const PU: usize, const PV: usize> DctModel<PU, PV> {
+impl<const PU: usize, const PV: usize, const N: usize> DctModel<PU, PV, N> {
     pub fn shipped() -> Self {
-        let dictionary = slf_host::firmware::Dictionary::<5, 5, PU, PV, 13>::dct();
-        match slf_host::decode::cs::ensemble::<PU, PV>(None).unwrap().schedules() {
+        let dictionary = slf_host::firmware::Dictionary::<slf_host::firmware::PatchShape<5, 5, PU, PV, 13, N>>::dct();
+        match slf_host::decode::cs::ensemble::<PU, PV, N>(None).unwrap().schedules() {
             Some(schedules) => {
                 Self::Scheduled(Box::new(slf_host::firmware::ScheduledDictionary { dictionary, schedules }))
             }
@@ -85,13 +85,13 @@ impl<const PU: usize, const PV: usize> DctModel<PU, PV> {
     }
 }
 
-impl<const PU: usize, const PV: usize, const N: usize> slf_host::firmware::PatchModel<5, 5, PU, PV, 13, N>
-    for DctModel<PU, PV>
+impl<const PU: usize, const PV: usize, const N: usize>
+    slf_host::firmware::PatchModel<slf_host::firmware::PatchShape<5, 5, PU, PV, 13, N>> for DctModel<PU, PV, N>
 {
     fn decode(
         &self,
         cfg: &slf_host::firmware::Sl0Config,
-        ws: &mut slf_host::firmware::Workspace<5, 5, PU, PV, 13, N>,
+        ws: &mut slf_host::firmware::Workspace<slf_host::firmware::PatchShape<5, 5, PU, PV, 13, N>>,
     ) -> Result<slf_host::firmware::ModelOutcome, slf_host::firmware::SolveError> {
         match self {
             Self::Bare(d) => d.decode(cfg, ws),
@@ -102,7 +102,7 @@ impl<const PU: usize, const PV: usize, const N: usize> slf_host::firmware::Patch
     fn decode_seeded(
         &self,
         cfg: &slf_host::firmware::Sl0Config,
-        ws: &mut slf_host::firmware::Workspace<5, 5, PU, PV, 13, N>,
+        ws: &mut slf_host::firmware::Workspace<slf_host::firmware::PatchShape<5, 5, PU, PV, 13, N>>,
     ) -> Result<slf_host::firmware::ModelOutcome, slf_host::firmware::SolveError> {
         match self {
             Self::Bare(d) => d.decode_seeded(cfg, ws),

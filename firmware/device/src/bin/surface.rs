@@ -63,9 +63,9 @@ mod device {
     /// Counts what it is given.
     #[derive(Default)]
     struct Count(u32, u32);
-    impl<const N: usize> PatchSink<N> for Count {
+    impl<S: Shape> PatchSink<S> for Count {
         type Error = Infallible;
-        fn accept(&mut self, _: PatchOrigin, p: &[f32; N], _: &PatchReport) -> Result<(), Infallible> {
+        fn accept(&mut self, _: PatchOrigin, p: &PerValue<S, f32>, _: &PatchReport) -> Result<(), Infallible> {
             self.0 += u32::from(p.iter().all(|x| x.is_finite()));
             Ok(())
         }
@@ -247,7 +247,7 @@ mod device {
 
         // The paper's general path for a kronecker block: set-up SVDs and the solve.
         if let Ok(mask) = masks[2]
-            && let Ok(phi) = mask.kronecker_phi::<5, 5, 4, 4>(black_box(0), black_box(0))
+            && let Ok(phi) = mask.kronecker_phi::<Fixed<5>, Fixed<5>, Fixed<4>, Fixed<4>>(black_box(0), black_box(0))
             && let Ok(op) = PinvOperator::new(&dct, &phi)
         {
             ws.measurements_mut().clear();

@@ -8,6 +8,8 @@
 
 use core::fmt;
 
+use crate::sensor::extent::{Array, Bands};
+
 /// The shape of a run of lenslet rows: views and lenslet columns (the bands are the
 /// engine's `B`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -61,14 +63,8 @@ pub struct Fill {
 /// `min`, as `f32::clamp` asserts its bounds, a panic path); a value of a view no patch
 /// covered (weight 0) the mean of its lenslet's covered views, in view order; a lenslet
 /// with none 0. `values` and `weights` are one row of `layout` with `B` bands.
-pub fn finish<const B: usize>(
-    values: &mut [f32],
-    weights: &[f32],
-    layout: RowLayout,
-    (lo, hi): (f32, f32),
-    fill: &mut Fill,
-) {
-    for (x, &w) in values.as_chunks_mut::<B>().0.iter_mut().zip(weights) {
+pub fn finish<C: Bands>(values: &mut [f32], weights: &[f32], layout: RowLayout, (lo, hi): (f32, f32), fill: &mut Fill) {
+    for (x, &w) in C::chunks_mut(values).iter_mut().zip(weights) {
         if w > 0.0 {
             for x in x.iter_mut() {
                 *x = (*x / w).max(lo).min(hi);
@@ -77,15 +73,15 @@ pub fn finish<const B: usize>(
     }
     // Each lenslet's views, `cols` pixels apart: their mean where some are not covered.
     let (views, cols) = (layout.views.0 * layout.views.1, layout.cols);
-    let (pixels, _) = values.as_chunks_mut::<B>();
+    let pixels = C::chunks_mut(values);
     for x in 0..cols {
-        let mut mean = [0.0f32; B];
+        let mut mean = C::ZEROS;
         let mut covered = 0u32;
         for p in (0..views).map(|view| view * cols + x) {
             if let (Some(&w), Some(v)) = (weights.get(p), pixels.get(p))
                 && w > 0.0
             {
-                for (m, &v) in mean.iter_mut().zip(v) {
+                for (m, &v) in mean.iter_mut().zip(v.iter()) {
                     *m += v;
                 }
                 covered += 1;
@@ -100,12 +96,12 @@ pub fn finish<const B: usize>(
                 continue;
             }
             if covered > 0 {
-                for (v, &m) in v.iter_mut().zip(&mean) {
+                for (v, &m) in v.iter_mut().zip(mean.iter()) {
                     *v = (m / covered as f32).max(lo).min(hi);
                 }
-                fill.filled += B as u32;
+                fill.filled += C::D as u32;
             } else {
-                fill.uncovered += B as u32;
+                fill.uncovered += C::D as u32;
             }
         }
     }
@@ -135,7 +131,7 @@ mod tests {
         set(1, 1, 4.0, [0.8, 1.2]);
         set(2, 1, 1.0, [0.5, 9.0]);
         let mut fill = Fill::default();
-        finish::<2>(&mut values, &weights, layout, (0.0, 1.0), &mut fill);
+        finish::<crate::sensor::extent::Fixed<2>>(&mut values, &weights, layout, (0.0, 1.0), &mut fill);
         let at = |view: usize, x: usize| {
             let p = (view * 3 + x) * 2;
             [values[p], values[p + 1]]

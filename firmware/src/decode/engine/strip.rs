@@ -13,6 +13,7 @@
 //! puts the columns `out` (inside them): the band's own columns, and beside them those the
 //! band's seeds are read from ([`crate::decode::engine::band`]).
 
+use core::marker::PhantomData;
 use core::num::NonZeroUsize;
 use core::ops::Range;
 
@@ -23,6 +24,8 @@ use crate::decode::engine::schedule::Schedule;
 use crate::decode::engine::tile_sums::{TileSums, pixel_at, weigh};
 use crate::decode::engine::window::Window;
 use crate::decode::tile::{PatchOrigin, PatchReport, PatchSeed, PatchSink};
+use crate::operators::shape::{PerBand, PerValue, Shape};
+use crate::sensor::extent::{Array, Bands};
 use crate::solver::sl0::SolveError;
 
 /// What a strip holds: config.
@@ -51,14 +54,15 @@ impl StripShape {
     }
 
     /// `f32`s of the strip's buffer with `B` bands.
-    pub fn buffer_len<const B: usize>(&self) -> usize {
+    pub fn buffer_len<C: Bands>(&self) -> usize {
         let pixels = self.layout().pixels();
-        self.slots * pixels * (B + 1) + if self.seeded { self.seed_slots * pixels * B } else { 0 }
+        self.slots * pixels * (C::D + 1) + if self.seeded { self.seed_slots * pixels * C::D } else { 0 }
     }
 }
 
 /// The held rows of an overlapped decode: see the module.
-pub struct Strip<'s, const B: usize> {
+pub struct Strip<'s, C: Bands> {
+    bands: PhantomData<C>,
     /// The slots' sums and weights: `slots x (pixels x B + pixels)`.
     sums: &'s mut [f32],
     /// The seeds' slots: `seed_slots x pixels x B` (empty unless seeded).
@@ -93,7 +97,7 @@ impl Ring {
     }
 }
 
-impl<'s, const B: usize> Strip<'s, B> {
+impl<'s, C: Bands> Strip<'s, C> {
     /// A strip of `shape` on `buf` (zeroed), finishing values into `range` and weighing
     /// estimates by `window`.
     ///
@@ -113,11 +117,18 @@ impl<'s, const B: usize> Strip<'s, B> {
             && shape.out.end <= shape.held.end;
         let slots = NonZeroUsize::new(shape.slots)?;
         let seed_slots = NonZeroUsize::new(shape.seed_slots)?;
-        let buf = buf.get_mut(..shape.buffer_len::<B>()).filter(|_| ok)?;
+        let buf = buf.get_mut(..shape.buffer_len::<C>()).filter(|_| ok)?;
         buf.fill(0.0);
         let layout = shape.layout();
-        let (sums, seeds) = buf.split_at_mut_checked(shape.slots * layout.pixels() * (B + 1))?;
-        Some(Self { sums, seeds, ring: Ring { shape, slots, seed_slots, layout, first: 0 }, range, window })
+        let (sums, seeds) = buf.split_at_mut_checked(shape.slots * layout.pixels() * (C::D + 1))?;
+        Some(Self {
+            bands: PhantomData,
+            sums,
+            seeds,
+            ring: Ring { shape, slots, seed_slots, layout, first: 0 },
+            range,
+            window,
+        })
     }
 
     /// What the strip holds.
@@ -128,12 +139,12 @@ impl<'s, const B: usize> Strip<'s, B> {
     /// Row `y`'s slot as its sums, weights and seeds (empty unless seeded); `None` outside
     /// the rows held.
     fn slot(&mut self, y: usize) -> Option<(&mut [f32], &mut [f32], &mut [f32])> {
-        slot_parts::<B>(&self.ring, self.sums, self.seeds, y)
+        slot_parts::<C>(&self.ring, self.sums, self.seeds, y)
     }
 
     /// Adds a tile's sums into the rows they reach: per lenslet row and view, the run of
     /// the tile's columns inside the held ones, a slice onto a slice.
-    pub fn join(&mut self, sums: &TileSums<'_, B>) {
+    pub fn join(&mut self, sums: &TileSums<'_, C>) {
         let tile = sums.tile;
         let (extent_rows, extent_cols) = sums.extent();
         // The sums' first column on the sensor, and the run `t0..t1` of them held.
@@ -156,17 +167,17 @@ impl<'s, const B: usize> Strip<'s, B> {
                 for v in 0..views.1 {
                     let (src, dst) = (sums.pixel(s, t0, u, v), layout.pixel(u, v, x0));
                     let (Some(d), Some(x)) =
-                        (row.get_mut(dst * B..(dst + len) * B), sums.sum.get(src * B..(src + len) * B))
+                        (row.get_mut(dst * C::D..(dst + len) * C::D), sums.sum.get(src * C::D..(src + len) * C::D))
                     else {
                         continue;
                     };
-                    for (d, &x) in d.iter_mut().zip(x) {
+                    for (d, &x) in d.iter_mut().zip(x.iter()) {
                         *d += x;
                     }
                     let (Some(d), Some(x)) = (weights.get_mut(dst..dst + len), sums.weight.get(src..src + len)) else {
                         continue;
                     };
-                    for (d, &x) in d.iter_mut().zip(x) {
+                    for (d, &x) in d.iter_mut().zip(x.iter()) {
                         *d += x;
                     }
                 }
@@ -181,8 +192,8 @@ impl<'s, const B: usize> Strip<'s, B> {
         if let Some((sums, weights, seeds)) = self.slot(y)
             && seeds.len() == sums.len()
         {
-            seeds.copy_from_slice(sums);
-            finish::<B>(seeds, weights, layout, range, fill);
+            seeds.copy_from_slice(sums.as_ref());
+            finish::<C>(seeds, weights, layout, range, fill);
         }
     }
 
@@ -193,14 +204,14 @@ impl<'s, const B: usize> Strip<'s, B> {
         let views = layout.views.0 * layout.views.1;
         let sent = match self.slot(y) {
             Some((sums, weights, _)) => {
-                finish::<B>(sums, weights, layout, range, fill);
+                finish::<C>(sums, weights, layout, range, fill);
                 // The `out` columns of each view, moved to the front (a run never moves past
                 // its own start).
                 let (o0, width) = (out.start.saturating_sub(held.start), out.len());
                 if width < layout.cols {
                     for p in 0..views {
-                        let (from, to) = ((p * layout.cols + o0) * B, p * width * B);
-                        for k in 0..width * B {
+                        let (from, to) = ((p * layout.cols + o0) * C::D, p * width * C::D);
+                        for k in 0..width * C::D {
                             if let Some(&x) = sums.get(from + k)
                                 && let Some(d) = sums.get_mut(to + k)
                             {
@@ -209,7 +220,7 @@ impl<'s, const B: usize> Strip<'s, B> {
                         }
                     }
                 }
-                let r = match sums.get(..views * width * B) {
+                let r = match sums.get(..views * width * C::D) {
                     Some(row) => sink.row(y as u16, out.start as u16, row),
                     None => Ok(()),
                 };
@@ -254,22 +265,20 @@ impl<'s, const B: usize> Strip<'s, B> {
     }
 
     /// The seeds held, to read.
-    pub fn seeds(&self) -> Seeds<'_, B> {
-        Seeds { seeds: self.seeds, ring: &self.ring }
+    pub fn seeds(&self) -> Seeds<'_, C> {
+        Seeds { bands: PhantomData, seeds: self.seeds, ring: &self.ring }
     }
 
     /// A sink that adds each accepted patch straight into the rows (by [`weigh`], in the
     /// patch's order; a device's way, without a tile's buffer), and the seeds beside it.
-    pub fn sink<const PS: usize, const PT: usize, const PU: usize, const PV: usize>(
-        &mut self,
-    ) -> (StripSink<'_, PS, PT, PU, PV, B>, Seeds<'_, B>) {
-        let sink = StripSink { sums: self.sums, ring: &self.ring, window: self.window };
-        (sink, Seeds { seeds: self.seeds, ring: &self.ring })
+    pub fn sink<S: Shape<Bands = C>>(&mut self) -> (StripSink<'_, S>, Seeds<'_, C>) {
+        let sink = StripSink { shape: PhantomData, sums: self.sums, ring: &self.ring, window: self.window };
+        (sink, Seeds { bands: PhantomData, seeds: self.seeds, ring: &self.ring })
     }
 }
 
 /// Row `y`'s slot of `ring` in `sums` and `seeds` as its sums, weights and seeds.
-fn slot_parts<'a, const B: usize>(
+fn slot_parts<'a, C: Bands>(
     ring: &Ring,
     sums: &'a mut [f32],
     seeds: &'a mut [f32],
@@ -277,10 +286,10 @@ fn slot_parts<'a, const B: usize>(
 ) -> Option<(&'a mut [f32], &'a mut [f32], &'a mut [f32])> {
     let i = ring.slot(y)?;
     let pixels = ring.layout.pixels();
-    let slot = sums.get_mut(i * pixels * (B + 1)..(i + 1) * pixels * (B + 1))?;
-    let (sums, weights) = slot.split_at_mut_checked(pixels * B)?;
+    let slot = sums.get_mut(i * pixels * (C::D + 1)..(i + 1) * pixels * (C::D + 1))?;
+    let (sums, weights) = slot.split_at_mut_checked(pixels * C::D)?;
     let seeds = match ring.seed_slot(y) {
-        Some(j) => seeds.get_mut(j * pixels * B..(j + 1) * pixels * B).unwrap_or_default(),
+        Some(j) => seeds.get_mut(j * pixels * C::D..(j + 1) * pixels * C::D).unwrap_or_default(),
         None => Default::default(),
     };
     Some((sums, weights, seeds))
@@ -289,12 +298,13 @@ fn slot_parts<'a, const B: usize>(
 /// The disjoint grid's finished values held by a [`Strip`]: the seeds of the shifted
 /// patches ([`PatchSeed`]).
 #[derive(Clone, Copy)]
-pub struct Seeds<'a, const B: usize> {
+pub struct Seeds<'a, C: Bands> {
+    bands: PhantomData<C>,
     seeds: &'a [f32],
     ring: &'a Ring,
 }
 
-impl<const B: usize> Seeds<'_, B> {
+impl<C: Bands> Seeds<'_, C> {
     /// Views (rows, cols) of a lenslet.
     pub fn views(&self) -> (usize, usize) {
         self.ring.shape.views
@@ -305,33 +315,28 @@ impl<const B: usize> Seeds<'_, B> {
     pub fn spectrum(&self, u: usize, v: usize, y: usize, x: usize) -> Option<&[f32]> {
         let r = self.ring;
         let i = r.seed_slot(y).filter(|_| r.shape.seeded && r.shape.held.contains(&x))?;
-        let at = (i * r.layout.pixels() + r.layout.pixel(u, v, x - r.shape.held.start)) * B;
-        self.seeds.get(at..at + B)
+        let at = (i * r.layout.pixels() + r.layout.pixel(u, v, x - r.shape.held.start)) * C::D;
+        self.seeds.get(at..at + C::D)
     }
 
     /// The estimate of the patch at `o` (a `PS x PT x PU x PV x B` patch): each pixel the
     /// seed of the lenslet its value is read from, clamped to the sensor (a sheared patch
     /// reaches past it: its nearest lenslet's value); `false` where a seed is not held.
-    pub fn patch<const PS: usize, const PT: usize, const PU: usize, const PV: usize>(
-        &self,
-        o: PatchOrigin,
-        patch: &mut [f32],
-        lenslets: (usize, usize),
-    ) -> bool {
+    pub fn patch<S: Shape<Bands = C>>(&self, o: PatchOrigin, patch: &mut [f32], lenslets: (usize, usize)) -> bool {
         let views = self.views();
         let (rows, cols) = (lenslets.0 as isize, lenslets.1 as isize);
         if rows == 0 || cols == 0 {
             return false;
         }
-        for (p, bands) in patch.as_chunks_mut::<B>().0.iter_mut().enumerate() {
-            let (s, t, u, v) = pixel_at::<PT, PU, PV>(p);
-            let Some((r, c)) = o.lenslet::<PS, PT>(s, t, u, v, views) else { continue };
+        for (p, bands) in S::Bands::chunks_mut(patch).iter_mut().enumerate() {
+            let (s, t, u, v) = pixel_at::<S>(p);
+            let Some((r, c)) = o.lenslet::<S>(s, t, u, v, views) else { continue };
             // (`max` then `min`: `clamp` asserts its bounds, a panic path.)
             let (r, c) = (r.max(0).min(rows - 1) as usize, c.max(0).min(cols - 1) as usize);
             let Some(seed) = self.spectrum(o.view_row as usize + u, o.view_col as usize + v, r, c) else {
                 return false;
             };
-            bands.copy_from_slice(seed);
+            bands.copy_from_slice(seed.as_ref());
         }
         true
     }
@@ -339,51 +344,48 @@ impl<const B: usize> Seeds<'_, B> {
 
 /// [`Seeds`] as a [`PatchSeed`] of `PS x PT x PU x PV x B` patches on a sensor of
 /// `lenslets`.
-pub struct SeedPatches<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> {
-    pub seeds: Seeds<'a, B>,
+pub struct SeedPatches<'a, S: Shape> {
+    pub seeds: Seeds<'a, S::Bands>,
     pub lenslets: (usize, usize),
 }
 
-impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize> PatchSeed<N>
-    for SeedPatches<'_, PS, PT, PU, PV, B>
-{
-    fn seed(&mut self, o: PatchOrigin, patch: &mut [f32; N]) -> bool {
-        self.seeds.patch::<PS, PT, PU, PV>(o, patch, self.lenslets)
+impl<S: Shape> PatchSeed<S> for SeedPatches<'_, S> {
+    fn seed(&mut self, o: PatchOrigin, patch: &mut PerValue<S, f32>) -> bool {
+        self.seeds.patch::<S>(o, patch.as_mut(), self.lenslets)
     }
 }
 
 /// A [`PatchSink`] adding each patch straight into a [`Strip`]'s rows.
-pub struct StripSink<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize> {
+pub struct StripSink<'a, S: Shape> {
+    shape: PhantomData<S>,
     sums: &'a mut [f32],
     ring: &'a Ring,
     window: Window,
 }
 
-impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize> PatchSink<N>
-    for StripSink<'_, PS, PT, PU, PV, B>
-{
+impl<S: Shape> PatchSink<S> for StripSink<'_, S> {
     type Error = core::convert::Infallible;
 
-    fn accept(&mut self, o: PatchOrigin, patch: &[f32; N], report: &PatchReport) -> Result<(), Self::Error> {
+    fn accept(&mut self, o: PatchOrigin, patch: &PerValue<S, f32>, report: &PatchReport) -> Result<(), Self::Error> {
         let ring = self.ring;
         let (views, window, frame_rows) = (ring.shape.views, self.window, ring.shape.frame_rows);
         let (held, layout, pixels) = (ring.shape.held.clone(), ring.layout, ring.layout.pixels());
         let sums_all = &mut *self.sums;
-        let add = |r: isize, c: isize, u: usize, v: usize, w: f32, bands: &[f32; B]| {
+        let add = |r: isize, c: isize, u: usize, v: usize, w: f32, bands: &PerBand<S, f32>| {
             let (Ok(r), Ok(c)) = (usize::try_from(r), usize::try_from(c)) else { return };
             if r >= frame_rows || !held.contains(&c) {
                 return;
             }
             let Some(i) = ring.slot(r) else { return };
-            let (j, base) = (layout.pixel(u, v, c - held.start), i * pixels * (B + 1));
-            let Some(dst) = sums_all.get_mut(base + j * B..base + j * B + B) else { return };
-            for (d, &x) in dst.iter_mut().zip(bands) {
+            let (j, base) = (layout.pixel(u, v, c - held.start), i * pixels * (S::B + 1));
+            let Some(dst) = sums_all.get_mut(base + j * S::B..base + j * S::B + S::B) else { return };
+            for (d, &x) in dst.iter_mut().zip(bands.iter()) {
                 *d += w * x;
             }
-            let Some(wt) = sums_all.get_mut(base + pixels * B + j) else { return };
+            let Some(wt) = sums_all.get_mut(base + pixels * S::B + j) else { return };
             *wt += w;
         };
-        weigh::<PS, PT, PU, PV, B>(patch, o, report.fallback, views, window, add);
+        weigh::<S>(patch.as_ref(), o, report.fallback, views, window, add);
         Ok(())
     }
 

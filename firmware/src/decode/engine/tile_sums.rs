@@ -13,12 +13,16 @@ use crate::decode::engine::error::EngineError;
 use crate::decode::engine::window::Window;
 use crate::decode::tile::{PatchOrigin, Tile};
 use crate::operators::disparity::FALLBACK_WEIGHT;
+use core::marker::PhantomData;
+
+use crate::operators::shape::{PerBand, Shape};
+use crate::sensor::extent::{Array, Bands};
 
 /// Lenslet `(s, t)` and view `(u, v)` of pixel `p` of a `PS x PT x PU x PV` patch, pixels in
 /// the patch's order ([`crate::shape::PatchShape::index`] without the band).
 #[inline]
-pub(crate) fn pixel_at<const PT: usize, const PU: usize, const PV: usize>(p: usize) -> (usize, usize, usize, usize) {
-    (p / (PV * PU * PT), (p / (PV * PU)) % PT, (p / PV) % PU, p % PV)
+pub(crate) fn pixel_at<S: Shape>(p: usize) -> (usize, usize, usize, usize) {
+    (p / (S::PV * S::PU * S::PT), (p / (S::PV * S::PU)) % S::PT, (p / S::PV) % S::PU, p % S::PV)
 }
 
 /// A patch's estimates weighed into pixels: for each pixel `(s, t, u, v)` of the patch at
@@ -27,19 +31,19 @@ pub(crate) fn pixel_at<const PT: usize, const PU: usize, const PV: usize>(p: usi
 /// lie outside the sensor), the lenslet's view, the window's weight (a fallback's times
 /// [`FALLBACK_WEIGHT`]) and its `B` values. A pixel a half-pixel shear names no lenslet of
 /// is skipped.
-pub fn weigh<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize>(
+pub fn weigh<S: Shape>(
     patch: &[f32],
     origin: PatchOrigin,
     fallback: bool,
     views: (usize, usize),
     window: Window,
-    mut add: impl FnMut(isize, isize, usize, usize, f32, &[f32; B]),
+    mut add: impl FnMut(isize, isize, usize, usize, f32, &PerBand<S, f32>),
 ) {
     let scale = if fallback { FALLBACK_WEIGHT } else { 1.0 };
-    for (p, bands) in patch.as_chunks::<B>().0.iter().enumerate() {
-        let (s, t, u, v) = pixel_at::<PT, PU, PV>(p);
-        let Some((r, c)) = origin.lenslet::<PS, PT>(s, t, u, v, views) else { continue };
-        let w = scale * window.weight::<PS, PT>(s, t);
+    for (p, bands) in S::Bands::chunks(patch).iter().enumerate() {
+        let (s, t, u, v) = pixel_at::<S>(p);
+        let Some((r, c)) = origin.lenslet::<S>(s, t, u, v, views) else { continue };
+        let w = scale * window.weight::<S>(s, t);
         add(r, c, origin.view_row as usize + u, origin.view_col as usize + v, w, bands);
     }
 }
@@ -47,7 +51,9 @@ pub fn weigh<const PS: usize, const PT: usize, const PU: usize, const PV: usize,
 /// Weighted sums of a tile's patch estimates over its lenslets and the halo a sheared patch
 /// reaches beyond them (`halo` lenslets on every side), all views and `B` bands, on
 /// caller-owned slices of [`TileSums::lens`].
-pub struct TileSums<'b, const B: usize> {
+pub struct TileSums<'b, C: Bands> {
+    /// The band count the sums are over.
+    pub bands: PhantomData<C>,
     pub tile: Tile,
     pub views: (usize, usize),
     pub window: Window,
@@ -58,7 +64,7 @@ pub struct TileSums<'b, const B: usize> {
     pub weight: &'b mut [f32],
 }
 
-impl<'b, const B: usize> TileSums<'b, B> {
+impl<'b, C: Bands> TileSums<'b, C> {
     /// Lenslet rows and columns of the sums of `tile` with `halo`.
     pub fn extent_of(tile: &Tile, halo: usize) -> (usize, usize) {
         (usize::from(tile.lenslet_rows) + 2 * halo, usize::from(tile.lenslet_cols) + 2 * halo)
@@ -68,7 +74,7 @@ impl<'b, const B: usize> TileSums<'b, B> {
     pub fn lens(tile: &Tile, views: (usize, usize), halo: usize) -> (usize, usize) {
         let (rows, cols) = Self::extent_of(tile, halo);
         let pixels = rows * cols * views.0 * views.1;
-        (pixels * B, pixels)
+        (pixels * C::D, pixels)
     }
 
     /// The sums of `tile` on `sum` and `weight`, zeroed (the rest of a longer slice is not
@@ -90,7 +96,7 @@ impl<'b, const B: usize> TileSums<'b, B> {
         };
         sum.fill(0.0);
         weight.fill(0.0);
-        Ok(Self { tile, views, window, halo, sum, weight })
+        Ok(Self { bands: PhantomData, tile, views, window, halo, sum, weight })
     }
 
     /// Lenslet rows and columns of the sums.
@@ -107,30 +113,25 @@ impl<'b, const B: usize> TileSums<'b, B> {
 
     /// Adds the estimates of the patch at `o` (a fallback's: see
     /// [`PatchReport::fallback`](crate::tile::PatchReport::fallback)).
-    pub fn add<const PS: usize, const PT: usize, const PU: usize, const PV: usize>(
-        &mut self,
-        o: PatchOrigin,
-        patch: &[f32],
-        fallback: bool,
-    ) {
+    pub fn add<S: Shape<Bands = C>>(&mut self, o: PatchOrigin, patch: &[f32], fallback: bool) {
         // The halo's corner, in sensor lenslets.
         let (r0, c0) =
             (self.tile.lenslet_row as isize - self.halo as isize, self.tile.lenslet_col as isize - self.halo as isize);
         let (rows, cols) = self.extent();
         let views = self.views;
         let (sum, weight) = (&mut *self.sum, &mut *self.weight);
-        let add = |r: isize, c: isize, u: usize, v: usize, w: f32, bands: &[f32; B]| {
+        let add = |r: isize, c: isize, u: usize, v: usize, w: f32, bands: &PerBand<S, f32>| {
             let (Ok(r), Ok(c)) = (usize::try_from(r - r0), usize::try_from(c - c0)) else { return };
             if r >= rows || c >= cols {
                 return;
             }
             let j = ((r * views.0 + u) * views.1 + v) * cols + c;
-            let (Some(dst), Some(wt)) = (sum.get_mut(j * B..j * B + B), weight.get_mut(j)) else { return };
-            for (d, &x) in dst.iter_mut().zip(bands) {
+            let (Some(dst), Some(wt)) = (sum.get_mut(j * C::D..j * C::D + C::D), weight.get_mut(j)) else { return };
+            for (d, &x) in dst.iter_mut().zip(bands.iter()) {
                 *d += w * x;
             }
             *wt += w;
         };
-        weigh::<PS, PT, PU, PV, B>(patch, o, fallback, views, self.window, add);
+        weigh::<S>(patch, o, fallback, views, self.window, add);
     }
 }

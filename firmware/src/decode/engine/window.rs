@@ -1,5 +1,7 @@
 //! How overlapping estimates of a value are weighed ([`Window`]).
 
+use crate::operators::shape::Shape;
+
 /// How overlapping estimates of a value are weighed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -15,13 +17,13 @@ pub enum Window {
 }
 
 impl Window {
-    /// The weight of lenslet `(s, t)` of a `PS x PT` patch.
+    /// The weight of lenslet `(s, t)` of a patch of shape `S`.
     #[inline]
-    pub fn weight<const PS: usize, const PT: usize>(self, s: usize, t: usize) -> f32 {
+    pub fn weight<S: Shape>(self, s: usize, t: usize) -> f32 {
         let taper = |i: usize, p: usize| (1 + i.min(p.saturating_sub(1).saturating_sub(i))) as f32;
         match self {
             Window::Uniform => 1.0,
-            Window::Tapered => taper(s, PS) * taper(t, PT),
+            Window::Tapered => taper(s, S::PS) * taper(t, S::PT),
         }
     }
 }

@@ -2,14 +2,14 @@
 //! estimate) and the disparity a block is sheared to.
 
 use super::*;
+use crate::operators::shape::{PerBand, Shape};
+use crate::sensor::extent::Array;
 
 /// A block's held-out error estimates at a half-pixel disparity and at the whole ones beside
 /// it (`None` where none), in that order.
 pub(crate) type ShearEstimates = [(Disparity, Option<f32>); 3];
 
-impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
-    TileDecoder<'a, PS, PT, PU, PV, B, N>
-{
+impl<'a, S: Shape> TileDecoder<'a, S> {
     /// [`Self::with_shear_check`]: `half`, or the whole disparity next to it whose first
     /// window's patch at block `(row, col)` estimates a held-out error below
     /// [`SHEAR_MARGIN`] times `half`'s (the smaller of the two).
@@ -17,15 +17,15 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     /// # Errors
     /// The source's error.
     #[inline(never)]
-    pub(super) fn check_shear<M: PatchModel<PS, PT, PU, PV, B, N>, S: TileSource>(
+    pub(super) fn check_shear<M: PatchModel<S>, Src: TileSource>(
         &self,
         model: &M,
         row: u16,
         col: u16,
         half: Disparity,
-        source: &mut S,
-        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
-    ) -> Result<Disparity, S::Error> {
+        source: &mut Src,
+        ws: &mut Workspace<S>,
+    ) -> Result<Disparity, Src::Error> {
         let mut best = (f32::INFINITY, half);
         // The check's estimating solves are the block's: a patch's report counts its own.
         for (d, error) in self.shear_errors(model, (row, col), half, source, ws)?.0 {
@@ -44,14 +44,14 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     ///
     /// # Errors
     /// The source's error.
-    pub(crate) fn shear_errors<M: PatchModel<PS, PT, PU, PV, B, N>, S: TileSource>(
+    pub(crate) fn shear_errors<M: PatchModel<S>, Src: TileSource>(
         &self,
         model: &M,
         (row, col): (u16, u16),
         half: Disparity,
-        source: &mut S,
-        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
-    ) -> Result<(ShearEstimates, u32), S::Error> {
+        source: &mut Src,
+        ws: &mut Workspace<S>,
+    ) -> Result<(ShearEstimates, u32), Src::Error> {
         let h = half.in_halves();
         let mut out =
             [half, Disparity::halves(h.saturating_sub(1)), Disparity::halves(h.saturating_add(1))].map(|d| (d, None));
@@ -80,7 +80,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         &self,
         cfg: &Sl0Config,
         flags: PatchFlags,
-        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+        ws: &mut Workspace<S>,
         done: &mut ModelOutcome,
     ) -> Checked {
         // A patch with saturated samples left out is brighter than it measured: no bound.
@@ -90,8 +90,8 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         {
             return Checked::Plausible;
         }
-        let bounds = self.plausibility.bounds::<PS, PT, PU, PV, B, N>(ws.measurements());
-        if implausible::<PS, PT, PU, PV, B, N>(&bounds, ws.patch()) == 0 {
+        let bounds = self.plausibility.bounds::<S>(ws.measurements());
+        if implausible::<S>(&bounds, ws.patch()) == 0 {
             return Checked::Plausible;
         }
         let safe = Sl0Config { cold_start: 1.0, ..*cfg };
@@ -99,17 +99,17 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         match solve(&crate::operators::dictionary::Dictionary::dct(), &safe, ws) {
             Ok(outcome) => {
                 done.outcome = outcome;
-                if implausible::<PS, PT, PU, PV, B, N>(&bounds, ws.patch()) == 0 {
+                if implausible::<S>(&bounds, ws.patch()) == 0 {
                     return Checked::Redecoded;
                 }
             }
             Err(_) => {
                 // Nothing finite to keep: the band-gain fill holds the measurements.
                 let Workspace { signal, measurements, .. } = ws;
-                crate::solver::fill::fill_bands::<B, N>(measurements, signal);
+                crate::solver::fill::fill_bands::<S>(measurements, signal);
             }
         }
-        clip::<PS, PT, PU, PV, B, N>(&bounds, &mut ws.signal);
+        clip::<S>(&bounds, &mut ws.signal);
         Checked::Clipped
     }
 
@@ -119,12 +119,12 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     ///
     /// # Errors
     /// The source's error.
-    pub fn choose_disparity<S: TileSource>(
+    pub fn choose_disparity<Src: TileSource>(
         &self,
         row: usize,
         col: usize,
-        source: &mut S,
-    ) -> Result<Disparity, S::Error> {
+        source: &mut Src,
+    ) -> Result<Disparity, Src::Error> {
         if self.disparities.is_off() {
             return Ok(Disparity::ZERO);
         }
@@ -132,11 +132,11 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let (lu, lv) = (c.sensor.lenslet.rows as usize, c.sensor.lenslet.cols as usize);
         let k = c.mask.snapshots();
         let mut best = Best::default();
-        let mut one = [[0.0f32; 1]; B];
+        let mut one = <PerBand<S, [f32; 1]>>::splat([0.0]);
         for d in self.disparities.candidates() {
             let mut score = Consistency::new();
-            for s in 0..PS {
-                for t in 0..PT {
+            for s in 0..S::PS {
+                for t in 0..S::PT {
                     for u in 0..lu {
                         let lr = (row + s) as isize + rounded_shift(d, u, lu);
                         for v in 0..lv {
@@ -148,7 +148,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                             for (j, o) in one.iter_mut().enumerate().take(k) {
                                 source.read(j, r, cc, o)?;
                             }
-                            for (band, o) in c.mask.bands_at(r, cc).iter().zip(&one) {
+                            for (band, o) in c.mask.bands_at(r, cc).iter().zip(one.iter()) {
                                 if let Ok(y) = self.balanced(*band, o[0], (r, cc)) {
                                     score.add(*band as usize, y);
                                 }
@@ -169,6 +169,6 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let (lu, lv) = (c.sensor.lenslet.rows as usize, c.sensor.lenslet.cols as usize);
         let (rows, cols) = (c.sensor.lenslets.0 as usize, c.sensor.lenslets.1 as usize);
         let (hr, hc) = (reach(d, lu), reach(d, lv));
-        row < hr || col < hc || row + PS + hr > rows || col + PT + hc > cols
+        row < hr || col < hc || row + S::PS + hr > rows || col + S::PT + hc > cols
     }
 }

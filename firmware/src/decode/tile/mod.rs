@@ -37,12 +37,12 @@ use crate::log::log;
 use crate::operators::disparity::{
     Best, Consistency, Disparity, DisparityRange, HalfViews, is_half, reach, rounded_shift, shift,
 };
-use crate::operators::shape::PatchShape;
 use crate::sensor::defects::DefectList;
+use crate::sensor::extent::Array;
 use crate::sensor::grid::LensletGrid;
 use crate::sensor::mask::{LensletSize, Mask, MaskFamily};
 use crate::sensor::raw::{Invalid, RawFormat};
-use crate::sensor::response::Response;
+use crate::sensor::response::{Response, StaticIdentity};
 use crate::solver::choice::{ModelOutcome, PatchModel};
 use crate::solver::fractional::{MAX_GRID, from_sensor, to_sensor};
 use crate::solver::holdout::{HoldOut, estimate, hold_out};
@@ -53,6 +53,7 @@ use crate::solver::shares;
 use crate::solver::sl0::{Ended, Outcome, Sl0Config, solve};
 use crate::solver::workspace::{CellShares, MAX_PLACES, MAX_SHARE_VIEWS, Workspace};
 
+use crate::operators::shape::{PerBand, Shape};
 /// The source trait lives with the raw frames (the sensor layer); named here too, where the
 /// decoder that reads it is.
 pub use crate::sensor::source::TileSource;
@@ -111,7 +112,7 @@ impl PatchOrigin {
     /// there: a decoded half-pixel patch is handed over at its pixels
     /// ([`crate::solver::fractional::to_sensor`]).
     #[inline]
-    pub fn lenslet<const PS: usize, const PT: usize>(
+    pub fn lenslet<S: Shape>(
         &self,
         s: usize,
         t: usize,
@@ -121,7 +122,7 @@ impl PatchOrigin {
     ) -> Option<(isize, isize)> {
         let d = self.disparity;
         let (vr, vc) = (self.view_row as usize + u, self.view_col as usize + v);
-        if (is_half(d, vr, views.0) && s + 1 >= PS) || (is_half(d, vc, views.1) && t + 1 >= PT) {
+        if (is_half(d, vr, views.0) && s + 1 >= S::PS) || (is_half(d, vc, views.1) && t + 1 >= S::PT) {
             return None;
         }
         let (du, dv) = (shift(d, vr, views.0), shift(d, vc, views.1));
@@ -144,23 +145,15 @@ pub struct DecoderConfig<'a> {
 /// unless set by [`with_gains`](Self::with_gains)). Stateless; all mutable state is in the
 /// caller's [`Workspace`].
 #[derive(Clone, Copy, Debug)]
-pub struct TileDecoder<
-    'a,
-    const PS: usize,
-    const PT: usize,
-    const PU: usize,
-    const PV: usize,
-    const B: usize,
-    const N: usize,
-> {
+pub struct TileDecoder<'a, S: Shape> {
     config: DecoderConfig<'a>,
-    gains: [f32; B],
+    gains: PerBand<S, f32>,
     disparities: DisparityRange,
     edge_fallback: bool,
     sheared_fallback: bool,
     /// Borrowed (from flash on a device): by value it made every copy of the decoder
     /// 1.35 KB larger, 9.7 KB more stack in the device's run.
-    response: &'a Response<B>,
+    response: &'a Response<S::Bands>,
     response_model: ResponseModel,
     view_gains: Option<(&'a [f32], (u16, u16))>,
     plausibility: Plausibility,
@@ -214,26 +207,23 @@ fn spans(total: usize, patch: NonZeroUsize, per_tile: NonZeroUsize) -> impl Iter
     grid.chain(edge)
 }
 
-impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
-    TileDecoder<'a, PS, PT, PU, PV, B, N>
-{
+impl<'a, S: Shape> TileDecoder<'a, S> {
     /// Checks that the parts of `config` agree with each other and with the patch type.
     ///
     /// # Errors
     /// The first [`ConfigError`] found.
     pub fn new(config: DecoderConfig<'a>) -> Result<Self, ConfigError> {
-        const { PatchShape::<PS, PT, PU, PV, B, N>::CHECK };
         let DecoderConfig { sensor, mask, raw, sl0, .. } = &config;
         if mask.lenslet_size() != sensor.lenslet {
             return Err(ConfigError::LensletMismatch);
         }
-        if PU > sensor.lenslet.rows as usize || PV > sensor.lenslet.cols as usize {
+        if S::PU > sensor.lenslet.rows as usize || S::PV > sensor.lenslet.cols as usize {
             return Err(ConfigError::PatchViews);
         }
-        if mask.bands() != B {
+        if mask.bands() != S::B {
             return Err(ConfigError::BandMismatch);
         }
-        if mask.family() == MaskFamily::Kronecker && mask.kronecker_phi::<PS, PT, PU, PV>(0, 0).is_err() {
+        if mask.family() == MaskFamily::Kronecker && mask.kronecker_phi::<S::S, S::T, S::U, S::V>(0, 0).is_err() {
             return Err(ConfigError::BlockMismatch);
         }
         if !raw.is_valid() {
@@ -242,11 +232,11 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         sl0.validate().map_err(ConfigError::Solver)?;
         Ok(Self {
             config,
-            gains: [1.0; B],
+            gains: <PerBand<S, _>>::splat(1.0),
             disparities: DisparityRange::OFF,
             edge_fallback: true,
             sheared_fallback: false,
-            response: &Response::IDENTITY,
+            response: S::Bands::IDENTITY_REF,
             response_model: ResponseModel::Unmix,
             view_gains: None,
             plausibility: Plausibility::DEFAULT,
@@ -267,15 +257,15 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     ///
     /// # Errors
     /// [`ConfigError::Gains`] for a gain outside `[1 / MAX_RATIO, MAX_RATIO]` ([`crate::sensor::gains::valid`]).
-    pub fn with_gains(self, gains: &[f32; B]) -> Result<Self, ConfigError> {
-        if !crate::sensor::gains::valid(gains) {
+    pub fn with_gains(self, gains: &PerBand<S, f32>) -> Result<Self, ConfigError> {
+        if !crate::sensor::gains::valid(gains.as_ref()) {
             return Err(ConfigError::Gains);
         }
         Ok(Self { gains: *gains, ..self })
     }
 
     /// The band gains the decode uses.
-    pub fn gains(&self) -> &[f32; B] {
+    pub fn gains(&self) -> &PerBand<S, f32> {
         &self.gains
     }
 
@@ -289,7 +279,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     /// # Errors
     /// [`ConfigError::Response`] for [`ResponseModel::Projection`] of a response that mixes
     /// bands on a kronecker mask.
-    pub fn with_response(self, response: &'a Response<B>, model: ResponseModel) -> Result<Self, ConfigError> {
+    pub fn with_response(self, response: &'a Response<S::Bands>, model: ResponseModel) -> Result<Self, ConfigError> {
         let projected = model == ResponseModel::Projection && !response.is_identity();
         if projected && self.config.mask.family() == MaskFamily::Kronecker {
             return Err(ConfigError::Response);
@@ -299,15 +289,15 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     }
 
     /// The response matrix the decode models, and where.
-    pub fn response(&self) -> (&'a Response<B>, ResponseModel) {
+    pub fn response(&self) -> (&'a Response<S::Bands>, ResponseModel) {
         (self.response, self.response_model)
     }
 
     /// The response the solves model: the identity unless [`ResponseModel::Projection`].
-    fn solved_response(&self) -> &'a Response<B> {
+    fn solved_response(&self) -> &'a Response<S::Bands> {
         match self.response_model {
             ResponseModel::Projection => self.response,
-            ResponseModel::Unmix => &Response::IDENTITY,
+            ResponseModel::Unmix => S::Bands::IDENTITY_REF,
         }
     }
 
@@ -443,16 +433,16 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     /// # Errors
     /// The source's error.
     #[inline(never)]
-    pub(super) fn estimate_error<M: PatchModel<PS, PT, PU, PV, B, N>, S: TileSource>(
+    pub(super) fn estimate_error<M: PatchModel<S>, Src: TileSource>(
         &self,
         model: &M,
         hold: &HoldOut,
         origin: PatchOrigin,
-        source: &mut S,
-        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+        source: &mut Src,
+        ws: &mut Workspace<S>,
         full: bool,
-    ) -> Result<(Option<f32>, u16), S::Error> {
-        if !self.solved_response().is_identity() || hold_out::<PS, PT, PU, PV, B, N>(hold, &mut ws.measurements) == 0 {
+    ) -> Result<(Option<f32>, u16), Src::Error> {
+        if !self.solved_response().is_identity() || hold_out::<S>(hold, &mut ws.measurements) == 0 {
             return Ok((None, 0));
         }
         // The model's own decode (a model trial), or its cheapest solve (the estimate).
@@ -465,14 +455,14 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let Ok(solves) = solved else { return Ok((None, 0)) };
         let half = ws.measurements().half_views();
         if !half.is_none() {
-            to_sensor::<PS, PT, PU, PV, B, N>(half, &mut ws.signal);
+            to_sensor::<S>(half, &mut ws.signal);
         }
         // Behind a lenslet grid, the held-out pixels as they measured the decode (the
         // coefficients are not needed after the solve).
         let Workspace { signal, coeffs, measurements, .. } = ws;
-        shares::to_sensor::<PS, PT, PU, PV, B, N>(measurements, signal, coeffs);
+        shares::to_sensor::<S>(measurements, signal, coeffs);
         let cfg = &self.config.sl0;
-        Ok((estimate::<PS, PT, PU, PV, B, N>(hold, ws.measurements(), ws.patch(), cfg.noise, cfg.shot), solves))
+        Ok((estimate::<S>(hold, ws.measurements(), ws.patch(), cfg.noise, cfg.shot), solves))
     }
 
     /// This decoder with each spatial block sheared to the disparity of `range` its
@@ -484,7 +474,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     /// kronecker mask (whose general path is for selections).
     pub fn with_disparities(self, range: DisparityRange) -> Self {
         let halves = range.has_halves()
-            && PS * PT <= MAX_GRID
+            && S::PS * S::PT <= MAX_GRID
             && self.config.mask.family() != MaskFamily::Kronecker
             && self.solved_response().is_identity();
         Self { disparities: range.with_halves(halves), ..self }
@@ -531,10 +521,10 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     }
 
     /// Patch origins of one spatial block: every angular window.
-    pub fn windows(&self) -> impl Iterator<Item = (u8, u8)> + use<'a, PS, PT, PU, PV, B, N> {
+    pub fn windows(&self) -> impl Iterator<Item = (u8, u8)> + use<'a, S> {
         let l = self.config.sensor.lenslet;
-        window_origins(l.rows as usize, PU)
-            .flat_map(move |u| window_origins(l.cols as usize, PV).map(move |v| (u as u8, v as u8)))
+        window_origins(l.rows as usize, S::PU)
+            .flat_map(move |u| window_origins(l.cols as usize, S::PV).map(move |v| (u as u8, v as u8)))
     }
 
     /// The sensor cut into tiles of at most `patches` = (rows, cols) patches each, row by
@@ -542,11 +532,11 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     /// multiple of the patch, one strip of patches aligned to the last lenslet row or
     /// column (overlapping the grid), so every lenslet is covered. Empty if the sensor is
     /// smaller than one patch.
-    pub fn tiles(&self, patches: (u16, u16)) -> impl Iterator<Item = Tile> + use<'a, PS, PT, PU, PV, B, N> {
+    pub fn tiles(&self, patches: (u16, u16)) -> impl Iterator<Item = Tile> + use<'a, S> {
         let (rows, cols) = (self.config.sensor.lenslets.0 as usize, self.config.sensor.lenslets.1 as usize);
         let nonzero = |n: usize| NonZeroUsize::new(n).unwrap_or(NonZeroUsize::MIN);
         let per = (nonzero(patches.0 as usize), nonzero(patches.1 as usize));
-        let (ps, pt) = (nonzero(PS), nonzero(PT));
+        let (ps, pt) = (nonzero(S::PS), nonzero(S::PT));
         spans(rows, ps, per.0).flat_map(move |(r0, nr)| {
             spans(cols, pt, per.1).map(move |(c0, nc)| Tile {
                 lenslet_row: r0 as u16,
@@ -561,8 +551,8 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         let (rows, cols) = self.config.sensor.lenslets;
         tile.lenslet_rows > 0
             && tile.lenslet_cols > 0
-            && (tile.lenslet_rows as usize).is_multiple_of(PS)
-            && (tile.lenslet_cols as usize).is_multiple_of(PT)
+            && (tile.lenslet_rows as usize).is_multiple_of(S::PS)
+            && (tile.lenslet_cols as usize).is_multiple_of(S::PT)
             && tile.lenslet_row as u32 + tile.lenslet_rows as u32 <= rows as u32
             && tile.lenslet_col as u32 + tile.lenslet_cols as u32 <= cols as u32
     }
@@ -573,14 +563,14 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     /// # Errors
     /// [`TileError::Geometry`] before anything is read; [`TileError::Source`] or
     /// [`TileError::Sink`] abandon the rest of the tile (what was sent stays sent).
-    pub fn decode_tile<M: PatchModel<PS, PT, PU, PV, B, N>, S: TileSource, K: PatchSink<N>>(
+    pub fn decode_tile<M: PatchModel<S>, Src: TileSource, K: PatchSink<S>>(
         &self,
         model: &M,
         tile: Tile,
-        source: &mut S,
+        source: &mut Src,
         sink: &mut K,
-        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
-    ) -> Result<TileReport, TileError<S::Error, K::Error>> {
+        ws: &mut Workspace<S>,
+    ) -> Result<TileReport, TileError<Src::Error, K::Error>> {
         self.decode_tile_seeded(model, tile, source, &mut NoSeed, sink, ws)
     }
 
@@ -590,27 +580,22 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     ///
     /// # Errors
     /// As [`decode_tile`](Self::decode_tile).
-    pub fn decode_tile_seeded<
-        M: PatchModel<PS, PT, PU, PV, B, N>,
-        S: TileSource,
-        Q: PatchSeed<N> + ?Sized,
-        K: PatchSink<N>,
-    >(
+    pub fn decode_tile_seeded<M: PatchModel<S>, Src: TileSource, Q: PatchSeed<S> + ?Sized, K: PatchSink<S>>(
         &self,
         model: &M,
         tile: Tile,
-        source: &mut S,
+        source: &mut Src,
         seed: &mut Q,
         sink: &mut K,
-        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
-    ) -> Result<TileReport, TileError<S::Error, K::Error>> {
+        ws: &mut Workspace<S>,
+    ) -> Result<TileReport, TileError<Src::Error, K::Error>> {
         if !self.check_tile(&tile) {
             return Err(TileError::Geometry);
         }
         let mut report = TileReport::default();
-        for bs in 0..tile.lenslet_rows as usize / PS {
-            for bt in 0..tile.lenslet_cols as usize / PT {
-                let (row, col) = (tile.lenslet_row + (bs * PS) as u16, tile.lenslet_col + (bt * PT) as u16);
+        for bs in 0..tile.lenslet_rows as usize / S::PS {
+            for bt in 0..tile.lenslet_cols as usize / S::PT {
+                let (row, col) = (tile.lenslet_row + (bs * S::PS) as u16, tile.lenslet_col + (bt * S::PT) as u16);
                 let mut disparity =
                     self.choose_disparity(row as usize, col as usize, source).map_err(TileError::Source)?;
                 if self.shear_check && !disparity.is_whole() {
@@ -648,21 +633,21 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     /// Reads, decodes and sends the patch at `origin` (a fallback: see
     /// [`PatchReport::fallback`]), counting it in `report`.
     #[allow(clippy::too_many_arguments)]
-    fn decode_patch<M: PatchModel<PS, PT, PU, PV, B, N>, S: TileSource, Q: PatchSeed<N> + ?Sized, K: PatchSink<N>>(
+    fn decode_patch<M: PatchModel<S>, Src: TileSource, Q: PatchSeed<S> + ?Sized, K: PatchSink<S>>(
         &self,
         model: &M,
         origin: PatchOrigin,
         fallback: bool,
-        source: &mut S,
+        source: &mut Src,
         seed: &mut Q,
         sink: &mut K,
-        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
+        ws: &mut Workspace<S>,
         report: &mut TileReport,
-    ) -> Result<(), TileError<S::Error, K::Error>> {
+    ) -> Result<(), TileError<Src::Error, K::Error>> {
         let (lo, hi) = self.config.raw.range();
         let (flags, excluded) = self.read_patch(origin, source, ws).map_err(TileError::Source)?;
         let cfg = &self.config.sl0;
-        let bands = bands_measured::<B, N>(ws.measurements());
+        let bands = bands_measured::<S>(ws.measurements());
         let (error, estimating) = match &self.holdout {
             Some(hold) if bands >= u32::from(cfg.min_bands) => {
                 self.estimate_error(model, hold, origin, source, ws, false).map_err(TileError::Source)?
@@ -672,19 +657,19 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
         // No band at all is no measurement: the model reports it.
         let decoded = if bands > 0 && bands < u32::from(cfg.min_bands) {
             let Workspace { signal, measurements, .. } = ws;
-            interpolate_bands::<B, N>(measurements, signal);
+            interpolate_bands::<S>(measurements, signal);
             // Each pixel's interpolated bands are as its filters saw them: `R x`.
-            unmix_all(&self.solved_response().balanced(&self.gains), signal);
+            unmix_all::<S>(&self.solved_response().balanced(self.gains.as_ref()), signal);
             Ok(ModelOutcome { outcome: Outcome::interpolated(), member: None, solves: 0 })
         } else if seed.seed(origin, &mut ws.signal) && ws.signal.iter().all(|x| x.is_finite()) {
             // (A seed with a NaN or an infinity is no estimate: the patch decodes from nothing.)
             let half = ws.measurements().half_views();
             if self.response_model == ResponseModel::Unmix {
                 // The seed is decoded light; the solve decodes it as the filters saw it.
-                mix_all(self.response, &mut ws.signal);
+                mix_all::<S>(self.response, &mut ws.signal);
             }
             if !half.is_none() {
-                from_sensor::<PS, PT, PU, PV, B, N>(half, &mut ws.signal);
+                from_sensor::<S>(half, &mut ws.signal);
             }
             ws.balance_patch(&self.gains);
             model.decode_seeded(cfg, ws)
@@ -696,12 +681,12 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                 let checked = self.check_plausible(cfg, flags, ws, &mut done);
                 let half = ws.measurements().half_views();
                 if !half.is_none() {
-                    to_sensor::<PS, PT, PU, PV, B, N>(half, &mut ws.signal);
+                    to_sensor::<S>(half, &mut ws.signal);
                 }
                 ws.unbalance_patch(&self.gains);
                 if self.response_model == ResponseModel::Unmix {
                     // Each decoded spectrum is as the filters saw it: `x = R^-1 z`.
-                    unmix_all(self.response, &mut ws.signal);
+                    unmix_all::<S>(self.response, &mut ws.signal);
                 }
                 ws.clamp_patch(lo, hi);
                 let r = PatchReport {
@@ -742,14 +727,14 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
 
     /// Decodes every tile of the sensor (see [`tiles`](Self::tiles)); a tile that fails
     /// is counted and the next one is decoded.
-    pub fn decode_frame<M: PatchModel<PS, PT, PU, PV, B, N>, S: TileSource, K: PatchSink<N>>(
+    pub fn decode_frame<M: PatchModel<S>, Src: TileSource, K: PatchSink<S>>(
         &self,
         model: &M,
         tile_patches: (u16, u16),
-        source: &mut S,
+        source: &mut Src,
         sink: &mut K,
-        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
-    ) -> FrameReport<S::Error, K::Error> {
+        ws: &mut Workspace<S>,
+    ) -> FrameReport<Src::Error, K::Error> {
         let mut frame = FrameReport { patches: TileReport::default(), tiles: 0, failed_tiles: 0, first_failure: None };
         for tile in self.tiles(tile_patches) {
             frame.tiles += 1;

@@ -2,10 +2,10 @@
 //! in the view cells of a turned grid), and the white balance estimated from the frame.
 
 use super::*;
+use crate::operators::shape::{PerBand, Shape};
+use crate::sensor::extent::{Array, Bands, Per};
 
-impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B: usize, const N: usize>
-    TileDecoder<'a, PS, PT, PU, PV, B, N>
-{
+impl<'a, S: Shape> TileDecoder<'a, S> {
     /// Grey-world band gains of a frame: every valid sample of the sensor (defects and
     /// invalid samples left out) summed per band ([`crate::sensor::gains::gains_from_sums`]).
     /// Reads the frame once, one sensor row at a time in runs of up to 16 samples per
@@ -13,19 +13,19 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     ///
     /// # Errors
     /// The source's error; nothing is estimated then.
-    pub fn estimate_gains<S: TileSource>(&self, source: &mut S) -> Result<[f32; B], S::Error> {
+    pub fn estimate_gains<Src: TileSource>(&self, source: &mut Src) -> Result<PerBand<S, f32>, Src::Error> {
         const RUN: usize = 16;
         let c = &self.config;
         let (rows, cols) = self.frame_size();
         let k = c.mask.snapshots();
-        let mut sums = [0.0f32; B];
-        let mut counts = [0u32; B];
+        let mut sums = <PerBand<S, _>>::splat(0.0f32);
+        let mut counts = <PerBand<S, _>>::splat(0u32);
         // A pixel measures at most `B` distinct bands, so `k <= B` (checked by the mask).
-        let mut runs = [[0.0f32; RUN]; B];
+        let mut runs = <PerBand<S, [f32; RUN]>>::splat([0.0; RUN]);
         for row in 0..rows {
             // Per row in f32, then added to the totals: a frame's sum in one f32 would lose
             // the small bands' low digits.
-            let mut row_sums = [0.0f32; B];
+            let mut row_sums = <PerBand<S, _>>::splat(0.0f32);
             for col0 in (0..cols).step_by(RUN) {
                 let len = RUN.min(cols - col0);
                 for (j, run) in runs.iter_mut().enumerate().take(k) {
@@ -38,7 +38,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                         continue;
                     }
                     // One band list per pixel, every snapshot's sample against it.
-                    for (band, run) in c.mask.bands_at(row, col).iter().zip(&runs) {
+                    for (band, run) in c.mask.bands_at(row, col).iter().zip(runs.iter()) {
                         let Ok(y) = c.raw.classify(run.get(dc).copied().unwrap_or(f32::NAN)) else { continue };
                         let y = y / self.view_gain(row, col);
                         if let (Some(s), Some(n)) = (row_sums.get_mut(*band as usize), counts.get_mut(*band as usize)) {
@@ -48,7 +48,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                     }
                 }
             }
-            for (t, r) in sums.iter_mut().zip(&row_sums) {
+            for (t, r) in sums.iter_mut().zip(row_sums.iter()) {
                 *t += r;
             }
         }
@@ -57,8 +57,8 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             // spectrum (leaked light from a bright band would otherwise inflate a dark
             // band's gain and tilt the balanced spectra: measured on the office scene at 10 %
             // leakage, 2.6 dB lost with the DCT).
-            let (mut means, mut ones) = ([0.0f32; B], [0u32; B]);
-            for (((m, o), &s), &n) in means.iter_mut().zip(&mut ones).zip(&sums).zip(&counts) {
+            let (mut means, mut ones) = (<PerBand<S, _>>::splat(0.0f32), <PerBand<S, _>>::splat(0u32));
+            for (((m, o), &s), &n) in means.iter_mut().zip(ones.iter_mut()).zip(sums.iter()).zip(counts.iter()) {
                 (*m, *o) = (s / n.max(1) as f32, u32::from(n > 0));
             }
             self.response.unmix(&mut means);
@@ -76,24 +76,24 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     ///
     /// # Errors
     /// The source's error.
-    pub fn read_patch<S: TileSource>(
+    pub fn read_patch<Src: TileSource>(
         &self,
         origin: PatchOrigin,
-        source: &mut S,
-        ws: &mut Workspace<PS, PT, PU, PV, B, N>,
-    ) -> Result<(PatchFlags, u16), S::Error> {
+        source: &mut Src,
+        ws: &mut Workspace<S>,
+    ) -> Result<(PatchFlags, u16), Src::Error> {
         let c = &self.config;
         let (lu, lv) = (c.sensor.lenslet.rows as usize, c.sensor.lenslet.cols as usize);
         let k = c.mask.snapshots();
         let m = ws.measurements_mut();
         m.clear();
         // Checked within [1/64, 64] by `with_gains`; `B <= MAX_BANDS` by `PatchShape`.
-        let _ = m.set_gains(&self.gains);
+        let _ = m.set_gains(self.gains.as_ref());
         ws.set_response(self.solved_response());
         let m = ws.measurements_mut();
         let mut flags = PatchFlags::default();
         let mut excluded = 0u16;
-        let mut run = [[0.0f32; PV]; B];
+        let mut run = <PerBand<S, Per<S::V, f32>>>::splat(S::V::ZEROS);
         let half = HalfViews::of(origin.disparity, (origin.view_row as usize, origin.view_col as usize), (lu, lv));
         m.set_half_views(half);
         // Behind a lenslet grid each pixel is the shares of the cells it covers; with a
@@ -103,18 +103,18 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
             let _ = m.set_shares(None);
         }
         let shared = m.shares().is_some();
-        for s in 0..PS {
-            for u in 0..PU {
-                for t in 0..PT {
+        for s in 0..S::PS {
+            for u in 0..S::PU {
+                for t in 0..S::PT {
                     if origin.disparity == Disparity::ZERO && self.grid.is_none() {
                         // One run of the lenslet's view row per snapshot.
                         let row = (origin.lenslet_row as usize + s) * lu + origin.view_row as usize + u;
                         let col0 = (origin.lenslet_col as usize + t) * lv + origin.view_col as usize;
                         for (j, r) in run.iter_mut().enumerate().take(k) {
-                            source.read(j, row, col0, r)?;
+                            source.read(j, row, col0, r.as_mut())?;
                         }
-                        for v in 0..PV {
-                            let at = PatchShape::<PS, PT, PU, PV, B, N>::pixel_index(s, t, u, v);
+                        for v in 0..S::PV {
+                            let at = S::pixel_index(s, t, u, v);
                             self.put_pixel(
                                 m,
                                 at,
@@ -126,19 +126,19 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
                             );
                         }
                     } else {
-                        for v in 0..PV {
+                        for v in 0..S::PV {
                             let (vr, vc) = (origin.view_row as usize + u, origin.view_col as usize + v);
-                            let Some(lenslet) = origin.lenslet::<PS, PT>(s, t, u, v, (lu, lv)) else { continue };
+                            let Some(lenslet) = origin.lenslet::<S>(s, t, u, v, (lu, lv)) else { continue };
                             let Some((row, col)) = self.sensor_pixel(lenslet, vr, vc) else { continue };
-                            let at = PatchShape::<PS, PT, PU, PV, B, N>::pixel_index(s, t, u, v);
+                            let at = S::pixel_index(s, t, u, v);
                             if shared {
                                 // The pixel's place in its cell; a pixel whose centre lies
                                 // in another cell is that cell's measurement, not this one's.
                                 let Some(place) = self.place_in_cell(lenslet, (vr, vc), (row, col)) else { continue };
-                                let _ = m.set_place(at / B, place);
+                                let _ = m.set_place(at / S::B, place);
                             }
                             for (j, r) in run.iter_mut().enumerate().take(k) {
-                                source.read(j, row, col, &mut r[..1])?;
+                                source.read(j, row, col, &mut r.as_mut()[..1])?;
                             }
                             self.put_pixel(m, at, row, col, |j| run.get(j).map(|r| r[0]), &mut flags, &mut excluded);
                         }
@@ -155,17 +155,17 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     /// (neither projection is built with shares).
     pub(super) fn cell_shares(&self, origin: PatchOrigin, half: HalfViews) -> Option<CellShares> {
         let g = self.grid.as_ref().filter(|g| !g.is_aligned())?;
-        let fits = PU <= MAX_SHARE_VIEWS && PV <= MAX_SHARE_VIEWS && PS * PT * PU * PV <= MAX_PLACES;
+        let fits = S::PU <= MAX_SHARE_VIEWS && S::PV <= MAX_SHARE_VIEWS && S::PS * S::PT * S::PU * S::PV <= MAX_PLACES;
         if !half.is_none() || !self.solved_response().is_identity() || !fits {
             return None;
         }
         let (lu, lv) = (usize::from(self.config.sensor.lenslet.rows), usize::from(self.config.sensor.lenslet.cols));
         let mut shares = CellShares::unsheared(g.pixel_width());
         let d = origin.disparity;
-        for (u, o) in shares.shift.0.iter_mut().enumerate().take(PU) {
+        for (u, o) in shares.shift.0.iter_mut().enumerate().take(S::PU) {
             *o = i8::try_from(shift(d, origin.view_row as usize + u, lu)).ok()?;
         }
-        for (v, o) in shares.shift.1.iter_mut().enumerate().take(PV) {
+        for (v, o) in shares.shift.1.iter_mut().enumerate().take(S::PV) {
             *o = i8::try_from(shift(d, origin.view_col as usize + v, lv)).ok()?;
         }
         Some(shares)
@@ -265,7 +265,7 @@ impl<'a, const PS: usize, const PT: usize, const PU: usize, const PV: usize, con
     #[allow(clippy::too_many_arguments)]
     pub(super) fn put_pixel(
         &self,
-        m: &mut crate::solver::workspace::Measurements<N>,
+        m: &mut crate::solver::workspace::Measurements<S::Values>,
         at: usize,
         row: usize,
         col: usize,

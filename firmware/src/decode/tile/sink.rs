@@ -2,21 +2,27 @@
 
 use core::fmt;
 
+use crate::operators::shape::{PerValue, Shape};
 use crate::solver::sl0::SolveError;
 
 use super::PatchOrigin;
 use super::report::PatchReport;
 
 /// Where decoded patches go.
-pub trait PatchSink<const N: usize> {
+pub trait PatchSink<S: Shape> {
     /// A write failure. `Copy`, to travel in errors.
     type Error: Copy + fmt::Debug;
 
-    /// A decoded patch (layout of [`PatchShape::index`](crate::operators::shape::PatchShape::index)) at `origin`, with its report.
+    /// A decoded patch (layout of [`Shape::index`]) at `origin`, with its report.
     ///
     /// # Errors
     /// The sink's own error; the decoder then abandons the current tile.
-    fn accept(&mut self, origin: PatchOrigin, patch: &[f32; N], report: &PatchReport) -> Result<(), Self::Error>;
+    fn accept(
+        &mut self,
+        origin: PatchOrigin,
+        patch: &PerValue<S, f32>,
+        report: &PatchReport,
+    ) -> Result<(), Self::Error>;
 
     /// A patch that could not be decoded; the decoder goes on with the next one.
     ///
@@ -32,21 +38,21 @@ pub trait PatchSink<const N: usize> {
 /// estimate of a patch from its overlapping neighbours' decode (on the host, the disjoint
 /// grid's averaged decode of the frame; the device's strip does not seed, see
 /// `docs/bench/README.md`).
-pub trait PatchSeed<const N: usize> {
+pub trait PatchSeed<S: Shape> {
     /// Writes the estimate of the patch at `origin` into `patch`, in the layout a
     /// [`PatchSink`] receives (sensor units, each value at the pixel
     /// [`PatchOrigin::lenslet`] names; a value it names none of is not read); `false` if
     /// there is none. A patch without an estimate, or with a NaN or an infinity in it, is
     /// decoded from nothing.
-    fn seed(&mut self, origin: PatchOrigin, patch: &mut [f32; N]) -> bool;
+    fn seed(&mut self, origin: PatchOrigin, patch: &mut PerValue<S, f32>) -> bool;
 }
 
 /// No estimate anywhere: every patch decodes from nothing.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct NoSeed;
 
-impl<const N: usize> PatchSeed<N> for NoSeed {
-    fn seed(&mut self, _: PatchOrigin, _: &mut [f32; N]) -> bool {
+impl<S: Shape> PatchSeed<S> for NoSeed {
+    fn seed(&mut self, _: PatchOrigin, _: &mut PerValue<S, f32>) -> bool {
         false
     }
 }

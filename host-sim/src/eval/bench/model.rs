@@ -5,19 +5,19 @@ use anyhow::Result;
 use slf_firmware::{Dictionary, Ended, ModelOutcome, Outcome, PatchModel, Sl0Config, SolveError};
 
 use crate::decode::paper_1d::{Factors, analyze_5d, solve_5d, solve_5d_seeded};
-use crate::io::patch::{BANDS, HostDictionary, HostWorkspace, LENSLETS};
+use crate::io::patch::{BANDS, HostDictionary, HostShape, HostWorkspace, LENSLETS};
 
 /// The f64 reference: SL0 with the DCT in f64 (the host's 5D reference), written back
 /// through the workspace so it runs in the same tile pipeline as the f32 decoder; for
 /// `5 x 5 x PU x PV x 13` patches.
-pub struct F64Dct<const PU: usize, const PV: usize> {
+pub struct F64Dct<const PU: usize, const PV: usize, const N: usize> {
     factors: Factors<f64>,
     /// The f32 DCT tables widened to f64, for writing the result back through them.
     widened: Factors<f64>,
-    dict: HostDictionary<PU, PV>,
+    dict: HostDictionary<PU, PV, N>,
 }
 
-impl<const PU: usize, const PV: usize> Default for F64Dct<PU, PV> {
+impl<const PU: usize, const PV: usize, const N: usize> Default for F64Dct<PU, PV, N> {
     fn default() -> Self {
         let dict = Dictionary::dct();
         Self {
@@ -28,9 +28,7 @@ impl<const PU: usize, const PV: usize> Default for F64Dct<PU, PV> {
     }
 }
 
-impl<const PU: usize, const PV: usize, const N: usize> PatchModel<LENSLETS, LENSLETS, PU, PV, BANDS, N>
-    for F64Dct<PU, PV>
-{
+impl<const PU: usize, const PV: usize, const N: usize> PatchModel<HostShape<PU, PV, N>> for F64Dct<PU, PV, N> {
     fn decode(&self, cfg: &Sl0Config, ws: &mut HostWorkspace<PU, PV, N>) -> Result<ModelOutcome, SolveError> {
         cfg.validate()?;
         let m = ws.measurements();
@@ -55,16 +53,11 @@ impl<const PU: usize, const PV: usize, const N: usize> PatchModel<LENSLETS, LENS
     }
 }
 
-impl<const PU: usize, const PV: usize> F64Dct<PU, PV> {
+impl<const PU: usize, const PV: usize, const N: usize> F64Dct<PU, PV, N> {
     /// Writes the f64 patch `x` back: its DCT coefficients (f64 analysis with the f32
     /// tables), then one f32 synthesis (rounding ~1e-7, far below the f32-vs-f64
     /// differences).
-    fn write_back<const N: usize>(
-        &self,
-        x: &[f64],
-        iterations: u32,
-        ws: &mut HostWorkspace<PU, PV, N>,
-    ) -> ModelOutcome {
+    fn write_back(&self, x: &[f64], iterations: u32, ws: &mut HostWorkspace<PU, PV, N>) -> ModelOutcome {
         let s = analyze_5d(&self.widened, x);
         for (dst, v) in ws.coefficients_mut().iter_mut().zip(&s) {
             *dst = *v as f32;

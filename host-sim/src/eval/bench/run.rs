@@ -197,8 +197,8 @@ fn run_decoder(
     match dec {
         Decoder::Basis(b) => decode_with(capture, b, opts),
         Decoder::F64 => match opts.patch_views_for(capture, &Basis::Dct)? {
-            PatchViews::Four => decode::<4, 4, 5200, _>(capture, &F64Dct::<4, 4>::default(), opts),
-            PatchViews::Five => decode::<5, 5, 8125, _>(capture, &F64Dct::<5, 5>::default(), opts),
+            PatchViews::Four => decode::<4, 4, 5200, _>(capture, &F64Dct::<4, 4, 5200>::default(), opts),
+            PatchViews::Five => decode::<5, 5, 8125, _>(capture, &F64Dct::<5, 5, 8125>::default(), opts),
         },
         Decoder::Baseline(m) => {
             let (lf, _) = m.run(capture)?;
