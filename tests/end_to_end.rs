@@ -25,6 +25,7 @@ use slf_host::eval::metrics::evaluate;
 use slf_host::firmware::MaskFamily;
 use slf_host::io::capture::{Capture, MaskDescription};
 use slf_host::sim::camera::{CameraConfig, simulate};
+use slf_host::sim::flags::FromFlags;
 use slf_host::sim::scene::{self, SceneSize};
 
 fn mask(family: &str, k: u8) -> MaskDescription {

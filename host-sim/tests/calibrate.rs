@@ -10,6 +10,7 @@ use slf_host::io::capture::{Capture, Light};
 use slf_host::io::sensor::{FilterDescription, SensorDescription};
 use slf_host::sim::calibration::calibration_captures;
 use slf_host::sim::camera::CameraConfig;
+use slf_host::sim::flags::FromFlags;
 use slf_host::sim::sensor::{Sensor, response};
 use slf_host::sim::spectra::BAND_NM;
 

@@ -11,6 +11,7 @@
 //!
 //!     SLF_FUZZ_CASES=20000 cargo test --release --test fuzz -- --nocapture
 
+use slf_host::sim::flags::FromFlags;
 use std::sync::atomic::{AtomicU32, Ordering};
 
 use proptest::prelude::*;

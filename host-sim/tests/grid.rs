@@ -11,6 +11,7 @@ use slf_host::io::capture::VERSION_SENSOR;
 use slf_host::io::lightfield::LightField;
 use slf_host::io::sensor::SensorDescription;
 use slf_host::sim::camera::{CameraConfig, GridSettings, simulate};
+use slf_host::sim::flags::FromFlags;
 
 const LENSLETS: [usize; 2] = [6, 7];
 const VIEWS: usize = 5;

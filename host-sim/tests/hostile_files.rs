@@ -4,6 +4,7 @@
 //! `.npy` files are written byte by byte here (no numpy needed), so each case is exactly the
 //! file named in the test.
 
+use slf_host::sim::flags::FromFlags;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc;

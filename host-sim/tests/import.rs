@@ -1,6 +1,7 @@
 //! `slf import`: band resampling, the RGB lift, views, cubes and disparity maps, each on
 //! fixtures the tests write themselves and checked against values worked by hand.
 
+use slf_host::sim::flags::FromFlags;
 use std::path::Path;
 
 use image::{ImageBuffer, Luma, Rgb};

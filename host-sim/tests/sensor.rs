@@ -7,6 +7,7 @@ use slf_host::io::capture::{Capture, VERSION, VERSION_SENSOR};
 use slf_host::io::lightfield::LightField;
 use slf_host::io::sensor::{FilterDescription, SensorDescription};
 use slf_host::sim::camera::{CameraConfig, simulate};
+use slf_host::sim::flags::FromFlags;
 use slf_host::sim::sensor::{Sensor, response, vignette};
 use slf_host::sim::settings::SimulateSettings;
 use slf_host::sim::spectra::BAND_NM;

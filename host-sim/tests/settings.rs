@@ -5,6 +5,7 @@ use slf_firmware::{DisparityRange, Sl0Config};
 use slf_host::decode::cs::{Balance, Basis, DecodeOptions, NoiseSource};
 use slf_host::decode::preset::Preset;
 use slf_host::decode::settings::DecodeSettings;
+use slf_host::sim::flags::FromFlags;
 
 fn resolved(flags: &[&str]) -> (Basis, DecodeOptions) {
     DecodeSettings::from_flags(flags).and_then(|s| s.resolve().map_err(|e| e.to_string())).unwrap()

@@ -7,6 +7,7 @@ use slf_host::firmware::DisparityRange;
 use slf_host::io::capture::Capture;
 use slf_host::io::lightfield::LightField;
 use slf_host::sim::camera::{CameraConfig, simulate};
+use slf_host::sim::flags::FromFlags;
 use slf_host::sim::scene::{SceneSize, named};
 
 /// The depth scene (its blocks sheared, so tiles reach past their rows) at `rows x 16`

@@ -1,6 +1,7 @@
 //! The decode: `slf decode`'s flags ([`DecodeSettings`]) on a capture held in numpy, with
 //! the GIL released, on a thread pool of the caller's size, and a progress callback.
 
+use slf_host::sim::flags::FromFlags;
 use std::sync::Mutex;
 
 use numpy::{PyArrayDyn, PyReadonlyArrayDyn};

@@ -4,6 +4,7 @@
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
 use slf_host::io::import::views::Imported;
+use slf_host::sim::flags::FromFlags;
 use slf_host::sim::import::{CubeSettings, ViewsSettings};
 
 use crate::arrays::{plane, to_array};

@@ -4,6 +4,7 @@
 use numpy::{PyArrayDyn, PyReadonlyArrayDyn};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use slf_host::sim::flags::FromFlags;
 use slf_host::sim::scene::SceneSize;
 use slf_host::sim::settings::SimulateSettings;
 

@@ -262,29 +262,47 @@ fn cholesky<const L: usize>(at: &[u8], r: &mut [f32; MAX_GRID], (hs, ht): (usize
 /// half axis, position `s` becomes the mean of `s` and `s + 1`, the value the pixel it
 /// read measured (the last position keeps its value; it names no pixel). In place.
 pub fn to_sensor<S: Shape>(half: crate::operators::disparity::HalfViews, patch: &mut PerValue<S, f32>) {
-    let index = S::index;
+    each_half_line::<S>(half, |line| {
+        for i in 0..line.len.saturating_sub(1) {
+            let next = patch.get(line.at(i + 1)).copied().unwrap_or(0.0);
+            if let Some(x) = patch.get_mut(line.at(i)) {
+                *x = 0.5 * (*x + next);
+            }
+        }
+    });
+}
+
+/// One line of a patch along a half axis: `len` positions, position `i` at `at(i)`.
+#[derive(Clone, Copy)]
+struct Line {
+    start: usize,
+    stride: usize,
+    len: usize,
+}
+
+impl Line {
+    /// The patch index of position `i` ([`Shape::index`] along the line).
+    fn at(self, i: usize) -> usize {
+        self.start + i * self.stride
+    }
+}
+
+/// Every line of the patch along a half axis, in one order for [`to_sensor`] and
+/// [`from_sensor`]: for each view `(u, v)` and band, the lines along `s` (one for each `t`)
+/// where the view's rows are half, then those along `t` where its columns are.
+fn each_half_line<S: Shape>(half: crate::operators::disparity::HalfViews, mut f: impl FnMut(Line)) {
     for u in 0..S::PU {
         for v in 0..S::PV {
             let (hs, ht) = (half.row(u), half.col(v));
             for b in 0..S::B {
                 if hs {
                     for t in 0..S::PT {
-                        for s in 0..S::PS - 1 {
-                            let next = patch.get(index(s + 1, t, u, v, b)).copied().unwrap_or(0.0);
-                            if let Some(x) = patch.get_mut(index(s, t, u, v, b)) {
-                                *x = 0.5 * (*x + next);
-                            }
-                        }
+                        f(Line { start: S::index(0, t, u, v, b), stride: S::index(1, 0, 0, 0, 0), len: S::PS });
                     }
                 }
                 if ht {
                     for s in 0..S::PS {
-                        for t in 0..S::PT - 1 {
-                            let next = patch.get(index(s, t + 1, u, v, b)).copied().unwrap_or(0.0);
-                            if let Some(x) = patch.get_mut(index(s, t, u, v, b)) {
-                                *x = 0.5 * (*x + next);
-                            }
-                        }
+                        f(Line { start: S::index(s, 0, u, v, b), stride: S::index(0, 1, 0, 0, 0), len: S::PT });
                     }
                 }
             }
@@ -298,24 +316,7 @@ pub fn to_sensor<S: Shape>(half: crate::operators::disparity::HalfViews, patch: 
 /// between pixels `s - 1` and `s` becomes their mean, and the end positions their one
 /// neighbour: linear interpolation, exact for a patch linear along the axis. In place.
 pub fn from_sensor<S: Shape>(half: crate::operators::disparity::HalfViews, patch: &mut PerValue<S, f32>) {
-    let index = S::index;
-    for u in 0..S::PU {
-        for v in 0..S::PV {
-            let (hs, ht) = (half.row(u), half.col(v));
-            for b in 0..S::B {
-                if hs {
-                    for t in 0..S::PT {
-                        back_along::<S>(patch, S::PS, |s| index(s, t, u, v, b));
-                    }
-                }
-                if ht {
-                    for s in 0..S::PS {
-                        back_along::<S>(patch, S::PT, |t| index(s, t, u, v, b));
-                    }
-                }
-            }
-        }
-    }
+    each_half_line::<S>(half, |line| back_along::<S>(patch, line.len, |i| line.at(i)));
 }
 
 /// [`from_sensor`] along one half axis of `len` positions, position `i` at `at(i)`: from

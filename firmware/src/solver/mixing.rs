@@ -153,6 +153,43 @@ impl<C: Bands> BandModel<C> {
             }
         }
     }
+
+    /// One pixel's residuals under `rows` (`R` for a spectrum `x`, `R D5` for its band
+    /// coefficients), with their filters.
+    fn pixel(rows: &Square<C, f32>, x: &C::Per<f32>, ys: &[f32], measured: &[bool]) -> PixelResiduals<C> {
+        let (mut filters, mut res) = (C::Per::<u8>::splat(0), C::Per::<f32>::splat(0.0));
+        let k = Self::residuals(rows, x, ys, band_bits(measured), &mut filters, &mut res);
+        PixelResiduals { filters, res, k }
+    }
+
+    /// `x += scale R_F^T (R_F R_F^T)^-1 r` for a pixel's residuals `r` under `rows`.
+    fn correct(&self, rows: &Square<C, f32>, x: &mut C::Per<f32>, p: &mut PixelResiduals<C>, scale: f32) {
+        let (Some(filters), Some(res)) = (p.filters.get(..p.k), p.res.get_mut(..p.k)) else { return };
+        self.solve(filters, res);
+        Self::add_rows(rows, x, filters, res, scale);
+    }
+}
+
+/// One pixel's residuals `y - rows_F x` in filter order ([`BandModel::pixel`]).
+struct PixelResiduals<C: Bands> {
+    filters: C::Per<u8>,
+    res: C::Per<f32>,
+    k: usize,
+}
+
+impl<C: Bands> PixelResiduals<C> {
+    /// Adds the residuals' squares to `r2`, and (a weighted `ball`) each over its
+    /// measurement's variance ([`Ball::weight`] of its value in `ys` and its band's gain) to
+    /// `w2`, in filter order.
+    fn add_squares(&self, ys: &[f32], gains: &[f32], ball: &Ball, (r2, w2): (&mut f32, &mut f32)) {
+        for (&f, &r) in self.filters.iter().zip(self.res.iter()).take(self.k) {
+            *r2 += r * r;
+            if ball.is_weighted() {
+                let f = usize::from(f);
+                *w2 += r * r * ball.weight(ys.get(f).copied().unwrap_or(0.0), gains.get(f).copied().unwrap_or(1.0));
+            }
+        }
+    }
 }
 
 /// The minimum-norm start in signal space: each pixel `R_F^T (R_F R_F^T)^-1 y`, zero where
@@ -161,18 +198,8 @@ pub fn min_norm<S: Shape>(model: &BandModel<S::Bands>, m: &Measurements<S::Value
     let pixels = S::Bands::chunks_mut(signal.as_mut()).iter_mut().zip(S::Bands::chunks(m.values.as_ref()));
     for ((x, ys), measured) in pixels.zip(S::Bands::chunks(m.measured.as_ref())) {
         *x = <PerBand<S, _>>::splat(0.0);
-        let (mut filters, mut res) = (<PerBand<S, _>>::splat(0u8), <PerBand<S, _>>::splat(0.0f32));
-        let k = BandModel::<S::Bands>::residuals(
-            &model.r,
-            x,
-            ys.as_ref(),
-            band_bits(measured.as_ref()),
-            &mut filters,
-            &mut res,
-        );
-        let (Some(filters), Some(res)) = (filters.get(..k), res.get_mut(..k)) else { continue };
-        model.solve(filters, res);
-        BandModel::<S::Bands>::add_rows(&model.r, x, filters, res, 1.0);
+        let mut p = BandModel::<S::Bands>::pixel(&model.r, x, ys.as_ref(), measured.as_ref());
+        model.correct(&model.r, x, &mut p, 1.0);
     }
 }
 
@@ -202,7 +229,6 @@ pub fn project_signal<S: Shape>(
     ball: &Ball,
 ) -> f32 {
     let (mut r2, mut w2) = (0.0f32, 0.0f32);
-    let weighted = ball.is_weighted();
     let pixels = || {
         S::Bands::chunks(x.as_ref())
             .iter()
@@ -210,22 +236,8 @@ pub fn project_signal<S: Shape>(
             .zip(S::Bands::chunks(m.measured.as_ref()))
     };
     for ((x, ys), measured) in pixels() {
-        let (mut filters, mut res) = (<PerBand<S, _>>::splat(0u8), <PerBand<S, _>>::splat(0.0f32));
-        let k = BandModel::<S::Bands>::residuals(
-            &model.r,
-            x,
-            ys.as_ref(),
-            band_bits(measured.as_ref()),
-            &mut filters,
-            &mut res,
-        );
-        for (&f, &r) in filters.iter().zip(res.iter()).take(k) {
-            r2 += r * r;
-            if weighted {
-                let f = usize::from(f);
-                w2 += r * r * ball.weight(ys.get(f).copied().unwrap_or(0.0), m.gains.get(f).copied().unwrap_or(1.0));
-            }
-        }
+        let p = BandModel::<S::Bands>::pixel(&model.r, x, ys.as_ref(), measured.as_ref());
+        p.add_squares(ys.as_ref(), m.gains.as_ref(), ball, (&mut r2, &mut w2));
     }
     let scale = match ball.move_for(r2, w2) {
         Move::Scale(scale) => scale,
@@ -233,18 +245,8 @@ pub fn project_signal<S: Shape>(
     };
     let pixels = S::Bands::chunks_mut(x.as_mut()).iter_mut().zip(S::Bands::chunks(m.values.as_ref()));
     for ((x, ys), measured) in pixels.zip(S::Bands::chunks(m.measured.as_ref())) {
-        let (mut filters, mut res) = (<PerBand<S, _>>::splat(0u8), <PerBand<S, _>>::splat(0.0f32));
-        let k = BandModel::<S::Bands>::residuals(
-            &model.r,
-            x,
-            ys.as_ref(),
-            band_bits(measured.as_ref()),
-            &mut filters,
-            &mut res,
-        );
-        let (Some(filters), Some(res)) = (filters.get(..k), res.get_mut(..k)) else { continue };
-        model.solve(filters, res);
-        BandModel::<S::Bands>::add_rows(&model.r, x, filters, res, scale);
+        let mut p = BandModel::<S::Bands>::pixel(&model.r, x, ys.as_ref(), measured.as_ref());
+        model.correct(&model.r, x, &mut p, scale);
     }
     libm::sqrtf(r2)
 }
@@ -263,31 +265,13 @@ pub fn project_mixed<S: Shape>(
     m: &Measurements<S::Values>,
     ball: &Ball,
 ) -> f32 {
-    let weighted = ball.is_weighted();
     let mut step = |fibres: &mut [PerBand<S, f32>], values: &[f32], measured: &[bool]| {
         let (mut r2, mut w2) = (0.0f32, 0.0f32);
         for ((fibre, ys), measured) in fibres.iter_mut().zip(S::Bands::chunks(values)).zip(S::Bands::chunks(measured)) {
-            let (mut filters, mut res) = (<PerBand<S, _>>::splat(0u8), <PerBand<S, _>>::splat(0.0f32));
-            let k = BandModel::<S::Bands>::residuals(
-                &model.rows,
-                fibre,
-                ys.as_ref(),
-                band_bits(measured.as_ref()),
-                &mut filters,
-                &mut res,
-            );
-            for (&f, &e) in filters.iter().zip(res.iter()).take(k) {
-                r2 += e * e;
-                if weighted {
-                    let f = usize::from(f);
-                    w2 +=
-                        e * e * ball.weight(ys.get(f).copied().unwrap_or(0.0), m.gains.get(f).copied().unwrap_or(1.0));
-                }
-            }
+            let mut p = BandModel::<S::Bands>::pixel(&model.rows, fibre, ys.as_ref(), measured.as_ref());
+            p.add_squares(ys.as_ref(), m.gains.as_ref(), ball, (&mut r2, &mut w2));
             *fibre = <PerBand<S, _>>::splat(0.0);
-            let (Some(filters), Some(res)) = (filters.get(..k), res.get_mut(..k)) else { continue };
-            model.solve(filters, res);
-            BandModel::<S::Bands>::add_rows(&model.rows, fibre, filters, res, 1.0);
+            model.correct(&model.rows, fibre, &mut p, 1.0);
         }
         (r2, w2)
     };

@@ -228,7 +228,7 @@ fn cold<S: Shape>(
         }
         project_interpolating(dict, coeffs, signal, m, &Ball::new(0.0, 0.0, m.count, 0), None);
         synthesize(dict, coeffs, signal);
-        return descend(dict, cfg, ws, &ball, plan);
+        return descend(&Descent { dict, cfg, ball: &ball, plan }, ws);
     }
     if let Some(outcome) = short_path(cfg, ws) {
         return Ok(outcome);
@@ -244,7 +244,7 @@ fn cold<S: Shape>(
             *x = if k { y } else { 0.0 };
         }
     }
-    descend(dict, cfg, ws, &ball, plan)
+    descend(&Descent { dict, cfg, ball: &ball, plan }, ws)
 }
 
 /// The short path for a flat patch: if every band is measured and each band's
@@ -339,7 +339,7 @@ fn descend_from<S: Shape>(
 ) -> Result<Outcome, SolveError> {
     let ball = start::<S>(cfg, &ws.measurements)?;
     let from = Sl0Config { sigma_f, steps: cfg.warm_steps, ..*cfg };
-    descend(dict, &from, ws, &ball, Plan::Annealed { scale: cfg.warm_start })
+    descend(&Descent { dict, cfg: &from, ball: &ball, plan: Plan::Annealed { scale: cfg.warm_start } }, ws)
 }
 
 /// Decodes the patch from the estimate in `ws.patch()` ([`seed`] must have prepared it):
@@ -434,6 +434,15 @@ enum Plan<'s, S: Shape> {
     Trained(&'s Schedule<S>),
 }
 
+/// One descent's configuration, apart from the workspace it runs in: the dictionary, the
+/// solver's config, the ball its projections move onto and its [`Plan`].
+struct Descent<'a, S: Shape> {
+    dict: &'a Dictionary<S>,
+    cfg: &'a Sl0Config,
+    ball: &'a Ball,
+    plan: Plan<'a, S>,
+}
+
 /// Decodes the patch whose measurements are in `ws` with a trained schedule's steps
 /// ([`crate::operators::schedule`]), from the start the schedule names: the minimum-norm
 /// solution or the band-gain fill (the config's `cold_start` is the hand-set schedule's).
@@ -463,68 +472,48 @@ pub fn solve_warm_scheduled<S: Shape>(
     ws: &mut Workspace<S>,
 ) -> Result<Outcome, SolveError> {
     let ball = start::<S>(cfg, &ws.measurements)?;
-    descend(dict, cfg, ws, &ball, Plan::Trained(schedule))
+    descend(&Descent { dict, cfg, ball: &ball, plan: Plan::Trained(schedule) }, ws)
 }
 
-/// The schedule from the patch in `ws.signal` (`plan`), projecting onto `ball`.
-fn descend<S: Shape>(
-    dict: &Dictionary<S>,
-    cfg: &Sl0Config,
-    ws: &mut Workspace<S>,
-    ball: &Ball,
-    plan: Plan<'_, S>,
-) -> Result<Outcome, SolveError> {
+/// The descent `d` from the patch in `ws.signal`.
+fn descend<S: Shape>(d: &Descent<'_, S>, ws: &mut Workspace<S>) -> Result<Outcome, SolveError> {
     if !ws.response.is_identity() {
-        return descend_mixed(dict, cfg, ws, ball, plan);
+        return descend_mixed(d, ws);
     }
     if ws.measurements.shares.is_some() {
-        return descend_shared(dict, cfg, ws, ball, plan);
+        return descend_shared(d, ws);
     }
-    descend_with(dict, cfg, ws, ball, plan, None, None)
+    descend_with(d, ws, None, None)
 }
 
 /// [`descend`] behind a lenslet grid: the solve's [`RowSums`] (32 KB for the full-view
 /// patch) in a frame of its own, so the other solves' stacks do not carry them.
 #[inline(never)]
-fn descend_shared<S: Shape>(
-    dict: &Dictionary<S>,
-    cfg: &Sl0Config,
-    ws: &mut Workspace<S>,
-    ball: &Ball,
-    plan: Plan<'_, S>,
-) -> Result<Outcome, SolveError> {
+fn descend_shared<S: Shape>(d: &Descent<'_, S>, ws: &mut Workspace<S>) -> Result<Outcome, SolveError> {
     let mut rows = RowSums::new();
-    descend_with(dict, cfg, ws, ball, plan, None, Some(&mut rows))
+    descend_with(d, ws, None, Some(&mut rows))
 }
 
 /// [`descend`] with a response that mixes bands: its [`BandModel`] (2 KB) in a frame of its
 /// own, so the one-hot solve's stack does not carry it.
 #[inline(never)]
-fn descend_mixed<S: Shape>(
-    dict: &Dictionary<S>,
-    cfg: &Sl0Config,
-    ws: &mut Workspace<S>,
-    ball: &Ball,
-    plan: Plan<'_, S>,
-) -> Result<Outcome, SolveError> {
+fn descend_mixed<S: Shape>(d: &Descent<'_, S>, ws: &mut Workspace<S>) -> Result<Outcome, SolveError> {
     if ws.measurements.interpolates() {
         return Err(SolveError::MixedHalfViews);
     }
-    let model = BandModel::new(&ws.response.balanced(&ws.measurements.gains), &dict.d.m5);
-    descend_with(dict, cfg, ws, ball, plan, Some(&model), None)
+    let model = BandModel::new(&ws.response.balanced(&ws.measurements.gains), &d.dict.d.m5);
+    descend_with(d, ws, Some(&model), None)
 }
 
 /// [`descend`]'s body: projections onto the mixed measurements of `mixing` if given, and
 /// behind a lenslet grid with the solve's `rows`.
 fn descend_with<S: Shape>(
-    dict: &Dictionary<S>,
-    cfg: &Sl0Config,
+    d: &Descent<'_, S>,
     ws: &mut Workspace<S>,
-    ball: &Ball,
-    plan: Plan<'_, S>,
     mixing: Option<&BandModel<S::Bands>>,
     mut rows: Option<&mut RowSums<S>>,
 ) -> Result<Outcome, SolveError> {
+    let Descent { dict, cfg, ball, plan } = *d;
     let Workspace { coeffs, signal, measurements: m, weights, .. } = ws;
     let selection = !m.interpolates();
     analyze(dict, signal, coeffs);

@@ -25,7 +25,7 @@ use crate::decode::cs::{
 use crate::decode::preset::Preset;
 use crate::io::message::number as show;
 use crate::io::patch::BANDS;
-use crate::sim::flags::parse;
+use crate::sim::flags::FromFlags;
 
 /// Decode method: compressed sensing, or a baseline without it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
@@ -466,20 +466,6 @@ pub fn plausibility(s: &str) -> Result<Plausibility, String> {
 }
 
 impl DecodeSettings {
-    /// The settings from `slf decode`'s flags (without the capture, `-o` and the output
-    /// flags), e.g. `["--preset", "preview", "--stride=3"]`.
-    ///
-    /// # Errors
-    /// The parser's message, one line, naming the flag (e.g. `invalid value '7' for
-    /// '--stride <STRIDE>': 7 is not in 1..=5`).
-    pub fn from_flags<I, S>(flags: I) -> Result<Self, String>
-    where
-        I: IntoIterator<Item = S>,
-        S: Into<std::ffi::OsString> + Clone,
-    {
-        parse("decode", flags)
-    }
-
     /// The compressed-sensing decode these settings ask for: the basis and the options.
     ///
     /// # Errors
@@ -683,4 +669,8 @@ pub fn disparity_range(s: &str) -> Result<DisparityRange, String> {
         Some(_) => return Err(bad()),
     };
     DisparityRange::new(a, b).map(|r| r.with_halves(halves)).ok_or_else(bad)
+}
+
+impl FromFlags for DecodeSettings {
+    const COMMAND: &'static str = "decode";
 }

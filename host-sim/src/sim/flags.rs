@@ -18,6 +18,28 @@ where
     cmd.try_get_matches_from(flags).and_then(|m| T::from_arg_matches(&m)).map_err(|e| one_line(&e))
 }
 
+/// A settings group that `slf` parses from a command's flags and the Python package from
+/// the same flags given as strings: its parser is [`parse`] under [`Self::COMMAND`].
+pub trait FromFlags: clap::Args + clap::FromArgMatches + Sized {
+    /// The command the group belongs to, as clap's messages name it.
+    const COMMAND: &'static str;
+
+    /// The settings from the command's flags, without the binary name and the command's
+    /// own positional arguments and `-o` (e.g. `["--mask=lenslet", "--snapshots=3"]` for
+    /// `slf simulate`).
+    ///
+    /// # Errors
+    /// The parser's message, one line, naming the flag (e.g. `invalid value '7' for
+    /// '--stride <STRIDE>': 7 is not in 1..=5`).
+    fn from_flags<I, S>(flags: I) -> Result<Self, String>
+    where
+        I: IntoIterator<Item = S>,
+        S: Into<std::ffi::OsString> + Clone,
+    {
+        parse(Self::COMMAND, flags)
+    }
+}
+
 /// `cmd` and every subcommand under it taking values that look like negative numbers
 /// (`--defects -0.1`) as values, for their parser to refuse by range, not as unknown flags
 /// ("unexpected argument '-0' found").

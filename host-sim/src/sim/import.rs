@@ -19,7 +19,7 @@ use crate::io::import::rgb::RgbLift;
 use crate::io::import::views::{Fill, Imported, MAX_DISPARITY, Naming, ViewsConfig, import_views};
 use crate::io::import::{Crop, Geometry, resample_lightfield};
 use crate::io::lightfield::LightField;
-use crate::sim::flags::{pair, parse, positive};
+use crate::sim::flags::{FromFlags, pair, positive};
 use crate::sim::spectra_data::BAND_NM;
 
 /// Where the spatial part of an import is cut and scaled.
@@ -108,18 +108,6 @@ fn max_disparity(s: &str) -> Result<f32, String> {
 }
 
 impl ViewsSettings {
-    /// The settings from `slf import views`'s arguments (the folder first, without `-o`).
-    ///
-    /// # Errors
-    /// The parser's message, one line, naming the flag.
-    pub fn from_flags<I, S>(flags: I) -> Result<Self, String>
-    where
-        I: IntoIterator<Item = S>,
-        S: Into<std::ffi::OsString> + Clone,
-    {
-        parse("views", flags)
-    }
-
     /// Reads the views: the light field `(U, V, H, W, 13)`, the centre view's disparity if
     /// the folder has one, and notes.
     ///
@@ -176,18 +164,6 @@ pub struct CubeSettings {
 }
 
 impl CubeSettings {
-    /// The settings from `slf import cube`'s arguments (the input first, without `-o`).
-    ///
-    /// # Errors
-    /// The parser's message, one line, naming the flag.
-    pub fn from_flags<I, S>(flags: I) -> Result<Self, String>
-    where
-        I: IntoIterator<Item = S>,
-        S: Into<std::ffi::OsString> + Clone,
-    {
-        parse("cube", flags)
-    }
-
     /// Reads the cube and makes its views: the light field `(U, V, H, W, 13)`, the centre
     /// view's disparity map if one was given, and notes.
     ///
@@ -331,4 +307,12 @@ fn crop(s: &str) -> Result<Crop, String> {
         [row, col, rows, cols] => Ok(Crop { row, col, rows, cols }),
         _ => Err(format!("{s:?} is not ROW,COL,ROWS,COLS")),
     }
+}
+
+impl FromFlags for ViewsSettings {
+    const COMMAND: &'static str = "views";
+}
+
+impl FromFlags for CubeSettings {
+    const COMMAND: &'static str = "cube";
 }

@@ -12,7 +12,7 @@ use crate::io::grid::MAX_ROTATION_DEG;
 use crate::io::lightfield::LightField;
 use crate::io::sensor::{FilterDescription, SensorDescription};
 use crate::sim::camera::{CameraConfig, GridSettings, simulate};
-use crate::sim::flags::{parse, positive};
+use crate::sim::flags::{FromFlags, positive};
 use crate::sim::import::{check_decodable, with_camera_bands};
 
 /// `--mask`: the mask family, which band each pixel sees in each snapshot.
@@ -245,19 +245,6 @@ impl SensorSettings {
 }
 
 impl SimulateSettings {
-    /// The settings from `slf simulate`'s flags (without the input and `-o`), e.g.
-    /// `["--mask=lenslet", "--snapshots=3"]`.
-    ///
-    /// # Errors
-    /// The parser's message, one line, naming the flag.
-    pub fn from_flags<I, S>(flags: I) -> Result<Self, String>
-    where
-        I: IntoIterator<Item = S>,
-        S: Into<std::ffi::OsString> + Clone,
-    {
-        parse("simulate", flags)
-    }
-
     /// The camera these settings describe.
     pub fn camera(&self) -> CameraConfig {
         let mut cam =
@@ -339,6 +326,10 @@ fn fraction(s: &str) -> Result<f64, String> {
         Ok(v) if (0.0..1.0).contains(&v) => Ok(v),
         _ => Err(format!("{s:?} is not a fraction in [0, 1)")),
     }
+}
+
+impl FromFlags for SimulateSettings {
+    const COMMAND: &'static str = "simulate";
 }
 
 #[cfg(test)]
