@@ -126,6 +126,8 @@ class Capture:
     levels, noise, defective pixels). Made by :func:`simulate`, read by
     :func:`load_capture`, written by :meth:`save` as the folder ``slf simulate`` writes and
     ``slf decode`` reads. Constructing one checks the frames against the description.
+    ``source`` is the folder :func:`load_capture` read it from (None for one made in memory):
+    a decode's ``output`` may not be one of its files.
     """
 
     def __init__(self, frames: np.ndarray, description: Dict[str, Any]):
@@ -133,6 +135,7 @@ class Capture:
         text = _slf.check_capture(frames, json.dumps(description))
         self.frames: np.ndarray = frames
         self.description: Dict[str, Any] = json.loads(text)
+        self.source: Optional[str] = None
 
     @property
     def snapshots(self) -> int:
@@ -164,11 +167,12 @@ class Capture:
         )
 
 
-def _from_parts(parts: Tuple[np.ndarray, str]) -> Capture:
+def _from_parts(parts: Tuple[np.ndarray, str], source: Optional[str] = None) -> Capture:
     frames, text = parts
     c = Capture.__new__(Capture)
     c.frames = frames
     c.description = json.loads(text)
+    c.source = source
     return c
 
 
@@ -285,7 +289,7 @@ def load_capture(path: PathLike) -> Capture:
     p = os.fspath(path)
     if not os.path.isdir(p):
         raise FileNotFoundError(f"{p}: no such capture folder")
-    return _from_parts(_slf.load_capture(p))
+    return _from_parts(_slf.load_capture(p), source=p)
 
 
 def calibrate(captures: Union[PathLike, Sequence[PathLike]], output: PathLike) -> list:
@@ -506,29 +510,17 @@ def decode(
     )
     frames = _raw_frames(cap.frames)
     path = None if output is None else os.fspath(output)
-    if path is not None and not isinstance(capture, Capture):
-        _check_output(os.fspath(capture), path)
-    if path is not None and not path.lower().endswith(".npy"):
-        raise ValueError(f"output {path}: a .npy path (an HDF5 file: slf decode -o OUT.h5)")
-    lf, rep = _slf.decode(frames, json.dumps(cap.description), args, threads, _progress_callback(progress), path)
+    # The native decode refuses an output that is a file of the capture's folder, the
+    # calibration or the blob, or not a .npy path, before it decodes (as `slf decode` does).
+    source = getattr(cap, "source", None)
+    lf, rep = _slf.decode(
+        frames, json.dumps(cap.description), args, threads, _progress_callback(progress), path, source
+    )
     if path is not None:
         lf = np.load(path, mmap_mode="r")
     if "warning" in rep:
         warnings.warn(f"slf: {rep['warning']}", stacklevel=2)
     return (lf, rep) if report or error_map else lf
-
-
-def _check_output(folder: str, output: str) -> None:
-    """Refuses an ``output`` that is a file of the capture folder it decodes (its
-    ``capture.json`` or a frame), as ``slf decode`` does; paths compared resolved."""
-    inputs = {os.path.realpath(os.path.join(folder, "capture.json"))}
-    try:
-        with open(os.path.join(folder, "capture.json"), encoding="utf-8") as f:
-            inputs |= {os.path.realpath(os.path.join(folder, n)) for n in json.load(f).get("frames", []) if isinstance(n, str)}
-    except (OSError, ValueError, AttributeError):
-        pass  # the load above read it; nothing more to find
-    if os.path.realpath(output) in inputs:
-        raise ValueError(f"output {output}: a file of the capture {folder}, which the decode reads")
 
 
 def evaluate(truth: np.ndarray, recon: np.ndarray, *, border: int = 0) -> Dict[str, float]:

@@ -11,8 +11,10 @@ use pyo3::types::PyDict;
 use slf_host::decode::cs::{PatchViews, disparity_per_lenslet, estimated_psnr};
 use slf_host::decode::pipeline::{Outcome, output_shape};
 use slf_host::decode::settings::DecodeSettings;
+use slf_host::io::calibration::Calibration;
 use slf_host::io::lightfield::Dtype;
 use slf_host::io::npy_rows::NpyRows;
+use slf_host::io::output::Outputs;
 
 use crate::arrays::{plane, to_array};
 use crate::capture::from_parts;
@@ -26,9 +28,12 @@ type Decoded<'py> = (Option<Bound<'py, PyArrayDyn<f32>>>, Bound<'py, PyDict>);
 /// `progress(done, total)` is called from the worker threads after each tile. With
 /// `output`, the light field is written to that `.npy` file as its rows are decoded (the
 /// memory of a band of rows, not the frame; the file is in place only once the decode is
-/// done) and `None` is returned in its stead.
+/// done) and `None` is returned in its stead. `source`: the capture folder the frames were
+/// read from, if any: `output` may not be one of its files, nor a file of the calibration
+/// or the blob the flags name (as `slf decode` refuses them: it would destroy an input).
 #[pyfunction]
-#[pyo3(signature = (frames, description, args, threads=None, progress=None, output=None))]
+#[pyo3(signature = (frames, description, args, threads=None, progress=None, output=None, source=None))]
+#[allow(clippy::too_many_arguments)] // the Python call's keyword arguments, one each
 pub fn decode<'py>(
     py: Python<'py>,
     frames: PyReadonlyArrayDyn<'py, u16>,
@@ -37,9 +42,28 @@ pub fn decode<'py>(
     threads: Option<usize>,
     progress: Option<Py<PyAny>>,
     output: Option<std::path::PathBuf>,
+    source: Option<std::path::PathBuf>,
 ) -> PyResult<Decoded<'py>> {
     let settings = DecodeSettings::from_flags(&args).map_err(flags)?;
     let capture = from_parts(&frames, description)?;
+    if let Some(path) = &output {
+        // Checked before the decode, with the command's check (paths resolved, hard links
+        // by inode): the decode reads the calibration and the blob again, and a capture
+        // folder written over is a user's raw data lost.
+        Outputs::new()
+            .inputs(source.iter().flat_map(|dir| capture.files_in(dir)), "a file of the capture")
+            .inputs(&settings.basis.blob, "blob")
+            .inputs(settings.calibration.iter().flat_map(|d| Calibration::files_in(d)), "a file of calibration")
+            .output(path, "output")
+            .check()
+            .map_err(|e| PyValueError::new_err(slf_host::io::message::one_line(&e)))?;
+        if !path.extension().is_some_and(|e| e.eq_ignore_ascii_case("npy")) {
+            return Err(PyValueError::new_err(format!(
+                "output {}: a .npy path (an HDF5 file: slf decode -o OUT.h5)",
+                path.display()
+            )));
+        }
+    }
     // The decode is compute-bound: threads past a few per core buy nothing, and 10**9 of
     // them were spawned until the OS refused.
     let most = 4 * std::thread::available_parallelism().map_or(1, usize::from);

@@ -187,3 +187,29 @@ def test_an_output_is_never_a_file_of_the_capture(capture, tmp_path):
         assert (folder / name).read_bytes() == before
     with pytest.raises(ValueError, match="a .npy path"):
         slf.decode(capture, output=tmp_path / "lf.h5")
+
+
+def test_an_output_is_never_an_input_of_a_loaded_capture_or_its_calibration(depth, tmp_path):
+    """Issue 65, item 1: a capture that load_capture read keeps its folder, and the decode
+    refuses an output that is one of its files, or a file of the calibration it reads,
+    before it decodes: nothing is replaced (the call returned normally and overwrote the
+    raw frame, and the dark frame, before)."""
+    folder = tmp_path / "cap"
+    slf.simulate(depth, k=1, seed=1, leakage=0.1, calibration_captures=tmp_path / "cc", exposures=1).save(folder)
+    slf.calibrate(tmp_path / "cc", tmp_path / "cal")
+    loaded = slf.load_capture(folder)
+    assert loaded.source == str(folder)
+    frame = json.loads((folder / "capture.json").read_text())["frames"][0]
+    before = (folder / frame).read_bytes()
+    with pytest.raises(ValueError, match="a file of the capture"):
+        slf.decode(loaded, preset="preview", output=folder / frame)
+    assert (folder / frame).read_bytes() == before
+    for name in ["dark.npy", "calibration.json"]:
+        target = tmp_path / "cal" / name
+        assert target.exists(), name
+        before = target.read_bytes()
+        with pytest.raises(ValueError, match="a file of calibration"):
+            slf.decode(loaded, preset="preview", calibration=tmp_path / "cal", output=target)
+        assert target.read_bytes() == before
+    # A capture made in memory has no folder: any output is the caller's to choose.
+    assert slf.Capture(loaded.frames, loaded.description).source is None
