@@ -142,9 +142,6 @@ pub use self::Extent as Bands;
 /// `B` bands.
 pub type BandCount<const B: usize> = Fixed<B>;
 
-/// One `T` a band of `C`.
-pub type PerBand<C, T> = <C as Extent>::Per<T>;
-
 /// One `T` an index of `E`.
 pub type Per<E, T> = <E as Extent>::Per<T>;
 
