@@ -10,32 +10,12 @@ pub use crate::sensor::mask::MAX_BANDS;
 use core::fmt::Debug;
 
 use crate::operators::mode::{Fold, Matrix, Mode, ModeMatrix, mode_pixel};
-use crate::sensor::extent::{Array, Extent, Fixed};
+use crate::sensor::extent::{Extent, Fixed};
 use crate::sensor::response::StaticIdentity;
 
-/// A count of patch values, as a type ([`crate::sensor::extent`] says why a type): what the
-/// buffers of one patch's values are generic over.
-pub trait Values: Copy + Debug + Default + PartialEq + Eq + Send + Sync + 'static {
-    /// The count.
-    const N: usize;
-    /// One `T` a patch value: `[T; N]`.
-    type PerValue<T: Copy + Debug + PartialEq>: Array<T>;
-    /// Every value zero, for `const` constructors.
-    const ZEROS: Self::PerValue<f32>;
-    /// No value flagged, for `const` constructors.
-    const NONE: Self::PerValue<bool>;
-}
-
-/// `N` patch values.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct ValueCount<const N: usize>;
-
-impl<const N: usize> Values for ValueCount<N> {
-    const N: usize = N;
-    type PerValue<T: Copy + Debug + PartialEq> = [T; N];
-    const ZEROS: [f32; N] = [0.0; N];
-    const NONE: [bool; N] = [false; N];
-}
+/// `N` patch values: the count of a patch's values is an extent too
+/// ([`crate::sensor::extent`]), what the buffers of one patch's values are generic over.
+pub type ValueCount<const N: usize> = Fixed<N>;
 
 /// The shape of a patch: its five extents and its value count, named once, with the checks
 /// and the index arithmetic. What every buffer, dictionary and solve is generic over (one
@@ -53,7 +33,7 @@ pub trait Shape: Copy + Debug + Default + PartialEq + Eq + Send + Sync + 'static
     /// Bands (mode 5).
     type Bands: Mode + StaticIdentity;
     /// The values of one patch.
-    type Values: Values;
+    type Values: Extent;
     /// One spatial slice of a patch (its values with the first index fixed, `N / PS` of
     /// them): the stack scratch of the slice-wise transforms.
     type Slice: Scratch;
@@ -74,7 +54,7 @@ pub trait Shape: Copy + Debug + Default + PartialEq + Eq + Send + Sync + 'static
     /// Bands.
     const B: usize = <Self::Bands as Extent>::D;
     /// Values of one patch.
-    const N: usize = <Self::Values as Values>::N;
+    const N: usize = <Self::Values as Extent>::D;
     /// Sensor pixels of one patch (`PS * PT * PU * PV`).
     const PIXELS: usize = Self::PS * Self::PT * Self::PU * Self::PV;
     /// The dimensions in mode order (1..=5 in the paper's numbering).
@@ -204,7 +184,7 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
     type U = Fixed<PU>;
     type V = Fixed<PV>;
     type Bands = Fixed<B>;
-    type Values = ValueCount<N>;
+    type Values = Fixed<N>;
     type Slice = [[[[f32; B]; PV]; PU]; PT];
     type Lenslet = [[[f32; B]; PV]; PU];
     type PerPixel<T: Copy + Debug + PartialEq> = [[[[T; PV]; PU]; PT]; PS];
@@ -216,7 +196,7 @@ impl<const PS: usize, const PT: usize, const PU: usize, const PV: usize, const B
 }
 
 /// One `T` a value of a patch of shape `S`: `[T; N]`.
-pub type PerValue<S, T> = <<S as Shape>::Values as Values>::PerValue<T>;
+pub type PerValue<S, T> = <<S as Shape>::Values as Extent>::Per<T>;
 
 /// One `T` a band of a patch of shape `S`: `[T; B]`.
 pub type PerBand<S, T> = <<S as Shape>::Bands as Extent>::Per<T>;

@@ -107,6 +107,8 @@ pub trait Extent: Copy + Debug + Default + PartialEq + Eq + Send + Sync + 'stati
     const ZEROS: Self::Per<f32>;
     /// Every entry 1, for `const` constructors.
     const ONES: Self::Per<f32>;
+    /// Every entry `false` (no value flagged), for `const` constructors.
+    const NONE: Self::Per<bool>;
     /// The `D x D` zero matrix, for `const` constructors.
     const ZERO_MATRIX: Square<Self, f32>;
     /// `v` as whole runs of `D` (a shorter tail left out): a patch's pixels, when `Self`
@@ -125,6 +127,7 @@ impl<const D: usize> Extent for Fixed<D> {
     type Per<T: Copy + Debug + PartialEq> = [T; D];
     const ZEROS: [f32; D] = [0.0; D];
     const ONES: [f32; D] = [1.0; D];
+    const NONE: [bool; D] = [false; D];
     const ZERO_MATRIX: [[f32; D]; D] = [[0.0; D]; D];
     #[inline(always)]
     fn chunks<T: Copy + Debug + PartialEq>(v: &[T]) -> &[[T; D]] {

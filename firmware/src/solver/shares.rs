@@ -47,8 +47,8 @@
 
 use crate::operators::dictionary::Dictionary;
 use crate::operators::mode::ModeMatrix;
-use crate::operators::shape::{PerBand, PerValue, Shape, Values};
-use crate::sensor::extent::{Array, Bands};
+use crate::operators::shape::{PerBand, PerValue, Shape};
+use crate::sensor::extent::{Array, Bands, Extent};
 use crate::solver::ball::Ball;
 use crate::solver::projection::{band_bits, dot, project_whole};
 use crate::solver::workspace::{CellShares, MAX_SHARE_VIEWS, Measurements, PLACE_UNIT};
@@ -222,7 +222,7 @@ pub struct RowSums<S: Shape> {
 impl<S: Shape> RowSums<S> {
     /// Not yet found: the next projection finds them.
     pub const fn new() -> Self {
-        Self { inv: <S::Values as Values>::ZEROS, ready: false }
+        Self { inv: <S::Values as Extent>::ZEROS, ready: false }
     }
 }
 

@@ -7,9 +7,9 @@
 //! `const fn`, so a device can place it in a `static`.
 
 use crate::operators::disparity::HalfViews;
-use crate::operators::shape::{MAX_BANDS, Values};
+use crate::operators::shape::MAX_BANDS;
 use crate::operators::shape::{PerBand, PerValue, Shape};
-use crate::sensor::extent::{Array, Bands};
+use crate::sensor::extent::{Array, Bands, Extent};
 use crate::sensor::response::Response;
 use crate::solver::error::SolveError;
 
@@ -28,9 +28,9 @@ use crate::solver::error::SolveError;
 /// Gains are 1 unless set, and [`clear`](Self::clear) keeps them (they are the unit of
 /// the values, not a measurement).
 #[derive(Clone, Debug)]
-pub struct Measurements<V: Values> {
-    pub(crate) values: V::PerValue<f32>,
-    pub(crate) measured: V::PerValue<bool>,
+pub struct Measurements<V: Extent> {
+    pub(crate) values: V::Per<f32>,
+    pub(crate) measured: V::Per<bool>,
     pub(crate) count: u32,
     /// Gain of each band (the first `B` entries; 1 beyond them).
     pub(crate) gains: [f32; MAX_BANDS],
@@ -86,7 +86,7 @@ impl CellShares {
     }
 }
 
-impl<V: Values> Measurements<V> {
+impl<V: Extent> Measurements<V> {
     /// Nothing measured.
     pub const fn new() -> Self {
         Self {
@@ -234,7 +234,7 @@ impl<V: Values> Measurements<V> {
     }
 
     /// Keeps the unmeasured entries of `patch` in the unmeasured slots of the values.
-    pub(crate) fn stash(&mut self, patch: &V::PerValue<f32>) {
+    pub(crate) fn stash(&mut self, patch: &V::Per<f32>) {
         for ((v, &k), &x) in self.values.as_mut().iter_mut().zip(self.measured.as_ref()).zip(patch.as_ref()) {
             if !k {
                 *v = x;
@@ -244,7 +244,7 @@ impl<V: Values> Measurements<V> {
 
     /// Makes each unmeasured entry `x` of `patch` the weighted mean `w s + (1 - w) x` with
     /// its stashed value `s`, and forgets the stash. Measured entries are left as they are.
-    pub(crate) fn blend_stash(&mut self, patch: &mut V::PerValue<f32>, w: f32) {
+    pub(crate) fn blend_stash(&mut self, patch: &mut V::Per<f32>, w: f32) {
         for ((v, &k), x) in self.values.as_mut().iter_mut().zip(self.measured.as_ref()).zip(patch.as_mut()) {
             if !k {
                 *x = w * *v + (1.0 - w) * *x;
@@ -263,7 +263,7 @@ impl<V: Values> Measurements<V> {
     }
 }
 
-impl<V: Values> Default for Measurements<V> {
+impl<V: Extent> Default for Measurements<V> {
     fn default() -> Self {
         Self::new()
     }
