@@ -460,6 +460,13 @@ fn baselines_decode_from_the_command_line() {
         ("ppid", vec!["--gains", "1,2"], "--gains"),
         ("demosaic", vec!["--blob", "/nonexistent"], "--blob"),
         ("ppid", vec!["--preset", "best", "--stride", "1"], "--preset, --stride"),
+        // Issue 65, item 9: the trials' and the estimate's flags too (before: exit 0).
+        ("demosaic", vec!["--shear-check"], "--shear-check"),
+        ("ppid", vec!["--model-trial", "true"], "--model-trial"),
+        ("interpolate", vec!["--shear-trial", "true"], "--shear-trial"),
+        ("demosaic", vec!["--trial-by", "decode"], "--trial-by"),
+        ("ppid", vec!["--baseline-blend", "true"], "--baseline-blend"),
+        ("demosaic", vec!["--estimate-by", "patches"], "--estimate-by"),
     ] {
         let e = failure(
             slf().arg("decode").arg(p("cap")).arg("-o").arg(p("x.npy")).args(["--method", method, "-q"]).args(&flags),

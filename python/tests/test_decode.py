@@ -213,3 +213,12 @@ def test_an_output_is_never_an_input_of_a_loaded_capture_or_its_calibration(dept
         assert target.read_bytes() == before
     # A capture made in memory has no folder: any output is the caller's to choose.
     assert slf.Capture(loaded.frames, loaded.description).source is None
+
+
+def test_a_baseline_refuses_the_estimate_and_the_trials(capture):
+    """Issue 65, item 9: a baseline decodes nothing to hold out of and runs no trial, so
+    these keywords are refused, as the command's flags are (before: accepted, ignored)."""
+    for kwargs in [{"error_map": True}, {"model_trial": True}, {"shear_trial": True}, {"shear_check": True}]:
+        with pytest.raises(ValueError, match="given with --method demosaic"):
+            slf.decode(capture, method="demosaic", **kwargs)
+

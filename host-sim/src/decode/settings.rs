@@ -603,6 +603,13 @@ impl DecodeSettings {
             (self.seeded == d.seeded, "--seeded"),
             (self.schedule == d.schedule, "--schedule"),
             (self.plausible == d.plausible, "--plausible"),
+            (self.estimate == d.estimate, "--estimate"),
+            (self.estimate_by == d.estimate_by, "--estimate-by"),
+            (self.shear_check == d.shear_check, "--shear-check"),
+            (self.model_trial == d.model_trial, "--model-trial"),
+            (self.trial_by == d.trial_by, "--trial-by"),
+            (self.baseline_blend == d.baseline_blend, "--baseline-blend"),
+            (self.shear_trial == d.shear_trial, "--shear-trial"),
         ]
         .into_iter()
         .filter_map(|(same, name)| (!same).then_some(name))
