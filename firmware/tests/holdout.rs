@@ -55,23 +55,38 @@ fn the_estimate_is_the_held_out_error_less_the_noise() {
         }
     }
     let (noise, shot) = (0.01f32, 0.002f32);
+    // A vignetted patch: each view's flat field, 0.3 to 1 (issue 65, item 12: the noise of
+    // a measurement divided by its flat is the raw noise over the flat).
+    let flats: Vec<f32> = (0..25).map(|_| r.random_range(0.3..1.0f32)).collect();
+    let flat = |i: usize| {
+        let [_, _, u, v, _] = <PaperShape as Shape>::coordinates(i);
+        flats[u * 5 + v]
+    };
     // By the definition, in f64: the squared error of the held-out ones in sensor units,
-    // less their noise variance, for the unmeasured share, and the noise for the rest.
+    // less their noise variance (the raw value's, divided by the flat as the value was),
+    // for the unmeasured share, and the noise for the rest.
     let m = ws.measurements();
-    let (mut r2, mut var, mut n) = (0.0f64, 0.0f64, 0.0f64);
-    for (i, &x) in predicted.iter().enumerate() {
-        let Some(y) = m.get(i).filter(|_| hold.held::<PaperShape>(Unit::Measurement, i)) else { continue };
-        let g = f64::from(gains[i % 13]);
-        r2 += ((f64::from(x) - f64::from(y)) * g).powi(2);
-        var += f64::from(noise).powi(2) + f64::from(shot) * (f64::from(y) * g).max(0.0);
-        n += 1.0;
-    }
-    let share = m.count() as f64 / 5200.0;
-    let want = ((r2 / n - var / n).max(0.0) * (1.0 - share) + var / n * share).sqrt();
-    let got = f64::from(estimate::<PaperShape>(&hold, m, &predicted, noise, shot).unwrap());
-    assert!((got - want).abs() <= 1e-5 * want, "{got} against {want}");
+    let want = |flat: &dyn Fn(usize) -> f32| {
+        let (mut r2, mut var, mut n) = (0.0f64, 0.0f64, 0.0f64);
+        for (i, &x) in predicted.iter().enumerate() {
+            let Some(y) = m.get(i).filter(|_| hold.held::<PaperShape>(Unit::Measurement, i)) else { continue };
+            let (g, f) = (f64::from(gains[i % 13]), f64::from(flat(i)));
+            r2 += ((f64::from(x) - f64::from(y)) * g).powi(2);
+            var += (f64::from(noise).powi(2) + f64::from(shot) * (f64::from(y) * g * f).max(0.0)) / (f * f);
+            n += 1.0;
+        }
+        let share = m.count() as f64 / 5200.0;
+        ((r2 / n - var / n).max(0.0) * (1.0 - share) + var / n * share).sqrt()
+    };
+    let (flat_want, plain_want) = (want(&flat), want(&|_| 1.0));
+    let got = f64::from(estimate::<PaperShape>(&hold, m, &predicted, (noise, shot), flat).unwrap());
+    assert!((got - flat_want).abs() <= 1e-5 * flat_want, "{got} against {flat_want}");
+    let plain = f64::from(estimate::<PaperShape>(&hold, m, &predicted, (noise, shot), |_| 1.0).unwrap());
+    assert!((plain - plain_want).abs() <= 1e-5 * plain_want, "{plain} against {plain_want}");
+    // The flats matter here: the two differ by more than the tolerance.
+    assert!((flat_want - plain_want).abs() > 1e-3 * plain_want, "{flat_want} {plain_want}");
     // Nothing held out, no estimate.
-    assert_eq!(estimate::<PaperShape>(&hold, &Measurements::new(), &predicted, noise, shot), None);
+    assert_eq!(estimate::<PaperShape>(&hold, &Measurements::new(), &predicted, (noise, shot), |_| 1.0), None);
 }
 
 const L5: LensletSize = LensletSize { rows: 5, cols: 5 };

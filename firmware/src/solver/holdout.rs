@@ -126,18 +126,31 @@ pub fn hold_out<S: Shape>(hold: &HoldOut, m: &mut Measurements<S::Values>) -> u3
     held
 }
 
+/// The noise variance of a measurement that reads `seen` in the light field's units, its
+/// view's flat field `flat` divided out: the sensor's noise (`noise` sd and `shot` per unit,
+/// normalised raw units, as [`crate::Sl0Config`]'s) on the raw value `seen * flat`, divided
+/// by `flat` as the value was. A vignetted view's measurement is noisier than its raw
+/// pixel's by `1 / flat`; taken as raw, its noise was under-subtracted and the estimate
+/// read the noise as error.
+#[inline]
+pub fn noise_variance(noise: f32, shot: f32, seen: f32, flat: f32) -> f32 {
+    let raw = seen * flat;
+    (noise * noise + shot * if raw > 0.0 { raw } else { 0.0 }) / (flat * flat)
+}
+
 /// The error estimate of a patch (RMS per value, sensor units) from `predicted`, the
 /// estimating solve's patch at the measurements' positions (a half-pixel patch moved to
 /// its pixels, [`crate::solver::fractional::to_sensor`]), against the held-out entries of
 /// `m` (all its measurements, read again). `noise` and `shot` are the capture's noise model
-/// (normalised units, as [`crate::Sl0Config`]'s); each band's values are divided by its
+/// (normalised units, as [`crate::Sl0Config`]'s), `flat(i)` the flat field of entry `i`'s
+/// view (1 without one, [`noise_variance`]); each band's values are divided by its
 /// gain in `m` and multiplied back here. `None` if `m` holds no held-out measurement.
 pub fn estimate<S: Shape>(
     hold: &HoldOut,
     m: &Measurements<S::Values>,
     predicted: &PerValue<S, f32>,
-    noise: f32,
-    shot: f32,
+    (noise, shot): (f32, f32),
+    flat: impl Fn(usize) -> f32,
 ) -> Option<f32> {
     let unit = Unit::of::<S>(m);
     let (mut r2, mut var, mut held) = (0.0f32, 0.0f32, 0u32);
@@ -148,7 +161,7 @@ pub fn estimate<S: Shape>(
         let g = m.gains.get(i % S::B).copied().unwrap_or(1.0);
         let (seen, d) = (y * g, (x - y) * g);
         r2 += d * d;
-        var += noise * noise + shot * if seen > 0.0 { seen } else { 0.0 };
+        var += noise_variance(noise, shot, seen, flat(i));
         held += 1;
     }
     if held == 0 || !r2.is_finite() {

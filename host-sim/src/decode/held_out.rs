@@ -40,6 +40,7 @@
 //! blend's ([`crate::decode::blend`]), whose tallies then estimate the blended output.
 
 use anyhow::{Result, ensure};
+use slf_firmware::holdout::noise_variance;
 use slf_firmware::raw::Invalid;
 use slf_firmware::{Frame, HoldOut, MaskFamily, RawFrame, RowSink};
 
@@ -232,7 +233,7 @@ impl<const PU: usize, const PV: usize, const N: usize> RowSink for Tallies<'_, P
         let (s, y) = (self.shape, usize::from(y));
         ensure!(y < s.rows && values.len() == s.row_len(), "held-out row {y} of {} values does not fit", values.len());
         let c = self.decoder.config();
-        let (noise, shot) = (f64::from(c.sl0.noise), f64::from(c.sl0.shot));
+        let (noise, shot) = (c.sl0.noise, c.sl0.shot);
         let top = f64::from(c.raw.range().1);
         let frame = self.decoder.frame_size();
         let (lu, lv) = s.views;
@@ -258,7 +259,8 @@ impl<const PU: usize, const PV: usize, const N: usize> RowSink for Tallies<'_, P
                         // value under it errs by the gap at least.
                         let (d, e) = match seen {
                             Ok(seen) => {
-                                t.variance += noise * noise + shot * f64::from(seen).max(0.0);
+                                let flat = self.decoder.view_gain(r, cc);
+                                t.variance += f64::from(noise_variance(noise, shot, seen, flat));
                                 (predicted - f64::from(seen), other - f64::from(seen))
                             }
                             Err(Invalid::OverRange) => ((top - predicted).max(0.0), (top - other).max(0.0)),

@@ -12,7 +12,7 @@
 //!
 //! All in f64. `tests/metrics_fixtures.rs` proves them against scikit-image to 1e-4.
 
-use anyhow::{Result, ensure};
+use anyhow::{Result, bail, ensure};
 
 use crate::decode::cs::estimated_psnr;
 use crate::io::lightfield::LightField;
@@ -88,10 +88,30 @@ pub struct MapAccuracy {
     pub estimated_psnr: f64,
 }
 
+/// Refuses an error map (row-major, `cols` lenslets a row) with a negative or infinite
+/// value: an RMS error is neither (NaN: a lenslet not estimated), and a negative one's
+/// square would score as an error.
+///
+/// # Errors
+/// The first such value, by lenslet.
+pub fn check_error_map(map: &[f32], cols: usize) -> Result<()> {
+    if let Some(i) = map.iter().position(|e| *e < 0.0 || e.is_infinite()) {
+        bail!(
+            "the error map's value at lenslet ({}, {}) is {}: an RMS error is finite and not negative (NaN where \
+             none was estimated)",
+            i / cols.max(1),
+            i % cols.max(1),
+            map[i]
+        );
+    }
+    Ok(())
+}
+
 /// [`MapAccuracy`] of `map` (`truth.rows x truth.cols`).
 ///
 /// # Errors
-/// A map of another size, or no block to compare.
+/// A map of another size, a negative or infinite value ([`check_error_map`]), or no block to
+/// compare.
 pub fn map_accuracy(truth: &LightField, recon: &LightField, map: &[f32]) -> Result<MapAccuracy> {
     ensure!(
         truth.shape() == recon.shape(),
@@ -106,6 +126,7 @@ pub fn map_accuracy(truth: &LightField, recon: &LightField, map: &[f32]) -> Resu
         truth.rows,
         truth.cols
     );
+    check_error_map(map, truth.cols)?;
     let (rows, cols) = (truth.rows / BLOCK, truth.cols / BLOCK);
     let mut err2 = vec![0.0f64; rows * cols];
     let mut n = vec![0usize; rows * cols];
@@ -196,7 +217,8 @@ pub fn psnr(truth: &[f32], recon: &[f32], data_range: f64) -> f64 {
 const SIGMA: f64 = 1.5;
 /// scipy's kernel radius `int(truncate * sigma + 0.5)` with truncate 3.5.
 const RADIUS: usize = 5;
-const WIN: usize = 2 * RADIUS + 1;
+/// SSIM's window: a slice (lenslets) must be at least this on each side.
+pub const WIN: usize = 2 * RADIUS + 1;
 
 fn kernel() -> [f64; WIN] {
     let mut k: [f64; WIN] = core::array::from_fn(|i| {

@@ -112,7 +112,7 @@ impl CalibrationDescription {
     /// # Errors
     /// The first field out of its range, named.
     pub fn check(&self) -> Result<(usize, usize)> {
-        ensure!(self.format == FORMAT, "format is {:?}, expected {FORMAT:?}", self.format);
+        ensure!(self.format == FORMAT, "format is {}, expected {FORMAT:?}", crate::io::message::quoted(&self.format));
         ensure!(self.version == VERSION, "version {} is not supported (this slf reads {VERSION})", self.version);
         ensure!(
             self.lenslets.iter().all(|&x| (1..=usize::from(u16::MAX)).contains(&x))

@@ -597,7 +597,7 @@ impl CaptureDescription {
     /// # Errors
     /// A message naming the field that is wrong and its range.
     pub fn frame_size(&self) -> Result<(usize, usize)> {
-        ensure!(self.format == FORMAT, "format is {:?}, expected {FORMAT:?}", self.format);
+        ensure!(self.format == FORMAT, "format is {}, expected {FORMAT:?}", crate::io::message::quoted(&self.format));
         ensure!(
             self.version == VERSION || self.version == VERSION_SENSOR,
             "version {} is not supported (this slf reads {VERSION} and {VERSION_SENSOR})",

@@ -216,12 +216,22 @@ pub fn verify(dir: &Path, description: &Path, records: &[FileRecord], names: &[&
     for r in records {
         ensure!(
             Path::new(&r.name).components().all(|c| matches!(c, std::path::Component::Normal(_))),
-            "{}: records a file {:?} outside its folder",
+            "{}: records a file {} outside its folder",
             description.display(),
-            r.name
+            crate::io::message::quoted(&r.name)
         );
         let path = dir.join(&r.name);
         let meta = fs::metadata(&path).with_context(|| format!("cannot read {}", path.display()))?;
+        ensure!(meta.is_file(), "{}: not a regular file ({})", path.display(), crate::io::output::file_kind(&meta));
+        // The record's hex in either case (a hand-edited or other tool's record).
+        let recorded = u32::from_str_radix(&r.crc32, 16).ok().filter(|_| r.crc32.len() == 8).with_context(|| {
+            format!(
+                "{}: records CRC-32 {} for {}: not 8 hex digits",
+                description.display(),
+                crate::io::message::quoted(&r.crc32),
+                r.name
+            )
+        })?;
         ensure!(
             meta.len() == r.bytes,
             "{}: {} bytes, but {} records {}: the folder is mixed or the file altered",
@@ -232,7 +242,7 @@ pub fn verify(dir: &Path, description: &Path, records: &[FileRecord], names: &[&
         );
         let (_, crc) = checksum(&path)?;
         ensure!(
-            format!("{crc:08x}") == r.crc32,
+            crc == recorded,
             "{}: CRC-32 {crc:08x}, but {} records {}: the folder is mixed or the file altered",
             path.display(),
             description.display(),

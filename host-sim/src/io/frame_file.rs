@@ -47,6 +47,14 @@ pub fn read_frame(path: &Path, expect: Option<(usize, usize)>) -> Result<FrameFi
         "pgm" => read_pgm(path, len, &sized),
         "png" => {
             use image::ImageDecoder;
+            // As a PGM: bytes after the image's end (IEND) are refused, not ignored.
+            let end = png_end(path)?;
+            ensure!(
+                end == len,
+                "{}: {} bytes after the PNG's end chunk (IEND) (the file is longer than its image)",
+                path.display(),
+                len.saturating_sub(end)
+            );
             let undecodable = || format!("{}: cannot decode image", path.display());
             let decoder = image::ImageReader::open(path)
                 .and_then(image::ImageReader::with_guessed_format)
@@ -68,6 +76,31 @@ pub fn read_frame(path: &Path, expect: Option<(usize, usize)>) -> Result<FrameFi
             Ok(FrameFile { data, rows: h as usize, cols: w as usize, top })
         }
         other => bail!("{}: unknown frame format {other:?} (use .pgm, .png or .npy)", path.display()),
+    }
+}
+
+/// Where a PNG file's image ends: the byte after its IEND chunk, found by walking the
+/// chunks' headers (length, type; each chunk is length + 12 bytes). Chunks are not read.
+///
+/// # Errors
+/// A file that is not a PNG, or ends before IEND.
+fn png_end(path: &Path) -> Result<u64> {
+    use std::io::{Read, Seek, SeekFrom};
+    let bad = |what: &str| anyhow!("{}: cannot decode image: {what}", path.display());
+    let mut f = fs::File::open(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let mut signature = [0u8; 8];
+    f.read_exact(&mut signature).map_err(|_| bad("not a PNG file"))?;
+    ensure!(signature == *b"\x89PNG\r\n\x1a\n", bad("not a PNG file"));
+    let mut at = 8u64;
+    loop {
+        let mut head = [0u8; 8];
+        f.read_exact(&mut head).map_err(|_| bad("the file ends before its end chunk (IEND)"))?;
+        let length = u64::from(u32::from_be_bytes([head[0], head[1], head[2], head[3]]));
+        at += 12 + length;
+        if &head[4..] == b"IEND" {
+            return Ok(at);
+        }
+        f.seek(SeekFrom::Start(at)).with_context(|| format!("cannot read {}", path.display()))?;
     }
 }
 

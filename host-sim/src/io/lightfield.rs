@@ -11,7 +11,7 @@ use std::path::Path;
 
 use npyz::WriterBuilder;
 
-use crate::io::output::write_whole;
+use crate::io::output::{WholeFile, stage, write_whole};
 
 /// A spectral light field, `(U, V, H, W, B)`, f32.
 #[derive(Clone, Debug, PartialEq)]
@@ -247,19 +247,34 @@ pub fn write_npy_f32_2d(path: &Path, data: &[f32], rows: usize, cols: usize) -> 
     write_npy_2d(path, data, rows, cols)
 }
 
+/// As [`write_npy_f32_2d`], left in its temporary file to be persisted with the run's other
+/// outputs ([`crate::io::output::stage`]).
+///
+/// # Errors
+/// The I/O error, with the path.
+pub fn stage_npy_f32_2d(path: &Path, data: &[f32], rows: usize, cols: usize) -> anyhow::Result<WholeFile> {
+    stage(path, |out| npy_2d(out, data, rows, cols))
+}
+
 fn write_npy_2d<T: npyz::AutoSerialize + Copy>(
     path: &Path,
     data: &[T],
     rows: usize,
     cols: usize,
 ) -> anyhow::Result<()> {
-    write_whole(path, |out| {
-        let mut w =
-            npyz::WriteOptions::new().default_dtype().shape(&[rows as u64, cols as u64]).writer(out).begin_nd()?;
-        w.extend(data.iter().copied())?;
-        w.finish()?;
-        Ok(())
-    })
+    write_whole(path, |out| npy_2d(out, data, rows, cols))
+}
+
+fn npy_2d<T: npyz::AutoSerialize + Copy>(
+    out: &mut dyn std::io::Write,
+    data: &[T],
+    rows: usize,
+    cols: usize,
+) -> anyhow::Result<()> {
+    let mut w = npyz::WriteOptions::new().default_dtype().shape(&[rows as u64, cols as u64]).writer(out).begin_nd()?;
+    w.extend(data.iter().copied())?;
+    w.finish()?;
+    Ok(())
 }
 
 /// Reads an f32 2D `.npy` array of `rows x cols` (an error map `slf decode` wrote); a

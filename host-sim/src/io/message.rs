@@ -12,8 +12,33 @@ pub fn number(v: f32) -> String {
     if v != 0.0 && v.is_finite() && !(1e-4..1e6).contains(&v.abs()) { format!("{v:e}") } else { v.to_string() }
 }
 
-/// `e`'s chain on one line, without repeated causes or line breaks.
+/// A value read from a file, quoted for a message: whole up to [`QUOTED`] characters, else
+/// its start and its length (a 10 MB `format` string was echoed whole into one line).
+pub fn quoted(s: &str) -> String {
+    match s.char_indices().nth(QUOTED) {
+        None => format!("{s:?}"),
+        Some((end, _)) => format!("{:?}... ({} bytes)", &s[..end], s.len()),
+    }
+}
+
+/// The characters of a value [`quoted`] shows.
+pub const QUOTED: usize = 60;
+
+/// The longest line [`one_line`] writes, in characters: past it the line is cut and says
+/// so (a file's text quoted by a message it does not cut itself).
+pub const LONGEST: usize = 4000;
+
+/// `e`'s chain on one line, without repeated causes or line breaks, at most [`LONGEST`]
+/// characters.
 pub fn one_line(e: &anyhow::Error) -> String {
+    let line = joined(e);
+    match line.char_indices().nth(LONGEST) {
+        None => line,
+        Some((end, _)) => format!("{}... (the message's {} bytes cut)", &line[..end], line.len()),
+    }
+}
+
+fn joined(e: &anyhow::Error) -> String {
     let mut line = String::new();
     for cause in e.chain() {
         let text = cause.to_string();
@@ -31,7 +56,19 @@ pub fn one_line(e: &anyhow::Error) -> String {
 
 #[cfg(test)]
 mod tests {
-    use crate::io::message::one_line;
+    use crate::io::message::{LONGEST, one_line, quoted};
+
+    #[test]
+    fn long_values_are_cut() {
+        let long = "x".repeat(10_000_000);
+        assert_eq!(quoted("npy"), "\"npy\"");
+        let q = quoted(&long);
+        assert!(q.len() < 100 && q.ends_with("(10000000 bytes)"), "{q}");
+        let line = one_line(&anyhow::anyhow!("format is {long:?}"));
+        assert!(line.chars().count() < LONGEST + 100 && line.contains("cut"), "{}", line.len());
+        // Multi-byte characters are cut at a character.
+        assert!(quoted(&"é".repeat(100)).starts_with("\"é"));
+    }
 
     #[derive(Debug)]
     struct Repeats(std::io::Error);

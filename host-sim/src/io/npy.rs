@@ -117,6 +117,13 @@ pub enum NpyErrorKind {
         expected: u64,
         found: u64,
     },
+    /// The file holds bytes after the values its header states.
+    Trailing {
+        expected: u64,
+        extra: u64,
+    },
+    /// The values would not fit the memory cap ([`crate::io::budget`]) or the allocator.
+    Memory(String),
     /// The array's shape is not what the caller needs.
     Shape(String),
     /// A finite float64 value (the `index`-th in the file's order) beyond float32's range.
@@ -148,6 +155,11 @@ impl fmt::Display for NpyError {
             NpyErrorKind::Truncated { expected, found } => {
                 write!(f, "truncated body: header promises {expected} values, file holds {found}")
             }
+            NpyErrorKind::Trailing { expected, extra } => write!(
+                f,
+                "{extra} bytes after the {expected} values the header states (the header does not describe the file)"
+            ),
+            NpyErrorKind::Memory(what) => write!(f, "{what}"),
             NpyErrorKind::Shape(what) => write!(f, "{what}"),
             NpyErrorKind::Range { index, value } => write!(
                 f,
@@ -262,6 +274,12 @@ pub fn read_from_checked(
     if bytes > body {
         return Err(NpyErrorKind::Truncated { expected: count, found: body / element.size() });
     }
+    // numpy writes nothing after the values: bytes past them mean a header that states a
+    // smaller shape than the writer wrote (a lying or hand-edited header), so the file is
+    // refused, not read in part.
+    if bytes < body {
+        return Err(NpyErrorKind::Trailing { expected: count, extra: body - bytes });
+    }
     let shape = header
         .shape
         .iter()
@@ -269,39 +287,60 @@ pub fn read_from_checked(
         .collect::<Result<Vec<_>, _>>()
         .map_err(|_| NpyErrorKind::Overflow { shape: shape64.clone() })?;
     check(&shape, element).map_err(NpyErrorKind::Shape)?;
-    // The body is at most the file's size: this allocation is bounded by the bytes on disk.
-    let mut raw = vec![0u8; bytes as usize];
-    r.read_exact(&mut raw).map_err(io)?;
+    // What the read holds at its peak: the values as kept (f32, or u16) and, for a Fortran-
+    // order array, their copy in C order; the body is read a chunk at a time.
+    let kept = if element == Element::U16 { 2 } else { 4 };
+    let need = count.saturating_mul(kept).saturating_mul(if header.fortran_order { 2 } else { 1 });
+    crate::io::budget::check(need, &format!("reading {count} values"), "a smaller array")
+        .map_err(|e| NpyErrorKind::Memory(e.to_string()))?;
+    let count_usize = usize::try_from(count).map_err(|_| NpyErrorKind::Overflow { shape: shape64.clone() })?;
 
     let mut notes = Vec::new();
     if swap {
         notes.push(format!("big-endian {} converted to little-endian", header.descr));
     }
-    let values = match element {
-        Element::F32 => Values::F32(raw.chunks_exact(4).map(|c| f32::from_bits(word32(c, swap))).collect()),
-        Element::F64 => {
-            notes.push("float64 converted to float32".into());
-            let wide: Vec<f64> = raw
-                .chunks_exact(8)
-                .map(|c| {
-                    let mut b = [0u8; 8];
-                    b.copy_from_slice(c);
-                    f64::from_bits(if swap { u64::from_be_bytes(b) } else { u64::from_le_bytes(b) })
-                })
-                .collect();
-            // A finite float64 beyond float32's range would become infinite: say so, not
-            // "not finite" of a value the file holds as finite.
-            if let Some(i) = wide.iter().position(|x| x.is_finite() && x.abs() > f64::from(f32::MAX)) {
-                return Err(NpyErrorKind::Range { index: i as u64, value: wide[i] });
+    let mut chunk = vec![0u8; CHUNK];
+    let values =
+        match element {
+            Element::F32 => {
+                let mut v = reserve::<f32>(count_usize)?;
+                read_chunks(&mut r, bytes, &mut chunk, 4, |c| {
+                    v.extend(c.chunks_exact(4).map(|w| f32::from_bits(word32(w, swap))))
+                })?;
+                Values::F32(v)
             }
-            Values::F32(wide.into_iter().map(|x| x as f32).collect())
-        }
-        Element::U16 => Values::U16(
-            raw.chunks_exact(2)
-                .map(|c| if swap { u16::from_be_bytes([c[0], c[1]]) } else { u16::from_le_bytes([c[0], c[1]]) })
-                .collect(),
-        ),
-    };
+            Element::F64 => {
+                notes.push("float64 converted to float32".into());
+                let mut v = reserve::<f32>(count_usize)?;
+                // A finite float64 beyond float32's range would become infinite: say so, not
+                // "not finite" of a value the file holds as finite.
+                let mut beyond = None;
+                read_chunks(&mut r, bytes, &mut chunk, 8, |c| {
+                    for w in c.chunks_exact(8) {
+                        let mut b = [0u8; 8];
+                        b.copy_from_slice(w);
+                        let x = f64::from_bits(if swap { u64::from_be_bytes(b) } else { u64::from_le_bytes(b) });
+                        if beyond.is_none() && x.is_finite() && x.abs() > f64::from(f32::MAX) {
+                            beyond = Some((v.len() as u64, x));
+                        }
+                        v.push(x as f32);
+                    }
+                })?;
+                if let Some((index, value)) = beyond {
+                    return Err(NpyErrorKind::Range { index, value });
+                }
+                Values::F32(v)
+            }
+            Element::U16 => {
+                let mut v = reserve::<u16>(count_usize)?;
+                read_chunks(&mut r, bytes, &mut chunk, 2, |c| {
+                    v.extend(c.chunks_exact(2).map(|w| {
+                        if swap { u16::from_be_bytes([w[0], w[1]]) } else { u16::from_le_bytes([w[0], w[1]]) }
+                    }))
+                })?;
+                Values::U16(v)
+            }
+        };
     let values = if header.fortran_order && shape.len() > 1 {
         notes.push("Fortran-order array converted to C order".into());
         match values {
@@ -312,6 +351,42 @@ pub fn read_from_checked(
         values
     };
     Ok(Npy { shape, values, notes })
+}
+
+/// The body is read this many bytes at a time (a multiple of every element's size).
+const CHUNK: usize = 1 << 20;
+
+/// An empty vector with room for `n` values, or the memory error (not an abort).
+fn reserve<T>(n: usize) -> Result<Vec<T>, NpyErrorKind> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(n).map_err(|_| {
+        NpyErrorKind::Memory(format!(
+            "reading {n} values: the allocator refused {} (ulimit -v, or the machine's memory)",
+            crate::io::budget::gib((n * std::mem::size_of::<T>()) as u64)
+        ))
+    })?;
+    Ok(v)
+}
+
+/// Reads `bytes` bytes of `r` through `chunk`, handing each read part (whole elements of
+/// `size` bytes) to `take`.
+fn read_chunks(
+    r: &mut impl Read,
+    bytes: u64,
+    chunk: &mut [u8],
+    size: usize,
+    mut take: impl FnMut(&[u8]),
+) -> Result<(), NpyErrorKind> {
+    let mut left = bytes;
+    while left > 0 {
+        let n = chunk.len().min(usize::try_from(left).unwrap_or(usize::MAX));
+        let n = n - n % size;
+        let part = &mut chunk[..n];
+        r.read_exact(part).map_err(NpyErrorKind::Io)?;
+        take(part);
+        left -= n as u64;
+    }
+    Ok(())
 }
 
 fn word32(c: &[u8], swap: bool) -> u32 {

@@ -18,19 +18,58 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail, ensure};
 
+/// The longest file name most file systems take, in bytes.
+const MAX_NAME: usize = 255;
+
+/// What a file that is not a regular file is, for a message.
+pub fn file_kind(meta: &fs::Metadata) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let t = meta.file_type();
+        if t.is_fifo() {
+            return "a FIFO";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+        if t.is_block_device() || t.is_char_device() {
+            return "a device";
+        }
+    }
+    if meta.is_dir() {
+        "a folder"
+    } else if meta.is_file() {
+        "a regular file"
+    } else {
+        "not a file"
+    }
+}
+
 /// Writes `path` whole: `write` fills a buffered temporary file in the same folder, which
 /// then replaces `path`. On any error nothing at `path` changes.
 ///
 /// # Errors
 /// What `write` returns, or the I/O error, with the path.
 pub fn write_whole(path: &Path, write: impl FnOnce(&mut dyn Write) -> Result<()>) -> Result<()> {
+    stage(path, write)?.persist()
+}
+
+/// As [`write_whole`], but left in its temporary file: the caller persists it once the
+/// run's other outputs are written too, so that a run that fails later (the light field's
+/// file past `ulimit -f`) leaves none of its results, not the small ones alone. Dropped
+/// unpersisted, the temporary file is removed.
+///
+/// # Errors
+/// What `write` returns, or the I/O error, with the path.
+pub fn stage(path: &Path, write: impl FnOnce(&mut dyn Write) -> Result<()>) -> Result<WholeFile> {
     let mut whole = WholeFile::create(path)?;
     let failed = || format!("cannot write {}", path.display());
     let mut out = BufWriter::new(whole.file());
     write(&mut out).with_context(failed)?;
     out.flush().with_context(failed)?;
     drop(out);
-    whole.persist()
+    Ok(whole)
 }
 
 /// A file written whole in any order (a streamed decode's rows at their offsets): a
@@ -51,8 +90,28 @@ impl WholeFile {
         let failed = || format!("cannot write {}", path.display());
         let name = path.file_name().with_context(|| format!("cannot write {}: not a file name", path.display()))?;
         ensure!(!path.is_dir(), "cannot write {}: a folder", path.display());
+        // A FIFO, a socket or a device would be replaced by the rename, not written: the
+        // reader at the other end of a FIFO would wait for ever and the name would become
+        // a plain file.
+        if let Ok(meta) = fs::metadata(path) {
+            ensure!(meta.is_file(), "cannot write {}: not a regular file ({})", path.display(), file_kind(&meta));
+        }
+        // ".NAME.XXXXXX.part": 13 bytes more than the name, so a legal name of up to 255
+        // bytes is cut to what the file system takes (the temporary's name is only seen
+        // if the run is killed).
         let mut prefix = std::ffi::OsString::from(".");
-        prefix.push(name);
+        if name.len() <= MAX_NAME - 13 {
+            prefix.push(name);
+        } else {
+            let mut cut = String::new();
+            for c in name.to_string_lossy().chars() {
+                if cut.len() + c.len_utf8() > MAX_NAME - 13 {
+                    break;
+                }
+                cut.push(c);
+            }
+            prefix.push(cut);
+        }
         prefix.push(".");
         let mut builder = tempfile::Builder::new();
         builder.prefix(&prefix).suffix(".part");

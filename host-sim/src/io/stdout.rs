@@ -25,26 +25,48 @@ macro_rules! outln {
 /// The write's error, as "cannot write to standard output".
 pub fn line(args: std::fmt::Arguments<'_>) -> anyhow::Result<()> {
     let mut out = std::io::stdout().lock();
-    out.write_fmt(args)
-        .and_then(|()| out.write_all(b"\n"))
-        .and_then(|()| out.flush())
-        .map_err(|e| anyhow::Error::new(e).context("cannot write to standard output"))
+    out.write_fmt(args).and_then(|()| out.write_all(b"\n")).and_then(|()| out.flush()).map_err(|e| {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            anyhow::Error::new(ClosedStdout)
+        } else {
+            anyhow::Error::new(e).context("cannot write to standard output")
+        }
+    })
 }
 
-/// Whether `e` is a write to a pipe whose reader has gone (`slf ... | head`).
+/// Standard output's reader has gone (`slf ... | head`). Its own type, so that a broken
+/// pipe elsewhere (an output file that is a FIFO whose reader died, a child's pipe) is
+/// still the error it is and never ends the run with exit 0.
+#[derive(Debug)]
+pub struct ClosedStdout;
+
+impl std::fmt::Display for ClosedStdout {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("standard output was closed by its reader")
+    }
+}
+
+impl std::error::Error for ClosedStdout {}
+
+/// Whether `e` is standard output's reader going away (`slf ... | head`), and nothing else:
+/// a broken pipe on any other file is a failure.
 pub fn closed_pipe(e: &anyhow::Error) -> bool {
-    e.chain().any(|c| c.downcast_ref::<std::io::Error>().is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe))
+    e.chain().any(|c| c.is::<ClosedStdout>())
 }
 
 #[cfg(test)]
 mod tests {
-    use crate::io::stdout::closed_pipe;
+    use crate::io::stdout::{ClosedStdout, closed_pipe};
 
     #[test]
     fn a_closed_pipe_is_told_from_other_failures() {
-        let pipe = anyhow::Error::new(std::io::Error::from(std::io::ErrorKind::BrokenPipe)).context("cannot write");
+        let stdout = anyhow::Error::new(ClosedStdout).context("while printing the summary");
         let full = anyhow::Error::new(std::io::Error::from(std::io::ErrorKind::StorageFull)).context("cannot write");
-        assert!(closed_pipe(&pipe));
+        // A broken pipe on an output file (a FIFO whose reader died) is a failure.
+        let fifo =
+            anyhow::Error::new(std::io::Error::from(std::io::ErrorKind::BrokenPipe)).context("cannot write out.npy");
+        assert!(closed_pipe(&stdout));
         assert!(!closed_pipe(&full));
+        assert!(!closed_pipe(&fifo));
     }
 }

@@ -462,7 +462,17 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
         let Workspace { signal, coeffs, measurements, .. } = ws;
         shares::to_sensor::<S>(measurements, signal, coeffs);
         let cfg = &self.config.sl0;
-        Ok((estimate::<S>(hold, ws.measurements(), ws.patch(), cfg.noise, cfg.shot), solves))
+        // Each entry's view flat, at the pixel the patch read it from (the shear's lenslet).
+        let views = (usize::from(self.config.sensor.lenslet.rows), usize::from(self.config.sensor.lenslet.cols));
+        let flat = |i: usize| {
+            let [s, t, u, v, _] = S::coordinates(i);
+            let (vr, vc) = (usize::from(origin.view_row) + u, usize::from(origin.view_col) + v);
+            origin
+                .lenslet::<S>(s, t, u, v, views)
+                .and_then(|l| self.sensor_pixel(l, vr, vc))
+                .map_or(1.0, |(row, col)| self.view_gain(row, col))
+        };
+        Ok((estimate::<S>(hold, ws.measurements(), ws.patch(), (cfg.noise, cfg.shot), flat), solves))
     }
 
     /// This decoder with each spatial block sheared to the disparity of `range` its

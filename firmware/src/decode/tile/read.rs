@@ -236,7 +236,7 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
     /// The flat field of sensor pixel `(row, col)`'s view ([`Self::with_view_gains`]); 1
     /// without one.
     #[inline(always)]
-    pub(super) fn view_gain(&self, row: usize, col: usize) -> f32 {
+    pub fn view_gain(&self, row: usize, col: usize) -> f32 {
         let Some((table, (rr, rc))) = self.view_gains else { return 1.0 };
         let (lenslet, lenslets) = (self.config.sensor.lenslet, self.config.sensor.lenslets);
         let (lu, lv) = (usize::from(lenslet.rows), usize::from(lenslet.cols));

@@ -14,9 +14,9 @@ use slf_host::firmware::disparity::Disparity;
 use slf_host::io::calibration::Calibration;
 use slf_host::io::capture::Capture;
 use slf_host::io::hdf5_rows::Hdf5Rows;
-use slf_host::io::lightfield::{Dtype, write_npy_f32_2d};
+use slf_host::io::lightfield::{Dtype, stage_npy_f32_2d};
 use slf_host::io::npy_rows::NpyRows;
-use slf_host::io::output::{Outputs, write_bytes};
+use slf_host::io::output::{Outputs, stage};
 use slf_host::io::rows::{RowSink, Rows};
 
 #[derive(clap::Args)]
@@ -77,6 +77,11 @@ impl RowSink for Interruptible<'_> {
         self.inner.row(y, first_col, row)
     }
 }
+
+/// The estimate line when no patch could be estimated.
+const NO_ESTIMATE: &str = "no patch could be estimated (with a response that mixes bands, `--response-model \
+                           projection`, a held-out measurement has no decoded value to be compared with); the \
+                           error map is NaN everywhere";
 
 /// `slf decode --format`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -205,6 +210,9 @@ pub fn run(args: Args) -> Result<()> {
         }
         Outcome::Cs { options, report } => (options, report),
     };
+    // The maps are written to their temporary files first and put in place only once the
+    // light field's file is: a decode that fails at its last write leaves none of them.
+    let mut staged = Vec::new();
     if let Some(path) = member_map {
         let mut csv = String::from("lenslet_row,lenslet_col,view_row,view_col,disparity,decoder,member\n");
         for (o, d) in &r.member_map {
@@ -219,19 +227,24 @@ pub fn run(args: Args) -> Result<()> {
                 d.name()
             );
         }
-        write_bytes(&path, csv.as_bytes())?;
+        staged.push(stage(&path, |w| Ok(w.write_all(csv.as_bytes())?))?);
     }
     let (rows, cols) = (cap.description.lenslets[0], cap.description.lenslets[1]);
     if let Some(path) = disparity_map {
         let map = disparity_per_lenslet(&r.disparity_map, rows, cols);
-        write_npy_f32_2d(&path, &map, rows, cols).with_context(|| format!("cannot write {}", path.display()))?;
+        staged.push(stage_npy_f32_2d(&path, &map, rows, cols)?);
     }
-    let errors = r.error_per_lenslet(rows, cols);
+    // Asked for and none made (the response in the projection leaves no patch a
+    // held-out measurement it can predict): NaN everywhere, as a lenslet no patch estimated.
+    let errors = r.error_per_lenslet(rows, cols).or_else(|| settings.estimate.then(|| vec![f32::NAN; rows * cols]));
     if let (Some(path), Some(map)) = (&error_map, &errors) {
-        write_npy_f32_2d(path, map, rows, cols).with_context(|| format!("cannot write {}", path.display()))?;
+        staged.push(stage_npy_f32_2d(path, map, rows, cols)?);
     }
     let peak = f64::from(file.max());
     file.finish(&format!("{opts:?}"))?;
+    for map in staged {
+        map.persist()?;
+    }
     let used = opts.solver_config(&cap);
     let ball = match (opts.noise, used.noise > 0.0 || used.shot > 0.0) {
         (_, false) => "exact projection".to_string(),
@@ -353,7 +366,9 @@ pub fn run(args: Args) -> Result<()> {
     }
     if let Some(map) = &errors {
         let psnr = estimated_psnr(map, peak).map_or("none".into(), |p| format!("{p:.2} dB"));
-        let by = if r.error_lenslets.is_empty() {
+        let by = if r.error_lenslets.is_empty() && r.error_map.is_empty() {
+            NO_ESTIMATE.to_string()
+        } else if r.error_lenslets.is_empty() {
             format!("{} of {} patches from held-out measurements", r.error_map.len(), r.patches.decoded)
         } else if r.blend.is_some() {
             "the baseline blend's held-out decodes, every sample held out once".to_string()

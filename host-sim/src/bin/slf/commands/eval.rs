@@ -1,11 +1,11 @@
 //! `slf eval`: PSNR, SSIM and spectral angle of a reconstruction against the ground truth.
 
-use std::io::Write;
 use std::path::PathBuf;
 
-use anyhow::{Result, ensure};
-use slf_host::eval::metrics::{BLOCK, blocks_over, evaluate, map_accuracy};
+use anyhow::{Context, Result, bail, ensure};
+use slf_host::eval::metrics::{BLOCK, WIN, blocks_over, check_error_map, evaluate, map_accuracy};
 use slf_host::io::lightfield::{LightField, read_npy, read_npy_f32_2d};
+use slf_host::outln;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -35,7 +35,19 @@ fn interior(lf: LightField, border: usize, what: &str) -> Result<LightField> {
         lf.rows,
         lf.cols
     );
-    Ok(lf.window(border, border, lf.rows - 2 * border, lf.cols - 2 * border))
+    let (rows, cols) = (lf.rows - 2 * border, lf.cols - 2 * border);
+    // SSIM's window must fit in what is scored: name the flag that cut it too small, and
+    // the largest it may be.
+    if (rows < WIN || cols < WIN) && lf.rows >= WIN && lf.cols >= WIN {
+        bail!(
+            "--border {border} leaves {rows} x {cols} of the {what}'s {} x {} lenslets, and SSIM needs at least {WIN} \
+             x {WIN}: at most --border {}",
+            lf.rows,
+            lf.cols,
+            (lf.rows.min(lf.cols) - WIN) / 2
+        );
+    }
+    Ok(lf.window(border, border, rows, cols))
 }
 
 pub fn run(args: Args) -> Result<()> {
@@ -51,22 +63,19 @@ pub fn run(args: Args) -> Result<()> {
     let (truth, recon) = (interior(truth, b, "ground truth")?, interior(recon, b, "reconstruction")?);
     let m = evaluate(&truth, &recon)?;
     let (over, blocks) = blocks_over(&truth, &recon);
-    // Written, not `println!`: a reader that stops early (`slf eval A B | head -1`)
-    // closes the pipe, and `println!` panics on that.
-    let mut out = std::io::stdout().lock();
     if b > 0 {
-        writeln!(
-            out,
+        outln!(
             "scored: lenslets {b}..{} x {b}..{} of {full_rows} x {full_cols} (--border {b})",
             full_rows - b,
             full_cols - b
         )?;
     }
-    writeln!(out, "PSNR {:.3} dB (data range {:.6} = max of ground truth)", m.psnr, m.data_range)?;
-    writeln!(out, "SSIM {:.4}", m.ssim)?;
-    writeln!(out, "SA   {:.3} deg", m.sa)?;
+    outln!("PSNR {:.3} dB (data range {:.6} = max of ground truth)", m.psnr, m.data_range)?;
+    outln!("SSIM {:.4}", m.ssim)?;
+    outln!("SA   {:.3} deg", m.sa)?;
     if let Some(path) = &args.error_map {
         let full = read_npy_f32_2d(path, (full_rows, full_cols))?;
+        check_error_map(&full, full_cols).with_context(|| path.display().to_string())?;
         let map: Vec<f32> = full
             .chunks_exact(full_cols)
             .skip(b)
@@ -74,8 +83,7 @@ pub fn run(args: Args) -> Result<()> {
             .flat_map(|row| row.iter().skip(b).take(truth.cols).copied())
             .collect();
         let a = map_accuracy(&truth, &recon, &map)?;
-        writeln!(
-            out,
+        outln!(
             "estimate PSNR {:.3} dB (true {:.3}); blocks of {BLOCK} x {BLOCK} lenslets: rank correlation {:.3}, {:.1} % \
              within 2 x of the true RMS error ({} blocks)",
             a.estimated_psnr,
@@ -85,8 +93,7 @@ pub fn run(args: Args) -> Result<()> {
             a.blocks
         )?;
     }
-    writeln!(
-        out,
+    outln!(
         "over {over} of {blocks} blocks of {BLOCK} x {BLOCK} lenslets decoded above 2 x the truth's maximum + 0.05"
     )?;
     Ok(())
