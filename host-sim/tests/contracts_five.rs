@@ -231,3 +231,132 @@ fn an_output_that_is_a_fifo_is_refused() {
     use std::os::unix::fs::FileTypeExt;
     assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
 }
+
+/// Sends `signal` to `child` once a temporary (`.NAME.*.part`) shows in `dir`; returns the
+/// exit code and standard error.
+#[cfg(unix)]
+fn interrupt_when_writing(
+    mut child: std::process::Child,
+    dir: &Path,
+    signal: nix::sys::signal::Signal,
+) -> (Option<i32>, String) {
+    let pid = nix::unistd::Pid::from_raw(child.id() as i32);
+    let start = std::time::Instant::now();
+    while start.elapsed() < std::time::Duration::from_secs(60) {
+        if files_in(dir).iter().any(|n| n.ends_with(".part")) {
+            nix::sys::signal::kill(pid, signal).unwrap();
+            break;
+        }
+        if child.try_wait().unwrap().is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let out = child.wait_with_output().unwrap();
+    (out.status.code(), String::from_utf8(out.stderr).unwrap())
+}
+
+/// Item 6: an interrupt (SIGINT, SIGTERM) during a decode, a simulate with calibration
+/// captures or a scene ends the run with 130 and leaves no temporary (before: `.NAME.*.part`
+/// folders after simulate, calibrate and scene, which had no handler; a decode saw the
+/// interrupt only at its next finished row, and two of them left its temporary).
+#[cfg(unix)]
+#[test]
+fn an_interrupt_leaves_no_temporary() {
+    use nix::sys::signal::Signal;
+    use std::process::Stdio;
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n);
+    ok(slf().args(["scene", "texture", "--size", "80", "-o"]).arg(p("lf.npy")));
+    ok(slf().arg("simulate").arg(p("lf.npy")).args(["-s", "3", "-o"]).arg(p("cap")));
+    let out = p("out");
+    std::fs::create_dir(&out).unwrap();
+    let spawn = |args: Vec<std::ffi::OsString>| {
+        Std::new(bin()).args(args).stdout(Stdio::null()).stderr(Stdio::piped()).spawn().unwrap()
+    };
+    let os = |v: &[&dyn AsRef<std::ffi::OsStr>]| v.iter().map(|a| a.as_ref().to_os_string()).collect::<Vec<_>>();
+    let runs: Vec<(Vec<std::ffi::OsString>, Signal)> = vec![
+        (os(&[&"decode", &p("cap"), &"-q", &"-o", &out.join("x.npy")]), Signal::SIGINT),
+        (os(&[&"decode", &p("cap"), &"-q", &"-o", &out.join("x.h5")]), Signal::SIGTERM),
+        (
+            os(&[
+                &"simulate",
+                &p("lf.npy"),
+                &"-o",
+                &out.join("c"),
+                &"--calibration-captures",
+                &out.join("cc"),
+                &"--exposures",
+                &"4",
+            ]),
+            Signal::SIGINT,
+        ),
+        (os(&[&"scene", &"texture", &"--size", &"400", &"-o", &out.join("s.npy")]), Signal::SIGTERM),
+    ];
+    for (args, signal) in runs {
+        let (code, err) = interrupt_when_writing(spawn(args.clone()), &out, signal);
+        assert_eq!(code, Some(130), "{args:?}: {err}");
+        assert!(err.contains("interrupted") && !err.contains("panicked"), "{err}");
+        assert_eq!(files_in(&out), Vec::<String>::new(), "{args:?}");
+    }
+}
+
+/// Item 7: `slf bench --from` writes its three files together: a `bench.png` that cannot be
+/// written leaves `bench.csv` and `bench.md` as they were (before: both already replaced);
+/// a large table of alternating masks is drawn (before: quadratic, past 120 s at 100,000
+/// rows; the series are tested in `plot.rs`).
+#[test]
+fn bench_from_writes_its_files_together() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n);
+    let mut csv = String::from(
+        "mask,k,setting,psnr_db,ssim,sa_deg,ms_per_patch_1_thread,ms_per_patch_all_threads,solves_per_patch,\
+         frame_512_s_1_thread,pareto\n",
+    );
+    for i in 0..20_000 {
+        let mask = if i % 2 == 0 { "pixel" } else { "lenslet" };
+        csv +=
+            &format!("{mask},3,s{i},{:.2},0.9,2.0,{:.3},1.0,1.0,10.0,false\n", 30.0 + (i % 7) as f64, 1.0 + i as f64);
+    }
+    std::fs::write(p("in.csv"), &csv).unwrap();
+    let out = p("out");
+    let n = ok(slf().args(["bench", "--from"]).arg(p("in.csv")).arg("--out").arg(&out));
+    assert!(n.starts_with("20000 points"), "{n}");
+    assert_eq!(files_in(&out), ["bench.csv", "bench.md", "bench.png"]);
+    // bench.png a folder: nothing is replaced.
+    std::fs::write(out.join("bench.csv"), "old csv").unwrap();
+    std::fs::write(out.join("bench.md"), "old md").unwrap();
+    std::fs::remove_file(out.join("bench.png")).unwrap();
+    std::fs::create_dir(out.join("bench.png")).unwrap();
+    let e = failure(slf().args(["bench", "--from"]).arg(p("in.csv")).arg("--out").arg(&out));
+    assert!(e.contains("bench.png"), "{e}");
+    assert_eq!(std::fs::read_to_string(out.join("bench.csv")).unwrap(), "old csv");
+    assert_eq!(std::fs::read_to_string(out.join("bench.md")).unwrap(), "old md");
+}
+
+/// Item 10: a grid offset that puts most of the array beside the sensor is refused (before:
+/// 200, 200 on 24 lenslets accepted, every lenslet off the sensor); a stray `capture.json`
+/// naming a user's file does not let `slf simulate -o` remove it (before: `thesis.tex`
+/// deleted with the folder it sat in).
+#[test]
+fn grids_and_folders_keep_to_what_is_theirs() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n);
+    ok(slf().args(["scene", "smooth", "--size", "24", "-o"]).arg(p("lf.npy")));
+    let e = failure(slf().arg("simulate").arg(p("lf.npy")).arg("-o").arg(p("g")).args(["--grid-offset", "200,200"]));
+    assert!(e.contains("the middle of the 24 x 24 lenslet array falls at") && e.contains("off the 120 x 120"), "{e}");
+    assert!(!p("g").exists());
+    ok(slf().arg("simulate").arg(p("lf.npy")).arg("-o").arg(p("g")).args(["--grid-offset", "-30,-30"]));
+    // A folder with a stray description naming the user's file.
+    let folder = p("work");
+    std::fs::create_dir(&folder).unwrap();
+    std::fs::write(folder.join("thesis.tex"), "my thesis").unwrap();
+    std::fs::write(
+        folder.join("capture.json"),
+        r#"{"frames": ["thesis.tex"], "files": [{"name": "thesis.tex", "bytes": 9, "crc32": "00000000"}]}"#,
+    )
+    .unwrap();
+    let e = failure(slf().arg("simulate").arg(p("lf.npy")).arg("-o").arg(&folder));
+    assert!(e.contains("thesis.tex") && e.contains("choose a new or empty folder"), "{e}");
+    assert_eq!(std::fs::read_to_string(folder.join("thesis.tex")).unwrap(), "my thesis");
+}

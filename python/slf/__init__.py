@@ -278,7 +278,12 @@ def simulate(
         grid_offset=grid_offset,
     )
     cal = None if calibration_captures is None else _path("calibration_captures", calibration_captures)
-    frames, text, notes = _slf.simulate(arr, args, cal, exposures)
+    # Checked here: a negative count reached the native call as an OverflowError.
+    if isinstance(exposures, (bool, np.bool_)) or not isinstance(exposures, (int, np.integer)):
+        raise TypeError(f"exposures: want an integer in 1..=256, got {exposures!r} ({type(exposures).__name__})")
+    if not 1 <= int(exposures) <= 256:
+        raise ValueError(f"exposures: {int(exposures)} is not in 1..=256")
+    frames, text, notes = _slf.simulate(arr, args, cal, int(exposures))
     for n in notes:
         warnings.warn(f"slf: {n}", stacklevel=2)
     return _from_parts((frames, text))
@@ -309,6 +314,11 @@ def _progress_callback(progress: Any) -> Optional[Callable[[int, int], None]]:
         return None
     if callable(progress):
         return progress
+    if progress is not True:
+        raise TypeError(
+            f"progress: want True, False, None or a callable f(done, total), got {progress!r} "
+            f"({type(progress).__name__})"
+        )
     try:
         from tqdm.auto import tqdm  # type: ignore
     except ImportError:

@@ -3,6 +3,7 @@
 
 use slf_host::sim::flags::FromFlags;
 use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use numpy::{PyArrayDyn, PyReadonlyArrayDyn};
 use pyo3::exceptions::PyValueError;
@@ -10,11 +11,13 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use slf_host::decode::cs::{PatchViews, disparity_per_lenslet, estimated_psnr};
 use slf_host::decode::pipeline::{Outcome, output_shape};
+use slf_host::decode::report::NO_ESTIMATE;
 use slf_host::decode::settings::DecodeSettings;
 use slf_host::io::calibration::Calibration;
 use slf_host::io::lightfield::Dtype;
 use slf_host::io::npy_rows::NpyRows;
 use slf_host::io::output::Outputs;
+use slf_host::io::rows::Stoppable;
 
 use crate::arrays::{plane, to_array};
 use crate::capture::from_parts;
@@ -76,47 +79,80 @@ pub fn decode<'py>(
         }
         _ => {}
     }
-    // The first exception the callback raised; the decode runs on, and it is raised after.
+    // The first exception the callback raised, or Python's KeyboardInterrupt: the decode
+    // stops at its next finished row, a file output is dropped unfinished, and the
+    // exception is raised. Python runs its signal handlers on the main thread only, so the
+    // decode runs on a thread of its own and the calling thread checks them while it waits.
     let raised: Mutex<Option<PyErr>> = Mutex::new(None);
+    let stop = AtomicBool::new(false);
+    let keep = |e: PyErr| {
+        if let Ok(mut r) = raised.lock() {
+            r.get_or_insert(e);
+        }
+        stop.store(true, Ordering::Relaxed);
+    };
     let observer = |done: usize, total: usize| {
-        if let Some(cb) = &progress {
-            Python::attach(|py| {
-                if let Err(e) = cb.call1(py, (done, total)) {
-                    raised.lock().map(|mut r| r.get_or_insert(e).clone_ref(py)).ok();
-                }
-            });
+        if let (Some(cb), false) = (&progress, stop.load(Ordering::Relaxed)) {
+            Python::attach(|py| cb.call1(py, (done, total)).map(drop)).unwrap_or_else(keep);
         }
     };
     // The light field in memory, or its file as it goes; the largest value either way
     // (the estimated PSNR's data range).
-    let (outcome, light_field, peak) = py
-        .detach(|| {
-            let run = || match &output {
-                None => settings.run(&capture, false, &observer).map(|d| {
-                    let peak = d.light_field.max();
-                    (d.outcome, Some(d.light_field), peak)
-                }),
-                Some(path) => {
-                    let mut file = NpyRows::create(path, output_shape(&capture), Dtype::F32)?;
-                    let outcome = settings.run_into(&capture, false, &observer, &mut file)?;
-                    let peak = file.max();
-                    file.finish()?;
-                    Ok((outcome, None, peak))
+    let work = || {
+        let run = || match &output {
+            None => {
+                let mut light_field = output_shape(&capture).zeros()?;
+                let outcome = settings.run_into(
+                    &capture,
+                    false,
+                    &observer,
+                    &mut Stoppable { inner: &mut light_field, stop: &stop },
+                )?;
+                let peak = light_field.max();
+                Ok((outcome, Some(light_field), peak))
+            }
+            Some(path) => {
+                let mut file = NpyRows::create(path, output_shape(&capture), Dtype::F32)?;
+                let outcome =
+                    settings.run_into(&capture, false, &observer, &mut Stoppable { inner: &mut file, stop: &stop })?;
+                let peak = file.max();
+                file.finish()?;
+                Ok((outcome, None, peak))
+            }
+        };
+        match threads {
+            None => run(),
+            Some(n) => rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .map_err(|e| anyhow::anyhow!("threads: {e}"))
+                .and_then(|pool| pool.install(run)),
+        }
+    };
+    let decoded = py.detach(|| {
+        std::thread::scope(|scope| {
+            let (tx, rx) = std::sync::mpsc::channel();
+            scope.spawn(move || tx.send(work()));
+            loop {
+                match rx.recv_timeout(std::time::Duration::from_millis(20)) {
+                    Ok(result) => return result,
+                    Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
+                        if !stop.load(Ordering::Relaxed) {
+                            Python::attach(|py| py.check_signals()).unwrap_or_else(keep);
+                        }
+                    }
+                    Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                        return Err(anyhow::anyhow!("the decode's thread ended without a result"));
+                    }
                 }
-            };
-            match threads {
-                None => run(),
-                Some(n) => rayon::ThreadPoolBuilder::new()
-                    .num_threads(n)
-                    .build()
-                    .map_err(|e| anyhow::anyhow!("threads: {e}"))
-                    .and_then(|pool| pool.install(run)),
             }
         })
-        .or_py()?;
+    });
+    // The callback's exception first: the decode's error is then only that it was stopped.
     if let Some(e) = raised.lock().ok().and_then(|mut r| r.take()) {
         return Err(e);
     }
+    let (outcome, light_field, peak) = decoded.or_py()?;
     let report = PyDict::new(py);
     if let Some(w) = outcome.warning() {
         report.set_item("warning", w)?;
@@ -195,7 +231,10 @@ pub fn decode<'py>(
                 report.set_item("trial", trial)?;
             }
             let (rows, cols) = (d.lenslets[0], d.lenslets[1]);
-            if let Some(map) = r.error_per_lenslet(rows, cols) {
+            if !r.estimated() && settings.estimate {
+                report.set_item("estimate_note", NO_ESTIMATE)?;
+            }
+            if let Some(map) = r.error_map(rows, cols, settings.estimate) {
                 report.set_item("estimated_psnr", estimated_psnr(&map, f64::from(peak)))?;
                 report.set_item("error_map", plane(py, map, rows, cols)?)?;
                 report.set_item("estimate_seconds", r.estimate_seconds)?;

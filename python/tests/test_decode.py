@@ -1,6 +1,8 @@
 """The decode from Python: threads, progress, reports, the GIL released."""
 
 import json
+import os
+import stat
 import threading
 import time
 
@@ -222,3 +224,72 @@ def test_a_baseline_refuses_the_estimate_and_the_trials(capture):
         with pytest.raises(ValueError, match="given with --method demosaic"):
             slf.decode(capture, method="demosaic", **kwargs)
 
+
+
+def test_a_raising_callback_stops_the_decode(capture, tmp_path):
+    """Issue 65, item 8: an exception in the progress callback stops the decode at its next
+    finished row; the callback is not called again and a file output is left unwritten
+    (before: the decode ran to its end, wrote the whole file, then raised)."""
+    calls = []
+
+    def boom(done, total):
+        calls.append(done)
+        raise RuntimeError("stop here")
+
+    out = tmp_path / "lf.npy"
+    with pytest.raises(RuntimeError, match="stop here"):
+        slf.decode(capture, preset="preview", threads=1, progress=boom, output=out)
+    assert calls == [1]
+    assert list(tmp_path.iterdir()) == []
+    with pytest.raises(KeyboardInterrupt):
+        slf.decode(capture, preset="preview", threads=1, progress=lambda d, t: (_ for _ in ()).throw(KeyboardInterrupt))
+
+
+def test_ctrl_c_stops_a_decode_without_a_callback(tmp_path):
+    """Issue 65, item 8: Python's signals are checked as the decode goes, so Ctrl-C
+    (SIGINT) stops it with KeyboardInterrupt and leaves no file (before: only after the
+    whole decode)."""
+    import signal
+
+    big = slf.simulate(slf.scene("texture", size=60), k=3, seed=1)
+    out = tmp_path / "lf.npy"
+    main = threading.main_thread().ident
+    start = time.perf_counter()
+    timer = threading.Timer(0.3, lambda: signal.pthread_kill(main, signal.SIGINT))
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        slf.decode(big, threads=1, output=out)
+    stopped = time.perf_counter() - start
+    timer.join()
+    assert list(tmp_path.iterdir()) == []
+    # The whole decode takes longer than the wait: the interrupt ended it early.
+    start = time.perf_counter()
+    slf.decode(big, threads=1)
+    assert stopped < time.perf_counter() - start
+
+
+def test_keywords_of_the_wrong_kind_are_refused(capture, tmp_path, depth):
+    """Issue 65, item 8: progress=5 is refused (before: accepted, no bar), exposures=-1 is a
+    ValueError naming the range (before: OverflowError), and an output that is a FIFO is
+    refused, not replaced by a file."""
+    with pytest.raises(TypeError, match="progress: want True, False, None or a callable"):
+        slf.decode(capture, preset="preview", progress=5)
+    with pytest.raises(ValueError, match=r"exposures: -1 is not in 1..=256"):
+        slf.simulate(depth, k=1, calibration_captures=tmp_path / "cc", exposures=-1)
+    fifo = tmp_path / "out.npy"
+    os.mkfifo(fifo)
+    with pytest.raises(ValueError, match="not a regular file"):
+        slf.decode(capture, preset="preview", output=fifo)
+    assert stat.S_ISFIFO(os.stat(fifo).st_mode)
+
+
+def test_an_error_map_asked_for_is_in_the_report(depth, tmp_path):
+    """Issue 65, item 4: error_map=True where no patch can be estimated (the response in
+    the projection) gives a NaN map and a note why (before: no error_map key)."""
+    cap = slf.simulate(depth, k=1, seed=1, vignetting=0.3, calibration_captures=tmp_path / "cc", exposures=1)
+    slf.calibrate(tmp_path / "cc", tmp_path / "cal")
+    _, report = slf.decode(
+        cap, preset="preview", calibration=tmp_path / "cal", response_model="projection", error_map=True
+    )
+    assert report["error_map"].shape == (20, 20) and np.isnan(report["error_map"]).all()
+    assert "no patch could be estimated" in report["estimate_note"]

@@ -200,7 +200,24 @@ impl DecodeReport {
         }
         (!self.error_map.is_empty()).then(|| error_per_lenslet(&self.error_map, rows, cols))
     }
+
+    /// As [`Self::error_per_lenslet`], and with `asked` (an estimate was asked for) NaN
+    /// everywhere where no patch could be estimated ([`NO_ESTIMATE`]): a map asked for is
+    /// always written, never silently left out.
+    pub fn error_map(&self, rows: usize, cols: usize, asked: bool) -> Option<Vec<f32>> {
+        self.error_per_lenslet(rows, cols).or_else(|| asked.then(|| vec![f32::NAN; rows * cols]))
+    }
+
+    /// Whether an estimate was made: a patch's or a held-out decode's.
+    pub fn estimated(&self) -> bool {
+        !self.error_lenslets.is_empty() || !self.error_map.is_empty()
+    }
 }
+
+/// Why an error map asked for is NaN everywhere.
+pub const NO_ESTIMATE: &str = "no patch could be estimated (with a response that mixes bands, `--response-model \
+                               projection`, a held-out measurement has no decoded value to be compared with); the \
+                               error map is NaN everywhere";
 
 /// The PSNR an error map estimates for a light field whose values span `data_range`: the
 /// mean squared error is the mean of the lenslets' squared estimates (NaN ones left out);

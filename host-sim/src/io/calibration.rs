@@ -328,7 +328,8 @@ impl Calibration {
     /// was (before, a failed write could leave new dark levels beside old flats). An
     /// existing `dir` must be empty or a calibration folder.
     pub fn save(&self, dir: &Path) -> Result<()> {
-        let folder = WholeFolder::create(dir, Kind::Files(DESCRIPTION, &[DARK, FLAT]))?;
+        // A calibration's files are the fixed two; its `files` names nothing more to replace.
+        let folder = WholeFolder::create(dir, Kind::Files(DESCRIPTION, &[DARK, FLAT], |_| false))?;
         let at = folder.path();
         let (rows, cols) = self.frame_size();
         write_npy_f32_2d(&at.join(DARK), &self.dark, rows, cols)?;

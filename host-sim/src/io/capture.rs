@@ -519,7 +519,7 @@ impl Capture {
     /// renamed into place at the end, so a failure leaves the old folder as it was. An
     /// existing `dir` must be empty or a capture folder.
     pub fn save(&self, dir: &Path) -> Result<()> {
-        let folder = WholeFolder::create(dir, Kind::Files(DESCRIPTION, &[]))?;
+        let folder = WholeFolder::create(dir, Kind::Files(DESCRIPTION, &[], is_frame_name))?;
         self.write_into(folder.path())?;
         folder.persist()
     }
@@ -544,6 +544,15 @@ impl Capture {
         let text = serde_json::to_string_pretty(&description)?;
         write_bytes(&dir.join(DESCRIPTION), (text + "\n").as_bytes())
     }
+}
+
+/// Whether `name` is a frame's name as a capture writes it: `snapshot_N.npy`, `.pgm` or
+/// `.png` ([`crate::io::frame_file::frame_names`]); only such files of an old capture are
+/// replaced with it.
+fn is_frame_name(name: &str) -> bool {
+    let Some(rest) = name.strip_prefix("snapshot_") else { return false };
+    let Some((n, ext)) = rest.split_once('.') else { return false };
+    !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()) && matches!(ext, "npy" | "pgm" | "png")
 }
 
 /// The folder path's description file.

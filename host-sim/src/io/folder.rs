@@ -21,18 +21,20 @@ use anyhow::{Context, Result, bail, ensure};
 use serde::{Deserialize, Serialize};
 
 /// What a folder holds, and so what an existing folder at the target may be replaced.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug)]
 pub enum Kind {
     /// Files: the description (`capture.json`, `calibration.json`), the files of fixed
-    /// names beside it, and the ones its `frames` or `files` name.
-    Files(&'static str, &'static [&'static str]),
+    /// names beside it, and the ones its `frames` or `files` name that are names of this
+    /// kind (the function): a stray `capture.json` naming `thesis.tex` does not make the
+    /// folder's `thesis.tex` one to replace.
+    Files(&'static str, &'static [&'static str], fn(&str) -> bool),
     /// Folders, each holding the description (a set of calibration captures).
     Folders(&'static str),
 }
 
 /// The names a folder of [`Kind::Files`] may hold: the description, `fixed`, and what the
 /// description at `target` names in `frames` and `files`.
-fn named_files(target: &Path, description: &str, fixed: &[&str]) -> Vec<String> {
+fn named_files(target: &Path, description: &str, fixed: &[&str], ours: fn(&str) -> bool) -> Vec<String> {
     let mut names: Vec<String> = std::iter::once(description).chain(fixed.iter().copied()).map(String::from).collect();
     // A description is small: one larger than 64 MiB (a capture's own cap) is not read,
     // and names nothing.
@@ -42,7 +44,7 @@ fn named_files(target: &Path, description: &str, fixed: &[&str]) -> Vec<String> 
     if let Ok(v) = serde_json::from_str::<serde_json::Value>(&text) {
         let frames = v["frames"].as_array().into_iter().flatten().filter_map(|f| f.as_str());
         let files = v["files"].as_array().into_iter().flatten().filter_map(|f| f["name"].as_str());
-        names.extend(frames.chain(files).map(String::from));
+        names.extend(frames.chain(files).filter(|n| ours(n)).map(String::from));
     }
     names
 }
@@ -52,6 +54,8 @@ fn named_files(target: &Path, description: &str, fixed: &[&str]) -> Vec<String> 
 pub struct WholeFolder {
     temp: tempfile::TempDir,
     target: PathBuf,
+    /// Removed by an interrupt's handler too ([`crate::io::interrupt`]).
+    _tracked: crate::io::interrupt::Tracked,
 }
 
 impl WholeFolder {
@@ -75,7 +79,8 @@ impl WholeFolder {
             .suffix(".part")
             .tempdir_in(&parent)
             .with_context(|| format!("cannot create a folder in {}", parent.display()))?;
-        Ok(Self { temp, target: target.to_path_buf() })
+        let _tracked = crate::io::interrupt::track(temp.path());
+        Ok(Self { temp, target: target.to_path_buf(), _tracked })
     }
 
     /// Where the files go until [`Self::persist`].
@@ -90,7 +95,7 @@ impl WholeFolder {
     /// # Errors
     /// The I/O error; the old folder is put back when the new one cannot take its place.
     pub fn persist(self) -> Result<()> {
-        let Self { temp, target } = self;
+        let Self { temp, target, _tracked } = self;
         let target_text = target.display().to_string();
         if fs::symlink_metadata(&target).is_err() {
             let temp = temp.keep();
@@ -121,11 +126,11 @@ impl WholeFolder {
 fn replaceable(target: &Path, kind: Kind) -> Result<()> {
     let Ok(meta) = fs::symlink_metadata(target) else { return Ok(()) };
     let what = match kind {
-        Kind::Files(d, _) => format!("a folder of {d} and the files it names"),
+        Kind::Files(d, _, _) => format!("a folder of {d} and the files it names"),
         Kind::Folders(d) => format!("a folder of folders holding {d}"),
     };
     let allowed = match kind {
-        Kind::Files(d, fixed) => named_files(target, d, fixed),
+        Kind::Files(d, fixed, ours) => named_files(target, d, fixed, ours),
         Kind::Folders(_) => Vec::new(),
     };
     ensure!(meta.is_dir(), "{} is not a folder: the output is {what}", target.display());
@@ -134,7 +139,7 @@ fn replaceable(target: &Path, kind: Kind) -> Result<()> {
         let entry = entry.with_context(|| format!("cannot read {}", target.display()))?;
         let (path, t) = (entry.path(), entry.file_type()?);
         let fits = match kind {
-            Kind::Files(d, _) => {
+            Kind::Files(d, _, _) => {
                 described |= entry.file_name() == d;
                 t.is_file() && allowed.iter().any(|n| entry.file_name() == n.as_str())
             }
@@ -152,7 +157,7 @@ fn replaceable(target: &Path, kind: Kind) -> Result<()> {
             );
         }
     }
-    if let Kind::Files(d, _) = kind {
+    if let Kind::Files(d, _, _) = kind {
         ensure!(
             described || fs::read_dir(target).map(|mut r| r.next().is_none()).unwrap_or(false),
             "{} holds files but no {d}: the output replaces the folder whole, so choose a new or empty folder",
@@ -260,7 +265,7 @@ mod tests {
     fn a_folder_is_replaced_whole_or_not_at_all() {
         let dir = tempfile::tempdir().unwrap();
         let target = dir.path().join("cap");
-        let kind = Kind::Files("capture.json", &["a", "b"]);
+        let kind = Kind::Files("capture.json", &["a", "b"], |_| false);
         let write = |files: &[(&str, &str)], keep: bool| -> Result<()> {
             let f = WholeFolder::create(&target, kind)?;
             for (n, t) in files {

@@ -140,6 +140,23 @@ impl GridDescription {
                 self.sensor[1]
             );
         }
+        // Most of the array on the sensor: its middle lenslet's centre on it (an offset of
+        // 200, 200 on 24 x 24 lenslets of 5 px once put every lenslet beside the sensor,
+        // exit 0, and a decode of nothing).
+        let mid = self.centre((lenslets[0] as f64 - 1.0) / 2.0, (lenslets[1] as f64 - 1.0) / 2.0);
+        ensure!(
+            (0..2).all(|a| (0.0..self.sensor[a] as f64).contains(&mid[a])),
+            "lenslet_grid.offset {}, {} px: the middle of the {} x {} lenslet array falls at ({:.1}, {:.1}), off the {} \
+             x {} sensor (a part of the array may reach past its edges, not most of it)",
+            number_f64(self.offset[0]),
+            number_f64(self.offset[1]),
+            lenslets[0],
+            lenslets[1],
+            mid[0],
+            mid[1],
+            self.sensor[0],
+            self.sensor[1]
+        );
         if let Some(r) = self.centres_rms_px {
             ensure!(r.is_finite() && r >= 0.0, "lenslet_grid.centres_rms_px {}: must be at or above 0", number_f64(r));
         }

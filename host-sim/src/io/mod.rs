@@ -14,6 +14,7 @@
 //! - [`hdf5_rows`]: a light field's HDF5 file, from its rows;
 //! - [`folder`]: folders written whole, and the checksums their descriptions record;
 //! - [`grid`]: the lenslet grid, where a real lenslet array sits on the sensor;
+//! - [`interrupt`]: an interrupt ends a command and removes its temporaries;
 //! - [`import`]: views, hyperspectral cubes, HDF5 light fields and band resampling;
 //! - [`message`]: an error as the one line a user reads;
 //! - [`output`]: results written whole, never over an input of the same run;
@@ -34,6 +35,7 @@ pub mod frame_file;
 pub mod grid;
 pub mod hdf5_rows;
 pub mod import;
+pub mod interrupt;
 pub mod lightfield;
 pub mod message;
 pub mod npy;

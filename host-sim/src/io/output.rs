@@ -79,6 +79,8 @@ pub fn stage(path: &Path, write: impl FnOnce(&mut dyn Write) -> Result<()>) -> R
 pub struct WholeFile {
     tmp: tempfile::NamedTempFile,
     path: PathBuf,
+    /// Removed by an interrupt's handler too ([`crate::io::interrupt`]).
+    _tracked: crate::io::interrupt::Tracked,
 }
 
 impl WholeFile {
@@ -120,7 +122,8 @@ impl WholeFile {
         #[cfg(unix)]
         builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
         let tmp = builder.tempfile_in(parent(path)).with_context(failed)?;
-        Ok(Self { tmp, path: path.to_path_buf() })
+        let _tracked = crate::io::interrupt::track(tmp.path());
+        Ok(Self { tmp, path: path.to_path_buf(), _tracked })
     }
 
     /// The temporary file, to write (and seek) in.

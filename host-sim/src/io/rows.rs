@@ -23,6 +23,23 @@ pub fn put_row(sink: &mut Rows<'_>, y: usize, row: &[f32]) -> Result<()> {
     sink.row(y, 0, row)
 }
 
+/// A sink that refuses the next row once `stop` is set: a run stopped from outside (Python's
+/// `KeyboardInterrupt`, an exception in a progress callback) ends at its next finished row
+/// with an error, and the file sink behind it is dropped unfinished (nothing written).
+pub struct Stoppable<'a, 'b> {
+    pub inner: &'a mut Rows<'b>,
+    pub stop: &'a std::sync::atomic::AtomicBool,
+}
+
+impl RowSink for Stoppable<'_, '_> {
+    type Error = anyhow::Error;
+
+    fn row(&mut self, y: u16, first_col: u16, row: &[f32]) -> Result<()> {
+        ensure!(!self.stop.load(std::sync::atomic::Ordering::Relaxed), "stopped at lenslet row {y}: nothing written");
+        self.inner.row(y, first_col, row)
+    }
+}
+
 /// Checks that a row put to a host sink is of the whole width (first column 0).
 ///
 /// # Errors

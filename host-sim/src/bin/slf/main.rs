@@ -116,6 +116,8 @@ fn main() -> ExitCode {
 }
 
 fn run(cli: Cli) -> Result<()> {
+    // Before any command makes a temporary: an interrupt removes what it was writing.
+    slf_host::io::interrupt::install()?;
     if let Some(cap) = cli.max_memory {
         slf_host::io::budget::set_cap((cap * f64::from(1u32 << 30)) as u64);
     }

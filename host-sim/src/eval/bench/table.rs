@@ -9,7 +9,7 @@ use super::plot::plot;
 use super::{PSNR_DB, Point, TIME_MS};
 use crate::eval::device_frame::{self, DeviceFrame};
 use crate::io::file_checks::regular_file;
-use crate::io::output::write_bytes;
+use crate::io::output::{WholeFile, stage};
 
 /// Marks, per mask family and k, the points no other point beats in both time (one
 /// thread) and PSNR.
@@ -37,9 +37,25 @@ pub fn write(points: &[Point], device: &[DeviceFrame], dir: &Path) -> Result<()>
     let csv = csv_of(points)?;
     let (md, png) = (markdown(points, device), plot(points)?);
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    write_bytes(&dir.join("bench.csv"), &csv)?;
-    write_bytes(&dir.join("bench.md"), md.as_bytes())?;
-    write_bytes(&dir.join("bench.png"), &png)
+    put_together(dir, Some(&csv), &md, &png)
+}
+
+/// Writes the tables' files into `dir` together: each to its temporary file first, then
+/// all put in place, so a file that cannot be written (`bench.png` read-only, a full disk)
+/// leaves the others as they were (before, `bench.csv` and `bench.md` were already
+/// replaced). `csv`: `None` leaves `bench.csv` as it is.
+fn put_together(dir: &Path, csv: Option<&[u8]>, md: &str, png: &[u8]) -> Result<()> {
+    let bytes = |b: &[u8]| {
+        let b = b.to_vec();
+        move |w: &mut dyn std::io::Write| Ok(w.write_all(&b)?)
+    };
+    let mut staged = Vec::new();
+    if let Some(csv) = csv {
+        staged.push(stage(&dir.join("bench.csv"), bytes(csv))?);
+    }
+    staged.push(stage(&dir.join("bench.md"), bytes(md.as_bytes()))?);
+    staged.push(stage(&dir.join("bench.png"), bytes(png))?);
+    staged.into_iter().try_for_each(WholeFile::persist)
 }
 
 /// Draws `bench.md` and `bench.png` into `dir` again from the `bench.csv` at `from` (with
@@ -57,11 +73,7 @@ pub fn redraw(from: &Path, device: &[DeviceFrame], dir: &Path) -> Result<usize> 
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let target = dir.join("bench.csv");
     let same = matches!((std::fs::canonicalize(from), std::fs::canonicalize(&target)), (Ok(a), Ok(b)) if a == b);
-    if !same {
-        write_bytes(&target, &bytes)?;
-    }
-    write_bytes(&dir.join("bench.md"), md.as_bytes())?;
-    write_bytes(&dir.join("bench.png"), &png)?;
+    put_together(dir, (!same).then_some(&bytes[..]), &md, &png)?;
     Ok(points.len())
 }
 

@@ -4,11 +4,11 @@
 
 use slf_host::outln;
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::{Context, Result};
 use slf_host::decode::cs::{Balance, NoiseSource, PatchDecoder, disparity_per_lenslet, estimated_psnr};
 use slf_host::decode::pipeline::{Outcome, output_shape};
+use slf_host::decode::report::NO_ESTIMATE;
 use slf_host::decode::settings::DecodeSettings;
 use slf_host::firmware::disparity::Disparity;
 use slf_host::io::calibration::Calibration;
@@ -17,7 +17,7 @@ use slf_host::io::hdf5_rows::Hdf5Rows;
 use slf_host::io::lightfield::{Dtype, stage_npy_f32_2d};
 use slf_host::io::npy_rows::NpyRows;
 use slf_host::io::output::{Outputs, stage};
-use slf_host::io::rows::{RowSink, Rows};
+use slf_host::io::rows::Rows;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -60,28 +60,6 @@ pub struct Args {
     #[arg(short, long)]
     pub quiet: bool,
 }
-
-/// Set by the first interrupt of a decode.
-static INTERRUPTED: AtomicBool = AtomicBool::new(false);
-
-/// A sink that refuses the next row once the run is interrupted.
-struct Interruptible<'a> {
-    inner: &'a mut Rows<'a>,
-}
-
-impl RowSink for Interruptible<'_> {
-    type Error = anyhow::Error;
-
-    fn row(&mut self, y: u16, first_col: u16, row: &[f32]) -> Result<()> {
-        anyhow::ensure!(!INTERRUPTED.load(Ordering::Relaxed), "interrupted at lenslet row {y}: nothing written");
-        self.inner.row(y, first_col, row)
-    }
-}
-
-/// The estimate line when no patch could be estimated.
-const NO_ESTIMATE: &str = "no patch could be estimated (with a response that mixes bands, `--response-model \
-                           projection`, a held-out measurement has no decoded value to be compared with); the \
-                           error map is NaN everywhere";
 
 /// `slf decode --format`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -173,8 +151,7 @@ pub fn run(args: Args) -> Result<()> {
     }
     // The light field goes to the file as its rows are decoded; the file takes its place
     // only once the decode and the maps are done. An interrupt (Ctrl-C, SIGTERM) ends the
-    // decode at its next row as an error, so the file is dropped unfinished and nothing is
-    // left in its place (a second interrupt exits at once).
+    // run at once and removes the temporary file (`slf_host::io::interrupt`).
     let mut file = match format {
         Format::Npy => OutputFile::Npy(NpyRows::create(&output, output_shape(&cap), dtype)?),
         Format::Hdf5 => {
@@ -184,14 +161,8 @@ pub fn run(args: Args) -> Result<()> {
             OutputFile::Hdf5(f)
         }
     };
-    let _ = ctrlc::set_handler(|| {
-        if INTERRUPTED.swap(true, Ordering::Relaxed) {
-            std::process::exit(130);
-        }
-    });
-    let outcome = settings
-        .run_into(&cap, !quiet, &|_, _| {}, &mut Interruptible { inner: file.sink() })
-        .with_context(|| capture.display().to_string())?;
+    let outcome =
+        settings.run_into(&cap, !quiet, &|_, _| {}, file.sink()).with_context(|| capture.display().to_string())?;
     if let Some(w) = outcome.warning() {
         eprintln!("warning: {}: {w}", capture.display());
     }
@@ -234,9 +205,8 @@ pub fn run(args: Args) -> Result<()> {
         let map = disparity_per_lenslet(&r.disparity_map, rows, cols);
         staged.push(stage_npy_f32_2d(&path, &map, rows, cols)?);
     }
-    // Asked for and none made (the response in the projection leaves no patch a
-    // held-out measurement it can predict): NaN everywhere, as a lenslet no patch estimated.
-    let errors = r.error_per_lenslet(rows, cols).or_else(|| settings.estimate.then(|| vec![f32::NAN; rows * cols]));
+    // Asked for and none made: NaN everywhere, as a lenslet no patch estimated.
+    let errors = r.error_map(rows, cols, settings.estimate);
     if let (Some(path), Some(map)) = (&error_map, &errors) {
         staged.push(stage_npy_f32_2d(path, map, rows, cols)?);
     }
@@ -366,7 +336,7 @@ pub fn run(args: Args) -> Result<()> {
     }
     if let Some(map) = &errors {
         let psnr = estimated_psnr(map, peak).map_or("none".into(), |p| format!("{p:.2} dB"));
-        let by = if r.error_lenslets.is_empty() && r.error_map.is_empty() {
+        let by = if !r.estimated() {
             NO_ESTIMATE.to_string()
         } else if r.error_lenslets.is_empty() {
             format!("{} of {} patches from held-out measurements", r.error_map.len(), r.patches.decoded)
