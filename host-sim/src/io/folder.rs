@@ -265,7 +265,7 @@ mod tests {
     fn a_folder_is_replaced_whole_or_not_at_all() {
         let dir = tempfile::tempdir().unwrap();
         let target = dir.path().join("cap");
-        let kind = Kind::Files("capture.json", &["a", "b"], |_| false);
+        let kind = Kind::Files("capture.json", &["a", "b"], |n| n.ends_with(".pgm"));
         let write = |files: &[(&str, &str)], keep: bool| -> Result<()> {
             let f = WholeFolder::create(&target, kind)?;
             for (n, t) in files {
