@@ -302,7 +302,7 @@ fn the_decode_unmixes_as_the_inverse_does() {
     };
     // The slow path: one-hot decode of the corrected capture (the white balance the
     // calibrated decode estimates from the same frames), unmixed in f64.
-    let mut slow = run(&corrected(&real, &cal).unwrap(), &[]);
+    let mut slow = run(&corrected(&real, &cal, false).unwrap().0, &[]);
     let r = nalgebra::DMatrix::from_fn(13, 13, |f, b| f64::from(cal.description.response[f][b]));
     let inv = r.try_inverse().unwrap();
     let hi = slow.data.iter().fold(0.0f32, |m, &x| m.max(x));

@@ -21,6 +21,7 @@ use crate::io::calibration::{
     Calibration, CalibrationDescription, FORMAT, Sources, VERSION, check_response, read_response,
 };
 use crate::io::capture::{Capture, DESCRIPTION, Light};
+use crate::io::grid::GridDescription;
 use crate::io::output::Outputs;
 
 /// A pixel whose dark level lies more than this fraction of the range (white - black) above
@@ -124,8 +125,10 @@ pub fn calibrate(captures: &[(String, Capture)], response: Option<Vec<Vec<f32>>>
                 && d.mask == d0.mask
                 && d.black_level == d0.black_level
                 && d.white_level == d0.white_level
-                && d.lenslet_grid.map(|g| g.sensor) == d0.lenslet_grid.map(|g| g.sensor),
-            "{name}: another camera than {first_name}'s (lenslets, views, bands, mask, levels or sensor size differ)"
+                && d.lenslet_grid.map(|g| g.sensor) == d0.lenslet_grid.map(|g| g.sensor)
+                && d.lenslet_grid.map(|g| g.offset) == d0.lenslet_grid.map(|g| g.offset),
+            "{name}: another camera than {first_name}'s (lenslets, views, bands, mask, levels, sensor size or the \
+             stated lenslet (0, 0) differ)"
         );
         // One sensor throughout: a folder holding another simulated sensor's captures
         // beside these once calibrated with rc 0 and cost the decode 5.5 dB.
@@ -190,9 +193,9 @@ pub fn calibrate(captures: &[(String, Capture)], response: Option<Vec<Vec<f32>>>
     let [u_n, v_n] = d0.views;
     let fit = match &d0.lenslet_grid {
         None => None,
-        Some(_) => {
+        Some(stated) => {
             let mended = mend(&flat, &bad, (rows, cols));
-            Some(fit_grid(&mended, (rows, cols), d0.lenslets, d0.views).context("the lenslet grid")?)
+            Some(fit_grid(&mended, (rows, cols), d0.lenslets, d0.views, stated.offset).context("the lenslet grid")?)
         }
     };
     // Vignetting per view: the mean flat of the working pixels at each view (behind a
@@ -333,13 +336,16 @@ pub fn calibrate(captures: &[(String, Capture)], response: Option<Vec<Vec<f32>>>
     if let Some(f) = &fit {
         let g = &f.grid;
         report.lines.push(format!(
-            "lenslet grid: rotation {:.4} degrees, pitch {:.4} x {:.4} px, lenslet (0, 0) at ({:.3}, {:.3}); {} \
-             micro-image centres within {:.3} px RMS ({} left out)",
+            "lenslet grid: rotation {:.4} degrees, pitch {:.4} x {:.4} px, lenslet (0, 0) at ({:.3}, {:.3}) (the \
+             micro-image nearest the captures' stated ({:.3}, {:.3})); {} micro-image centres within {:.3} px RMS ({} \
+             left out)",
             g.rotation_deg,
             g.pitch[0],
             g.pitch[1],
             g.offset[0],
             g.offset[1],
+            g.indexed_at.unwrap_or(g.offset)[0],
+            g.indexed_at.unwrap_or(g.offset)[1],
             f.centres,
             g.centres_rms_px.unwrap_or(0.0),
             f.outliers
@@ -373,11 +379,16 @@ fn mend(flat: &[f32], bad: &[bool], (rows, cols): (usize, usize)) -> Vec<f32> {
 /// capture's black and white levels; hot, dead and saturated pixels join the defects. The
 /// corrected capture's saturation level is the top of 16 bits (a vignetted pixel corrected
 /// may read above the sensor's top code and is still a measurement). A lenslet grid the
-/// calibration found replaces the capture's.
+/// calibration found replaces the capture's, its lenslets named as the capture names
+/// them ([`GridDescription::indexed_as`]; the aligned grid's names without a stated grid):
+/// the whole lenslets it was moved by come back beside the capture. With `keep_grid` the
+/// capture keeps its own grid (`--grid capture` or `aligned`), and the calibration's is
+/// not looked at.
 ///
 /// # Errors
-/// A calibration of another geometry, bands or levels.
-pub fn corrected(capture: &Capture, cal: &Calibration) -> Result<Capture> {
+/// A calibration of another geometry, bands or levels, or whose lenslet grid does not say
+/// which of its lenslets is the capture's (0, 0).
+pub fn corrected(capture: &Capture, cal: &Calibration, keep_grid: bool) -> Result<(Capture, [i64; 2])> {
     let (d, c) = (&capture.description, &cal.description);
     ensure!(
         d.lenslets == c.lenslets && d.views == c.views,
@@ -438,10 +449,17 @@ pub fn corrected(capture: &Capture, cal: &Calibration) -> Result<Capture> {
     }
     let mut description = d.clone();
     description.saturation_level = top;
-    // The grid the calibration found from its flats replaces the one the capture states.
-    description.lenslet_grid = c.lenslet_grid.or(d.lenslet_grid);
+    // The grid the calibration found from its flats replaces the one the capture states,
+    // with the capture's lenslet (0, 0).
+    let mut moved = [0, 0];
+    if let Some(found) = c.lenslet_grid.as_ref().filter(|_| !keep_grid) {
+        let stated = d.lenslet_grid.unwrap_or_else(|| GridDescription::aligned(d.lenslets, d.views));
+        let (grid, by) = found.indexed_as(&stated, d.lenslets, d.views)?;
+        description.lenslet_grid = Some(grid);
+        moved = by;
+    }
     description.defective_pixels = defects.into_iter().collect();
-    Capture::new(description, frames)
+    Ok((Capture::new(description, frames)?, moved))
 }
 
 /// The inverse of `cal`'s response matrix, row-major `[band][filter]`.

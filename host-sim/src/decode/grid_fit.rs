@@ -14,12 +14,14 @@
 //! across a thousand lenslets never loses count. The last fit over every centre, outliers
 //! (a centre more than [`OUTLIER_PX`], or 4 times the median, from the fit) left out,
 //! gives the grid: its pitch the
-//! steps' lengths, its rotation their mean angle. Lenslet `(0, 0)` is the micro-image
-//! nearest where the `S x T` array centred on the sensor puts it.
+//! steps' lengths, its rotation their mean angle. Lenslet `(0, 0)` is the lattice point
+//! nearest where the calibration captures' stated grid puts it (recorded as the grid's
+//! `indexed_at`), so a capture stating the same grid names the same lenslets; the decode
+//! re-names them for a capture stating another ([`GridDescription::indexed_as`]).
 
 use anyhow::{Result, bail, ensure};
 
-use crate::io::grid::{GridDescription, rotate};
+use crate::io::grid::GridDescription;
 
 /// A centre farther than this from the grid fitted to all is left out of the fit, pixels.
 pub const OUTLIER_PX: f64 = 0.5;
@@ -193,7 +195,8 @@ fn solve3(m: [[f64; 3]; 3], rhs: [f64; 3]) -> Option<[f64; 3]> {
 
 /// The lenslet grid of a flat `flat` (`rows x cols`, each pixel's light over white; hot
 /// pixels already replaced), for a light field of `lenslets` lenslets of `views` views,
-/// starting from micro-images `views` pixels apart, unrotated.
+/// starting from micro-images `views` pixels apart, unrotated; its lenslet (0, 0) the
+/// lattice point nearest sensor point `index_at`.
 ///
 /// # Errors
 /// A flat without micro-images to find (no vignetting, too much noise), or a grid outside
@@ -203,6 +206,7 @@ pub fn fit_grid(
     (rows, cols): (usize, usize),
     lenslets: [usize; 2],
     views: [usize; 2],
+    index_at: [f64; 2],
 ) -> Result<GridFit> {
     ensure!(flat.len() == rows * cols && rows >= 3 && cols >= 3, "a flat of {} values for {rows} x {cols}", flat.len());
     let f = Flat { values: flat, rows, cols };
@@ -276,10 +280,8 @@ pub fn fit_grid(
     let pitch = [a[0].hypot(a[1]), b[0].hypot(b[1])];
     // Down a lenslet column is (cos, -sin) * p0, along a row (sin, cos) * p1.
     let rotation_deg = 0.5 * ((-a[1]).atan2(a[0]) + b[0].atan2(b[1])).to_degrees();
-    // Lenslet (0, 0): the micro-image nearest the centred array's.
-    let half = [(lenslets[0] as f64 - 1.0) / 2.0 * pitch[0], (lenslets[1] as f64 - 1.0) / 2.0 * pitch[1]];
-    let turned = rotate(rotation_deg, half);
-    let want = [mid[0] - turned[0], mid[1] - turned[1]];
+    // Lenslet (0, 0): the lattice point nearest the one the captures state.
+    let want = index_at;
     let (mut near, mut dist) = ([0i64; 2], f64::INFINITY);
     // The lattice index of `want`, and the integers about it.
     let det = a[0] * b[1] - b[0] * a[1];
@@ -300,6 +302,7 @@ pub fn fit_grid(
         offset: lattice.at(near[0] as f64, near[1] as f64),
         sensor: [rows, cols],
         centres_rms_px: None,
+        indexed_at: Some(index_at),
     };
     let sq: f64 = found
         .iter()

@@ -103,10 +103,12 @@ impl DecodeSettings {
         let (lo, hi) = capture.raw_format().range();
         let stated = capture.description.lenslet_grid;
         let calibrated;
+        let mut grid_moved = [0, 0];
         let (capture, inverse, response) = match &self.calibration {
             Some(dir) => {
                 let cal = Calibration::load(dir)?;
-                calibrated = corrected(capture, &cal)?;
+                (calibrated, grid_moved) = corrected(capture, &cal, self.grid != GridChoice::Auto)
+                    .map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
                 // The same check on the corrected frames: a dark level at or above the raw
                 // values once decoded to all zeros with "0 flagged".
                 ensure!(
@@ -153,7 +155,7 @@ impl DecodeSettings {
             )),
             _ => None,
         };
-        match (&inverse, modelled) {
+        let mut outcome = match (&inverse, modelled) {
             (Some(inverse), None) => {
                 let bands = output_shape(capture).bands;
                 // Unmixing can take a value below 0 or past the sensor's top (PPID's wrote
@@ -165,7 +167,11 @@ impl DecodeSettings {
                 self.run_corrected(capture, modelled, progress, observer, &mut unmixed)
             }
             _ => self.run_corrected(capture, modelled, progress, observer, sink),
+        }?;
+        if let (Outcome::Cs { report, .. }, GridChoice::Auto) = (&mut outcome, self.grid) {
+            report.grid_moved = grid_moved;
         }
+        Ok(outcome)
     }
 
     /// [`Self::run_into`] on a capture as it is (corrected already, or needing no

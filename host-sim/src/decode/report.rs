@@ -94,6 +94,9 @@ pub struct DecodeReport {
     pub shear_trial: Option<ShearTrialReport>,
     /// The lenslet grid the decode read the frames through (`None`: the aligned sensor).
     pub grid: Option<GridDescription>,
+    /// The whole lenslets `(s, t)` a calibration's grid was moved by to name its lenslets
+    /// as the capture does ([`GridDescription::indexed_as`]; `[0, 0]` when they agreed).
+    pub grid_moved: [i64; 2],
     /// What that grid puts off the sensor: views never measured, their values guessed from
     /// their neighbours (a turned array's corners; none on the aligned grid).
     pub off_sensor: OffSensor,

@@ -262,9 +262,17 @@ pub fn run(args: Args) -> Result<()> {
         } else {
             ""
         };
+        let moved = match r.grid_moved {
+            [0, 0] => String::new(),
+            [s, t] => format!(
+                "; the calibration's grid named as the capture's: its lenslets moved by ({s}, {t}) to put lenslet (0, \
+                 0) at ({:.2}, {:.2}) px",
+                g.offset[0], g.offset[1]
+            ),
+        };
         outln!(
             "lenslet grid: turned {:.4} degrees, pitch {:.4} x {:.4} px, each pixel the shares of the view cells it \
-             covers{edges}{halves}",
+             covers{moved}{edges}{halves}",
             g.rotation_deg,
             g.pitch[0],
             g.pitch[1]
