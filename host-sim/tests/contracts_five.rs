@@ -463,3 +463,19 @@ fn a_calibrations_grid_names_the_lenslets_as_the_capture_does() {
     assert!(!p("d.npy").exists());
     ok(&mut decode("between", "d.npy", &["-q", "--grid", "capture"]));
 }
+
+/// Item 9: `--shear-trial true` where the decode has no half-pixel disparity to try says
+/// it did not run (before: not a word), and says nothing when the preset asked for it.
+#[test]
+fn a_shear_trial_with_nothing_to_try_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n);
+    ok(slf().args(["scene", "texture", "--size", "12", "-o"]).arg(p("lf.npy")));
+    ok(slf().arg("simulate").arg(p("lf.npy")).arg("-o").arg(p("cap")).args(["-s", "3", "--seed", "1"]));
+    let decode = |extra: &[&str]| ok(slf().arg("decode").arg(p("cap")).args(extra).arg("-o").arg(p("a.npy")));
+    let out = decode(&["--shear-trial", "true"]);
+    assert!(out.contains("shear trial: not run (the decode's disparities, -1:1 in whole pixels"), "{out}");
+    let out = decode(&["--shear-trial", "true", "--disparities", "0:0"]);
+    assert!(out.contains("shear trial: not run (the decode searches no disparity)"), "{out}");
+    assert!(!decode(&[]).contains("shear trial"));
+}

@@ -204,6 +204,9 @@ pub fn decode<'py>(
                 trial.set_item("whole_error", t.whole_error)?;
                 report.set_item("shear_trial", trial)?;
             }
+            if let Some(why) = &r.shear_trial_skipped {
+                report.set_item("shear_trial_skipped", why)?;
+            }
             if let Some(why) = &r.blend_skipped {
                 report.set_item("baseline_blend_skipped", why)?;
             }

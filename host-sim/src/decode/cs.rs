@@ -367,6 +367,15 @@ where
         let (half_error, whole_error) = rms(&t.errors);
         ShearTrialReport { pilots: t.errors.pilots, halves: !plan.alias, half_error, whole_error }
     });
+    // Asked for with nothing to try: said, not silent.
+    if opts.shear_trial && plan.shear_trial.is_none() {
+        let d = plan.decoder.disparities();
+        report.shear_trial_skipped = Some(if d.is_off() {
+            "the decode searches no disparity".into()
+        } else {
+            format!("the decode's disparities, {}:{} in whole pixels, have no half-pixel step to try", d.min(), d.max())
+        });
+    }
     report.trial = plan.model_trial.map(|trial| {
         let t = trial.errors;
         let (dct_error, ensemble_error) = rms(&t);

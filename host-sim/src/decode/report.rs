@@ -92,6 +92,8 @@ pub struct DecodeReport {
     /// What the shear trial found ([`crate::decode::options::DecodeOptions::shear_trial`]; `None` without it or
     /// without half-pixel disparities).
     pub shear_trial: Option<ShearTrialReport>,
+    /// Why the shear trial was asked for and not run (no half-pixel disparity to try).
+    pub shear_trial_skipped: Option<String>,
     /// The lenslet grid the decode read the frames through (`None`: the aligned sensor).
     pub grid: Option<GridDescription>,
     /// The whole lenslets `(s, t)` a calibration's grid was moved by to name its lenslets

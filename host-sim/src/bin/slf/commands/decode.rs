@@ -291,6 +291,11 @@ pub fn run(args: Args) -> Result<()> {
             p.margin
         )?;
     }
+    // Said when asked for by name (the presets ask for it wherever the capture's disparities
+    // may have halves).
+    if let Some(why) = r.shear_trial_skipped.as_ref().filter(|_| settings.shear_trial == Some(true)) {
+        outln!("shear trial: not run ({why})")?;
+    }
     if r.shear_trial.is_some_and(|t| t.pilots == 0) {
         outln!(
             "shear trial: no pilot patch at a half-pixel disparity could be estimated; half-pixel disparities kept"
