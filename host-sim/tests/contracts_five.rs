@@ -479,3 +479,34 @@ fn a_shear_trial_with_nothing_to_try_says_so() {
     assert!(out.contains("shear trial: not run (the decode searches no disparity)"), "{out}");
     assert!(!decode(&[]).contains("shear trial"));
 }
+
+/// Item 10: `simulate` with calibration captures writes both folders or neither. A refused
+/// `--calibration-captures` folder (a user's file in it) once left the new capture
+/// written; the capture's own `-o` given as that folder blamed "the user's folder".
+#[test]
+fn simulate_writes_the_capture_and_its_calibration_captures_or_neither() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n);
+    ok(slf().args(["scene", "smooth", "--size", "12", "-o"]).arg(p("lf.npy")));
+    let simulate = |out: &str, cc: &Path| {
+        let mut cmd = slf();
+        cmd.arg("simulate").arg(p("lf.npy")).arg("-o").arg(p(out));
+        cmd.args(["--exposures", "1", "--calibration-captures"]).arg(cc);
+        cmd
+    };
+    std::fs::create_dir(p("mine")).unwrap();
+    std::fs::write(p("mine/notes.txt"), "mine").unwrap();
+    let err = failure(&mut simulate("cap", &p("mine")));
+    assert!(err.contains("notes.txt"), "{err}");
+    assert!(!p("cap").exists(), "the capture was written before the calibration captures were refused");
+    assert_eq!(files_in(dir.path()), ["lf.npy", "mine"]);
+    for (cc, says) in [(p("cap"), "is the capture's folder"), (p("cap/cc"), "is inside the capture's folder")] {
+        let err = failure(&mut simulate("cap", &cc));
+        assert!(err.contains(says) && err.contains("--calibration-captures"), "{err}");
+        assert_eq!(files_in(dir.path()), ["lf.npy", "mine"]);
+    }
+    let err = failure(&mut simulate("cc/cap", &p("cc")));
+    assert!(err.contains("holds the capture's folder"), "{err}");
+    ok(&mut simulate("cap", &p("cc")));
+    assert_eq!(files_in(dir.path()), ["cap", "cc", "lf.npy", "mine"]);
+}

@@ -519,9 +519,19 @@ impl Capture {
     /// renamed into place at the end, so a failure leaves the old folder as it was. An
     /// existing `dir` must be empty or a capture folder.
     pub fn save(&self, dir: &Path) -> Result<()> {
+        self.stage(dir)?.persist()
+    }
+
+    /// As [`Self::save`], short of putting the folder in place: the caller persists it
+    /// once everything written beside it is in too (`slf simulate` with calibration
+    /// captures writes both or neither).
+    ///
+    /// # Errors
+    /// As [`Self::save`].
+    pub fn stage(&self, dir: &Path) -> Result<WholeFolder> {
         let folder = WholeFolder::create(dir, Kind::Files(DESCRIPTION, &[], is_frame_name))?;
         self.write_into(folder.path())?;
-        folder.persist()
+        Ok(folder)
     }
 
     /// Writes the capture's files into the existing folder `dir` (one being written whole:

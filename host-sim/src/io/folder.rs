@@ -54,6 +54,7 @@ fn named_files(target: &Path, description: &str, fixed: &[&str], ours: fn(&str) 
 pub struct WholeFolder {
     temp: tempfile::TempDir,
     target: PathBuf,
+    kind: Kind,
     /// Removed by an interrupt's handler too ([`crate::io::interrupt`]).
     _tracked: crate::io::interrupt::Tracked,
 }
@@ -67,7 +68,7 @@ impl WholeFolder {
     /// `kind` would (a user's other files are never removed), or the I/O error.
     pub fn create(target: &Path, kind: Kind) -> Result<Self> {
         ensure!(!target.as_os_str().is_empty(), "an empty path names no folder to write");
-        replaceable(target, kind)?;
+        replaceable(target, target, kind)?;
         let parent = match target.parent() {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
@@ -80,7 +81,7 @@ impl WholeFolder {
             .tempdir_in(&parent)
             .with_context(|| format!("cannot create a folder in {}", parent.display()))?;
         let _tracked = crate::io::interrupt::track(temp.path());
-        Ok(Self { temp, target: target.to_path_buf(), _tracked })
+        Ok(Self { temp, target: target.to_path_buf(), kind, _tracked })
     }
 
     /// Where the files go until [`Self::persist`].
@@ -91,11 +92,14 @@ impl WholeFolder {
     /// Puts the folder at its target: an old folder there is moved aside, the new one
     /// renamed in, and the old one removed. At no moment does the target hold a mix; a
     /// crash between the two renames leaves the old folder beside it as `.NAME.old.*`.
+    /// The old folder is looked at again once aside: a file put into it since
+    /// [`Self::create`] looked (during a long run) puts it back, and nothing is replaced.
     ///
     /// # Errors
-    /// The I/O error; the old folder is put back when the new one cannot take its place.
+    /// The I/O error; the old folder is put back when the new one cannot take its place,
+    /// or when it now holds what the kind does not.
     pub fn persist(self) -> Result<()> {
-        let Self { temp, target, _tracked } = self;
+        let Self { temp, target, kind, _tracked } = self;
         let target_text = target.display().to_string();
         if fs::symlink_metadata(&target).is_err() {
             let temp = temp.keep();
@@ -110,6 +114,17 @@ impl WholeFolder {
         let aside = old.keep();
         fs::remove_dir(&aside).with_context(|| format!("cannot use {}", aside.display()))?;
         fs::rename(&target, &aside).with_context(|| format!("cannot move the old {target_text} aside"))?;
+        // What is aside is what gets removed: looked at there, after the rename, so a file
+        // added to the target during the run is never removed with it.
+        if let Err(e) = replaceable(&aside, &target, kind) {
+            let back = fs::rename(&aside, &target);
+            return Err(e).with_context(|| match back {
+                Ok(()) => {
+                    format!("{target_text} changed during the run; it is left as it was, and nothing was written")
+                }
+                Err(b) => format!("{target_text} changed during the run; it is now {} ({b})", aside.display()),
+            });
+        }
         let temp = temp.keep();
         if let Err(e) = fs::rename(&temp, &target) {
             let _ = fs::rename(&aside, &target);
@@ -122,22 +137,23 @@ impl WholeFolder {
 }
 
 /// Checks that `target` may be written whole: absent, an empty folder, or a folder of
-/// `kind` holding nothing else.
-fn replaceable(target: &Path, kind: Kind) -> Result<()> {
-    let Ok(meta) = fs::symlink_metadata(target) else { return Ok(()) };
+/// `kind` holding nothing else; `dir` is where it is now (the target, or the old folder
+/// moved aside), `target` the name the messages give.
+fn replaceable(dir: &Path, target: &Path, kind: Kind) -> Result<()> {
+    let Ok(meta) = fs::symlink_metadata(dir) else { return Ok(()) };
     let what = match kind {
         Kind::Files(d, _, _) => format!("a folder of {d} and the files it names"),
         Kind::Folders(d) => format!("a folder of folders holding {d}"),
     };
     let allowed = match kind {
-        Kind::Files(d, fixed, ours) => named_files(target, d, fixed, ours),
+        Kind::Files(d, fixed, ours) => named_files(dir, d, fixed, ours),
         Kind::Folders(_) => Vec::new(),
     };
     ensure!(meta.is_dir(), "{} is not a folder: the output is {what}", target.display());
     let mut described = false;
-    for entry in fs::read_dir(target).with_context(|| format!("cannot read {}", target.display()))? {
+    for entry in fs::read_dir(dir).with_context(|| format!("cannot read {}", target.display()))? {
         let entry = entry.with_context(|| format!("cannot read {}", target.display()))?;
-        let (path, t) = (entry.path(), entry.file_type()?);
+        let (path, t) = (target.join(entry.file_name()), entry.file_type()?);
         let fits = match kind {
             Kind::Files(d, _, _) => {
                 described |= entry.file_name() == d;
@@ -145,7 +161,7 @@ fn replaceable(target: &Path, kind: Kind) -> Result<()> {
             }
             Kind::Folders(d) => {
                 described = true;
-                t.is_dir() && path.join(d).is_file()
+                t.is_dir() && entry.path().join(d).is_file()
             }
         };
         if !fits {
@@ -159,7 +175,7 @@ fn replaceable(target: &Path, kind: Kind) -> Result<()> {
     }
     if let Kind::Files(d, _, _) = kind {
         ensure!(
-            described || fs::read_dir(target).map(|mut r| r.next().is_none()).unwrap_or(false),
+            described || fs::read_dir(dir).map(|mut r| r.next().is_none()).unwrap_or(false),
             "{} holds files but no {d}: the output replaces the folder whole, so choose a new or empty folder",
             target.display()
         );
@@ -307,6 +323,27 @@ mod tests {
         let e = WholeFolder::create(&other, kind).err().unwrap().to_string();
         assert!(e.contains("holds files but no capture.json"), "{e}");
         assert!(WholeFolder::create(Path::new(""), kind).err().unwrap().to_string().contains("empty path"));
+    }
+
+    #[test]
+    fn a_file_added_during_the_run_is_never_removed() {
+        // Issue 65, item 10: the old folder was checked when the run began and removed whole
+        // at its end, with a file the user put into it meanwhile.
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("cap");
+        let kind = Kind::Files("capture.json", &["a"], |_| false);
+        fs::create_dir(&target).unwrap();
+        fs::write(target.join("capture.json"), "old").unwrap();
+        let f = WholeFolder::create(&target, kind).unwrap();
+        fs::write(f.path().join("capture.json"), "new").unwrap();
+        fs::write(target.join("notes.txt"), "mine").unwrap();
+        let e = format!("{:#}", f.persist().unwrap_err());
+        assert!(e.contains("changed during the run") && e.contains("notes.txt"), "{e}");
+        assert!(!e.contains(".old."), "names the folder moved aside: {e}");
+        assert_eq!(fs::read_to_string(target.join("notes.txt")).unwrap(), "mine");
+        assert_eq!(fs::read_to_string(target.join("capture.json")).unwrap(), "old");
+        let names: Vec<_> = fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+        assert_eq!(names, ["cap"], "a temporary or the old folder left beside it");
     }
 
     #[test]

@@ -105,11 +105,48 @@ pub fn with_outputs(outputs: Outputs, captures: &[(String, Capture)], dir: &Path
 /// # Errors
 /// A `dir` holding anything else; I/O errors.
 pub fn save(captures: &[(String, Capture)], dir: &Path) -> Result<()> {
+    stage(captures, dir)?.persist()
+}
+
+/// As [`save`], short of putting the folder in place ([`WholeFolder::persist`]).
+///
+/// # Errors
+/// As [`save`].
+pub fn stage(captures: &[(String, Capture)], dir: &Path) -> Result<WholeFolder> {
     let folder = WholeFolder::create(dir, Kind::Folders(DESCRIPTION))?;
     for (name, c) in captures {
         let at = folder.path().join(name);
         std::fs::create_dir(&at).map_err(|e| anyhow::anyhow!("cannot create {}: {e}", at.display()))?;
         c.write_into(&at)?;
     }
-    folder.persist()
+    Ok(folder)
+}
+
+/// Checks that the calibration captures' folder `dir` and the scene capture's folder
+/// `capture` are apart: neither is the other nor holds it (each is replaced whole).
+///
+/// # Errors
+/// The two folders overlapping, named.
+pub fn apart_from(dir: &Path, capture: &Path) -> Result<()> {
+    let full = |p: &Path| {
+        let p = std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+        // Existing folders by their real place (a link or `..` names the same folder).
+        p.canonicalize().unwrap_or(p)
+    };
+    let (d, c) = (full(dir), full(capture));
+    anyhow::ensure!(
+        !(d.starts_with(&c) || c.starts_with(&d)),
+        "--calibration-captures {}: {} the capture's folder -o {}, and each is written whole: give the calibration \
+         captures a folder of their own",
+        dir.display(),
+        if d == c {
+            "is"
+        } else if d.starts_with(&c) {
+            "is inside"
+        } else {
+            "holds"
+        },
+        capture.display()
+    );
+    Ok(())
 }

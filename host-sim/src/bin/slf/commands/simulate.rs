@@ -47,10 +47,18 @@ pub fn run(args: Args) -> Result<()> {
         outputs = calibration::with_outputs(outputs, &calibration, dir);
     }
     outputs.check_distinct()?;
-    simulated.capture.save(&output)?;
-    outln!("wrote {} ({} snapshots)", output.display(), simulated.capture.frames.len())?;
     if let Some(dir) = &calibration_captures {
-        calibration::save(&calibration, dir)?;
+        calibration::apart_from(dir, &output)?;
+    }
+    // Both folders written before either is put in place: a refused or failed calibration
+    // folder leaves no new capture either.
+    let capture_folder = simulated.capture.stage(&output)?;
+    let calibration_folder =
+        calibration_captures.as_deref().map(|dir| calibration::stage(&calibration, dir)).transpose()?;
+    capture_folder.persist()?;
+    outln!("wrote {} ({} snapshots)", output.display(), simulated.capture.frames.len())?;
+    if let (Some(folder), Some(dir)) = (calibration_folder, &calibration_captures) {
+        folder.persist()?;
         outln!("wrote {} calibration captures into {}", calibration.len(), dir.display())?;
     }
     Ok(())
