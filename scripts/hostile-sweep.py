@@ -59,11 +59,16 @@ class Sweep:
 
     def run(self, args, name, outputs=(), keep=(), refuse=False, stdout=None, file_limit=None, python=None):
         """Runs `slf ARGS` (or, with `python`, that Python source with the package); `outputs`
-        are .npy light fields an exit 0 must leave readable, `keep` files no run may
+        are .npy light fields an exit 0 must leave whole (removed before the run; after an
+        exit 0 each must be there and read by `slf eval`), `keep` files no run may
         change; `refuse`: the run must fail (an exit 0 is a failure of the sweep); `stdout`
         a file to write standard output to; `file_limit` bytes of RLIMIT_FSIZE."""
         self.cases += 1
         before = {p: Path(p).read_bytes() for p in keep if Path(p).is_file()}
+        # An output an earlier case left would pass for this one's.
+        for out in outputs:
+            if out not in keep:
+                Path(self.work, out).unlink(missing_ok=True)
 
         def preexec():
             limits()
@@ -105,12 +110,18 @@ class Sweep:
             lines = [line for line in err.splitlines() if not line.startswith(("note:", "warning:"))]
             if len(lines) != 1 or not lines[0].startswith("error"):
                 self.failures.append(f"{name}: not one error line: {err!r}")
+            elif len(lines[0]) > 4200:
+                self.failures.append(f"{name}: an error line of {len(lines[0])} characters")
         else:
             self.accepted += 1
+            # Strict: an exit 0 leaves each output whole, a light field slf itself reads.
             for out in outputs:
+                if not Path(self.work, out).is_file():
+                    self.failures.append(f"{name}: exit 0 and no {out}")
+                    continue
                 check = subprocess.run([SLF, "eval", out, out], cwd=self.work, capture_output=True, text=True)
-                if Path(out).exists() and check.returncode != 0 and "not finite" in check.stderr:
-                    self.failures.append(f"{name}: exit 0 wrote a light field slf refuses: {check.stderr.strip()}")
+                if check.returncode != 0:
+                    self.failures.append(f"{name}: exit 0 wrote {out}, which slf eval refuses: {check.stderr.strip()}")
         for path, data in before.items():
             if not Path(path).is_file() or Path(path).read_bytes() != data:
                 self.failures.append(f"{name}: {path} changed or destroyed")
@@ -204,7 +215,85 @@ def issue_51(s, work, ok):
                  ["decode", "cap16", "--response-model", "projection", "-o", "m.npy", "-q"]]:
         s.run(args, " ".join(args[:1] + args[2:]), refuse=True)
 
+    issue_65(s, work, ok)
     python_cases(s)
+
+
+def psnr(work, truth, decoded):
+    """`slf eval --border 2`'s PSNR, dB (None when eval refuses)."""
+    p = subprocess.run([SLF, "eval", truth, decoded, "--border", "2"], cwd=work, capture_output=True, text=True)
+    line = next((x for x in p.stdout.splitlines() if x.startswith("PSNR")), None)
+    return float(line.split()[1]) if p.returncode == 0 and line else None
+
+
+def issue_65(s, work, ok):
+    """The surfaces of issue 65 (round 5): the lenslet grid's index, folders that are not
+    ours, readers of files longer than their header, long names and values, flags the
+    baselines ignore, FIFOs as outputs, large tables and `.npy` files past the memory."""
+    # 2: a calibration's grid names the lenslets as the capture does (the issue's case).
+    ok("scene", "texture", "--size", "24", "-o", "tex.npy")
+    ok("simulate", "tex.npy", "-o", "capg", "--rotation", "0.3", "--vignetting", "0.5", "--grid-offset", "0,0",
+       "-s", "1", "--calibration-captures", "ccg", "--exposures", "1")
+    ok("calibrate", "ccg", "-o", "calg")
+    s.run(["decode", "capg", "--calibration", "calg", "-o", "g.npy", "-q"], "decode a grid at the sensor's corner",
+          outputs=["g.npy"])
+    s.run(["decode", "capg", "--calibration", "calg", "--grid", "capture", "-o", "gc.npy", "-q"],
+          "decode a grid at the sensor's corner, --grid capture", outputs=["gc.npy"])
+    a, b = psnr(work, "tex.npy", "g.npy"), psnr(work, "tex.npy", "gc.npy")
+    if a is None or b is None or a < b - 1.0:
+        s.failures.append(f"grid index: the calibration's grid decodes at {a} dB, the capture's at {b} dB")
+    # 10: a grid beside the sensor; a stray description naming a user's file; the
+    # calibration captures' folder overlapping the capture's.
+    s.run(["simulate", "truth.npy", "-o", "g-off", "--grid-offset", "200,200"], "simulate --grid-offset 200,200",
+          refuse=True)
+    (work / "stray").mkdir(exist_ok=True)
+    (work / "stray" / "thesis.tex").write_text("mine")
+    (work / "stray" / "capture.json").write_text('{"frames": ["thesis.tex"]}')
+    s.run(["simulate", "truth.npy", "-o", "stray"], "simulate -o a folder whose capture.json names a user's file",
+          refuse=True, keep=[str(work / "stray" / "thesis.tex")])
+    for cc in ["capx", "capx/cc"]:
+        s.run(["simulate", "truth.npy", "-o", "capx", "--calibration-captures", cc, "--exposures", "1"],
+              f"simulate -o capx --calibration-captures {cc}", refuse=True)
+        if (work / "capx").exists():
+            s.failures.append(f"simulate -o capx --calibration-captures {cc}: refused, and wrote capx")
+    # 11: files longer than their header, a frame that is a folder, a long format, an
+    # upper-case CRC, a long output name, the border, a negative error map.
+    (work / "trailing.npy").write_bytes((work / "truth.npy").read_bytes() + b"\0" * 8)
+    s.run(["eval", "truth.npy", "trailing.npy"], "eval a .npy longer than its header", refuse=True)
+    shutil.copytree(work / "cap", work / "cap-dir")
+    os.remove(work / "cap-dir" / "snapshot_0.npy")
+    (work / "cap-dir" / "snapshot_0.npy").mkdir()
+    s.run(["decode", "cap-dir", "-o", "x.npy", "-q"], "decode a capture whose frame is a folder", refuse=True)
+    shutil.copytree(work / "cap", work / "cap-long")
+    desc = (work / "cap-long" / "capture.json").read_text()
+    (work / "cap-long" / "capture.json").write_text(desc.replace('"format": "', '"format": "' + "x" * 10_000_000, 1))
+    s.run(["decode", "cap-long", "-o", "x.npy", "-q"], "decode a capture of a 10 MB format", refuse=True)
+    shutil.copytree(work / "cap", work / "cap-upper")
+    import re
+    path = work / "cap-upper" / "capture.json"
+    path.write_text(re.sub(r'"crc32": "([0-9a-f]+)"', lambda m: f'"crc32": "{m.group(1).upper()}"', path.read_text()))
+    long_name = "a" * 246 + ".npy"
+    s.run(["decode", "cap-upper", "-o", long_name, "-q"], "decode an upper-case CRC to a 250-byte name",
+          outputs=[long_name])
+    s.run(["eval", "truth.npy", "truth.npy", "--border", "7"], "eval --border 7 on 12 lenslets", refuse=True)
+    (work / "neg.npy").write_bytes(npy("<f4", (12, 12), struct.pack("<f", -1.0) * 144))
+    s.run(["eval", "truth.npy", "truth.npy", "--error-map", "neg.npy"], "eval a negative error map", refuse=True)
+    # 9: flags the baselines would ignore; 8, 12: a FIFO as the output.
+    for extra in [["--shear-trial", "true"], ["--shear-check"], ["--model-trial", "true"]]:
+        s.run(["decode", "cap", "-o", "x.npy", "-q", "--method", "demosaic", *extra],
+              f"decode --method demosaic {' '.join(extra)}", refuse=True)
+    s.run(["decode", "cap", "-o", "fifo.npy", "-q"], "decode -o a FIFO", refuse=True)
+    # 7: a long table in alternating order (quadratic once: past 120 s at 100,000 rows).
+    header = (work / "header.csv").read_text()
+    rows = "".join(f"{m},3,x{i},30,0.9,4,1,0.5,1,2,true\n" for i, m in
+                   zip(range(100_000), ["pixel", "lenslet"] * 50_000))
+    (work / "long.csv").write_text(header + rows)
+    s.run(["bench", "--from", "long.csv", "--out", "bench-long"], "bench --from 100,000 alternating rows")
+    # 3: a .npy of 2^30 values, inside the documented cap, past the run's memory.
+    sparse(work / "g30.npy", npy("<f4", (8, 8, 1024, 1024, 16)), 128 + 4 * (1 << 30))
+    for args in [["eval", "g30.npy", "g30.npy"], ["simulate", "g30.npy", "-o", "g30-cap"],
+                 ["import", "bands", "g30.npy", "--wavelengths", "400:775:25", "-o", "imp.npy"]]:
+        s.run(args, f"{args[0]} a .npy of 2^30 values", refuse=True)
 
 
 def python_cases(s):
@@ -222,6 +311,16 @@ def python_cases(s):
                         ("calibrate('cc', '')", "slf.calibrate('cc', '')"),
                         ("simulate(calibration_captures='')", "slf.simulate(lf, leakage=0.1, calibration_captures='')"),
                         ("decode(output='')", "slf.decode(cap, output='')")]:
+        s.run([], f"python: {label}", python=pre + code, refuse=True)
+    # Issue 65: outputs over the decode's own inputs; keywords of the wrong kind.
+    for label, code in [("decode(output=its own frame)",
+                         "cap.save('pcap'); c = slf.load_capture('pcap'); slf.decode(c, output='pcap/' + "
+                         "[f for f in __import__('os').listdir('pcap') if f.startswith('snapshot')][0])"),
+                        ("decode(progress=5)", "slf.decode(cap, progress=5)"),
+                        ("simulate(exposures=-1)", "slf.simulate(lf, leakage=0.1, calibration_captures='pcc', "
+                                                   "exposures=-1)"),
+                        ("decode(error_map=True, method='demosaic')",
+                         "slf.decode(cap, error_map=True, method='demosaic')")]:
         s.run([], f"python: {label}", python=pre + code, refuse=True)
     s.run([], "python: noise=None is noise on", python=pre + (
         "a = slf.simulate(lf, seed=3, noise=None).frames; b = slf.simulate(lf, seed=3).frames\n"

@@ -425,6 +425,8 @@ fn calibration_captures_are_checked_against_the_memory_cap() {
     // 960 captures of 12.8 KB: 12.4 MB, over a cap of 0.01 GiB (10.7 MB).
     let e = failure(slf().arg("calibrate").arg(p("cc")).arg("-o").arg(p("cal")).args(["--max-memory", "0.01"]));
     assert!(e.contains("960 calibration captures of 1 frames of 80 x 80 pixels needs about"), "{e}");
+    // Both sizes shown with their digits, not as "0.0 GiB".
+    assert!(e.contains("more than the 10.2 MiB cap") && !e.contains("0.0 GiB"), "{e}");
     ok(slf().arg("calibrate").arg(p("cc")).arg("-o").arg(p("cal")));
 }
 

@@ -52,7 +52,10 @@ pub fn check(need: u64, what: &str, smaller: &str) -> anyhow::Result<()> {
 
 /// `bytes` as "1.7 GiB".
 pub fn gib(bytes: u64) -> String {
-    format!("{:.1} GiB", bytes as f64 / f64::from(1u32 << 30))
+    let g = bytes as f64 / f64::from(1u32 << 30);
+    // Under a tenth of a GiB in MiB: a cap of 0.01 GiB against 12 MB once read "about 0.0
+    // GiB of memory, more than the 0.0 GiB cap".
+    if g < 0.095 { format!("{:.1} MiB", bytes as f64 / f64::from(1u32 << 20)) } else { format!("{g:.1} GiB") }
 }
 
 #[cfg(test)]
@@ -66,5 +69,8 @@ mod tests {
         assert!(e.starts_with("an HDF5 dataset of 5 x 5 x 1200 x 1200 x 13 needs about"), "{e}");
         assert!(e.contains("crop it, or raise the cap with --max-memory GIB"), "{e}");
         assert_eq!(gib(3 << 29), "1.5 GiB");
+        assert_eq!(gib(1 << 30 >> 3), "0.1 GiB");
+        assert_eq!(gib(13 << 20), "13.0 MiB");
+        assert_eq!(gib(10_737_418), "10.2 MiB");
     }
 }

@@ -92,12 +92,7 @@ impl WholeFile {
         let failed = || format!("cannot write {}", path.display());
         let name = path.file_name().with_context(|| format!("cannot write {}: not a file name", path.display()))?;
         ensure!(!path.is_dir(), "cannot write {}: a folder", path.display());
-        // A FIFO, a socket or a device would be replaced by the rename, not written: the
-        // reader at the other end of a FIFO would wait for ever and the name would become
-        // a plain file.
-        if let Ok(meta) = fs::metadata(path) {
-            ensure!(meta.is_file(), "cannot write {}: not a regular file ({})", path.display(), file_kind(&meta));
-        }
+        regular_if_there(path).with_context(failed)?;
         // ".NAME.XXXXXX.part": 13 bytes more than the name, so a legal name of up to 255
         // bytes is cut to what the file system takes (the temporary's name is only seen
         // if the run is killed).
@@ -311,12 +306,23 @@ fn writable(path: &Path) -> Result<()> {
     let dir = parent(path);
     ensure!(dir.is_dir(), "the folder {} does not exist", dir.display());
     tempfile::Builder::new().prefix(".slf-check.").tempfile_in(dir).context("the folder takes no new file")?;
-    if path.exists() {
-        let meta = fs::metadata(path)?;
-        ensure!(meta.is_file(), "not a regular file (a FIFO or device is not written over)");
+    if let Some(meta) = regular_if_there(path)? {
         ensure!(!meta.permissions().readonly(), "read-only");
     }
     Ok(())
+}
+
+/// `path`'s metadata if it exists, checked to be a regular file's: a FIFO, a socket or a
+/// device would be replaced by the rename, not written (the reader at the other end of a
+/// FIFO would wait for ever, and the name would become a plain file).
+fn regular_if_there(path: &Path) -> Result<Option<fs::Metadata>> {
+    match fs::metadata(path) {
+        Ok(meta) => {
+            ensure!(meta.is_file(), "not a regular file ({})", file_kind(&meta));
+            Ok(Some(meta))
+        }
+        Err(_) => Ok(None),
+    }
 }
 
 #[cfg(test)]

@@ -465,6 +465,10 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
         // Each entry's view flat, at the pixel the patch read it from (the shear's lenslet).
         let views = (usize::from(self.config.sensor.lenslet.rows), usize::from(self.config.sensor.lenslet.cols));
         let flat = |i: usize| {
+            // Without view gains every flat is 1: no pixel to look up.
+            if self.view_gains.is_none() {
+                return 1.0;
+            }
             let [s, t, u, v, _] = S::coordinates(i);
             let (vr, vc) = (usize::from(origin.view_row) + u, usize::from(origin.view_col) + v);
             origin
