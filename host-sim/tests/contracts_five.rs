@@ -34,7 +34,7 @@ fn ok(cmd: &mut Command) -> String {
 /// calibration captures, and the calibration: `lf.npy`, `cap`, `cc`, `cal` in `dir`.
 fn calibrated(dir: &Path, k: &str) {
     let p = |n: &str| dir.join(n);
-    ok(slf().args(["scene", "texture", "--size", "24", "-o"]).arg(p("lf.npy")));
+    scene(dir, "texture", "24");
     ok(slf()
         .arg("simulate")
         .arg(p("lf.npy"))
@@ -43,6 +43,11 @@ fn calibrated(dir: &Path, k: &str) {
         .args(["-s", k, "--seed", "1", "--vignetting", "0.3", "--exposures", "1", "--calibration-captures"])
         .arg(p("cc")));
     ok(slf().arg("calibrate").arg(p("cc")).arg("-o").arg(p("cal")));
+}
+
+/// Writes the scene `name` of `size` lenslets to `dir/lf.npy`.
+fn scene(dir: &Path, name: &str, size: &str) {
+    ok(slf().args(["scene", name, "--size", size, "-o"]).arg(dir.join("lf.npy")));
 }
 
 fn files_in(dir: &Path) -> Vec<String> {
@@ -117,7 +122,7 @@ fn maps_do_not_outlive_a_failed_output() {
 fn eval_names_the_border_and_refuses_a_negative_error_map() {
     let dir = tempfile::tempdir().unwrap();
     let p = |n: &str| dir.path().join(n);
-    ok(slf().args(["scene", "texture", "--size", "24", "-o"]).arg(p("lf.npy")));
+    scene(dir.path(), "texture", "24");
     let e = failure(slf().arg("eval").arg(p("lf.npy")).arg(p("lf.npy")).args(["--border", "7"]));
     assert!(e.contains("--border 7 leaves 10 x 10") && e.contains("at most --border 6"), "{e}");
     let mut map = vec![0.01f32; 24 * 24];
@@ -137,7 +142,7 @@ fn eval_names_the_border_and_refuses_a_negative_error_map() {
 fn files_longer_than_their_header_are_refused() {
     let dir = tempfile::tempdir().unwrap();
     let p = |n: &str| dir.path().join(n);
-    ok(slf().args(["scene", "smooth", "--size", "12", "-o"]).arg(p("lf.npy")));
+    scene(dir.path(), "smooth", "12");
     // A light field with one f32 more than its header states.
     let mut bytes = std::fs::read(p("lf.npy")).unwrap();
     bytes.extend_from_slice(&1.0f32.to_le_bytes());
@@ -182,7 +187,7 @@ fn rerecord(cap: &Path, name: &str) {
 fn records_and_formats_are_read_as_meant() {
     let dir = tempfile::tempdir().unwrap();
     let p = |n: &str| dir.path().join(n);
-    ok(slf().args(["scene", "smooth", "--size", "12", "-o"]).arg(p("lf.npy")));
+    scene(dir.path(), "smooth", "12");
     ok(slf().arg("simulate").arg(p("lf.npy")).arg("-o").arg(p("cap")));
     let json = p("cap").join("capture.json");
     let text = std::fs::read_to_string(&json).unwrap();
@@ -267,7 +272,7 @@ fn an_interrupt_leaves_no_temporary() {
     use std::process::Stdio;
     let dir = tempfile::tempdir().unwrap();
     let p = |n: &str| dir.path().join(n);
-    ok(slf().args(["scene", "texture", "--size", "80", "-o"]).arg(p("lf.npy")));
+    scene(dir.path(), "texture", "80");
     ok(slf().arg("simulate").arg(p("lf.npy")).args(["-s", "3", "-o"]).arg(p("cap")));
     let out = p("out");
     std::fs::create_dir(&out).unwrap();
@@ -342,7 +347,7 @@ fn bench_from_writes_its_files_together() {
 fn grids_and_folders_keep_to_what_is_theirs() {
     let dir = tempfile::tempdir().unwrap();
     let p = |n: &str| dir.path().join(n);
-    ok(slf().args(["scene", "smooth", "--size", "24", "-o"]).arg(p("lf.npy")));
+    scene(dir.path(), "smooth", "24");
     let e = failure(slf().arg("simulate").arg(p("lf.npy")).arg("-o").arg(p("g")).args(["--grid-offset", "200,200"]));
     assert!(e.contains("the middle of the 24 x 24 lenslet array falls at") && e.contains("off the 120 x 120"), "{e}");
     assert!(!p("g").exists());
@@ -420,7 +425,7 @@ fn renamed(dir: &Path, (s, t): (f64, f64), rows: f64) {
 fn a_calibrations_grid_names_the_lenslets_as_the_capture_does() {
     let dir = tempfile::tempdir().unwrap();
     let p = |n: &str| dir.path().join(n);
-    ok(slf().args(["scene", "texture", "--size", "24", "-o"]).arg(p("lf.npy")));
+    scene(dir.path(), "texture", "24");
     ok(slf()
         .arg("simulate")
         .arg(p("lf.npy"))
@@ -470,7 +475,7 @@ fn a_calibrations_grid_names_the_lenslets_as_the_capture_does() {
 fn a_shear_trial_with_nothing_to_try_says_so() {
     let dir = tempfile::tempdir().unwrap();
     let p = |n: &str| dir.path().join(n);
-    ok(slf().args(["scene", "texture", "--size", "12", "-o"]).arg(p("lf.npy")));
+    scene(dir.path(), "texture", "12");
     ok(slf().arg("simulate").arg(p("lf.npy")).arg("-o").arg(p("cap")).args(["-s", "3", "--seed", "1"]));
     let decode = |extra: &[&str]| ok(slf().arg("decode").arg(p("cap")).args(extra).arg("-o").arg(p("a.npy")));
     let out = decode(&["--shear-trial", "true"]);
@@ -487,7 +492,7 @@ fn a_shear_trial_with_nothing_to_try_says_so() {
 fn simulate_writes_the_capture_and_its_calibration_captures_or_neither() {
     let dir = tempfile::tempdir().unwrap();
     let p = |n: &str| dir.path().join(n);
-    ok(slf().args(["scene", "smooth", "--size", "12", "-o"]).arg(p("lf.npy")));
+    scene(dir.path(), "smooth", "12");
     let simulate = |out: &str, cc: &Path| {
         let mut cmd = slf();
         cmd.arg("simulate").arg(p("lf.npy")).arg("-o").arg(p(out));

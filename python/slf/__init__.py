@@ -436,7 +436,8 @@ def decode(
     gives PPID's mean weight, its weight per lenslet (``"weights"``), the lenslets mostly PPID's
     and its seconds), ``shear_trial`` (whole disparities only for the frame where pilot patches
     estimate them clearly better than the half-pixel ones; default True:
-    ``report["shear_trial"]``), ``error_map`` (the decode's error per lenslet in
+    ``report["shear_trial"]``, or ``report["shear_trial_skipped"]`` saying why it did not
+    run: no half-pixel disparity to try), ``error_map`` (the decode's error per lenslet in
     ``report["error_map"]`` and its estimated PSNR), ``estimate_by`` decode (the frame
     decoded again from seven in eight samples by the same plan, the default: a second
     decode's time) or patches (each patch solved once more, a solve a patch).
