@@ -299,8 +299,8 @@ def test_a_shear_trial_with_nothing_to_try_says_so(depth):
     """Issue 65, item 9: shear_trial=True at three snapshots (whole disparities only) says
     why it did not run (before: no word); where it runs, no such key."""
     cap = slf.simulate(depth, k=3, seed=1)
-    _, report = slf.decode(cap, shear_trial=True)
+    _, report = slf.decode(cap, shear_trial=True, report=True)
     assert "shear_trial" not in report
     assert "no half-pixel step to try" in report["shear_trial_skipped"]
-    _, report = slf.decode(cap, shear_trial=True, disparities="0:0")
+    _, report = slf.decode(cap, shear_trial=True, disparities="0:0", report=True)
     assert report["shear_trial_skipped"] == "the decode searches no disparity"
