@@ -515,3 +515,22 @@ fn simulate_writes_the_capture_and_its_calibration_captures_or_neither() {
     ok(&mut simulate("cap", &p("cc")));
     assert_eq!(files_in(dir.path()), ["cap", "cc", "lf.npy", "mine"]);
 }
+
+/// Item 3: `slf eval` of two files that each fit the memory cap, and not together, is
+/// refused from the second's header (before: each was checked alone, and the second
+/// allocation could abort).
+#[test]
+fn eval_checks_its_two_files_together_against_the_cap() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n);
+    // 5 x 5 x 68 x 68 x 13 float32: 6.0 MB each, under a cap of 0.01 GiB (10.7 MB).
+    let values = 5 * 5 * 68 * 68 * 13;
+    let header = "{'descr': '<f4', 'fortran_order': False, 'shape': (5, 5, 68, 68, 13), }";
+    let body: Vec<u8> = std::iter::repeat_n(0.5f32.to_le_bytes(), values).flatten().collect();
+    let file = common::npy_bytes(1, header, &body);
+    std::fs::write(p("a.npy"), &file).unwrap();
+    std::fs::write(p("b.npy"), &file).unwrap();
+    let err = failure(slf().args(["--max-memory", "0.01", "eval"]).arg(p("a.npy")).arg(p("b.npy")));
+    assert!(err.contains("beside the ground truth") && err.contains("more than the 10.2 MiB cap"), "{err}");
+    ok(slf().args(["--max-memory", "0.02", "eval"]).arg(p("a.npy")).arg(p("b.npy")));
+}

@@ -185,6 +185,24 @@ pub fn read_npy(path: &Path) -> Result<LightField, NpyError> {
 /// # Errors
 /// As [`read_npy`].
 pub fn read_npy_with_notes(path: &Path) -> Result<(LightField, Vec<String>), NpyError> {
+    read_npy_held(path, None)
+}
+
+/// As [`read_npy`], for a light field read while another is held (`held`: what, and its bytes; `slf eval`'s
+/// second file): the two together are checked against the memory cap before this one's
+/// values are read (each alone once passed the check, and the second allocation aborted).
+///
+/// # Errors
+/// As [`read_npy`], and the two past the cap.
+pub fn read_npy_beside(path: &Path, held: (&str, u64)) -> Result<LightField, NpyError> {
+    let (lf, notes) = read_npy_held(path, Some(held))?;
+    for n in notes {
+        eprintln!("note: {}: {n}", path.display());
+    }
+    Ok(lf)
+}
+
+fn read_npy_held(path: &Path, held: Option<(&str, u64)>) -> Result<(LightField, Vec<String>), NpyError> {
     // The shape is checked from the header, before the body is read: a sparse file can
     // claim more values than memory holds.
     let a = npy::read_checked(path, |s, _| {
@@ -194,7 +212,18 @@ pub fn read_npy_with_notes(path: &Path) -> Result<(LightField, Vec<String>), Npy
         if s.contains(&0) {
             return Err(format!("shape {s:?} has an empty axis"));
         }
-        LightField::check_size((s[0], s[1]), s[2], s[3], s[4]).map_err(|e| format!("shape {s:?}: {e}"))
+        LightField::check_size((s[0], s[1]), s[2], s[3], s[4]).map_err(|e| format!("shape {s:?}: {e}"))?;
+        if let Some((what, bytes)) = held {
+            // Bounded by `check_size`: the product fits.
+            let own = s.iter().map(|&d| d as u64).product::<u64>().saturating_mul(4);
+            crate::io::budget::check(
+                own.saturating_add(bytes),
+                &format!("reading shape {s:?} beside {what}"),
+                "smaller light fields",
+            )
+            .map_err(|e| e.to_string())?;
+        }
+        Ok(())
     })?;
     let shape_err = |what: String| NpyError::new(path, NpyErrorKind::Shape(what));
     let s = &a.shape;

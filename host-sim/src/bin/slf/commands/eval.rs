@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail, ensure};
 use slf_host::eval::metrics::{BLOCK, WIN, blocks_over, check_error_map, evaluate, map_accuracy};
-use slf_host::io::lightfield::{LightField, read_npy, read_npy_f32_2d};
+use slf_host::io::lightfield::{LightField, read_npy, read_npy_beside, read_npy_f32_2d};
 use slf_host::outln;
 
 #[derive(clap::Args)]
@@ -51,7 +51,8 @@ fn interior(lf: LightField, border: usize, what: &str) -> Result<LightField> {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let (truth, recon) = (read_npy(&args.truth)?, read_npy(&args.recon)?);
+    let truth = read_npy(&args.truth)?;
+    let recon = read_npy_beside(&args.recon, ("the ground truth", truth.data.len() as u64 * 4))?;
     ensure!(
         truth.shape() == recon.shape(),
         "shapes differ: truth {:?}, reconstruction {:?}",
