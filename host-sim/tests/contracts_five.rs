@@ -534,3 +534,32 @@ fn eval_checks_its_two_files_together_against_the_cap() {
     assert!(err.contains("beside the ground truth") && err.contains("more than the 10.2 MiB cap"), "{err}");
     ok(slf().args(["--max-memory", "0.02", "eval"]).arg(p("a.npy")).arg(p("b.npy")));
 }
+
+/// Item 3: the summary's `memory:` line counts the seed rows the strip holds (before: the
+/// sums alone, half of a seeded decode's strip).
+#[test]
+fn the_memory_line_counts_the_seed_rows() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n);
+    scene(dir.path(), "texture", "24");
+    ok(slf().arg("simulate").arg(p("lf.npy")).arg("-o").arg(p("cap")).args(["-s", "3", "--seed", "1"]));
+    let line = |extra: &[&str]| -> (usize, usize, f64) {
+        let out = ok(slf().arg("decode").arg(p("cap")).args(extra).arg("-o").arg(p("a.npy")));
+        let l = out.lines().find(|l| l.starts_with("memory:")).unwrap_or_else(|| panic!("{out}")).to_string();
+        let words: Vec<&str> = l.split_whitespace().collect();
+        let at = |w: &str| words.iter().position(|x| *x == w).unwrap_or_else(|| panic!("{l}"));
+        let sums: usize = words[at("most") + 1].parse().unwrap();
+        let seeds: usize = if l.contains("rows of seeds") { words[at("seeds") - 3].parse().unwrap() } else { 0 };
+        let mb: f64 = words[at("MB") - 1].trim_start_matches('(').parse().unwrap();
+        (sums, seeds, mb)
+    };
+    // A lenslet row: 5 x 5 views of 24 pixels; sums 13 values and a weight a pixel, seeds 13.
+    let pixels = 5 * 5 * 24;
+    let mb = |sums: usize, seeds: usize| ((sums * pixels * 14 + seeds * pixels * 13) * 4) as f64 / 1e6;
+    let (sums, seeds, printed) = line(&[]);
+    assert!(seeds > 0, "the default decode is seeded");
+    assert!((printed - mb(sums, seeds)).abs() <= 0.05, "{printed} MB, the strip holds {} MB", mb(sums, seeds));
+    let (sums, seeds, printed) = line(&["--seeded", "false"]);
+    assert_eq!(seeds, 0);
+    assert!((printed - mb(sums, 0)).abs() <= 0.05, "{printed} MB, the strip holds {} MB", mb(sums, 0));
+}

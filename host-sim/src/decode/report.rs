@@ -68,6 +68,11 @@ pub struct DecodeReport {
     /// tiles: what its memory grows with, bounded by the tiles' height, not the frame's
     /// ([`crate::decode::strip`]).
     pub rows_held: usize,
+    /// The bytes of the streamed decode's strip: the slots of [`Self::rows_held`]'s sums and
+    /// of the seed rows (the seeds' spectra, 4 bytes a value, when seeded or adaptive).
+    pub strip_bytes: usize,
+    /// The lenslet rows of seeds the strip holds (0 unseeded).
+    pub seed_rows: usize,
     /// Wall time, seconds.
     pub seconds: f64,
     /// The band gains the decode used (1 without white balance).

@@ -155,6 +155,10 @@ where
         seeded: seeds_needed,
     };
     let mut buf = vec![0.0f32; held.buffer_len::<HostBands>()];
+    // The strip's whole allocation, the seed rows' slots with the sums' (the summary's
+    // `memory:` line once counted the sums alone).
+    report.strip_bytes = buf.len() * 4;
+    report.seed_rows = if seeds_needed { needs.seed_rows } else { 0 };
     let mut strip = Strip::<HostBands>::new(&mut buf, held, plan.range, plan.window)
         .map_err(|e| anyhow::anyhow!("{e} ({slots} rows of {} x {} lenslets)", shape.rows, shape.cols))?;
     let (mut fill, mut unused) = (Fill::default(), Fill::default());

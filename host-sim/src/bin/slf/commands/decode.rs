@@ -368,13 +368,12 @@ pub fn run(args: Args) -> Result<()> {
         per(r.solves),
         per(r.steps)
     )?;
-    let shape = output_shape(&cap);
-    let row_mb = ((shape.row_len() + shape.pixels()) * 4) as f64 / 1e6;
+    let seeds = if r.seed_rows > 0 { format!(" and {} rows of seeds", r.seed_rows) } else { String::new() };
     outln!(
-        "memory: the decode held at most {} of the frame's {rows} lenslet rows of sums at once ({:.1} MB; the \
-         light field is written to {} as its rows are finished)",
+        "memory: the decode held at most {} of the frame's {rows} lenslet rows of sums at once{seeds} ({:.1} MB in \
+         its strip; the light field is written to {} as its rows are finished)",
         r.rows_held,
-        r.rows_held as f64 * row_mb,
+        r.strip_bytes as f64 / 1e6,
         output.display()
     )?;
     outln!(
