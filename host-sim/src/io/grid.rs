@@ -243,8 +243,8 @@ impl GridDescription {
     /// The view-cell coordinates of sensor point `p` for `views` views: cell
     /// `(floor(q0), floor(q1))` = `(s U + u, t V + v)` holds it (module docs).
     pub fn cell(&self, views: [usize; 2], p: [f64; 2]) -> [f64; 2] {
-        let d = rotate(-self.rotation_deg, [p[0] - self.offset[0], p[1] - self.offset[1]]);
-        let q = |a: usize| d[a] / self.pitch[a] * views[a] as f64 + views[a] as f64 / 2.0;
+        let l = self.lattice(p);
+        let q = |a: usize| l[a] * views[a] as f64 + views[a] as f64 / 2.0;
         [q(0), q(1)]
     }
 }

@@ -173,7 +173,12 @@ pub use crate::io::npy::{NpyError, NpyErrorKind};
 /// [`NpyError`] saying what is wrong and where: I/O, header, dtype, rank, an empty axis,
 /// truncation, values that are not finite.
 pub fn read_npy(path: &Path) -> Result<LightField, NpyError> {
-    let (lf, notes) = read_npy_with_notes(path)?;
+    noted(path, read_npy_held(path, None))
+}
+
+/// The light field of a read, its conversion notes printed to stderr.
+fn noted(path: &Path, read: Result<(LightField, Vec<String>), NpyError>) -> Result<LightField, NpyError> {
+    let (lf, notes) = read?;
     for n in notes {
         eprintln!("note: {}: {n}", path.display());
     }
@@ -195,11 +200,7 @@ pub fn read_npy_with_notes(path: &Path) -> Result<(LightField, Vec<String>), Npy
 /// # Errors
 /// As [`read_npy`], and the two past the cap.
 pub fn read_npy_beside(path: &Path, held: (&str, u64)) -> Result<LightField, NpyError> {
-    let (lf, notes) = read_npy_held(path, Some(held))?;
-    for n in notes {
-        eprintln!("note: {}: {n}", path.display());
-    }
-    Ok(lf)
+    noted(path, read_npy_held(path, Some(held)))
 }
 
 fn read_npy_held(path: &Path, held: Option<(&str, u64)>) -> Result<(LightField, Vec<String>), NpyError> {
