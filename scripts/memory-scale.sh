@@ -6,6 +6,9 @@
 # is N (N x N lenslets) or ROWSxCOLS (wider than tall: the memory against the frame's height
 # at equal width). A size whose scene or capture would not fit is reported and skipped.
 #
+# SLF_FORMATS: the outputs measured (default "npy"; "npy h5 zarr" for issue 65's table: the
+# HDF5 file and the Zarr store are written a band of rows at a time, as the .npy is).
+#
 # SLF_BEFORE=PATH: another slf binary (e.g. one built before the streamed decode) measured in
 # the same run beside this one, on sizes whose output is at most SLF_BEFORE_MAX_MB (default
 # 150: the whole-frame decode needed 35 x its output); SLF_BEFORE_LABEL names it in the table.
@@ -20,6 +23,7 @@ cargo build --release -q -p slf-host
 slf=${SLF_BIN:-./target/release/slf}
 sizes=${SLF_SIZES:-100 200 300 500 500x1000 1000}
 presets=${SLF_PRESETS:-default preview}
+formats=${SLF_FORMATS:-npy}
 before=${SLF_BEFORE:-}
 before_max=${SLF_BEFORE_MAX_MB:-150}
 label=${SLF_BEFORE_LABEL:-$before}
@@ -35,41 +39,43 @@ if [ -n "$before" ]; then
   echo "output is at most $before_max MB (it held about 35 x its output)."
 fi
 echo
-echo "| lenslets | output MB | preset | peak resident MB | peak / output | seconds | before: peak MB | before: seconds |"
-echo "| --- | --- | --- | --- | --- | --- | --- | --- |"
-# Peak MB and seconds of `$1 decode CAP -o OUT --preset P`, or "failed".
+echo "| lenslets | output MB | preset | format | peak resident MB | peak / output | seconds | before: peak MB | before: seconds |"
+echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+# Peak MB and seconds of `$1 decode CAP -o OUT.$5 --preset P`, or "failed".
 measure() {
-  local bin=$1 cap=$2 p=$3 log=$4
-  if /usr/bin/time -v "$bin" decode "$cap" -o "$out/rec.npy" -q --preset "$p" > /dev/null 2> "$log"; then
+  local bin=$1 cap=$2 p=$3 log=$4 ext=${5:-npy}
+  if /usr/bin/time -v "$bin" decode "$cap" -o "$out/rec.$ext" -q --preset "$p" > /dev/null 2> "$log"; then
     kb=$(awk -F': ' '/Maximum resident set size/ { print $2 }' "$log")
     s=$(awk -F': ' '/Elapsed \(wall clock\)/ { n = split($2, a, ":"); t = 0; for (i = 1; i <= n; i++) t = 60 * t + a[i]; print t }' "$log")
     printf '%.0f %.1f' "$(echo "$kb / 1000" | bc -l)" "$s"
   else
     echo "failed"
   fi
-  rm -f "$out/rec.npy"
+  rm -rf "$out/rec.$ext"
 }
 for n in $sizes; do
   rows=${n%x*}; cols=${n#*x}
   lf="$out/texture-$n.npy"; cap="$out/cap-$n"
   if ! { [ -d "$cap" ] || [ -f "$lf" ] || "$slf" scene texture --size "$cols" --rows "$rows" -o "$lf" > /dev/null 2>&1; } ||
      ! { [ -d "$cap" ] || "$slf" simulate "$lf" -o "$cap" --mask pixel -s 1 --seed 1 > /dev/null 2>&1; }; then
-    echo "| $rows x $cols | | | could not simulate (memory?) | | | | |"
+    echo "| $rows x $cols | | | | could not simulate (memory?) | | | | |"
     continue
   fi
   rm -f "$lf"  # the truth is not needed to decode; keep the disk for the output
   output=$(echo "$rows * $cols * 25 * 13 * 4 / 1000000" | bc -l)
   for p in $presets; do
-    read -r mb s <<< "$(measure "$slf" "$cap" "$p" "$out/time-$n-$p.txt") "
-    if [ "$mb" = failed ]; then
-      printf '| %s x %s | %.0f | %s | failed (see %s) | | | | |\n' "$rows" "$cols" "$output" "$p" "$out/time-$n-$p.txt"
-      continue
-    fi
-    old="| |"
-    if [ -n "$before" ] && [ "$(echo "$output <= $before_max" | bc -l)" = 1 ]; then
-      read -r bmb bs <<< "$(measure "$before" "$cap" "$p" "$out/before-$n-$p.txt") "
-      old="| $bmb | $bs |"
-    fi
-    printf '| %s x %s | %.0f | %s | %s | %.1f | %s %s\n' "$rows" "$cols" "$output" "$p" "$mb" "$(echo "$mb / $output" | bc -l)" "$s" "$old"
+    for f in $formats; do
+      read -r mb s <<< "$(measure "$slf" "$cap" "$p" "$out/time-$n-$p-$f.txt" "$f") "
+      if [ "$mb" = failed ]; then
+        printf '| %s x %s | %.0f | %s | %s | failed (see %s) | | | | |\n' "$rows" "$cols" "$output" "$p" "$f" "$out/time-$n-$p-$f.txt"
+        continue
+      fi
+      old="| |"
+      if [ -n "$before" ] && [ "$f" = npy ] && [ "$(echo "$output <= $before_max" | bc -l)" = 1 ]; then
+        read -r bmb bs <<< "$(measure "$before" "$cap" "$p" "$out/before-$n-$p.txt") "
+        old="| $bmb | $bs |"
+      fi
+      printf '| %s x %s | %.0f | %s | %s | %s | %.1f | %s %s\n' "$rows" "$cols" "$output" "$p" "$f" "$mb" "$(echo "$mb / $output" | bc -l)" "$s" "$old"
+    done
   done
 done

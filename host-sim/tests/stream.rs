@@ -203,3 +203,84 @@ fn the_decode_written_to_hdf5_is_the_decode_written_to_npy() {
         assert!(!dir.path().join(name).exists());
     }
 }
+
+/// `slf decode -o OUT.zarr` (issue 65, item 4): the Zarr v3 store's `lightfield` array, read
+/// back by `zarrs`, is the `.npy` decode value for value, compressed or not, with its
+/// dimension names, chunks of 8 lenslet rows, the band centres as the `band` array and the
+/// capture's description in the group's attributes. A second decode replaces the store
+/// whole; a folder holding anything else is refused and left as it was.
+#[test]
+fn the_decode_written_to_zarr_is_the_decode_written_to_npy() {
+    use slf_host::io::lightfield::read_npy;
+    use zarrs::array::Array;
+    use zarrs::filesystem::FilesystemStore;
+    let dir = tempfile::tempdir().unwrap();
+    let cap = dir.path().join("cap");
+    let captured = capture(23);
+    captured.save(&cap).unwrap();
+    let decode = |out: &std::path::Path, flags: &[&str]| {
+        assert_cmd::Command::cargo_bin("slf")
+            .unwrap()
+            .arg("decode")
+            .arg(&cap)
+            .arg("-o")
+            .arg(out)
+            .args(["-q", "--preset", "preview"])
+            .args(flags)
+            .output()
+            .unwrap()
+    };
+    let npy = dir.path().join("lf.npy");
+    assert!(decode(&npy, &[]).status.success());
+    let want = read_npy(&npy).unwrap();
+    for (name, flags) in [("lf.zarr", &[][..]), ("gz.zarr", &["--deflate", "5"]), ("lf.store", &["--format", "zarr"])] {
+        let out = dir.path().join(name);
+        // Twice: the second replaces the first's store.
+        for _ in 0..2 {
+            let run = decode(&out, flags);
+            assert!(run.status.success(), "{name}: {}", String::from_utf8_lossy(&run.stderr));
+        }
+        let store = std::sync::Arc::new(FilesystemStore::new(&out).unwrap());
+        let array = Array::open(store.clone(), "/lightfield").unwrap();
+        let shape: Vec<u64> = want.shape().iter().map(|&d| d as u64).collect();
+        assert_eq!(array.shape(), shape.as_slice());
+        let all: Vec<std::ops::Range<u64>> = shape.iter().map(|&d| 0..d).collect();
+        let got: Vec<f32> = array.retrieve_array_subset(&all).unwrap();
+        assert!(got == want.data, "{name} {flags:?}: differs from the .npy");
+        let meta = serde_json::to_value(array.metadata()).unwrap();
+        assert_eq!(meta["dimension_names"], serde_json::json!(["u", "v", "h", "w", "band"]), "{name}");
+        assert_eq!(meta["chunk_grid"]["configuration"]["chunk_shape"][2], 8, "{name}");
+        assert_eq!(flags.contains(&"--deflate"), meta["codecs"].to_string().contains("gzip"), "{name}");
+        let band = Array::open(store.clone(), "/band").unwrap();
+        let nm: Vec<f32> = band.retrieve_chunk(&[0]).unwrap();
+        assert_eq!(nm, captured.description.bands_nm);
+        let group = zarrs::group::Group::open(store, "/").unwrap();
+        let attrs = group.attributes();
+        let text = serde_json::to_string(&captured.description).unwrap();
+        assert_eq!(attrs["description"], serde_json::from_str::<serde_json::Value>(&text).unwrap());
+        assert!(attrs["command"].as_str().unwrap().contains("decode") && attrs["settings"].is_string());
+    }
+    // A folder of the user's is never replaced.
+    let theirs = dir.path().join("theirs.zarr");
+    std::fs::create_dir(&theirs).unwrap();
+    std::fs::write(theirs.join("notes.txt"), "mine").unwrap();
+    let run = decode(&theirs, &[]);
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success() && err.contains("notes.txt"), "{err}");
+    assert_eq!(std::fs::read_to_string(theirs.join("notes.txt")).unwrap(), "mine");
+    let run = decode(&dir.path().join("x.zarr"), &["--dtype", "u16"]);
+    assert!(!run.status.success() && String::from_utf8_lossy(&run.stderr).contains("--dtype u16"));
+    // Nothing the run reads or writes may lie inside the store it replaces whole.
+    let store = dir.path().join("lf.zarr");
+    for (out, flags, says) in [
+        (cap.clone(), vec!["--format", "zarr"], "holds a file of the capture"),
+        (store.clone(), vec!["--member-map", "lf.zarr/m.csv"], "is inside -o"),
+    ] {
+        let flags: Vec<String> = flags.iter().map(|f| f.replace("lf.zarr", &store.display().to_string())).collect();
+        let flags: Vec<&str> = flags.iter().map(String::as_str).collect();
+        let run = decode(&out, &flags);
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert!(!run.status.success() && err.contains(says), "{flags:?}: {err}");
+    }
+    assert!(cap.join("capture.json").is_file() && store.join("zarr.json").is_file());
+}

@@ -222,33 +222,87 @@ def test_evaluate_equals_cli(tmp_path, slf_bin, depth, capture):
 
 def test_an_hdf5_decode_reads_in_h5py(tmp_path, slf_bin, capture):
     # `slf decode -o OUT.h5`: h5py reads the light field (the package's decode, bit for
-    # bit), its axes, its 13 band centres and the capture's description.
+    # bit), its axes, its 13 band centres and the capture's description; the file is
+    # chunked by bands of 8 lenslet rows (it is written a band at a time, issue 65), so a
+    # few rows read without the rest.
     import h5py
 
     capture.save(tmp_path / "cap")
     run([slf_bin, "decode", tmp_path / "cap", "-o", tmp_path / "lf.h5", "--deflate", "4", "-q"])
+    want = slf.decode(capture)
     with h5py.File(tmp_path / "lf.h5", "r") as f:
         d = f["lightfield"]
-        assert np.array_equal(d[()], slf.decode(capture))
-        assert [a.decode() for a in d.attrs["axes"]] == list("uvhwb")
+        assert d.shape == want.shape and d.dtype == np.float32
+        assert np.array_equal(d[()], want)
+        assert np.array_equal(d[:, :, 9:11], want[:, :, 9:11])
+        assert [str(a) for a in d.attrs["axes"]] == list("uvhwb")
         assert np.array_equal(d.attrs["bands_nm"], np.asarray(capture.description["bands_nm"], dtype=np.float32))
         assert json.loads(d.attrs["description"]) == capture.description
-        assert d.compression == "gzip" and d.chunks is not None
+        assert "--deflate 4" in d.attrs["command"] and d.attrs["settings"]
+        u, v, h, w, b = want.shape
+        assert d.compression == "gzip" and d.chunks == (u, v, min(h, 8), min(w, 128), b)
 
 
-def test_an_hdf5_soft_link_is_named_as_one(tmp_path, slf_bin):
-    # Issue 51, item 16: a soft link said "need 18446744073709551615 bytes"; the dataset
-    # itself imports.
+def test_a_zarr_decode_opens_lazily_in_zarr_xarray_and_dask(tmp_path, slf_bin, capture):
+    # `slf decode -o OUT.zarr` (issue 65, item 4): a Zarr v3 store that zarr-python, xarray
+    # and Dask open without reading it, holding the package's decode bit for bit, with the
+    # axes' names, the band centres as the band axis's coordinate and the description.
+    import dask.array as da
+    import xarray as xr
+    import zarr
+
+    capture.save(tmp_path / "cap")
+    run([slf_bin, "decode", tmp_path / "cap", "-o", tmp_path / "lf.zarr", "--deflate", "4", "-q"])
+    want = slf.decode(capture)
+    u, v, h, w, b = want.shape
+    group = zarr.open_group(tmp_path / "lf.zarr", mode="r")
+    a = group["lightfield"]
+    assert a.metadata.zarr_format == 3 and a.shape == want.shape and a.dtype == np.float32
+    assert a.chunks == (u, v, min(h, 8), min(w, 128), b)
+    assert np.array_equal(a[:, :, 9:11], want[:, :, 9:11])
+    assert group.attrs["description"] == capture.description
+    nm = np.asarray(capture.description["bands_nm"], dtype=np.float32)
+    ds = xr.open_zarr(tmp_path / "lf.zarr", consolidated=False)
+    lf = ds["lightfield"]
+    assert lf.dims == ("u", "v", "h", "w", "band")
+    assert np.array_equal(lf["band"].values, nm)
+    assert np.array_equal(lf.sel(band=nm[3]).values, want[..., 3])
+    lazy = da.from_zarr(str(tmp_path / "lf.zarr"), component="lightfield")
+    assert lazy.chunksize == a.chunks
+    assert np.array_equal(lazy.compute(), want)
+
+
+@pytest.mark.parametrize("libver", ["earliest", "latest"])
+@pytest.mark.parametrize("compression", [None, "gzip"])
+def test_h5py_files_import_whatever_their_format_version(tmp_path, slf_bin, libver, compression):
+    # Issue 65, item 4: a chunked, compressed dataset h5py writes with libver="latest" (its
+    # layout message version 5) was refused ("invalid data layout version: 5").
+    import h5py
+
+    lf = np.random.default_rng(5).random((2, 3, 10, 12, 13), dtype=np.float32)
+    with h5py.File(tmp_path / "lf.h5", "w", libver=libver) as f:
+        f.create_dataset("g/lf", data=lf, chunks=(1, 3, 4, 12, 13), compression=compression)
+    run([slf_bin, "import", "hdf5", tmp_path / "lf.h5", "--dataset", "g/lf", "--axes", "uvhwb", "-o", tmp_path / "x.npy"])
+    assert np.array_equal(np.load(tmp_path / "x.npy"), lf)
+
+
+def test_an_hdf5_soft_link_imports_as_its_dataset(tmp_path, slf_bin):
+    # Issue 51, item 16: a soft link said "need 18446744073709551615 bytes". The reader
+    # follows it now; a link to nothing is refused with one line naming it.
     import h5py
 
     with h5py.File(tmp_path / "soft.h5", "w") as f:
-        f["real"] = np.zeros((2, 2, 3, 3, 13), "f4")
+        f["real"] = np.arange(2 * 2 * 3 * 3 * 13, dtype="f4").reshape(2, 2, 3, 3, 13) / 500
         f["lf"] = h5py.SoftLink("/real")
-    base = [slf_bin, "import", "hdf5", tmp_path / "soft.h5", "--axes", "uvhwb", "-o", tmp_path / "x.npy"]
-    p = subprocess.run([str(c) for c in base + ["--dataset", "lf"]], capture_output=True, text=True)
-    assert p.returncode == 1
-    assert "is a soft link or another object" in p.stderr and "18446744073709551615" not in p.stderr
-    run(base + ["--dataset", "real"])
+        f["dangling"] = h5py.SoftLink("/nothing")
+    base = [slf_bin, "import", "hdf5", tmp_path / "soft.h5", "--axes", "uvhwb", "-o"]
+    run(base + [tmp_path / "a.npy", "--dataset", "lf"])
+    run(base + [tmp_path / "b.npy", "--dataset", "real"])
+    assert np.array_equal(np.load(tmp_path / "a.npy"), np.load(tmp_path / "b.npy"))
+    p = subprocess.run([str(c) for c in base + [tmp_path / "c.npy", "--dataset", "dangling"]], capture_output=True, text=True)
+    assert p.returncode == 1 and p.stderr.count("\n") == 1, p.stderr
+    assert "dangling" in p.stderr and "18446744073709551615" not in p.stderr
+    assert not (tmp_path / "c.npy").exists()
 
 
 def test_baseline_blend_equals_cli(tmp_path, slf_bin, depth):

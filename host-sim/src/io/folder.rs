@@ -30,6 +30,9 @@ pub enum Kind {
     Files(&'static str, &'static [&'static str], fn(&str) -> bool),
     /// Folders, each holding the description (a set of calibration captures).
     Folders(&'static str),
+    /// A store: the description at its top, and folders (its arrays) each holding the
+    /// description too (a Zarr store's `zarr.json`).
+    Store(&'static str),
 }
 
 /// The names a folder of [`Kind::Files`] may hold: the description, `fixed`, and what the
@@ -144,10 +147,11 @@ fn replaceable(dir: &Path, target: &Path, kind: Kind) -> Result<()> {
     let what = match kind {
         Kind::Files(d, _, _) => format!("a folder of {d} and the files it names"),
         Kind::Folders(d) => format!("a folder of folders holding {d}"),
+        Kind::Store(d) => format!("a store ({d} and folders holding {d})"),
     };
     let allowed = match kind {
         Kind::Files(d, fixed, ours) => named_files(dir, d, fixed, ours),
-        Kind::Folders(_) => Vec::new(),
+        Kind::Folders(_) | Kind::Store(_) => Vec::new(),
     };
     ensure!(meta.is_dir(), "{} is not a folder: the output is {what}", target.display());
     let mut described = false;
@@ -163,6 +167,11 @@ fn replaceable(dir: &Path, target: &Path, kind: Kind) -> Result<()> {
                 described = true;
                 t.is_dir() && entry.path().join(d).is_file()
             }
+            Kind::Store(d) if entry.file_name() == d => {
+                described = true;
+                t.is_file()
+            }
+            Kind::Store(d) => t.is_dir() && entry.path().join(d).is_file(),
         };
         if !fits {
             bail!(
@@ -173,7 +182,7 @@ fn replaceable(dir: &Path, target: &Path, kind: Kind) -> Result<()> {
             );
         }
     }
-    if let Kind::Files(d, _, _) = kind {
+    if let Kind::Files(d, _, _) | Kind::Store(d) = kind {
         ensure!(
             described || fs::read_dir(dir).map(|mut r| r.next().is_none()).unwrap_or(false),
             "{} holds files but no {d}: the output replaces the folder whole, so choose a new or empty folder",

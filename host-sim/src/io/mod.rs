@@ -12,6 +12,9 @@
 //! - [`frame_file`]: a raw frame's file (PGM, PNG, `.npy`), read and written;
 //! - [`file_checks`]: a file checked before it is opened (regular, not too large);
 //! - [`hdf5_rows`]: a light field's HDF5 file, from its rows;
+//! - [`zarr_rows`]: a light field's Zarr v3 store, from its rows;
+//! - [`row_band`]: rows gathered into bands of whole chunks (what the HDF5 and Zarr outputs
+//!   write at a time);
 //! - [`folder`]: folders written whole, and the checksums their descriptions record;
 //! - [`grid`]: the lenslet grid, where a real lenslet array sits on the sensor;
 //! - [`interrupt`]: an interrupt ends a command and removes its temporaries;
@@ -42,7 +45,9 @@ pub mod npy;
 pub mod npy_rows;
 pub mod output;
 pub mod patch;
+pub mod row_band;
 pub mod rows;
 pub mod sensor;
 #[macro_use]
 pub mod stdout;
+pub mod zarr_rows;

@@ -131,6 +131,12 @@ impl WholeFile {
         &self.path
     }
 
+    /// The temporary file's own path, for a writer that opens the file by name (the HDF5
+    /// writer); it is renamed over [`Self::path`] by [`Self::persist`].
+    pub fn part_path(&self) -> &Path {
+        self.tmp.path()
+    }
+
     /// Syncs the temporary file and renames it over the destination.
     ///
     /// # Errors
@@ -203,15 +209,22 @@ struct Named {
     what: String,
     at: PathBuf,
     id: Option<(u64, u64)>,
+    /// A folder written whole (a Zarr store): what lies inside it is its.
+    folder: bool,
 }
 
 impl Named {
     fn new(given: &Path, what: &str) -> Self {
-        Self { given: given.to_path_buf(), what: what.into(), at: resolved(given), id: identity(given) }
+        Self { given: given.to_path_buf(), what: what.into(), at: resolved(given), id: identity(given), folder: false }
     }
 
     fn same(&self, other: &Named) -> bool {
         self.at == other.at || matches!((self.id, other.id), (Some(a), Some(b)) if a == b)
+    }
+
+    /// `other` is this folder output or lies inside it.
+    fn holds(&self, other: &Named) -> bool {
+        self.same(other) || (self.folder && other.at.starts_with(&self.at))
     }
 }
 
@@ -249,6 +262,15 @@ impl Outputs {
         self
     }
 
+    /// A folder the run writes whole (a Zarr store): no input or other output may lie
+    /// inside it, and it is checked as a folder ([`crate::io::folder::WholeFolder`] checks
+    /// what an old one holds when it is made).
+    #[must_use]
+    pub fn folder_output(mut self, path: &Path, what: &str) -> Self {
+        self.outputs.push(Named { folder: true, ..Named::new(path, what) });
+        self
+    }
+
     /// Files the run writes (an `Option` for an output that may not be asked for).
     #[must_use]
     pub fn outputs<P: AsRef<Path>>(self, paths: impl IntoIterator<Item = P>, what: &str) -> Self {
@@ -263,7 +285,7 @@ impl Outputs {
     pub fn check(&self) -> Result<()> {
         self.check_distinct()?;
         for o in &self.outputs {
-            writable(&o.given)
+            if o.folder { folder_writable(&o.given) } else { writable(&o.given) }
                 .with_context(|| format!("cannot write {} {} (checked before the run)", o.what, o.given.display()))?;
         }
         Ok(())
@@ -276,27 +298,51 @@ impl Outputs {
     /// One line naming the two flags and the file.
     pub fn check_distinct(&self) -> Result<()> {
         for (i, o) in self.outputs.iter().enumerate() {
-            if let Some(inp) = self.inputs.iter().find(|inp| inp.same(o)) {
+            if let Some(inp) = self.inputs.iter().find(|inp| o.holds(inp)) {
+                let is = if o.same(inp) { "is" } else { "holds" };
                 bail!(
-                    "{} {} is {} {}: an output may not be a file the run reads (it would be destroyed)",
+                    "{} {} {is} {} {}: an output may not be a file the run reads (it would be destroyed)",
                     o.what,
                     o.given.display(),
                     inp.what,
                     inp.given.display()
                 );
             }
-            if let Some(other) = self.outputs[..i].iter().find(|other| other.same(o)) {
+            if let Some(other) = self.outputs[..i].iter().find(|other| other.holds(o) || o.holds(other)) {
+                let (a, b) = if o.holds(other) { (o, other) } else { (other, o) };
+                if a.same(b) {
+                    bail!(
+                        "{} {} and {} {} are the same file: each output needs its own",
+                        other.what,
+                        other.given.display(),
+                        o.what,
+                        o.given.display()
+                    );
+                }
                 bail!(
-                    "{} {} and {} {} are the same file: each output needs its own",
-                    other.what,
-                    other.given.display(),
-                    o.what,
-                    o.given.display()
+                    "{} {} is inside {} {}, which is written whole: each output needs its own place",
+                    b.what,
+                    b.given.display(),
+                    a.what,
+                    a.given.display()
                 );
             }
         }
         Ok(())
     }
+}
+
+/// Fails if the folder `path` cannot be written whole: a file there, a missing parent, a
+/// parent that refuses a new folder. Creates nothing.
+fn folder_writable(path: &Path) -> Result<()> {
+    ensure!(!path.as_os_str().is_empty(), "an empty path names no folder");
+    if let Ok(meta) = fs::symlink_metadata(path) {
+        ensure!(meta.is_dir(), "not a folder ({})", file_kind(&meta));
+    }
+    let dir = parent(path);
+    ensure!(dir.is_dir(), "the folder {} does not exist", dir.display());
+    tempfile::Builder::new().prefix(".slf-check.").tempdir_in(dir).context("the folder takes no new folder")?;
+    Ok(())
 }
 
 /// Fails if `path` cannot be written: a folder, a missing parent, a folder that refuses a

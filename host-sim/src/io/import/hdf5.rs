@@ -1,6 +1,6 @@
-//! Light fields in HDF5 files, read by the pure-Rust `hdf5-pure` crate (no C library, so
+//! Light fields in HDF5 files, read by the pure-Rust `rust-hdf5` crate (no C library, so
 //! no cargo feature is needed; it reads h5py's files, chunked and gzip-compressed ones
-//! included).
+//! included, and those written with `libver="latest"`).
 //!
 //! The dataset's path and its axis order are given (`--dataset /lf --axes hwuvb`): any
 //! permutation of `u`, `v` (views), `h`, `w` (space) and `b` (bands). Values of any
@@ -13,7 +13,7 @@ use anyhow::{Context, Result, bail, ensure};
 
 use crate::io::lightfield::LightField;
 
-/// The largest HDF5 file read (the reader holds it in memory).
+/// The largest HDF5 file read.
 pub const MAX_FILE: u64 = 8 << 30;
 
 /// The most values a light field may have: a light field's own cap, as the README says.
@@ -49,28 +49,13 @@ pub fn read_hdf5(path: &Path, layout: &Hdf5Layout, white: f32) -> Result<LightFi
     let meta = std::fs::metadata(path).with_context(|| format!("{}: cannot read", path.display()))?;
     ensure!(meta.is_file(), "{}: not a regular file", path.display());
     ensure!(meta.len() <= MAX_FILE, "{}: {} bytes, more than the {MAX_FILE} read", path.display(), meta.len());
-    let file = hdf5_pure::File::open(path)
-        .map_err(|e| anyhow::anyhow!("{}: not an HDF5 file slf reads: {e}", path.display()))?;
-    let ds = file.dataset(layout.dataset.trim_start_matches('/')).map_err(|e| {
-        // HDF5's undefined address (all ones) is where the reader meets a link it does not
-        // follow: a soft link once said "need 18446744073709551615 bytes".
-        if e.to_string().contains(&u64::MAX.to_string()) {
-            anyhow::anyhow!(
-                "{}: {:?} is a soft link or another object slf's HDF5 reader does not follow (its address is \
-                 undefined): give the path of the dataset itself (h5py: f[name].name)",
-                path.display(),
-                layout.dataset
-            )
-        } else {
-            anyhow::anyhow!("{}: no dataset {:?}: {e}", path.display(), layout.dataset)
-        }
-    })?;
-    let shape: Vec<usize> = ds
-        .shape()
-        .map_err(|e| anyhow::anyhow!("{}: {}: unreadable shape: {e}", path.display(), layout.dataset))?
-        .into_iter()
-        .map(|d| d as usize)
-        .collect();
+    let file = rust_hdf5::H5File::open(path)
+        .map_err(|e| anyhow::anyhow!("{}: not an HDF5 file slf reads: {}", path.display(), one_line(&e)))?;
+    // A soft link is followed; one to nothing says where it points.
+    let ds = file
+        .dataset(layout.dataset.trim_start_matches('/'))
+        .map_err(|e| anyhow::anyhow!("{}: no dataset {:?}: {}", path.display(), layout.dataset, one_line(&e)))?;
+    let shape = ds.shape();
     ensure!(
         shape.len() == 5,
         "{}: {}: shape {shape:?} has {} axes; a light field has 5 ({})",
@@ -84,57 +69,44 @@ pub fn read_hdf5(path: &Path, layout: &Hdf5Layout, white: f32) -> Result<LightFi
     let Some(total) = total else {
         bail!("{}: {}: shape {shape:?} is more than {MAX_VALUES} values", path.display(), layout.dataset);
     };
-    // The element type first: a type the reader does not convert (float16, strings,
-    // compounds) is named, not reported as the library's "type mismatch".
-    use hdf5_pure::DType;
-    let dtype = ds
-        .dtype()
-        .map_err(|e| anyhow::anyhow!("{}: {}: unreadable element type: {e}", path.display(), layout.dataset))?;
-    let numeric = matches!(
-        dtype,
-        DType::F32
-            | DType::F64
-            | DType::I8
-            | DType::I16
-            | DType::I32
-            | DType::I64
-            | DType::U8
-            | DType::U16
-            | DType::U32
-            | DType::U64
-    );
-    if !numeric {
-        let what = match ds.datatype() {
-            Ok(hdf5_pure::Datatype::FloatingPoint { size, .. }) => format!("{}-bit floats", 8 * size),
-            _ => format!("{dtype:?}").chars().take(60).collect(),
-        };
-        bail!(
-            "{}: {}: holds {what}; slf reads 32- or 64-bit floats and integers (convert it, e.g. h5py: \
-             f[name][...].astype('float32'))",
-            path.display(),
-            layout.dataset
-        );
-    }
+    // The element type first: a type the reader does not convert (strings, compounds,
+    // opaque bytes) is named, not reported as the library's "type mismatch".
+    use rust_hdf5::DatatypeMessage as T;
+    let dtype = ds.datatype().map_err(|e| {
+        anyhow::anyhow!("{}: {}: unreadable element type: {}", path.display(), layout.dataset, one_line(&e))
+    })?;
+    let element = match dtype {
+        T::FixedPoint { size: size @ (1 | 2 | 4 | 8), .. } => u64::from(size),
+        T::FloatingPoint { size: size @ (2 | 4 | 8), .. } => u64::from(size),
+        other => {
+            let what: String = match other {
+                T::FloatingPoint { size, .. } => format!("{}-bit floats", 8 * size),
+                T::FixedPoint { size, .. } => format!("{}-bit integers", 8 * size),
+                other => format!("{other:?}").chars().take(60).collect(),
+            };
+            bail!(
+                "{}: {}: holds {what}; slf reads 32- or 64-bit floats and integers (convert it, e.g. h5py: \
+                 f[name][...].astype('float32'))",
+                path.display(),
+                layout.dataset
+            );
+        }
+    };
     // What the read holds at its peak, from what the file declares, before anything is
     // allocated (a 1.4 KB file declaring 5 x 5 x 1200 x 1200 x 13 once aborted the process
-    // in the allocator): the file, the values in their own type, as f32, and the light
-    // field (13 bands after resampling, at most as many as read).
-    let element = match dtype {
-        DType::F64 | DType::I64 | DType::U64 => 8u64,
-        DType::I8 | DType::U8 => 1,
-        DType::I16 | DType::U16 => 2,
-        _ => 4,
-    };
+    // in the allocator): the values in their own type, as f64 (the reader converts every
+    // numeric type by widening), and the light field (13 bands after resampling, at most as
+    // many as read).
     let light_field = (total / shape[at[4]]) as u64 * shape[at[4]].max(13) as u64 * 4;
-    let need = meta.len() + total as u64 * (element + 4) + light_field;
+    let need = total as u64 * (element + 8) + light_field;
     crate::io::budget::check(
         need,
         &format!("{}: {} of shape {shape:?}", path.display(), layout.dataset),
         "crop or split the dataset",
     )?;
-    let values = ds
-        .read_f32()
-        .map_err(|e| anyhow::anyhow!("{}: {}: cannot read the values: {e}", path.display(), layout.dataset))?;
+    let values = ds.read_numeric_as::<f64>().map_err(|e| {
+        anyhow::anyhow!("{}: {}: cannot read the values: {}", path.display(), layout.dataset, one_line(&e))
+    })?;
     ensure!(
         values.len() == total,
         "{}: {}: {} values for shape {shape:?}",
@@ -159,7 +131,7 @@ pub fn read_hdf5(path: &Path, layout: &Hdf5Layout, white: f32) -> Result<LightFi
                 for w in 0..dims[3] {
                     let base = u * st[0] + v * st[1] + h * st[2] + w * st[3];
                     for b in 0..dims[4] {
-                        let x = values[base + b * st[4]];
+                        let x = values[base + b * st[4]] as f32;
                         ensure!(
                             x.is_finite(),
                             "{}: {}: value at (u, v, h, w, b) = ({u}, {v}, {h}, {w}, {b}) is {x}",
@@ -184,4 +156,10 @@ pub fn read_hdf5(path: &Path, layout: &Hdf5Layout, white: f32) -> Result<LightFi
         }
     }
     Ok(lf)
+}
+
+/// An HDF5 error on one line (a reader's message may hold a newline), at most 300 characters.
+fn one_line(e: &rust_hdf5::Hdf5Error) -> String {
+    let s = e.to_string().split_whitespace().collect::<Vec<_>>().join(" ");
+    if s.chars().count() > 300 { s.chars().take(300).collect::<String>() + "..." } else { s }
 }

@@ -18,22 +18,24 @@ use slf_host::io::lightfield::{Dtype, stage_npy_f32_2d};
 use slf_host::io::npy_rows::NpyRows;
 use slf_host::io::output::{Outputs, stage};
 use slf_host::io::rows::Rows;
+use slf_host::io::zarr_rows::ZarrRows;
 
 #[derive(clap::Args)]
 pub struct Args {
     /// Capture folder (capture.json and frames).
     pub capture: PathBuf,
-    /// Output file, .npy (written as its rows are decoded) or HDF5 (.h5, .hdf5; or
-    /// --format): normalised units (white = 1), every method's values clamped to the
+    /// Output, written as its rows are decoded: a .npy file, an HDF5 file (.h5, .hdf5) or
+    /// a Zarr v3 store (.zarr, a folder; or --format): normalised units (white = 1), every method's values clamped to the
     /// sensor's physical range, 0 to (max_valid - black) / (white - black) (1.111 for the
     /// simulator's default sensor).
     #[arg(short, long)]
     pub output: PathBuf,
-    /// The output's format [default: hdf5 for a name ending in .h5 or .hdf5, else npy].
+    /// The output's format [default: hdf5 for a name ending in .h5 or .hdf5, zarr for .zarr,
+    /// else npy].
     #[arg(long, value_enum)]
     pub format: Option<Format>,
-    /// HDF5: compress the dataset's chunks by deflate at this level (1..=9, with the
-    /// shuffle filter); none by default.
+    /// HDF5 and Zarr: compress the light field's chunks by deflate at this level (1..=9;
+    /// HDF5 with the shuffle filter, Zarr as gzip); none by default.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=9))]
     pub deflate: Option<u32>,
     #[command(flatten)]
@@ -70,12 +72,19 @@ pub enum Format {
     /// band centres in nm, the capture's description and the decode's command as
     /// attributes (`slf import hdf5 OUT --dataset lightfield --axes uvhwb` reads it back).
     Hdf5,
+    /// A Zarr v3 store (a folder): the array `lightfield` (U, V, H, W, 13) with its
+    /// dimension names, the array `band` (the band centres in nm), and the capture's
+    /// description and the decode's command as the group's attributes; Dask, xarray,
+    /// zarr-python and napari open it lazily.
+    Zarr,
 }
 
 /// The file a decode writes, by format.
 enum OutputFile {
     Npy(NpyRows),
     Hdf5(Hdf5Rows),
+    /// Boxed: the array's description is a kilobyte, the other sinks a few hundred bytes.
+    Zarr(Box<ZarrRows>),
 }
 
 impl OutputFile {
@@ -83,6 +92,7 @@ impl OutputFile {
         match self {
             Self::Npy(f) => f,
             Self::Hdf5(f) => f,
+            Self::Zarr(f) => &mut **f,
         }
     }
 
@@ -90,15 +100,21 @@ impl OutputFile {
         match self {
             Self::Npy(f) => f.max(),
             Self::Hdf5(f) => f.max(),
+            Self::Zarr(f) => f.max(),
         }
     }
 
-    /// Puts the file in place, an HDF5 file with `settings` (the decode's, resolved).
+    /// Puts the file in place, an HDF5 file or Zarr store with `settings` (the decode's,
+    /// resolved).
     fn finish(self, settings: &str) -> Result<()> {
         match self {
             Self::Npy(f) => f.finish(),
             Self::Hdf5(mut f) => {
-                f.attr("settings", settings);
+                f.attr("settings", settings)?;
+                f.finish()
+            }
+            Self::Zarr(mut f) => {
+                f.attr("settings", settings.into());
                 f.finish()
             }
         }
@@ -108,25 +124,33 @@ impl OutputFile {
 pub fn run(args: Args) -> Result<()> {
     let Args { capture, output, format, deflate, mut settings, member_map, disparity_map, error_map, dtype, quiet } =
         args;
-    let hdf5_name = output.extension().is_some_and(|e| e.eq_ignore_ascii_case("h5") || e.eq_ignore_ascii_case("hdf5"));
-    let format = format.unwrap_or(if hdf5_name { Format::Hdf5 } else { Format::Npy });
+    let named = |ext: &[&str]| output.extension().is_some_and(|e| ext.iter().any(|x| e.eq_ignore_ascii_case(x)));
+    let format = format.unwrap_or(if named(&["h5", "hdf5"]) {
+        Format::Hdf5
+    } else if named(&["zarr"]) {
+        Format::Zarr
+    } else {
+        Format::Npy
+    });
     anyhow::ensure!(
-        format == Format::Hdf5 || deflate.is_none(),
-        "--deflate compresses an HDF5 output: give -o OUT.h5 or --format hdf5"
+        format != Format::Npy || deflate.is_none(),
+        "--deflate compresses an HDF5 or Zarr output: give -o OUT.h5, -o OUT.zarr or --format hdf5|zarr"
     );
     anyhow::ensure!(
         format == Format::Npy || dtype == Dtype::F32,
-        "--dtype u16 is for a .npy output; the HDF5 output is float32"
+        "--dtype u16 is for a .npy output; the HDF5 and Zarr outputs are float32"
     );
     settings.estimate |= error_map.is_some();
     let cap = Capture::load(&capture)?;
     // Where the results go is checked before the decode, not found unwritable after it, and
     // no result may be written over a file the decode reads or another result.
-    Outputs::new()
+    let outputs = Outputs::new()
         .inputs(cap.files(), "a file of the capture")
         .inputs(&settings.basis.blob, "--blob")
-        .inputs(settings.calibration.iter().flat_map(|d| Calibration::files_in(d)), "a file of --calibration")
-        .output(&output, "-o")
+        .inputs(settings.calibration.iter().flat_map(|d| Calibration::files_in(d)), "a file of --calibration");
+    let outputs =
+        if format == Format::Zarr { outputs.folder_output(&output, "-o") } else { outputs.output(&output, "-o") };
+    outputs
         .outputs(member_map.as_deref(), "--member-map")
         .outputs(disparity_map.as_deref(), "--disparity-map")
         .outputs(error_map.as_deref(), "--error-map")
@@ -156,9 +180,17 @@ pub fn run(args: Args) -> Result<()> {
         Format::Npy => OutputFile::Npy(NpyRows::create(&output, output_shape(&cap), dtype)?),
         Format::Hdf5 => {
             let mut f = Hdf5Rows::create(&output, output_shape(&cap), &cap.description.bands_nm, deflate)?;
-            f.attr("description", &serde_json::to_string(&cap.description)?);
-            f.attr("command", &std::env::args().collect::<Vec<_>>().join(" "));
+            f.attr("description", &serde_json::to_string(&cap.description)?)?;
+            f.attr("command", &std::env::args().collect::<Vec<_>>().join(" "))?;
             OutputFile::Hdf5(f)
+        }
+        Format::Zarr => {
+            let mut f = ZarrRows::create(&output, output_shape(&cap), &cap.description.bands_nm, deflate)?;
+            // Through its text, as capture.json holds it: a value from the f32 fields
+            // directly would carry their binary expansion (3691.89990234375 for 3691.9).
+            f.attr("description", serde_json::from_str(&serde_json::to_string(&cap.description)?)?);
+            f.attr("command", std::env::args().collect::<Vec<_>>().join(" ").into());
+            OutputFile::Zarr(Box::new(f))
         }
     };
     let outcome =
