@@ -68,7 +68,11 @@ class Sweep:
         # An output an earlier case left would pass for this one's.
         for out in outputs:
             if out not in keep:
-                Path(self.work, out).unlink(missing_ok=True)
+                at = Path(self.work, out)
+                if at.is_dir():
+                    shutil.rmtree(at)
+                else:
+                    at.unlink(missing_ok=True)
 
         def preexec():
             limits()
@@ -116,7 +120,18 @@ class Sweep:
             self.accepted += 1
             # Strict: an exit 0 leaves each output whole, a light field slf itself reads.
             for out in outputs:
-                if not Path(self.work, out).is_file():
+                at = Path(self.work, out)
+                if out.endswith(".zarr"):
+                    # A store: its group and its array described (zarr-python reads it in
+                    # the package's tests).
+                    if not (at / "zarr.json").is_file() or not (at / "lightfield" / "zarr.json").is_file():
+                        self.failures.append(f"{name}: exit 0 and no whole store {out}")
+                    continue
+                if out.endswith(".h5"):
+                    if not at.is_file() or at.read_bytes()[:8] != b"\x89HDF\r\n\x1a\n":
+                        self.failures.append(f"{name}: exit 0 and no HDF5 file {out}")
+                    continue
+                if not at.is_file():
                     self.failures.append(f"{name}: exit 0 and no {out}")
                     continue
                 check = subprocess.run([SLF, "eval", out, out], cwd=self.work, capture_output=True, text=True)
@@ -283,6 +298,22 @@ def issue_65(s, work, ok):
         s.run(["decode", "cap", "-o", "x.npy", "-q", "--method", "demosaic", *extra],
               f"decode --method demosaic {' '.join(extra)}", refuse=True)
     s.run(["decode", "cap", "-o", "fifo.npy", "-q"], "decode -o a FIFO", refuse=True)
+    # 4: the chunked outputs, HDF5 and a Zarr store: written, replaced, and refused over
+    # what is not theirs (a file, a user's folder, the capture, a map inside the store).
+    capture_files = [str(p) for p in (work / "cap").iterdir()]
+    for out, extra in [("o.h5", []), ("o.h5", ["--deflate", "9"]), ("o.zarr", []), ("o.zarr", ["--deflate", "1"]),
+                       ("o.zarr", ["--method", "ppid"])]:
+        s.run(["decode", "cap", "-o", out, "-q", *extra], f"decode -o {out} {' '.join(extra)}", outputs=[out],
+              keep=capture_files)
+    (work / "file.zarr").write_text("mine")
+    (work / "mine.zarr").mkdir(exist_ok=True)
+    (work / "mine.zarr" / "notes.txt").write_text("mine")
+    for out, extra in [("file.zarr", []), ("mine.zarr", []), ("cap", ["--format", "zarr"]),
+                       ("o.zarr", ["--error-map", "o.zarr/em.npy"]), ("o.zarr", ["--dtype", "u16"]),
+                       ("o.zarr", ["--deflate", "0"]), ("o.zarr", ["--deflate", "10"]), ("", ["--format", "zarr"]),
+                       ("missing/o.zarr", [])]:
+        s.run(["decode", "cap", "-o", out, "-q", *extra], f"decode -o {out!r} {' '.join(extra)}", refuse=True,
+              keep=capture_files + [str(work / "file.zarr"), str(work / "mine.zarr" / "notes.txt")])
     # 7: a long table in alternating order (quadratic once: past 120 s at 100,000 rows).
     header = (work / "header.csv").read_text()
     rows = "".join(f"{m},3,x{i},30,0.9,4,1,0.5,1,2,true\n" for i, m in
