@@ -86,6 +86,20 @@ fn the_rows_a_streamed_decode_holds_do_not_grow_with_the_frame() {
     assert_eq!(report.rows_held, 60);
 }
 
+/// `slf decode CAP -o OUT -q FLAGS`, its output.
+fn slf_decode(cap: &std::path::Path, out: &std::path::Path, flags: &[&str]) -> std::process::Output {
+    assert_cmd::Command::cargo_bin("slf")
+        .unwrap()
+        .arg("decode")
+        .arg(cap)
+        .arg("-o")
+        .arg(out)
+        .arg("-q")
+        .args(flags)
+        .output()
+        .unwrap()
+}
+
 /// `slf decode -o OUT.npy` writes its rows as they are decoded: the file is the light field
 /// the library decodes into memory with the same flags, value for value: compressed sensing
 /// streamed by the strip, and a baseline decoded whole and put row by row.
@@ -172,18 +186,7 @@ fn the_decode_written_to_hdf5_is_the_decode_written_to_npy() {
     let dir = tempfile::tempdir().unwrap();
     let cap = dir.path().join("cap");
     capture(23).save(&cap).unwrap();
-    let decode = |out: &std::path::Path, flags: &[&str]| {
-        assert_cmd::Command::cargo_bin("slf")
-            .unwrap()
-            .arg("decode")
-            .arg(&cap)
-            .arg("-o")
-            .arg(out)
-            .arg("-q")
-            .args(flags)
-            .output()
-            .unwrap()
-    };
+    let decode = |out: &std::path::Path, flags: &[&str]| slf_decode(&cap, out, flags);
     let npy = dir.path().join("lf.npy");
     assert!(decode(&npy, &["--preset", "preview"]).status.success());
     let want = read_npy(&npy).unwrap();
@@ -218,18 +221,8 @@ fn the_decode_written_to_zarr_is_the_decode_written_to_npy() {
     let cap = dir.path().join("cap");
     let captured = capture(23);
     captured.save(&cap).unwrap();
-    let decode = |out: &std::path::Path, flags: &[&str]| {
-        assert_cmd::Command::cargo_bin("slf")
-            .unwrap()
-            .arg("decode")
-            .arg(&cap)
-            .arg("-o")
-            .arg(out)
-            .args(["-q", "--preset", "preview"])
-            .args(flags)
-            .output()
-            .unwrap()
-    };
+    let decode =
+        |out: &std::path::Path, flags: &[&str]| slf_decode(&cap, out, &[&["--preset", "preview"], flags].concat());
     let npy = dir.path().join("lf.npy");
     assert!(decode(&npy, &[]).status.success());
     let want = read_npy(&npy).unwrap();
