@@ -337,7 +337,12 @@ fn hostile_capture_descriptions_are_one_line_errors() {
             "is not a path inside the capture folder",
         ),
         ("no frames", Box::new(|j| j["frames"] = serde_json::json!([])), "frames lists 0 files"),
-        ("nan level", Box::new(|j| j["white_level"] = serde_json::json!(1e39)), "finite black_level"),
+        // JSON has no infinity: a level past f32's range is named, not read as infinity.
+        (
+            "huge white level",
+            Box::new(|j| j["white_level"] = serde_json::json!(1e39)),
+            "white_level: number out of range",
+        ),
         // Issue 41, item 11: finite levels whose difference is not (before: all zeros, exit 0).
         (
             "huge levels",

@@ -21,7 +21,7 @@ pub fn from_parts(frames: &PyReadonlyArrayDyn<'_, u16>, description: &str) -> Py
             shape.len()
         )));
     };
-    let d: CaptureDescription = serde_json::from_str(description)
+    let d: CaptureDescription = slf_host::io::json::parse(description)
         .map_err(|e| PyValueError::new_err(format!("description: invalid capture description: {e}")))?;
     let data = crate::arrays::c_order(frames);
     let frames: Vec<Vec<u16>> =

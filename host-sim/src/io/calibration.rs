@@ -276,7 +276,7 @@ impl Calibration {
         let path = dir.join(DESCRIPTION);
         let text = read_small_file(&path, MAX_DESCRIPTION)?;
         let mut description: CalibrationDescription =
-            serde_json::from_str(&text).map_err(|e| anyhow!("{}: invalid calibration: {e}", path.display()))?;
+            super::json::parse(&text).map_err(|e| anyhow!("{}: invalid calibration: {e}", path.display()))?;
         match description.files.take() {
             // A flat from another calibration beside these dark levels once decoded with
             // exit 0.

@@ -439,7 +439,7 @@ impl Capture {
         let desc_path = dir.join(DESCRIPTION);
         let named = |e: anyhow::Error| anyhow!("{}: {}", desc_path.display(), one_line(&e));
         let text = read_small_file(&desc_path, MAX_DESCRIPTION)?;
-        let mut description: CaptureDescription = serde_json::from_str(&text)
+        let mut description: CaptureDescription = super::json::parse(&text)
             .map_err(|e| anyhow!("{}: invalid capture description: {e}", desc_path.display()))?;
         let records = description.files.take();
         let (rows, cols) = description.frame_size().map_err(named)?;

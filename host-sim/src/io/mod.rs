@@ -11,6 +11,7 @@
 //! - [`capture`]: the capture folder (frames and `capture.json`), loaded and saved;
 //! - [`frame_file`]: a raw frame's file (PGM, PNG, `.npy`), read and written;
 //! - [`file_checks`]: a file checked before it is opened (regular, not too large);
+//! - [`json`]: descriptions parsed from JSON, errors naming the field;
 //! - [`hdf5_rows`]: a light field's HDF5 file, from its rows;
 //! - [`zarr_rows`]: a light field's Zarr v3 store, from its rows;
 //! - [`row_band`]: rows gathered into bands of whole chunks (what the HDF5 and Zarr outputs
@@ -39,6 +40,7 @@ pub mod grid;
 pub mod hdf5_rows;
 pub mod import;
 pub mod interrupt;
+pub mod json;
 pub mod lightfield;
 pub mod message;
 pub mod npy;
