@@ -6,6 +6,8 @@
 # is N (N x N lenslets) or ROWSxCOLS (wider than tall: the memory against the frame's height
 # at equal width). A size whose scene or capture would not fit is reported and skipped.
 #
+# SLF_PRESETS: presets, or the baseline methods interpolate, demosaic and ppid (`--method`).
+#
 # SLF_FORMATS: the outputs measured (default "npy"; "npy h5 zarr" for issue 65's table: the
 # HDF5 file and the Zarr store are written a band of rows at a time, as the .npy is).
 #
@@ -41,10 +43,12 @@ fi
 echo
 echo "| lenslets | output MB | preset | format | peak resident MB | peak / output | seconds | before: peak MB | before: seconds |"
 echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"
-# Peak MB and seconds of `$1 decode CAP -o OUT.$5 --preset P`, or "failed".
+# Peak MB and seconds of `$1 decode CAP -o OUT.$5 --preset P` (or `--method P`), or "failed".
 measure() {
   local bin=$1 cap=$2 p=$3 log=$4 ext=${5:-npy}
-  if /usr/bin/time -v "$bin" decode "$cap" -o "$out/rec.$ext" -q --preset "$p" > /dev/null 2> "$log"; then
+  local how=(--preset "$p")
+  case $p in interpolate | demosaic | ppid) how=(--method "$p") ;; esac
+  if /usr/bin/time -v "$bin" decode "$cap" -o "$out/rec.$ext" -q "${how[@]}" > /dev/null 2> "$log"; then
     kb=$(awk -F': ' '/Maximum resident set size/ { print $2 }' "$log")
     s=$(awk -F': ' '/Elapsed \(wall clock\)/ { n = split($2, a, ":"); t = 0; for (i = 1; i <= n; i++) t = 60 * t + a[i]; print t }' "$log")
     printf '%.0f %.1f' "$(echo "$kb / 1000" | bc -l)" "$s"

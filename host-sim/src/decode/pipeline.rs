@@ -18,7 +18,7 @@ use crate::io::calibration::Calibration;
 use crate::io::capture::Capture;
 use crate::io::lightfield::LightField;
 use crate::io::patch::BANDS;
-use crate::io::rows::{MapRows, RowShape, Rows, put_light_field};
+use crate::io::rows::{MapRows, RowShape, Rows};
 
 /// A decode's light field and what it reports.
 #[derive(Clone, Debug)]
@@ -53,8 +53,8 @@ impl DecodeSettings {
     }
 
     /// [`Self::run`], each finished lenslet row of the light field ([`output_shape`]) put
-    /// into `sink` in order: a compressed-sensing decode holds a band of rows, not the
-    /// frame (a baseline decodes the frame, then puts its rows).
+    /// into `sink` in order: a compressed-sensing decode holds a band of rows, a baseline a
+    /// window of lenslet rows as tall as its neighbourhood, never the frame.
     ///
     /// # Errors
     /// As [`Self::run`], or what the sink returns. On an error the sink may hold some rows
@@ -193,8 +193,7 @@ impl DecodeSettings {
                 given.join(", "),
                 self.method.to_possible_value().map_or_else(String::new, |v| v.get_name().to_string())
             );
-            let (light_field, report) = baseline.run(capture)?;
-            put_light_field(&light_field, sink)?;
+            let report = baseline.stream(capture, sink)?;
             return Ok(Outcome::Baseline { method: self.method, report });
         }
         let (basis, options) = self.resolve()?;
