@@ -394,6 +394,7 @@ def decode(
     progress: Any = None,
     report: bool = False,
     output: Optional[PathLike] = None,
+    slot: Optional[int] = None,
 ) -> Union[np.ndarray, Tuple[np.ndarray, Dict[str, Any]]]:
     """Decodes a capture (or a capture folder's path) as ``slf decode`` does, bit for bit.
 
@@ -451,7 +452,12 @@ def decode(
     frame of any size fits), the file is in place only once the decode is done (a failed
     decode leaves none), and the light field returned is a read-only memory map of it
     (``np.load(output, mmap_mode="r")``). ``report["rows_held"]``: the most lenslet rows
-    of sums the decode held at once.
+    of sums the decode held at once. A path ending in ``.zarr`` writes a Zarr v3 store as
+    ``slf decode -o OUT.zarr`` does (the array ``lightfield``, the ``band`` coordinate, the
+    capture's description and the settings in the group's attributes), and the light field
+    returned is the store's array opened read-only by zarr-python (None without it).
+    ``slot``: with ``output`` the temporary store ``slf.batch.decode_folder`` made for many
+    captures, the capture's index in it (None is returned).
     """
     cap = capture if isinstance(capture, Capture) else load_capture(capture)
     if isinstance(disparities, (list, tuple)):
@@ -524,11 +530,28 @@ def decode(
     # The native decode refuses an output that is a file of the capture's folder, the
     # calibration or the blob, or not a .npy path, before it decodes (as `slf decode` does).
     source = getattr(cap, "source", None)
+    if slot is not None and (isinstance(slot, (bool, np.bool_)) or not isinstance(slot, (int, np.integer)) or slot < 0):
+        raise TypeError(f"slot: want a capture's index at or above 0, got {slot!r}")
     lf, rep = _slf.decode(
-        frames, json.dumps(cap.description), args, threads, _progress_callback(progress), path, source
+        frames,
+        json.dumps(cap.description),
+        args,
+        threads,
+        _progress_callback(progress),
+        path,
+        source,
+        None if slot is None else int(slot),
     )
-    if path is not None:
-        lf = np.load(path, mmap_mode="r")
+    if path is not None and slot is None:
+        if path.lower().endswith(".zarr"):
+            try:
+                import zarr
+            except ImportError:
+                lf = None
+            else:
+                lf = zarr.open_array(path, path="lightfield", mode="r")
+        else:
+            lf = np.load(path, mmap_mode="r")
     if "warning" in rep:
         warnings.warn(f"slf: {rep['warning']}", stacklevel=2)
     return (lf, rep) if report or error_map else lf

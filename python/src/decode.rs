@@ -18,6 +18,8 @@ use slf_host::io::lightfield::Dtype;
 use slf_host::io::npy_rows::NpyRows;
 use slf_host::io::output::Outputs;
 use slf_host::io::rows::Stoppable;
+use slf_host::io::zarr_rows::ZarrRows;
+use slf_host::io::zarr_stack::ZarrSlot;
 
 use crate::arrays::{plane, to_array};
 use crate::capture::from_parts;
@@ -35,7 +37,7 @@ type Decoded<'py> = (Option<Bound<'py, PyArrayDyn<f32>>>, Bound<'py, PyDict>);
 /// read from, if any: `output` may not be one of its files, nor a file of the calibration
 /// or the blob the flags name (as `slf decode` refuses them: it would destroy an input).
 #[pyfunction]
-#[pyo3(signature = (frames, description, args, threads=None, progress=None, output=None, source=None))]
+#[pyo3(signature = (frames, description, args, threads=None, progress=None, output=None, source=None, slot=None))]
 #[allow(clippy::too_many_arguments)] // the Python call's keyword arguments, one each
 pub fn decode<'py>(
     py: Python<'py>,
@@ -46,26 +48,32 @@ pub fn decode<'py>(
     progress: Option<Py<PyAny>>,
     output: Option<std::path::PathBuf>,
     source: Option<std::path::PathBuf>,
+    slot: Option<usize>,
 ) -> PyResult<Decoded<'py>> {
     let settings = DecodeSettings::from_flags(&args).map_err(flags)?;
     let capture = from_parts(&frames, description)?;
-    if let Some(path) = &output {
+    let kind = match (&output, slot) {
+        (None, None) => None,
+        (None, Some(_)) => return Err(PyValueError::new_err("slot: a capture's slot of a store named by output")),
+        (Some(path), slot) => Some(output_kind(path, slot)?),
+    };
+    if let (Some(path), Some(kind)) = (&output, kind)
+        && kind != OutputKind::Slot
+    {
         // Checked before the decode, with the command's check (paths resolved, hard links
         // by inode): the decode reads the calibration and the blob again, and a capture
-        // folder written over is a user's raw data lost.
-        Outputs::new()
+        // folder written over is a user's raw data lost. (A slot's store is the temporary
+        // folder slf.batch made: nothing else is in it.)
+        let outputs = Outputs::new()
             .inputs(source.iter().flat_map(|dir| capture.files_in(dir)), "a file of the capture")
             .inputs(&settings.basis.blob, "blob")
-            .inputs(settings.calibration.iter().flat_map(|d| Calibration::files_in(d)), "a file of calibration")
-            .output(path, "output")
-            .check()
-            .map_err(|e| PyValueError::new_err(slf_host::io::message::one_line(&e)))?;
-        if !path.extension().is_some_and(|e| e.eq_ignore_ascii_case("npy")) {
-            return Err(PyValueError::new_err(format!(
-                "output {}: a .npy path (an HDF5 file: slf decode -o OUT.h5)",
-                path.display()
-            )));
+            .inputs(settings.calibration.iter().flat_map(|d| Calibration::files_in(d)), "a file of calibration");
+        match kind {
+            OutputKind::Zarr => outputs.folder_output(path, "output"),
+            _ => outputs.output(path, "output"),
         }
+        .check()
+        .map_err(|e| PyValueError::new_err(slf_host::io::message::one_line(&e)))?;
     }
     // The decode is compute-bound: threads past a few per core buy nothing, and 10**9 of
     // them were spawned until the OS refused.
@@ -112,12 +120,36 @@ pub fn decode<'py>(
                 Ok((outcome, Some(light_field), peak))
             }
             Some(path) => {
-                let mut file = NpyRows::create(path, output_shape(&capture), Dtype::F32)?;
-                let outcome =
-                    settings.run_into(&capture, false, &observer, &mut Stoppable { inner: &mut file, stop: &stop })?;
-                let peak = file.max();
-                file.finish()?;
-                Ok((outcome, None, peak))
+                let shape = output_shape(&capture);
+                let run_into = |sink: &mut slf_host::io::rows::Rows<'_>| {
+                    settings.run_into(&capture, false, &observer, &mut Stoppable { inner: sink, stop: &stop })
+                };
+                match kind {
+                    Some(OutputKind::Zarr) => {
+                        let mut file = ZarrRows::create(path, shape, &capture.description.bands_nm, None)?;
+                        // Through its text, as capture.json holds it (as `slf decode -o OUT.zarr`).
+                        file.attr("description", serde_json::from_str(&serde_json::to_string(&capture.description)?)?);
+                        file.attr("settings", args.join(" ").into());
+                        let outcome = run_into(&mut file)?;
+                        let peak = file.max();
+                        file.finish()?;
+                        Ok((outcome, None, peak))
+                    }
+                    Some(OutputKind::Slot) => {
+                        let mut file = ZarrSlot::open(path, slot.unwrap_or_default(), shape)?;
+                        let outcome = run_into(&mut file)?;
+                        let peak = file.max();
+                        file.finish()?;
+                        Ok((outcome, None, peak))
+                    }
+                    _ => {
+                        let mut file = NpyRows::create(path, shape, Dtype::F32)?;
+                        let outcome = run_into(&mut file)?;
+                        let peak = file.max();
+                        file.finish()?;
+                        Ok((outcome, None, peak))
+                    }
+                }
             }
         };
         match threads {
@@ -245,4 +277,32 @@ pub fn decode<'py>(
         }
     }
     Ok((light_field.map(|lf| to_array(py, lf)).transpose()?, report))
+}
+
+/// Where a decode's light field goes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum OutputKind {
+    /// A `.npy` file, written as the rows come.
+    Npy,
+    /// A Zarr v3 store of its own (`OUT.zarr`, a folder).
+    Zarr,
+    /// Capture `slot` of the store `slf.batch` made for many captures.
+    Slot,
+}
+
+/// The kind of `path`, by its extension, or a slot of a store.
+///
+/// # Errors
+/// A slot of something other than a store, or an extension that names no output.
+fn output_kind(path: &std::path::Path, slot: Option<usize>) -> PyResult<OutputKind> {
+    let ext = |e: &str| path.extension().is_some_and(|x| x.eq_ignore_ascii_case(e));
+    match (slot, ext("npy"), ext("zarr")) {
+        (Some(_), ..) => Ok(OutputKind::Slot),
+        (None, true, _) => Ok(OutputKind::Npy),
+        (None, _, true) => Ok(OutputKind::Zarr),
+        _ => Err(PyValueError::new_err(format!(
+            "output {}: a .npy file or a .zarr store (an HDF5 file: slf decode -o OUT.h5)",
+            path.display()
+        ))),
+    }
 }

@@ -25,6 +25,7 @@ mod errors;
 mod import;
 mod metrics;
 mod scene;
+mod stack;
 
 #[pymodule]
 fn _slf(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -36,6 +37,7 @@ fn _slf(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(capture::check_capture, m)?)?;
     m.add_function(wrap_pyfunction!(calibration::calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(decode::decode, m)?)?;
+    m.add_class::<stack::Stack>()?;
     m.add_function(wrap_pyfunction!(metrics::evaluate, m)?)?;
     m.add_function(wrap_pyfunction!(import::import_views, m)?)?;
     m.add_function(wrap_pyfunction!(import::import_cube, m)?)?;

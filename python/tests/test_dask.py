@@ -91,3 +91,69 @@ def test_an_output_is_never_a_capture_file_or_another_output(folder, tmp_path, d
     with pytest.raises(ValueError, match="would both write"):
         slf.batch.decode_folder([folder / "cap1", other], out, preset="preview")
     assert not out.exists()
+
+
+def test_a_folder_decoded_into_one_zarr_store(folder, tmp_path):
+    """Issue 65, item 4: many captures along a capture axis of one store, each written by
+    its own task on its own worker; a failed capture's slot is NaN and its error kept."""
+    import xarray
+    import zarr
+
+    small = tmp_path / "small"  # another shape: refused a slot, the others go on
+    slf.simulate(slf.scene("depth", size=12), k=1, seed=5).save(small)
+    out = tmp_path / "all.zarr"
+    captures = [folder / "cap1", folder / "broken", small, folder / "cap2"]
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None
+    ) as cluster, distributed.Client(cluster) as client:
+        seen = []
+        results = slf.batch.decode_folder(captures, out, client, on_result=seen.append, preset="preview")
+    assert [r.ok for r in results] == [True, False, False, True], [r.error for r in results]
+    assert [r.index for r in results] == [0, 1, 2, 3] and len(seen) == 4
+    assert "snapshot_0.pgm" in results[1].error
+    assert "not the store's (5, 5, 20, 20, 13)" in results[2].error, results[2].error
+    group = zarr.open_group(out, mode="r")
+    lf = group["lightfield"]
+    assert lf.shape == (4, 5, 5, 20, 20, 13) and lf.chunks[:4] == (1, 5, 5, 8), lf.chunks
+    assert lf.metadata.dimension_names == ("capture", "u", "v", "h", "w", "band")
+    for i, name in [(0, "cap1"), (3, "cap2")]:
+        assert np.array_equal(lf[i], expected(folder, name)), name
+    assert np.isnan(lf[1]).all() and np.isnan(lf[2]).all()
+    attrs = dict(group.attrs)
+    assert attrs["captures"] == ["cap1", "broken", "small", "cap2"]
+    assert attrs["decoded"] == [True, False, False, True]
+    assert attrs["errors"][0] is None and "snapshot_0.pgm" in attrs["errors"][1]
+    assert attrs["options"] == {"preset": "preview"} and attrs["axes"] == "cuvhwb"
+    # Lazily, by band centre, in xarray.
+    data = xarray.open_zarr(out)["lightfield"]
+    assert data.dims == ("capture", "u", "v", "h", "w", "band")
+    nm = float(data["band"][4])
+    assert np.array_equal(data.sel(band=nm).isel(capture=3).values, expected(folder, "cap2")[..., 4])
+    # Nothing temporary is left beside it.
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["all.zarr", "small"]
+
+
+def test_a_store_in_which_nothing_decoded_is_not_written(folder, tmp_path):
+    out = tmp_path / "none.zarr"
+    with pytest.raises(ValueError, match="no capture decoded .*snapshot_0.pgm.*nothing written"):
+        slf.batch.decode_folder([folder / "broken"], out, preset="preview")
+    assert list(tmp_path.iterdir()) == []
+    # A capture inside the store it would be written into is refused before any task.
+    inside = tmp_path / "in.zarr" / "cap"
+    (tmp_path / "in.zarr").mkdir()
+    (tmp_path / "in.zarr" / "zarr.json").write_text('{"zarr_format": 3, "node_type": "group"}')
+    slf.simulate(slf.scene("depth", size=12), k=1, seed=5).save(inside)
+    with pytest.raises(ValueError, match="in.zarr holds a capture folder .*in.zarr.cap"):
+        slf.batch.decode_folder([inside], tmp_path / "in.zarr", preset="preview")
+    assert (inside / "capture.json").exists()
+
+
+def test_a_decode_to_a_zarr_store_returns_it_opened(folder, tmp_path):
+    import zarr
+
+    out = tmp_path / "one.zarr"
+    lf = slf.decode(folder / "cap3", preset="preview", threads=1, output=out)
+    assert isinstance(lf, zarr.Array) and np.array_equal(lf[...], expected(folder, "cap3"))
+    assert "description" in dict(zarr.open_group(out, mode="r").attrs)
+    with pytest.raises(TypeError, match="slot"):
+        slf.decode(folder / "cap3", preset="preview", output=out, slot=-1)

@@ -14,6 +14,7 @@
 //! - [`json`]: descriptions parsed from JSON, errors naming the field;
 //! - [`hdf5_rows`]: a light field's HDF5 file, from its rows;
 //! - [`zarr_rows`]: a light field's Zarr v3 store, from its rows;
+//! - [`zarr_stack`]: many captures' light fields in one store, a slot each (`slf.batch`);
 //! - [`row_band`]: rows gathered into bands of whole chunks (what the HDF5 and Zarr outputs
 //!   write at a time);
 //! - [`folder`]: folders written whole, and the checksums their descriptions record;
@@ -53,3 +54,4 @@ pub mod sensor;
 #[macro_use]
 pub mod stdout;
 pub mod zarr_rows;
+pub mod zarr_stack;

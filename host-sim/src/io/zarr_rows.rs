@@ -48,8 +48,83 @@ pub struct ZarrRows {
 }
 
 /// A `zarrs` error with what was being written.
-fn failed(path: &Path) -> impl Fn(String) -> anyhow::Error + '_ {
+pub(crate) fn failed(path: &Path) -> impl Fn(String) -> anyhow::Error + '_ {
     move |e| anyhow::anyhow!("cannot write {}: {e}", path.display())
+}
+
+/// The attributes of a store's light field and of its group: the axes, the band centres
+/// and the units.
+pub(crate) fn light_field_attrs(axes: &str, bands_nm: &[f32]) -> Map<String, Value> {
+    let mut attrs = Map::new();
+    attrs.insert("axes".into(), axes.into());
+    attrs.insert("bands_nm".into(), json!(bands_nm));
+    attrs.insert("units".into(), "normalised (white = 1)".into());
+    attrs
+}
+
+/// The float32 light-field array `/lightfield` of a store: `dims` in chunks of `chunk`,
+/// NaN where nothing was written, gzip-compressed at `gzip` when given.
+///
+/// # Errors
+/// A gzip level the codec refuses, or the I/O error.
+pub(crate) fn light_field_array(
+    store: &Arc<FilesystemStore>,
+    dims: Vec<usize>,
+    chunk: Vec<usize>,
+    names: &[&str],
+    attrs: &Map<String, Value>,
+    gzip: Option<u32>,
+    path: &Path,
+) -> Result<Array<FilesystemStore>> {
+    let err = failed(path);
+    let dims: Vec<u64> = dims.iter().map(|&d| d as u64).collect();
+    let chunk: Vec<u64> = chunk.iter().map(|&d| d as u64).collect();
+    let mut builder = ArrayBuilder::new(dims, chunk, zarrs::array::data_type::float32(), f32::NAN);
+    builder.dimension_names(Some(names.to_vec())).attributes(attrs.clone());
+    if let Some(level) = gzip {
+        let codec = zarrs::array::codec::GzipCodec::new(level).map_err(|e| err(e.to_string()))?;
+        builder.bytes_to_bytes_codecs(vec![Arc::new(codec)]);
+    }
+    let array = builder.build(store.clone(), &format!("/{DATASET}")).map_err(|e| err(e.to_string()))?;
+    array.store_metadata().map_err(|e| err(e.to_string()))?;
+    Ok(array)
+}
+
+/// The band centres as an array of their own, `/band`: xarray's coordinate of the band
+/// axis.
+///
+/// # Errors
+/// The I/O error.
+pub(crate) fn band_array(store: &Arc<FilesystemStore>, bands_nm: &[f32], path: &Path) -> Result<()> {
+    let err = failed(path);
+    let n = bands_nm.len() as u64;
+    let mut nm = ArrayBuilder::new(vec![n], vec![n], zarrs::array::data_type::float32(), f32::NAN);
+    let mut units = Map::new();
+    units.insert("units".into(), "nm".into());
+    units.insert("long_name".into(), "band centre".into());
+    nm.dimension_names(Some(["band"])).attributes(units);
+    let nm = nm.build(store.clone(), "/band").map_err(|e| err(e.to_string()))?;
+    nm.store_metadata().map_err(|e| err(e.to_string()))?;
+    nm.store_chunk(&[0], bands_nm).map_err(|e| err(e.to_string()))
+}
+
+/// Writes the group's description, its attributes `attrs`, at the store's root, with the
+/// arrays' metadata consolidated into it (zarr-python's and xarray's one read of a store's
+/// layout; without it xarray warns and reads every array's `zarr.json`).
+///
+/// # Errors
+/// The I/O error.
+pub(crate) fn store_group(store: &Arc<FilesystemStore>, attrs: Map<String, Value>, path: &Path) -> Result<()> {
+    use zarrs::metadata_ext::group::consolidated_metadata::{ConsolidatedMetadata, ConsolidatedMetadataKind};
+    let err = failed(path);
+    let mut group = zarrs::group::GroupBuilder::new();
+    group.attributes(attrs);
+    let mut group = group.build(store.clone(), "/").map_err(|e| err(e.to_string()))?;
+    group.store_metadata().map_err(|e| err(e.to_string()))?;
+    let node = zarrs::node::Node::open(store, "/").map_err(|e| err(e.to_string()))?;
+    let metadata = node.consolidate_metadata().unwrap_or_default();
+    group.set_consolidated_metadata(Some(ConsolidatedMetadata { metadata, kind: ConsolidatedMetadataKind::Inline }));
+    group.store_metadata().map_err(|e| err(e.to_string()))
 }
 
 impl ZarrRows {
@@ -66,34 +141,17 @@ impl ZarrRows {
         let folder = WholeFolder::create(path, STORE)?;
         let err = failed(path);
         let store = Arc::new(FilesystemStore::new(folder.path()).map_err(|e| err(e.to_string()))?);
-        let dims: Vec<u64> = shape.shape().iter().map(|&d| d as u64).collect();
-        let chunk: Vec<u64> = chunk_shape(shape).iter().map(|&d| d as u64).collect();
-        let mut attrs = Map::new();
-        attrs.insert("axes".into(), AXES.into());
-        attrs.insert("bands_nm".into(), json!(bands_nm));
-        attrs.insert("units".into(), "normalised (white = 1)".into());
-        let mut builder = ArrayBuilder::new(dims, chunk, zarrs::array::data_type::float32(), f32::NAN);
-        builder.dimension_names(Some(DIMENSIONS)).attributes(attrs.clone());
-        if let Some(level) = gzip {
-            let codec = zarrs::array::codec::GzipCodec::new(level).map_err(|e| err(e.to_string()))?;
-            builder.bytes_to_bytes_codecs(vec![Arc::new(codec)]);
-        }
-        let array = builder.build(store.clone(), &format!("/{DATASET}")).map_err(|e| err(e.to_string()))?;
-        array.store_metadata().map_err(|e| err(e.to_string()))?;
-        // The band centres as an array of their own: xarray's coordinate of the band axis.
-        let mut nm = ArrayBuilder::new(
-            vec![bands_nm.len() as u64],
-            vec![bands_nm.len() as u64],
-            zarrs::array::data_type::float32(),
-            f32::NAN,
-        );
-        let mut units = Map::new();
-        units.insert("units".into(), "nm".into());
-        units.insert("long_name".into(), "band centre".into());
-        nm.dimension_names(Some(["band"])).attributes(units);
-        let nm = nm.build(store.clone(), "/band").map_err(|e| err(e.to_string()))?;
-        nm.store_metadata().map_err(|e| err(e.to_string()))?;
-        nm.store_chunk(&[0], bands_nm).map_err(|e| err(e.to_string()))?;
+        let attrs = light_field_attrs(AXES, bands_nm);
+        let array = light_field_array(
+            &store,
+            shape.shape().to_vec(),
+            chunk_shape(shape).to_vec(),
+            &DIMENSIONS,
+            &attrs,
+            gzip,
+            path,
+        )?;
+        band_array(&store, bands_nm, path)?;
         Ok(Self { array, store, folder, target: path.to_path_buf(), shape, attrs, band })
     }
 
@@ -117,11 +175,7 @@ impl ZarrRows {
         let path = self.target.display().to_string();
         let put = self.band.rows_put();
         ensure!(put == self.shape.rows, "cannot write {path}: {put} of {} rows decoded", self.shape.rows);
-        let err = failed(&self.target);
-        let mut group = zarrs::group::GroupBuilder::new();
-        group.attributes(std::mem::take(&mut self.attrs));
-        let group = group.build(self.store.clone(), "/").map_err(|e| err(e.to_string()))?;
-        group.store_metadata().map_err(|e| err(e.to_string()))?;
+        store_group(&self.store, std::mem::take(&mut self.attrs), &self.target)?;
         let Self { array, store, folder, .. } = self;
         drop((array, store));
         folder.persist().with_context(|| format!("cannot write {path}"))
