@@ -52,14 +52,7 @@ pub fn decode<'py>(
 ) -> PyResult<Decoded<'py>> {
     let settings = DecodeSettings::from_flags(&args).map_err(flags)?;
     let capture = from_parts(&frames, description)?;
-    let kind = match (&output, slot) {
-        (None, None) => None,
-        (None, Some(_)) => return Err(PyValueError::new_err("slot: a capture's slot of a store named by output")),
-        (Some(path), slot) => Some(output_kind(path, slot)?),
-    };
-    if let (Some(path), Some(kind)) = (&output, kind)
-        && kind != OutputKind::Slot
-    {
+    if let (Some(path), None) = (&output, slot) {
         // Checked before the decode, with the command's check (paths resolved, hard links
         // by inode): the decode reads the calibration and the blob again, and a capture
         // folder written over is a user's raw data lost. (A slot's store is the temporary
@@ -68,13 +61,18 @@ pub fn decode<'py>(
             .inputs(source.iter().flat_map(|dir| capture.files_in(dir)), "a file of the capture")
             .inputs(&settings.basis.blob, "blob")
             .inputs(settings.calibration.iter().flat_map(|d| Calibration::files_in(d)), "a file of calibration");
-        match kind {
-            OutputKind::Zarr => outputs.folder_output(path, "output"),
-            _ => outputs.output(path, "output"),
+        match path.extension().is_some_and(|e| e.eq_ignore_ascii_case("zarr")) {
+            true => outputs.folder_output(path, "output"),
+            false => outputs.output(path, "output"),
         }
         .check()
         .map_err(|e| PyValueError::new_err(slf_host::io::message::one_line(&e)))?;
     }
+    let kind = match (&output, slot) {
+        (None, None) => None,
+        (None, Some(_)) => return Err(PyValueError::new_err("slot: a capture's slot of a store named by output")),
+        (Some(path), slot) => Some(output_kind(path, slot)?),
+    };
     // The decode is compute-bound: threads past a few per core buy nothing, and 10**9 of
     // them were spawned until the OS refused.
     let most = 4 * std::thread::available_parallelism().map_or(1, usize::from);
