@@ -528,7 +528,7 @@ def decode(
     frames = _raw_frames(cap.frames)
     path = None if output is None else os.fspath(output)
     # The native decode refuses an output that is a file of the capture's folder, the
-    # calibration or the blob, or not a .npy path, before it decodes (as `slf decode` does).
+    # calibration or the blob, or not a .npy or .zarr path, before it decodes (as `slf decode` does).
     source = getattr(cap, "source", None)
     if slot is not None and (isinstance(slot, (bool, np.bool_)) or not isinstance(slot, (int, np.integer)) or slot < 0):
         raise TypeError(f"slot: want a capture's index at or above 0, got {slot!r}")
