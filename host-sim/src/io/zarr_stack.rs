@@ -37,6 +37,8 @@ pub struct ZarrStack {
     folder: WholeFolder,
     store: Arc<FilesystemStore>,
     target: PathBuf,
+    /// The light field's attributes, which the group repeats.
+    attrs: Map<String, Value>,
 }
 
 impl ZarrStack {
@@ -61,7 +63,7 @@ impl ZarrStack {
         let attrs = light_field_attrs(STACK_AXES, bands_nm);
         light_field_array(&store, dims, chunk, &names, &attrs, gzip, path)?;
         band_array(&store, bands_nm, path)?;
-        Ok(Self { folder, store, target: path.to_path_buf() })
+        Ok(Self { folder, store, target: path.to_path_buf(), attrs })
     }
 
     /// The temporary folder the workers write their slots into.
@@ -75,19 +77,12 @@ impl ZarrStack {
     /// # Errors
     /// The I/O error.
     pub fn finish(self, attrs: Map<String, Value>) -> Result<()> {
-        let Self { folder, store, target } = self;
-        let mut all = store_attrs(&store, &target)?;
+        let Self { folder, store, target, attrs: mut all } = self;
         all.extend(attrs);
         store_group(&store, all, &target)?;
         drop(store);
         folder.persist().with_context(|| format!("cannot write {}", target.display()))
     }
-}
-
-/// The light field's own attributes (axes, bands, units), which the group repeats.
-fn store_attrs(store: &Arc<FilesystemStore>, path: &Path) -> Result<Map<String, Value>> {
-    let array = Array::open(store.clone(), &format!("/{DATASET}")).map_err(|e| failed(path)(e.to_string()))?;
-    Ok(array.attributes().clone())
 }
 
 /// One capture's slot of a [`ZarrStack`], its rows put in order ([`RowSink`]): the worker's

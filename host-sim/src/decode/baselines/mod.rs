@@ -157,10 +157,7 @@ fn in_memory(
     capture: &Capture,
     stream: impl FnOnce(&mut Rows<'_>) -> Result<BaselineReport>,
 ) -> Result<(LightField, BaselineReport)> {
-    let d = &capture.description;
-    let shape =
-        RowShape { views: (d.views[0], d.views[1]), rows: d.lenslets[0], cols: d.lenslets[1], bands: d.bands_nm.len() };
-    let mut lf = shape.zeros()?;
+    let mut lf = crate::decode::pipeline::output_shape(capture).zeros()?;
     let report = stream(&mut lf)?;
     Ok((lf, report))
 }
