@@ -84,7 +84,7 @@ fn a_hot_pixel_is_left_out_and_costs_almost_nothing() {
     let truth = scene::named("smooth").unwrap().render(SIZE);
     let clean = simulate(&truth, &CameraConfig::pixel(2, 3).noiseless()).unwrap();
     let mut hot = clean.clone();
-    hot.frames[1][23 * 50 + 17] = 4095;
+    hot.held_frames_mut().unwrap()[1][23 * 50 + 17] = 4095;
     let (a, _) = checked(&clean, &ensemble(), Sl0Config::DEFAULT);
     let (b, report) = checked(&hot, &ensemble(), Sl0Config::DEFAULT);
     assert!(report.patches.flagged >= 1);
@@ -134,9 +134,9 @@ fn patches_with_few_valid_pixels_and_bad_raw_values() {
         }
     }
     // Out-of-range raw values elsewhere.
-    cap.frames[0][30 * 50 + 3] = 4095;
-    cap.frames[2][40 * 50 + 9] = 4095;
-    let cap = Capture::new(d, cap.frames).unwrap();
+    cap.held_frames_mut().unwrap()[0][30 * 50 + 3] = 4095;
+    cap.held_frames_mut().unwrap()[2][40 * 50 + 9] = 4095;
+    let cap = Capture::with_frames(d, cap.frames).unwrap();
     let (recon, report) = checked(&cap, &ensemble(), Sl0Config::DEFAULT);
     assert_eq!(report.patches.failed, 1, "block (1, 1): a typed error for its full-view patch");
     // Block (0, 0) (its defects) and block (1, 0) (both out-of-range values) are flagged.

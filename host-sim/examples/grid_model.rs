@@ -153,7 +153,7 @@ fn main() -> Result<()> {
                 let (r, c) = (s0 * 5 + i, t0 * 5 + j);
                 let b = mask.bands_at(r, c)[0] as usize;
                 rows.push(vec![(entry(i, j, b), 1.0)]);
-                y.push(f64::from(aligned.frames[0][r * cols + c]) / 65535.0);
+                y.push(f64::from(aligned.held_frames().unwrap()[0][r * cols + c]) / 65535.0);
             }
         }
         sum += psnr(&truth((s0, t0)), &sl0(&f, &rows, &y, &gains), peak);
@@ -179,7 +179,7 @@ fn main() -> Result<()> {
                     let Some((r, c)) = fw.pixel(l, (i % 5, j % 5)) else { continue };
                     let b = mask.bands_at(r, c)[0] as usize;
                     rows.push(vec![(entry(i, j, b), 1.0)]);
-                    y.push(f64::from(cap.frames[0][r * cols_n + c]) / 65535.0);
+                    y.push(f64::from(cap.held_frames().unwrap()[0][r * cols_n + c]) / 65535.0);
                 }
             }
             nearest += psnr(&want, &sl0(&f, &rows, &y, &gains), peak);
@@ -202,7 +202,7 @@ fn main() -> Result<()> {
                             .map(|&([i, j], w)| (entry((i - lo_r) as usize, (j - lo_c) as usize, b), w))
                             .collect(),
                     );
-                    y.push(f64::from(cap.frames[0][r * cols_n + c]) / 65535.0);
+                    y.push(f64::from(cap.held_frames().unwrap()[0][r * cols_n + c]) / 65535.0);
                 }
             }
             exact += psnr(&want, &sl0(&f, &rows, &y, &gains), peak);

@@ -56,7 +56,7 @@ fn slow_tallies(cap: &Capture, opts: &DecodeOptions) -> Vec<[f64; 6]> {
     let plain = DecodeOptions { baseline_blend: false, error_estimate: false, ..*opts };
     let mut t = vec![[0.0f64; 6]; d.lenslets[0] * lc];
     for fold in 0..3 {
-        let mut frames = cap.frames.clone();
+        let mut frames = cap.held_frames().unwrap().into_owned();
         for (j, f) in frames.iter_mut().enumerate() {
             for r in 0..rows {
                 for c in 0..cols {
@@ -74,7 +74,7 @@ fn slow_tallies(cap: &Capture, opts: &DecodeOptions) -> Vec<[f64; 6]> {
                 let (y, x, u, v) = (r / lu, c / lv, r % lu, c % lv);
                 let slot = &mut t[y * lc + x];
                 for (j, &band) in mask.bands_at(r, c).iter().enumerate() {
-                    let raw = f64::from(cap.frames[j][r * cols + c]);
+                    let raw = f64::from(cap.held_frames().unwrap()[j][r * cols + c]);
                     let over = raw > f64::from(d.saturation_level) - 0.5;
                     if fold == 0 && !over {
                         slot[5] += 1.0;

@@ -79,7 +79,7 @@ fn positions_without_a_measurement_are_filled_and_counted() {
     cam.defect_fraction = 0.2;
     let cap = simulate(&truth, &cam).unwrap();
     let defects = cap.description.defective_pixels.len();
-    let saturated = cap.saturated_pixels().0;
+    let saturated = cap.saturated_pixels().unwrap().0;
     for (lf, r) in [
         interpolate(&cap).unwrap(),
         demosaic(&cap, &DemosaicConfig::default()).unwrap(),
@@ -145,7 +145,7 @@ fn the_demosaic_and_ppid_recover_a_flat_field_and_keep_measured_values() {
             // A measured band keeps its measured value exactly (here: the quantised truth).
             let mask = cap.mask().unwrap();
             let b = usize::from(mask.bands_at(13, 17)[0]);
-            let raw = f32::from(cap.frames[0][13 * 60 + 17]);
+            let raw = f32::from(cap.held_frames().unwrap()[0][13 * 60 + 17]);
             let fmt = cap.raw_format();
             assert_eq!(lf.get(3, 2, 2, 3, b), (raw - fmt.black) / (fmt.white - fmt.black), "{name}, k = {k}");
         }

@@ -31,6 +31,7 @@ impl Frame {
         let d = &cap.description;
         let (views, lenslets) = ((d.views[0], d.views[1]), (d.lenslets[0], d.lenslets[1]));
         let (mask, raw, defects, cols) = (cap.mask().unwrap(), cap.raw_format(), cap.defects(), cap.frame_size().1);
+        let frames = cap.held_frames().unwrap();
         let mut samples = Vec::new();
         for u in 0..views.0 {
             for v in 0..views.1 {
@@ -39,7 +40,7 @@ impl Frame {
                         let (row, col) = (s * views.0 + u, t * views.1 + v);
                         let mut here = Vec::new();
                         if !defects.contains(row, col) {
-                            for (&b, frame) in mask.bands_at(row, col).iter().zip(&cap.frames) {
+                            for (&b, frame) in mask.bands_at(row, col).iter().zip(frames.iter()) {
                                 if let Ok(x) = raw.classify(f32::from(frame[row * cols + col])) {
                                     here.push((b, x));
                                 }

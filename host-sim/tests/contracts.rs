@@ -227,7 +227,7 @@ fn calibrations_are_checked_when_made_and_when_read() {
     // Item 5: a capture that records nothing above the calibration's dark levels (before:
     // "0 flagged", every value 0, exit 0).
     let black = calibration.description.black_level;
-    edit_capture(&p("cap"), |c| c.frames.iter_mut().flatten().for_each(|x| *x = black as u16 + 4));
+    edit_capture(&p("cap"), |c| c.held_frames_mut().unwrap().iter_mut().flatten().for_each(|x| *x = black as u16 + 4));
     let mut dark = calibration.clone();
     dark.dark.iter_mut().for_each(|d| *d = black + 8.0);
     dark.save(&p("dark-cal")).unwrap();
@@ -288,7 +288,7 @@ fn calibrate_refuses_saturated_mislabelled_and_mixed_sweeps() {
     let saturated = copy("saturated");
     let top = Capture::load(&saturated.join("band-03-00")).unwrap().description.saturation_level as u16;
     for n in ["band-03-00", "band-03-01"] {
-        edit_capture(&saturated.join(n), |c| c.frames.iter_mut().flatten().for_each(|x| *x = top));
+        edit_capture(&saturated.join(n), |c| c.held_frames_mut().unwrap().iter_mut().flatten().for_each(|x| *x = top));
     }
     let e = failure(&mut calibrate(&saturated));
     assert!(e.contains("band-03-00") && e.contains("under band 3's light") && e.contains("saturated"), "{e}");

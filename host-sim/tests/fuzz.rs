@@ -199,7 +199,7 @@ fn fuzz_capture_loader() {
                 Ok(c) => {
                     LOADED.fetch_add(1, Ordering::Relaxed);
                     let (rows, cols) = c.frame_size();
-                    prop_assert!(c.frames.iter().all(|f| f.len() == rows * cols));
+                    prop_assert!(c.held_frames().unwrap().iter().all(|f| f.len() == rows * cols));
                     prop_assert_eq!(c.mask().map(|m| m.snapshots()).ok(), Some(c.frames.len()));
                 }
                 Err(e) => {

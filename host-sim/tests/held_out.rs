@@ -35,7 +35,7 @@ fn slow_map(cap: &Capture, opts: &DecodeOptions) -> (Vec<f64>, usize) {
         .collect();
     let mut hidden = cap.clone();
     hidden.description.defective_pixels = held.iter().map(|&(r, c)| [r as u32, c as u32]).collect();
-    let hidden = Capture::new(hidden.description, hidden.frames).unwrap();
+    let hidden = Capture::with_frames(hidden.description, hidden.frames).unwrap();
     let plain = DecodeOptions { error_estimate: false, ..*opts };
     let lf: LightField = decode_with(&hidden, &Basis::Dct, &plain).unwrap().0;
     let mask = cap.mask().unwrap();
@@ -47,7 +47,7 @@ fn slow_map(cap: &Capture, opts: &DecodeOptions) -> (Vec<f64>, usize) {
     let mut saturated = 0;
     for r in 0..rows {
         for c in 0..cols {
-            let raw = f64::from(cap.frames[0][r * cols + c]);
+            let raw = f64::from(cap.held_frames().unwrap()[0][r * cols + c]);
             let over = raw > f64::from(d.saturation_level) - 0.5;
             let seen = (raw - black) / (white - black);
             let (y, x, u, v) = (r / lu, c / lv, r % lu, c % lv);

@@ -282,13 +282,13 @@ fn a_capture_from_a_12_bit_tool_decodes_like_its_16_bit_copy() {
     cap.save(dir.path()).unwrap();
     forget_records(dir.path()); // another tool's folder
     let (rows, cols) = cap.frame_size();
-    pgm_4095(&dir.path().join("snapshot_0.pgm"), rows, cols, &cap.frames[0]);
+    pgm_4095(&dir.path().join("snapshot_0.pgm"), rows, cols, &cap.held_frames().unwrap()[0]);
     let back = Capture::load(dir.path()).unwrap();
-    assert_eq!(back.frames, cap.frames);
+    assert_eq!(back.held_frames().unwrap(), cap.held_frames().unwrap());
     // MAXVAL below the capture's saturation level: saturated pixels would pass as
     // measurements, so the file is refused.
     let mut bytes = format!("P5\n{cols} {rows}\n255\n").into_bytes();
-    bytes.extend(cap.frames[0].iter().map(|&x| (x / 16) as u8));
+    bytes.extend(cap.held_frames().unwrap()[0].iter().map(|&x| (x / 16) as u8));
     std::fs::write(dir.path().join("snapshot_0.pgm"), bytes).unwrap();
     let e = format!("{:#}", Capture::load(dir.path()).unwrap_err());
     assert!(e.contains("snapshot_0.pgm") && e.contains("below saturation_level 4095"), "{e}");
@@ -458,16 +458,16 @@ fn captures_without_signal_or_with_impossible_noise_are_refused() {
     let mut noise = d.noise.unwrap();
     noise.read_noise_dn = 1e30;
     d.noise = Some(noise);
-    let e = format!("{:#}", Capture::new(d.clone(), cap.frames.clone()).unwrap_err());
+    let e = format!("{:#}", Capture::new(d.clone(), cap.held_frames().unwrap().into_owned()).unwrap_err());
     assert!(e.contains("noise.read_noise_dn 1000000000000000000000000000000: must be finite"), "{e}");
     noise.read_noise_dn = 2.0;
     noise.full_well_electrons = 0.0;
     d.noise = Some(noise);
-    let e = format!("{:#}", Capture::new(d, cap.frames.clone()).unwrap_err());
+    let e = format!("{:#}", Capture::new(d, cap.held_frames().unwrap().into_owned()).unwrap_err());
     assert!(e.contains("noise.full_well_electrons 0"), "{e}");
     // Every pixel at the black level: refused by every method, not decoded to zeros.
     let black = cap.description.black_level as u16;
-    let dark = Capture::new(cap.description.clone(), vec![vec![black; cap.frames[0].len()]]).unwrap();
+    let dark = Capture::new(cap.description.clone(), vec![vec![black; cap.held_frames().unwrap()[0].len()]]).unwrap();
     for method in ["cs", "demosaic", "ppid", "interpolate"] {
         let s = DecodeSettings::from_flags(["--method", method]).unwrap();
         let e = format!("{:#}", s.run(&dark, false, &|_, _| {}).unwrap_err());
@@ -533,12 +533,12 @@ fn frames_stay_inside_their_capture_folder() {
     ] {
         let mut d = cap.description.clone();
         d.frames = names.iter().map(|s| s.to_string()).collect();
-        let e = format!("{:#}", Capture::new(d, cap.frames.clone()).unwrap_err());
+        let e = format!("{:#}", Capture::new(d, cap.held_frames().unwrap().into_owned()).unwrap_err());
         assert!(e.contains(says), "{e}");
     }
     let mut d = cap.description.clone();
     d.frames = vec!["a.pgm".into(), "a.pgm".into()];
-    let e = format!("{:#}", Capture::new(d, vec![cap.frames[0].clone(); 2]).unwrap_err());
+    let e = format!("{:#}", Capture::new(d, vec![cap.held_frames().unwrap()[0].clone(); 2]).unwrap_err());
     assert!(e.contains("frames[1]: \"a.pgm\" is named twice"), "{e}");
     // A link to a frame outside the folder.
     #[cfg(unix)]
@@ -553,6 +553,6 @@ fn frames_stay_inside_their_capture_folder() {
         std::fs::remove_file(dir.path().join(&name)).unwrap();
         std::fs::rename(outside.path().join(&name), dir.path().join("real.pgm")).unwrap();
         std::os::unix::fs::symlink("real.pgm", dir.path().join(&name)).unwrap();
-        assert_eq!(Capture::load(dir.path()).unwrap().frames, cap.frames);
+        assert_eq!(Capture::load(dir.path()).unwrap().held_frames().unwrap(), cap.held_frames().unwrap());
     }
 }

@@ -29,12 +29,12 @@ pub fn from_parts(frames: &PyReadonlyArrayDyn<'_, u16>, description: &str) -> Py
     Capture::new(d, frames).or_py()
 }
 
-/// A capture as `(frames, description JSON)`, the frames' buffer moved.
+/// A capture as `(frames, description JSON)`, the frames read whole if they were paged.
 pub fn to_parts<'py>(py: Python<'py>, capture: Capture) -> PyResult<(Bound<'py, PyArrayDyn<u16>>, String)> {
     let (rows, cols) = capture.frame_size();
     let k = capture.frames.len();
     let json = serde_json::to_string(&capture.description).map_err(|e| PyValueError::new_err(e.to_string()))?;
-    let data: Vec<u16> = capture.frames.into_iter().flatten().collect();
+    let data: Vec<u16> = capture.frames.held((rows, cols)).or_py()?.iter().flatten().copied().collect();
     Ok((PyArray1::from_vec(py, data).reshape(&[k, rows, cols][..])?, json))
 }
 

@@ -181,6 +181,16 @@ pub trait Frame {
     fn size(&self) -> (usize, usize);
     /// Sample `i` (row-major); `None` past the end.
     fn sample(&self, i: usize) -> Option<f32>;
+    /// Samples `start..start + out.len()` (row-major, inside one row) into `out`; `None` if
+    /// any is past the end. A frame read from storage a band of rows at a time (the host's
+    /// paged frame) finds the band once a run, not once a sample.
+    #[inline]
+    fn read_run(&self, start: usize, out: &mut [f32]) -> Option<()> {
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = self.sample(start.checked_add(i)?)?;
+        }
+        Some(())
+    }
 }
 
 impl<T: Sample> Frame for RawFrame<'_, T> {
@@ -229,10 +239,6 @@ impl<F: Frame> TileSource for FrameSource<'_, F> {
         if row >= rows || col.saturating_add(out.len()) > cols {
             return Err(oob);
         }
-        let start = row * cols + col;
-        for (i, o) in out.iter_mut().enumerate() {
-            *o = frame.sample(start + i).ok_or(oob)?;
-        }
-        Ok(())
+        frame.read_run(row * cols + col, out).ok_or(oob)
     }
 }

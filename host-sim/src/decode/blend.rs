@@ -31,8 +31,9 @@
 //! Checked against the memory cap before it starts; the decode goes on without a blend that
 //! cannot be made ([`crate::decode::report::DecodeReport::blend_skipped`]).
 
+use crate::io::frames::SensorFrame;
 use anyhow::{Result, ensure};
-use slf_firmware::{MaskFamily, RawFrame, RowSink};
+use slf_firmware::{MaskFamily, RowSink};
 
 use crate::decode::baselines::{PpidConfig, ppid};
 use crate::decode::held_out::{Held, HeldOutDecode, Hiding};
@@ -73,7 +74,7 @@ impl BaselineBlend {
         plan: &FramePlan<'_, PU, PV, N>,
         model: &M,
         capture: &Capture,
-        raw: &[RawFrame<'_, u16>],
+        raw: &[SensorFrame<'_>],
         batch: usize,
     ) -> Result<Self>
     where
@@ -121,7 +122,7 @@ impl BaselineBlend {
 /// baseline, which reads its samples as the decoder does.
 fn hidden(capture: &Capture, hiding: Hiding) -> Result<Capture> {
     let (rows, cols) = capture.frame_size();
-    let mut frames = capture.frames.clone();
+    let mut frames = capture.frames.held((rows, cols))?.into_owned();
     for (snapshot, frame) in frames.iter_mut().enumerate() {
         for (i, x) in frame.iter_mut().enumerate() {
             if hiding.hides(snapshot, (i / cols.max(1), i % cols.max(1)), (rows, cols)) {

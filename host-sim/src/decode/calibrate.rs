@@ -151,7 +151,7 @@ pub fn calibrate(captures: &[(String, Capture)], response: Option<Vec<Vec<f32>>>
     let mut dark = vec![0.0f64; rows * cols];
     let mut n = 0usize;
     for (_, c) in &darks {
-        for f in &c.frames {
+        for f in c.frames.held((rows, cols))?.iter() {
             for (d, &x) in dark.iter_mut().zip(f) {
                 *d += f64::from(x);
             }
@@ -167,7 +167,7 @@ pub fn calibrate(captures: &[(String, Capture)], response: Option<Vec<Vec<f32>>>
     let mut n = 0usize;
     for (_, c) in &flats {
         let Light::Flat { level } = c.description.light else { continue };
-        for f in &c.frames {
+        for f in c.frames.held((rows, cols))?.iter() {
             for (p, &x) in f.iter().enumerate() {
                 saturated[p] |= f32::from(x) >= saturation;
                 flat[p] += f64::from((f32::from(x) - dark[p]) / (range * level));
@@ -239,7 +239,7 @@ pub fn calibrate(captures: &[(String, Capture)], response: Option<Vec<Vec<f32>>>
                 *seen.entry(b).or_insert(0usize) += 1;
                 let mask = c.mask()?;
                 let entry = clipped.entry(b).or_insert((0, 0, name));
-                for (j, f) in c.frames.iter().enumerate() {
+                for (j, f) in c.frames.held((rows, cols))?.iter().enumerate() {
                     for (p, &x) in f.iter().enumerate() {
                         if bad[p] {
                             continue;
@@ -427,6 +427,7 @@ pub fn corrected(capture: &Capture, cal: &Calibration, keep_grid: bool) -> Resul
     let top = f32::from(u16::MAX);
     let frames: Vec<Vec<u16>> = capture
         .frames
+        .held(capture.frame_size())?
         .iter()
         .map(|f| {
             f.iter()

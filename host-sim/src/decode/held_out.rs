@@ -39,10 +39,11 @@
 //! (a baseline's from the same samples, with the two errors' products): the baseline
 //! blend's ([`crate::decode::blend`]), whose tallies then estimate the blended output.
 
+use crate::io::frames::SensorFrame;
 use anyhow::{Result, ensure};
 use slf_firmware::holdout::noise_variance;
 use slf_firmware::raw::Invalid;
-use slf_firmware::{Frame, HoldOut, MaskFamily, RawFrame, RowSink};
+use slf_firmware::{Frame, HoldOut, MaskFamily, RowSink};
 
 use crate::decode::plan::FramePlan;
 use crate::decode::strip::decode_rows;
@@ -154,14 +155,14 @@ impl Hiding {
 /// A snapshot's raw frame with its held-out samples hidden (not finite: the decode leaves
 /// them out).
 pub struct HeldOutFrame<'a> {
-    frame: &'a RawFrame<'a, u16>,
+    frame: &'a SensorFrame<'a>,
     snapshot: usize,
     hiding: Hiding,
 }
 
 impl<'a> HeldOutFrame<'a> {
     /// `frames` (one per snapshot) with the samples `hiding` names hidden.
-    pub fn of(frames: &'a [RawFrame<'a, u16>], hiding: Hiding) -> Vec<Self> {
+    pub fn of(frames: &'a [SensorFrame<'a>], hiding: Hiding) -> Vec<Self> {
         frames.iter().enumerate().map(|(snapshot, frame)| Self { frame, snapshot, hiding }).collect()
     }
 }
@@ -179,6 +180,21 @@ impl Frame for HeldOutFrame<'_> {
             return Some(f32::NAN);
         }
         self.frame.sample(i)
+    }
+
+    /// The run as read, then its hidden samples hidden: a paged frame's band is found once
+    /// a run.
+    #[inline]
+    fn read_run(&self, start: usize, out: &mut [f32]) -> Option<()> {
+        self.frame.read_run(start, out)?;
+        let (rows, cols) = self.frame.size();
+        for (i, o) in out.iter_mut().enumerate() {
+            let at = start + i;
+            if self.hiding.hides(self.snapshot, (at.checked_div(cols)?, at.checked_rem(cols)?), (rows, cols)) {
+                *o = f32::NAN;
+            }
+        }
+        Some(())
     }
 }
 
@@ -217,7 +233,7 @@ impl Tally {
 /// samples under it, against the samples, tallied per lenslet.
 struct Tallies<'a, const PU: usize, const PV: usize, const N: usize> {
     decoder: &'a HostDecoder<'a, PU, PV, N>,
-    raw: &'a [RawFrame<'a, u16>],
+    raw: &'a [SensorFrame<'a>],
     hiding: Hiding,
     shape: RowShape,
     tallies: Vec<Tally>,
@@ -297,7 +313,7 @@ impl HeldOutDecode {
     pub fn run<const PU: usize, const PV: usize, const N: usize, M>(
         plan: &FramePlan<'_, PU, PV, N>,
         model: &M,
-        raw: &[RawFrame<'_, u16>],
+        raw: &[SensorFrame<'_>],
         hold: HoldOut,
         batch: usize,
     ) -> Result<Self>
@@ -315,7 +331,7 @@ impl HeldOutDecode {
     pub fn run_hiding<const PU: usize, const PV: usize, const N: usize, M>(
         plan: &FramePlan<'_, PU, PV, N>,
         model: &M,
-        raw: &[RawFrame<'_, u16>],
+        raw: &[SensorFrame<'_>],
         hiding: Hiding,
         other: Option<&LightField>,
         batch: usize,

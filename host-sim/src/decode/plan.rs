@@ -4,9 +4,10 @@
 //! engine's [`Grids`]: the disjoint grid and the grids shifted by the stride, in the order
 //! the strip decodes them, [`crate::decode::strip`]).
 
+use crate::io::frames::SensorFrame;
 use anyhow::{Result, anyhow, ensure};
 use slf_firmware::decode::engine::plan::Grids;
-use slf_firmware::{FrameSource, HoldOut, ModelTrial, PairedErrors, Pick, RawFrame, ShearTrial, Tile};
+use slf_firmware::{FrameSource, HoldOut, ModelTrial, PairedErrors, Pick, ShearTrial, Tile};
 
 use crate::decode::options::{Balance, DecodeOptions, EstimateBy};
 use crate::decode::trial::{frame_shear_trial, frame_trial, pilot_budget};
@@ -53,7 +54,7 @@ impl<'a, const PU: usize, const PV: usize, const N: usize> FramePlan<'a, PU, PV,
         second: &Z,
         pick: ModelPick,
         opts: &'a DecodeOptions,
-        raw: &[RawFrame<'_, u16>],
+        raw: &[SensorFrame<'_>],
     ) -> Result<Self>
     where
         A: HostModel<PU, PV, N>,

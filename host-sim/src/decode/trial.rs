@@ -18,8 +18,9 @@
 use rayon::prelude::*;
 use std::ops::AddAssign;
 
+use crate::io::frames::SensorFrame;
 use crate::io::patch::{HostDecoder, HostModel, HostWorkspace};
-use slf_firmware::{FrameSource, ModelTrial, PairedErrors, RawFrame, ShearTrial, Tile};
+use slf_firmware::{FrameSource, ModelTrial, PairedErrors, ShearTrial, Tile};
 
 /// The most pilots a frame's trial takes. With 64, the HCI crops' 196 tiles gave 49 pilots,
 /// and cotton and antinous at lenslet k = 3 went to the DCT (held-out RMS 0.00164 against
@@ -57,7 +58,7 @@ pub fn frame_trial<const PU: usize, const PV: usize, const N: usize, A, Z>(
     decoder: &HostDecoder<'_, PU, PV, N>,
     first: &A,
     second: &Z,
-    raw: &[RawFrame<'_, u16>],
+    raw: &[SensorFrame<'_>],
     tiles: &[Tile],
     budget: usize,
 ) -> ModelTrial
@@ -75,7 +76,7 @@ where
 pub fn frame_shear_trial<const PU: usize, const PV: usize, const N: usize, M>(
     decoder: &HostDecoder<'_, PU, PV, N>,
     model: &M,
-    raw: &[RawFrame<'_, u16>],
+    raw: &[SensorFrame<'_>],
     tiles: &[Tile],
     budget: usize,
 ) -> ShearTrial
@@ -89,11 +90,11 @@ where
 /// spaced, in parallel (a workspace a thread); their trials summed (a pilot whose source
 /// failed counts as none).
 fn pilots<const PU: usize, const PV: usize, const N: usize, T: AddAssign + Default + Send>(
-    raw: &[RawFrame<'_, u16>],
+    raw: &[SensorFrame<'_>],
     tiles: &[Tile],
     budget: usize,
     pilot: impl Fn(
-        &mut FrameSource<'_, RawFrame<'_, u16>>,
+        &mut FrameSource<'_, SensorFrame<'_>>,
         (u16, u16),
         &mut HostWorkspace<PU, PV, N>,
     ) -> Result<T, slf_firmware::raw::ReadError>

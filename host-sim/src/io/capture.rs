@@ -9,16 +9,18 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, anyhow, bail, ensure};
 use serde::{Deserialize, Serialize};
 use slf_firmware::{
-    BandTile, DecoderConfig, DefectList, LensletSize, Mask, MaskFamily, Pixel, RawFormat, RawFrame, SensorGeometry,
-    Sl0Config, TileDecoder,
+    BandTile, DecoderConfig, DefectList, LensletSize, Mask, MaskFamily, Pixel, RawFormat, SensorGeometry, Sl0Config,
+    TileDecoder,
 };
 
 use crate::io::file_checks::read_small_file;
 use crate::io::folder::{FileRecord, Kind, WholeFolder, record, verify};
 use crate::io::frame_file::{extension, read_frame, write_frame};
+use crate::io::frames::{Frames, SensorFrame};
 use crate::io::grid::GridDescription;
 use crate::io::message::one_line;
 use crate::io::output::write_bytes;
+use crate::io::paged_frame::PagedFrame;
 use crate::io::sensor::SensorDescription;
 
 /// The largest `capture.json` read (a long defect list fits many times over).
@@ -183,8 +185,9 @@ pub const MAX_NM: f32 = 2500.0;
 #[derive(Clone, Debug)]
 pub struct Capture {
     pub description: CaptureDescription,
-    /// One raw frame per snapshot, row-major.
-    pub frames: Vec<Vec<u16>>,
+    /// One raw frame per snapshot, row-major: held, or read from the files a band at a
+    /// time ([`Capture::load`] of `.npy` frames).
+    pub frames: Frames,
     /// Flattened tile bands (`[snapshot][row][col]`) when the mask is a tile.
     tile_bands: Vec<u8>,
     /// Defective pixels, sorted.
@@ -199,6 +202,15 @@ impl Capture {
     /// # Errors
     /// A message naming the field that is wrong.
     pub fn new(description: CaptureDescription, frames: Vec<Vec<u16>>) -> Result<Self> {
+        Self::with_frames(description, Frames::Held(frames))
+    }
+
+    /// As [`Self::new`], with frames held or paged (a paged frame's size was checked when
+    /// its file was opened).
+    ///
+    /// # Errors
+    /// As [`Self::new`].
+    pub fn with_frames(description: CaptureDescription, frames: Frames) -> Result<Self> {
         let d = &description;
         let (rows, cols) = d.frame_size()?;
         ensure!(frames.len() == d.frames.len(), "{} frames for {} names", frames.len(), d.frames.len());
@@ -211,7 +223,7 @@ impl Capture {
             );
             ensure!(!d.frames[..i].contains(name), "frames[{i}]: {name:?} is named twice (one file per snapshot)");
         }
-        for (i, f) in frames.iter().enumerate() {
+        for (i, f) in frames.in_memory().iter().enumerate() {
             ensure!(
                 f.len() == rows * cols,
                 "frame {i} ({}) holds {} pixels, expected {rows} x {cols}",
@@ -278,17 +290,20 @@ impl Capture {
 
     /// Pixels at or above the saturation level over all frames, defective pixels left out,
     /// and all pixels.
-    pub fn saturated_pixels(&self) -> (usize, usize) {
+    ///
+    /// # Errors
+    /// A paged frame's read that fails.
+    pub fn saturated_pixels(&self) -> Result<(usize, usize)> {
         let sat = self.description.saturation_level;
-        let cols = self.frame_size().1;
+        let (rows, cols) = self.frame_size();
         let mut count = 0;
-        for frame in &self.frames {
-            for (i, &x) in frame.iter().enumerate() {
-                let p = Pixel { row: (i / cols) as u16, col: (i % cols) as u16 };
+        self.frames.visit((rows, cols), |_, first, values| {
+            for (i, &x) in values.iter().enumerate() {
+                let p = Pixel { row: (first + i / cols) as u16, col: (i % cols) as u16 };
                 count += usize::from(f32::from(x) >= sat && self.defects.binary_search(&p).is_err());
             }
-        }
-        (count, self.frames.iter().map(Vec::len).sum())
+        })?;
+        Ok((count, self.frames.len() * rows * cols))
     }
 
     /// Sensor geometry.
@@ -406,8 +421,12 @@ impl Capture {
             d.lenslets,
             d.views
         );
-        let frames =
-            self.frames.iter().map(|f| (0..rows).flat_map(|r| f[r * c0..r * c0 + cols].to_vec()).collect()).collect();
+        let frames = self
+            .frames
+            .held((r0, c0))?
+            .iter()
+            .map(|f| (0..rows).flat_map(|r| f[r * c0..r * c0 + cols].to_vec()).collect())
+            .collect();
         let mut description = d.clone();
         description.lenslet_grid = None;
         description.defective_pixels.retain(|p| (p[0] as usize) < rows && (p[1] as usize) < cols);
@@ -416,13 +435,29 @@ impl Capture {
         Ok(c)
     }
 
+    /// The frames in memory, read whole if they are paged ([`Frames::held`]).
+    ///
+    /// # Errors
+    /// Frames past the memory cap, or a read that fails.
+    pub fn held_frames(&self) -> Result<std::borrow::Cow<'_, [Vec<u16>]>> {
+        self.frames.held(self.frame_size())
+    }
+
+    /// The frames in memory for changing them ([`Frames::held_mut`]).
+    ///
+    /// # Errors
+    /// As [`Self::held_frames`].
+    pub fn held_frames_mut(&mut self) -> Result<&mut Vec<Vec<u16>>> {
+        let size = self.frame_size();
+        self.frames.held_mut(size)
+    }
+
     /// The frames as the decoder reads them.
     ///
     /// # Errors
     /// A frame whose size differs from the description's (checked in `new`, so not expected).
-    pub fn raw_frames(&self) -> Result<Vec<RawFrame<'_, u16>>> {
-        let (rows, cols) = self.frame_size();
-        self.frames.iter().map(|f| RawFrame::new(f, rows, cols).map_err(|e| anyhow::anyhow!("{e}"))).collect()
+    pub fn raw_frames(&self) -> Result<Vec<SensorFrame<'_>>> {
+        self.frames.sensor(self.frame_size())
     }
 
     /// The defect list for the decoder.
@@ -467,6 +502,23 @@ impl Capture {
                  from another capture would not be noticed",
                 desc_path.display()
             ),
+        }
+        // `.npy` frames are read as the decode asks, a band of rows at a time: their header
+        // and length are checked now. The others are read whole.
+        let mut paged = Vec::with_capacity(paths.len());
+        for path in &paths {
+            if extension(path) != "npy" {
+                break;
+            }
+            match PagedFrame::open_npy(path, (rows, cols))? {
+                Some(frame) => paged.push(frame),
+                None => break,
+            }
+        }
+        if paged.len() == paths.len() {
+            let mut capture = Self::with_frames(description, Frames::Paged(paged)).map_err(named)?;
+            capture.source = Some(desc_path);
+            return Ok(capture);
         }
         let mut frames = Vec::with_capacity(description.frames.len());
         for path in paths {
@@ -542,7 +594,8 @@ impl Capture {
     pub fn write_into(&self, dir: &Path) -> Result<()> {
         let (rows, cols) = self.frame_size();
         let mut records = Vec::with_capacity(self.frames.len());
-        for (name, data) in self.description.frames.iter().zip(&self.frames) {
+        let held = self.frames.held((rows, cols))?;
+        for (name, data) in self.description.frames.iter().zip(held.iter()) {
             let path = dir.join(name);
             if let Some(parent) = path.parent() {
                 fs::create_dir_all(parent).with_context(|| format!("cannot create {}", parent.display()))?;

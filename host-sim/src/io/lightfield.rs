@@ -328,6 +328,27 @@ pub fn read_npy_f32_2d(path: &Path, (rows, cols): (usize, usize)) -> Result<Vec<
     }
 }
 
+/// Whether a `.npy` header's `shape` and `element` are a raw frame's: `uint16`, two axes,
+/// `expect` (rows, cols) where given. Shared by the whole read and the paged one
+/// ([`crate::io::paged_frame`]).
+///
+/// # Errors
+/// What differs, in the words of the capture.
+pub fn check_frame_header(s: &[usize], element: npy::Element, expect: Option<(usize, usize)>) -> Result<(), String> {
+    if s.len() != 2 {
+        return Err(format!("a raw frame has 2 axes (H, W), this array {s:?}"));
+    }
+    if element != npy::Element::U16 {
+        return Err("a raw frame holds uint16 ('<u2') values, this array floats".into());
+    }
+    match expect {
+        Some((rows, cols)) if (s[0], s[1]) != (rows, cols) => {
+            Err(format!("frame is {} x {}, the capture's frames are {rows} x {cols}", s[0], s[1]))
+        }
+        _ => Ok(()),
+    }
+}
+
 /// Reads a uint16 2D `.npy` array (a raw frame): `(data, rows, cols)`; with `expect`, a
 /// header of another size is refused before the body is read.
 ///
@@ -335,20 +356,7 @@ pub fn read_npy_f32_2d(path: &Path, (rows, cols): (usize, usize)) -> Result<Vec<
 /// [`NpyError`]: what is wrong and where.
 pub fn read_npy_u16_2d(path: &Path, expect: Option<(usize, usize)>) -> Result<(Vec<u16>, usize, usize), NpyError> {
     // Rank, type and size from the header, before the body is read.
-    let a = npy::read_checked(path, |s, element| {
-        if s.len() != 2 {
-            return Err(format!("a raw frame has 2 axes (H, W), this array {s:?}"));
-        }
-        if element != npy::Element::U16 {
-            return Err("a raw frame holds uint16 ('<u2') values, this array floats".into());
-        }
-        match expect {
-            Some((rows, cols)) if (s[0], s[1]) != (rows, cols) => {
-                Err(format!("frame is {} x {}, the capture's frames are {rows} x {cols}", s[0], s[1]))
-            }
-            _ => Ok(()),
-        }
-    })?;
+    let a = npy::read_checked(path, |s, element| check_frame_header(s, element, expect))?;
     match a.values {
         Values::U16(v) => Ok((v, a.shape[0], a.shape[1])),
         Values::F32(_) => {

@@ -221,15 +221,35 @@ pub fn read_from(r: impl Read, len: u64) -> Result<Npy, NpyErrorKind> {
     read_from_checked(r, len, |_, _| Ok(()))
 }
 
-/// As [`read_from`], with `check` on the shape and element type before the body is read.
+/// Where an array's values lie in its file and how they are stored: what the header says,
+/// checked against the file's length (the body is exactly the values: no fewer, no more).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Layout {
+    /// The shape, slowest axis first.
+    pub shape: Vec<usize>,
+    pub element: Element,
+    /// Big-endian values (swapped to native as they are read).
+    pub swap: bool,
+    /// Stored first axis fastest (Fortran order).
+    pub fortran_order: bool,
+    /// The body's first byte in the file.
+    pub body: u64,
+    /// Values in the body.
+    pub count: u64,
+    /// The header's type string (`'<u2'`), for notes.
+    pub descr: String,
+}
+
+/// Reads the header of the array `r` holds (`len` bytes in all), calls `check` on its
+/// shape and element type, and checks the body's length; nothing is allocated for the body.
 ///
 /// # Errors
 /// What is wrong, without the file's name.
-pub fn read_from_checked(
-    mut r: impl Read,
+pub fn read_layout(
+    r: &mut impl Read,
     len: u64,
     check: impl FnOnce(&[usize], Element) -> Result<(), String>,
-) -> Result<Npy, NpyErrorKind> {
+) -> Result<Layout, NpyErrorKind> {
     let io = NpyErrorKind::Io;
     let mut preamble = [0u8; 8];
     if len < 10 {
@@ -287,17 +307,41 @@ pub fn read_from_checked(
         .collect::<Result<Vec<_>, _>>()
         .map_err(|_| NpyErrorKind::Overflow { shape: shape64.clone() })?;
     check(&shape, element).map_err(NpyErrorKind::Shape)?;
+    usize::try_from(count).map_err(|_| NpyErrorKind::Overflow { shape: shape64 })?;
+    Ok(Layout {
+        shape,
+        element,
+        swap,
+        fortran_order: header.fortran_order,
+        body: start + header_len,
+        count,
+        descr: header.descr,
+    })
+}
+
+/// As [`read_from`], with `check` on the shape and element type before the body is read.
+///
+/// # Errors
+/// What is wrong, without the file's name.
+pub fn read_from_checked(
+    mut r: impl Read,
+    len: u64,
+    check: impl FnOnce(&[usize], Element) -> Result<(), String>,
+) -> Result<Npy, NpyErrorKind> {
+    let Layout { shape, element, swap, fortran_order, count, descr, .. } = read_layout(&mut r, len, check)?;
+    let bytes = count * element.size();
     // What the read holds at its peak: the values as kept (f32, or u16) and, for a Fortran-
     // order array, their copy in C order; the body is read a chunk at a time.
     let kept = if element == Element::U16 { 2 } else { 4 };
-    let need = count.saturating_mul(kept).saturating_mul(if header.fortran_order { 2 } else { 1 });
+    let need = count.saturating_mul(kept).saturating_mul(if fortran_order { 2 } else { 1 });
     crate::io::budget::check(need, &format!("reading {count} values"), "a smaller array")
         .map_err(|e| NpyErrorKind::Memory(e.to_string()))?;
-    let count_usize = usize::try_from(count).map_err(|_| NpyErrorKind::Overflow { shape: shape64.clone() })?;
+    // Checked in `read_layout`.
+    let count_usize = usize::try_from(count).unwrap_or(usize::MAX);
 
     let mut notes = Vec::new();
     if swap {
-        notes.push(format!("big-endian {} converted to little-endian", header.descr));
+        notes.push(format!("big-endian {descr} converted to little-endian"));
     }
     let mut chunk = vec![0u8; CHUNK];
     let values =
@@ -341,7 +385,7 @@ pub fn read_from_checked(
                 Values::U16(v)
             }
         };
-    let values = if header.fortran_order && shape.len() > 1 {
+    let values = if fortran_order && shape.len() > 1 {
         notes.push("Fortran-order array converted to C order".into());
         match values {
             Values::F32(v) => Values::F32(fortran_to_c(&v, &shape)),

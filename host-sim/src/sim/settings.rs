@@ -280,7 +280,7 @@ impl SimulateSettings {
                 lf.data.len()
             ));
         }
-        let (clipped, total) = capture.saturated_pixels();
+        let (clipped, total) = capture.saturated_pixels()?;
         if clipped > 0 {
             let top = 1.0 / cam.white_fraction;
             // Who saturated them: the light field only when it exceeds white; else the

@@ -58,7 +58,7 @@ pub(super) fn stream(reader: &Reader<'_>, cfg: &DemosaicConfig, sink: &mut Rows<
     let mut read: Lagged<Measured> = Lagged::new();
     let mut out = vec![0.0f32; lt * uv * nb];
     for s in 0..rows {
-        read.fill_to(s + r, rows, |s| Measured::read(reader, s));
+        read.fill_to(s + r, rows, |s| Measured::read(reader, s))?;
         let e = estimate(&read, s, reader, r, cfg.sigma);
         let mine = &read.get(s).row;
         out.par_chunks_mut(nb).enumerate().for_each(|(p, o)| {

@@ -60,7 +60,7 @@ pub(super) fn stream(reader: &Reader<'_>, sink: &mut Rows<'_>) -> Result<Baselin
     let mut done: Lagged<Interpolated> = Lagged::new();
     let mut out = vec![0.0f32; lt * uv * nb];
     for s in 0..rows {
-        done.fill_to(s + 1, rows, |s| interpolated(&reader.row(s), lt, uv, nb));
+        done.fill_to(s + 1, rows, |s| Ok(interpolated(&reader.row(s)?, lt, uv, nb)))?;
         let here = done.get(s);
         out.copy_from_slice(&here.values);
         report.filled += here.missing.iter().filter(|&&m| m).count();

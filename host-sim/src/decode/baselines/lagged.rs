@@ -21,12 +21,21 @@ impl<T> Lagged<T> {
 
     /// Computes rows with `make` until row `last` is held (or row `end - 1`, the frame's
     /// last): every row once, in order.
-    pub(super) fn fill_to(&mut self, last: usize, end: usize, mut make: impl FnMut(usize) -> T) {
+    ///
+    /// # Errors
+    /// The first error `make` returns (a frame's row that cannot be read).
+    pub(super) fn fill_to(
+        &mut self,
+        last: usize,
+        end: usize,
+        mut make: impl FnMut(usize) -> anyhow::Result<T>,
+    ) -> anyhow::Result<()> {
         let stop = (last + 1).min(end);
         while self.first + self.rows.len() < stop {
             let s = self.first + self.rows.len();
-            self.rows.push_back(make(s));
+            self.rows.push_back(make(s)?);
         }
+        Ok(())
     }
 
     /// Row `s`, which must be held (computed and not yet dropped).
@@ -64,14 +73,15 @@ mod tests {
         let mut w = Lagged::new();
         w.fill_to(2, 5, |s| {
             made.push(s);
-            s * 10
-        });
-        w.fill_to(1, 5, |s| s);
+            Ok(s * 10)
+        })
+        .unwrap();
+        w.fill_to(1, 5, Ok).unwrap();
         assert_eq!(made, [0, 1, 2]);
         assert_eq!(*w.get(2), 20);
         w.keep_from(2);
         assert_eq!(w.held(), 1);
-        w.fill_to(9, 5, |s| s * 10);
+        w.fill_to(9, 5, |s| Ok(s * 10)).unwrap();
         assert_eq!((w.held(), *w.get(4)), (3, 40));
         assert_eq!(around(0, 2, 5), 0..3);
         assert_eq!(around(4, 2, 5), 2..5);

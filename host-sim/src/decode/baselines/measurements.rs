@@ -5,11 +5,15 @@
 use anyhow::Result;
 use slf_firmware::{DefectList, Mask, RawFormat};
 
+use slf_firmware::Frame;
+
 use crate::io::capture::Capture;
+use crate::io::frames::SensorFrame;
 
 /// Reads lenslet rows of one capture.
 pub(super) struct Reader<'a> {
     capture: &'a Capture,
+    frames: Vec<SensorFrame<'a>>,
     mask: Mask<'a>,
     raw: RawFormat,
     defects: DefectList<'a>,
@@ -40,6 +44,7 @@ impl<'a> Reader<'a> {
         let d = &capture.description;
         Ok(Self {
             capture,
+            frames: capture.raw_frames()?,
             mask: capture.mask()?,
             raw: capture.raw_format(),
             defects: capture.defects(),
@@ -57,8 +62,28 @@ impl<'a> Reader<'a> {
 
     /// Lenslet row `s`'s measurements. Lenslet `(s, t)`'s view `(u, v)` is sensor pixel
     /// `(s U + u, t V + v)`.
-    pub(super) fn row(&self, s: usize) -> LensletRow {
+    ///
+    /// # Errors
+    /// A paged frame's read that fails.
+    pub(super) fn row(&self, s: usize) -> Result<LensletRow> {
         let (vu, vv) = self.views;
+        // The lenslet row's sensor rows of every frame, read a row at a time (a paged
+        // frame finds its band once a row).
+        let cols = self.cols;
+        let mut sensor = vec![0.0f32; self.frames.len() * vu * cols];
+        for (j, frame) in self.frames.iter().enumerate() {
+            for u in 0..vu {
+                let at = (j * vu + u) * cols;
+                frame.read_run((s * vu + u) * cols, &mut sensor[at..at + cols]).ok_or_else(|| {
+                    anyhow::anyhow!(
+                        "{}: cannot read row {} of frame {j}{}",
+                        self.capture.source(),
+                        s * vu + u,
+                        self.capture.frames.read_error().err().map_or_else(String::new, |e| format!(": {e}"))
+                    )
+                })?;
+            }
+        }
         let mut taken = Vec::new();
         let mut start = Vec::with_capacity(self.positions() + 1);
         start.push(0);
@@ -68,8 +93,8 @@ impl<'a> Reader<'a> {
                     let (row, col) = (s * vu + u, t * vv + v);
                     if !self.defects.contains(row, col) {
                         let bands = self.mask.bands_at(row, col);
-                        for (&band, frame) in bands.iter().zip(&self.capture.frames) {
-                            if let Ok(x) = self.raw.classify(f32::from(frame[row * self.cols + col])) {
+                        for (j, &band) in bands.iter().enumerate().take(self.frames.len()) {
+                            if let Ok(x) = self.raw.classify(sensor[(j * vu + u) * cols + col]) {
                                 taken.push((band, x));
                             }
                         }
@@ -78,7 +103,7 @@ impl<'a> Reader<'a> {
                 }
             }
         }
-        LensletRow { taken, start, views: vu * vv }
+        Ok(LensletRow { taken, start, views: vu * vv })
     }
 
     /// The capture's name, for messages.

@@ -15,10 +15,13 @@ pub(super) struct Measured {
 
 impl Measured {
     /// Lenslet row `s` of `reader`'s capture.
-    pub(super) fn read(reader: &Reader<'_>, s: usize) -> Self {
-        let row = reader.row(s);
+    ///
+    /// # Errors
+    /// A frame's row that cannot be read.
+    pub(super) fn read(reader: &Reader<'_>, s: usize) -> anyhow::Result<Self> {
+        let row = reader.row(s)?;
         let sums = Sums::of(&row, reader.lenslets.1, reader.bands);
-        Self { row, sums }
+        Ok(Self { row, sums })
     }
 }
 

@@ -129,13 +129,13 @@ pub(super) fn stream(reader: &Reader<'_>, cfg: &PpidConfig, sink: &mut Rows<'_>)
     let mut ppi: Lagged<Vec<f32>> = Lagged::new();
     let mut out = vec![0.0f32; lt * uv * nb];
     for s in 0..rows {
-        read.fill_to(s + 3 * r, rows, |s| Measured::read(reader, s));
+        read.fill_to(s + 3 * r, rows, |s| Measured::read(reader, s))?;
         coarse.fill_to(s + 2 * r, rows, |s| {
             let estimate = estimate(&read, s, reader, r, cfg.sigma);
             let coarse = estimate.chunks_exact(nb).map(|e| e.iter().sum::<f32>() / nb as f32).collect();
-            Coarse { estimate, coarse }
-        });
-        ppi.fill_to(s + r, rows, |s| ppi_row(&read, &coarse, s, reader, cfg));
+            Ok(Coarse { estimate, coarse })
+        })?;
+        ppi.fill_to(s + r, rows, |s| Ok(ppi_row(&read, &coarse, s, reader, cfg)))?;
         // Step 2: each band is the PPI plus the band's difference to it, interpolated with
         // edge-sensing weights.
         let (here, mine, ppi_here) = (coarse.get(s), &read.get(s).row, ppi.get(s));

@@ -1,0 +1,186 @@
+//! A capture's raw frames, one per snapshot ([`Frames`]): held in memory (made by the
+//! simulator, given from numpy, or read from a PNG or PGM), or read from their `.npy` files
+//! a band of rows at a time ([`PagedFrame`]); and the frame the decoder reads either way
+//! ([`SensorFrame`]).
+//!
+//! Whole-frame work (a calibration's correction, a capture saved again, the frames handed
+//! to numpy) asks for the frames held ([`Frames::held`]), which reads paged ones whole
+//! after checking the memory cap; the decode reads them paged.
+
+use std::borrow::Cow;
+
+use anyhow::{Result, anyhow};
+use slf_firmware::{Frame, RawFrame};
+
+use crate::io::paged_frame::PagedFrame;
+
+/// A capture's frames, one per snapshot, row-major.
+#[derive(Clone, Debug)]
+pub enum Frames {
+    /// In memory.
+    Held(Vec<Vec<u16>>),
+    /// Read from their files as the decode asks.
+    Paged(Vec<PagedFrame>),
+}
+
+/// One snapshot's frame as the decoder reads it.
+#[derive(Clone, Copy, Debug)]
+pub enum SensorFrame<'a> {
+    Held(RawFrame<'a, u16>),
+    Paged(&'a PagedFrame),
+}
+
+impl Frames {
+    /// Snapshots.
+    pub fn len(&self) -> usize {
+        match self {
+            Self::Held(f) => f.len(),
+            Self::Paged(f) => f.len(),
+        }
+    }
+
+    /// No snapshot (not a capture: [`crate::io::capture::Capture::new`] refuses it).
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The frames held in memory (none where they are paged).
+    pub fn in_memory(&self) -> &[Vec<u16>] {
+        match self {
+            Self::Held(f) => f,
+            Self::Paged(_) => &[],
+        }
+    }
+
+    /// Whether the frames are read from their files.
+    pub fn is_paged(&self) -> bool {
+        matches!(self, Self::Paged(_))
+    }
+
+    /// The frames in memory: as held, or read whole (`rows x cols` each) after the memory
+    /// cap is checked.
+    ///
+    /// # Errors
+    /// Frames past the memory cap, or a read that fails.
+    pub fn held(&self, (rows, cols): (usize, usize)) -> Result<Cow<'_, [Vec<u16>]>> {
+        match self {
+            Self::Held(f) => Ok(Cow::Borrowed(f)),
+            Self::Paged(f) => {
+                crate::io::budget::check(
+                    (f.len() * rows * cols * 2) as u64,
+                    &format!("holding {} raw frames of {rows} x {cols}", f.len()),
+                    "a capture of fewer snapshots or a smaller sensor",
+                )?;
+                let mut all = Vec::with_capacity(f.len());
+                for frame in f {
+                    let mut values = vec![0u16; rows * cols];
+                    frame.read_rows(0, &mut values)?;
+                    all.push(values);
+                }
+                Ok(Cow::Owned(all))
+            }
+        }
+    }
+
+    /// The frames held in memory for changing them: paged frames are read whole first (as
+    /// [`Self::held`]).
+    ///
+    /// # Errors
+    /// As [`Self::held`].
+    pub fn held_mut(&mut self, size: (usize, usize)) -> Result<&mut Vec<Vec<u16>>> {
+        if let Self::Paged(_) = self {
+            *self = Self::Held(self.held(size)?.into_owned());
+        }
+        match self {
+            Self::Held(f) => Ok(f),
+            Self::Paged(_) => Err(anyhow!("the frames could not be held")),
+        }
+    }
+
+    /// Calls `f(snapshot, first row, rows)` on every frame's rows in order, a band of
+    /// rows at a time (`rows x cols` frames; held frames in one call each): a pass that
+    /// holds no frame.
+    ///
+    /// # Errors
+    /// A read that fails.
+    pub fn visit(&self, (rows, cols): (usize, usize), mut f: impl FnMut(usize, usize, &[u16])) -> Result<()> {
+        match self {
+            Self::Held(frames) => frames.iter().enumerate().for_each(|(j, v)| f(j, 0, v)),
+            Self::Paged(frames) => {
+                let band = crate::io::paged_frame::MIN_BAND_ROWS;
+                let mut values = vec![0u16; band * cols];
+                for (j, frame) in frames.iter().enumerate() {
+                    for first in (0..rows).step_by(band) {
+                        let n = band.min(rows - first);
+                        let part = &mut values[..n * cols];
+                        frame.read_rows(first, part)?;
+                        f(j, first, part);
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The frames as the decoder reads them, each `rows x cols`.
+    ///
+    /// # Errors
+    /// A held frame of another size (checked when the capture was made, so not expected).
+    pub fn sensor(&self, (rows, cols): (usize, usize)) -> Result<Vec<SensorFrame<'_>>> {
+        match self {
+            Self::Held(f) => f
+                .iter()
+                .map(|f| RawFrame::new(f, rows, cols).map(SensorFrame::Held).map_err(|e| anyhow!("{e}")))
+                .collect(),
+            Self::Paged(f) => Ok(f.iter().map(SensorFrame::Paged).collect()),
+        }
+    }
+
+    /// The first read of a paged frame that failed since it was opened: a decode that read
+    /// no sample there must not pass as one that flagged the pixels.
+    ///
+    /// # Errors
+    /// That read's error.
+    pub fn read_error(&self) -> Result<()> {
+        match self {
+            Self::Held(_) => Ok(()),
+            Self::Paged(f) => match f.iter().find_map(PagedFrame::error) {
+                Some(e) => Err(anyhow!("{e}")),
+                None => Ok(()),
+            },
+        }
+    }
+
+    /// Bands read from the files so far, all frames (0 for held frames).
+    pub fn loads(&self) -> u64 {
+        match self {
+            Self::Held(_) => 0,
+            Self::Paged(f) => f.iter().map(PagedFrame::loads).sum(),
+        }
+    }
+}
+
+impl Frame for SensorFrame<'_> {
+    fn size(&self) -> (usize, usize) {
+        match self {
+            Self::Held(f) => f.size(),
+            Self::Paged(f) => f.size(),
+        }
+    }
+
+    #[inline]
+    fn sample(&self, i: usize) -> Option<f32> {
+        match self {
+            Self::Held(f) => f.sample(i),
+            Self::Paged(f) => f.sample(i),
+        }
+    }
+
+    #[inline]
+    fn read_run(&self, start: usize, out: &mut [f32]) -> Option<()> {
+        match self {
+            Self::Held(f) => f.read_run(start, out),
+            Self::Paged(f) => f.read_run(start, out),
+        }
+    }
+}

@@ -1,0 +1,345 @@
+//! A raw frame read from its file a band of rows at a time ([`PagedFrame`]), so a decode
+//! holds a few bands of each snapshot, never the frame.
+//!
+//! Every pass of a decode goes down the frame (the trials' pilots, the white balance's
+//! sums, the streamed decode and its held-out twin, the baselines' lenslet rows), so the
+//! bands it reads are near each other: a small cache of bands, the least recently used
+//! one dropped for the next, reads each band about once a pass. The cache is shared by the
+//! decode's threads behind one read-write lock, taken once a run of samples (the
+//! firmware's [`Frame::read_run`]), not once a sample.
+//!
+//! The file stays open from [`PagedFrame::open_npy`] on: a frame renamed or deleted during
+//! the decode is still the frame that was checked. A read that fails later (a disk error,
+//! a file cut short by another program) reads as no sample and is kept; the decode then
+//! fails with it ([`PagedFrame::error`]) instead of flagging the pixels.
+
+use std::fmt;
+use std::fs::File;
+use std::io::{Read, Seek, SeekFrom};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex, RwLock};
+
+use anyhow::{Result, anyhow};
+use slf_firmware::Frame;
+
+use crate::io::npy::{self, NpyError, NpyErrorKind};
+
+/// A band holds at least this many rows, and at least [`BAND_BYTES`].
+pub const MIN_BAND_ROWS: usize = 32;
+
+/// A band's least size in bytes: a narrow frame's bands are taller, so the cache's index
+/// stays short.
+pub const BAND_BYTES: usize = 64 << 10;
+
+/// The cache holds this many bytes of a frame, and at least [`MIN_BANDS`] + 4 bands a
+/// worker thread (each thread's tile or pilot reads from two bands at most).
+pub const CACHE_BYTES: usize = 8 << 20;
+
+/// The fewest bands the cache holds.
+pub const MIN_BANDS: usize = 8;
+
+/// Where a frame's values are in its file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Stored {
+    /// The first value's byte.
+    body: u64,
+    /// Big-endian `u16` values.
+    big_endian: bool,
+    rows: usize,
+    cols: usize,
+}
+
+/// A raw frame of `u16` values read from its file a band of rows at a time.
+pub struct PagedFrame {
+    path: Arc<PathBuf>,
+    file: Arc<Mutex<File>>,
+    stored: Stored,
+    band_rows: usize,
+    capacity: usize,
+    cache: RwLock<Cache>,
+    /// Bumped at each band read: a band's `used` is the count when it was last read from.
+    clock: AtomicU64,
+    /// Bands read from the file so far.
+    loads: AtomicU64,
+    /// The first read that failed, as one line.
+    error: Mutex<Option<String>>,
+}
+
+/// The bands held, and where each band of the frame is held (`NONE` where it is not).
+struct Cache {
+    slot_of: Vec<u32>,
+    slots: Vec<Slot>,
+}
+
+struct Slot {
+    band: usize,
+    used: AtomicU64,
+    values: Vec<u16>,
+}
+
+const NONE: u32 = u32::MAX;
+
+impl PagedFrame {
+    /// Opens a `.npy` raw frame (`uint16`, two axes in C order) of `rows x cols`: its header
+    /// and length are checked now, its values read as the decode asks for them. `None` for
+    /// a file that is valid but not stored so (Fortran order): the caller reads it whole.
+    ///
+    /// # Errors
+    /// The file and what is wrong with it, as [`npy::read_checked`] says it.
+    pub fn open_npy(path: &Path, (rows, cols): (usize, usize)) -> Result<Option<Self>, NpyError> {
+        let err = |kind| NpyError::new(path, kind);
+        // Look before opening: opening a FIFO blocks until a writer comes.
+        let meta = std::fs::metadata(path).map_err(|e| err(NpyErrorKind::Io(e)))?;
+        if !meta.is_file() {
+            return Err(err(NpyErrorKind::NotAFile));
+        }
+        let mut file = File::open(path).map_err(|e| err(NpyErrorKind::Io(e)))?;
+        let layout = npy::read_layout(&mut std::io::BufReader::new(&mut file), meta.len(), |s, element| {
+            crate::io::lightfield::check_frame_header(s, element, Some((rows, cols)))
+        })
+        .map_err(err)?;
+        if layout.fortran_order && rows > 1 && cols > 1 {
+            return Ok(None);
+        }
+        let stored = Stored { body: layout.body, big_endian: layout.swap, rows, cols };
+        Ok(Some(Self::new(path, file, stored)))
+    }
+
+    fn new(path: &Path, file: File, stored: Stored) -> Self {
+        let row_bytes = stored.cols.max(1) * 2;
+        let band_rows = MIN_BAND_ROWS.max(BAND_BYTES.div_ceil(row_bytes));
+        let threads = rayon::current_num_threads();
+        let capacity = (MIN_BANDS + 4 * threads).max(CACHE_BYTES / (band_rows * row_bytes));
+        Self::with_bands(Arc::new(path.to_path_buf()), Arc::new(Mutex::new(file)), stored, band_rows, capacity)
+    }
+
+    fn with_bands(
+        path: Arc<PathBuf>,
+        file: Arc<Mutex<File>>,
+        stored: Stored,
+        band_rows: usize,
+        capacity: usize,
+    ) -> Self {
+        let band_rows = band_rows.max(1);
+        let bands = stored.rows.div_ceil(band_rows);
+        Self {
+            path,
+            file,
+            stored,
+            band_rows,
+            capacity: capacity.clamp(1, bands.max(1)),
+            cache: RwLock::new(Cache { slot_of: vec![NONE; bands], slots: Vec::new() }),
+            clock: AtomicU64::new(0),
+            loads: AtomicU64::new(0),
+            error: Mutex::new(None),
+        }
+    }
+
+    /// This frame with bands of `band_rows` rows and at most `capacity` of them held (tests
+    /// and benchmarks of the cache; a fresh cache).
+    pub fn with_cache(&self, band_rows: usize, capacity: usize) -> Self {
+        Self::with_bands(self.path.clone(), self.file.clone(), self.stored, band_rows, capacity)
+    }
+
+    /// The file read.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Bands read from the file so far (a pass reads each band about once).
+    pub fn loads(&self) -> u64 {
+        self.loads.load(Ordering::Relaxed)
+    }
+
+    /// The most bytes the cache holds.
+    pub fn cache_bytes(&self) -> usize {
+        self.capacity * self.band_rows * self.stored.cols * 2
+    }
+
+    /// The first read that failed since the frame was opened, as one line naming the file.
+    pub fn error(&self) -> Option<String> {
+        self.error.lock().ok().and_then(|e| e.clone())
+    }
+
+    /// Reads rows `first..first + out.len() / cols` from the file into `out`, past the
+    /// cache (a pass that reads each row once: the no-light check, the saturation count).
+    ///
+    /// # Errors
+    /// The file and the rows that could not be read.
+    pub fn read_rows(&self, first: usize, out: &mut [u16]) -> Result<()> {
+        let Stored { body, big_endian, rows, cols } = self.stored;
+        let n = out.len() / cols.max(1);
+        if !out.len().is_multiple_of(cols.max(1)) || first + n > rows {
+            return Err(anyhow!("{}: rows {first}..{} of a {rows} x {cols} frame", self.path.display(), first + n));
+        }
+        let mut bytes = vec![0u8; out.len() * 2];
+        let mut read = || -> std::io::Result<()> {
+            let mut f = self.file.lock().map_err(|_| std::io::Error::other("a reader panicked"))?;
+            f.seek(SeekFrom::Start(body + (first * cols * 2) as u64))?;
+            f.read_exact(&mut bytes)
+        };
+        read().map_err(|e| {
+            anyhow!("{}: cannot read rows {first}..{} of the frame: {e}", self.path.display(), first + n)
+        })?;
+        for (o, b) in out.iter_mut().zip(bytes.chunks_exact(2)) {
+            *o = if big_endian { u16::from_be_bytes([b[0], b[1]]) } else { u16::from_le_bytes([b[0], b[1]]) };
+        }
+        Ok(())
+    }
+
+    /// Calls `f` with the held values of `row` from column `col` on, reading the row's
+    /// band first if it is not held; `None` where it cannot be read (the error kept).
+    fn with_row<R>(&self, row: usize, col: usize, f: impl FnOnce(&[u16]) -> R) -> Option<R> {
+        let band = row / self.band_rows;
+        let at = (row - band * self.band_rows) * self.stored.cols + col;
+        {
+            let cache = self.cache.read().ok()?;
+            if let Some(slot) = cache.held(band) {
+                let now = self.clock.load(Ordering::Relaxed);
+                if slot.used.load(Ordering::Relaxed) != now {
+                    slot.used.store(now, Ordering::Relaxed);
+                }
+                return slot.values.get(at..).map(f);
+            }
+        }
+        let mut cache = self.cache.write().ok()?;
+        if cache.held(band).is_none() {
+            let first = band * self.band_rows;
+            let rows = self.band_rows.min(self.stored.rows - first);
+            let mut values = vec![0u16; rows * self.stored.cols];
+            if let Err(e) = self.read_rows(first, &mut values) {
+                if let Ok(mut kept) = self.error.lock() {
+                    kept.get_or_insert_with(|| crate::io::message::one_line(&e));
+                }
+                return None;
+            }
+            self.loads.fetch_add(1, Ordering::Relaxed);
+            let used = AtomicU64::new(self.clock.fetch_add(1, Ordering::Relaxed) + 1);
+            let slot = Slot { band, used, values };
+            if cache.slots.len() < self.capacity {
+                let i = cache.slots.len() as u32;
+                cache.slots.push(slot);
+                cache.slot_of[band] = i;
+            } else {
+                // The least recently used band gives its place.
+                let i = (0..cache.slots.len()).min_by_key(|&i| cache.slots[i].used.load(Ordering::Relaxed))?;
+                let old = cache.slots[i].band;
+                cache.slot_of[old] = NONE;
+                cache.slots[i] = slot;
+                cache.slot_of[band] = i as u32;
+            }
+        }
+        cache.held(band).and_then(|slot| slot.values.get(at..)).map(f)
+    }
+}
+
+impl Cache {
+    fn held(&self, band: usize) -> Option<&Slot> {
+        let i = *self.slot_of.get(band)?;
+        if i == NONE { None } else { self.slots.get(i as usize) }
+    }
+}
+
+impl Frame for PagedFrame {
+    fn size(&self) -> (usize, usize) {
+        (self.stored.rows, self.stored.cols)
+    }
+
+    fn sample(&self, i: usize) -> Option<f32> {
+        let cols = self.stored.cols;
+        let (row, col) = (i.checked_div(cols)?, i.checked_rem(cols)?);
+        if row >= self.stored.rows {
+            return None;
+        }
+        self.with_row(row, col, |v| v.first().map(|&x| f32::from(x)))?
+    }
+
+    fn read_run(&self, start: usize, out: &mut [f32]) -> Option<()> {
+        let cols = self.stored.cols;
+        let (row, col) = (start.checked_div(cols)?, start.checked_rem(cols)?);
+        if row >= self.stored.rows || col + out.len() > cols {
+            return None;
+        }
+        self.with_row(row, col, |v| {
+            let run = v.get(..out.len())?;
+            for (o, &x) in out.iter_mut().zip(run) {
+                *o = f32::from(x);
+            }
+            Some(())
+        })?
+    }
+}
+
+/// A copy shares the open file, with a cache of its own.
+impl Clone for PagedFrame {
+    fn clone(&self) -> Self {
+        Self::with_bands(self.path.clone(), self.file.clone(), self.stored, self.band_rows, self.capacity)
+    }
+}
+
+impl fmt::Debug for PagedFrame {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let Stored { rows, cols, .. } = self.stored;
+        write!(f, "PagedFrame({}, {rows} x {cols}, bands of {} rows)", self.path.display(), self.band_rows)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn frame(dir: &Path, rows: usize, cols: usize) -> (PathBuf, Vec<u16>) {
+        let data: Vec<u16> = (0..rows * cols).map(|i| (i * 7919 % 65521) as u16).collect();
+        let path = dir.join("f.npy");
+        crate::io::lightfield::write_npy_u16_2d(&path, &data, rows, cols).unwrap();
+        (path, data)
+    }
+
+    /// Samples and runs read through a cache of two bands of 3 rows equal the frame's,
+    /// in any order, and a pass down the frame reads each band once.
+    #[test]
+    fn a_small_cache_reads_what_the_file_holds_in_any_order() {
+        let dir = tempfile::tempdir().unwrap();
+        let (rows, cols) = (17, 5);
+        let (path, data) = frame(dir.path(), rows, cols);
+        let f = PagedFrame::open_npy(&path, (rows, cols)).unwrap().unwrap().with_cache(3, 2);
+        assert_eq!(f.size(), (rows, cols));
+        for (i, &x) in data.iter().enumerate() {
+            assert_eq!(f.sample(i), Some(f32::from(x)), "sample {i}");
+        }
+        assert_eq!(f.loads(), 6, "17 rows in bands of 3, each read once going down");
+        // Backwards and scattered: still the file's values.
+        let mut out = [0.0f32; 3];
+        for row in (0..rows).rev().chain([0, 16, 8, 1, 15]) {
+            f.read_run(row * cols + 2, &mut out).unwrap();
+            let want: Vec<f32> = data[row * cols + 2..row * cols + 5].iter().map(|&x| f32::from(x)).collect();
+            assert_eq!(out.to_vec(), want, "row {row}");
+        }
+        assert_eq!(f.sample(rows * cols), None);
+        assert!(f.read_run(cols - 1, &mut out).is_none(), "a run past its row's end");
+        assert!(f.error().is_none());
+    }
+
+    /// A file cut short after it was opened reads as no sample, and the error names it.
+    #[test]
+    fn a_read_that_fails_later_is_kept() {
+        let dir = tempfile::tempdir().unwrap();
+        let (path, _) = frame(dir.path(), 40, 4);
+        let f = PagedFrame::open_npy(&path, (40, 4)).unwrap().unwrap().with_cache(4, 2);
+        assert!(f.sample(0).is_some());
+        File::options().write(true).open(&path).unwrap().set_len(200).unwrap();
+        assert_eq!(f.sample(39 * 4), None);
+        let e = f.error().unwrap();
+        assert!(e.contains("f.npy") && e.contains("rows 36..40"), "{e}");
+    }
+
+    /// The header is checked when the frame is opened: another size is refused.
+    #[test]
+    fn another_size_is_refused_at_open() {
+        let dir = tempfile::tempdir().unwrap();
+        let (path, _) = frame(dir.path(), 6, 4);
+        let e = PagedFrame::open_npy(&path, (4, 6)).unwrap_err().to_string();
+        assert!(e.contains("frame is 6 x 4, the capture's frames are 4 x 6"), "{e}");
+    }
+}

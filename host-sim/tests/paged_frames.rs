@@ -1,0 +1,116 @@
+//! Raw frames read a band of rows at a time (issue 65, item 3): a capture loaded from `.npy`
+//! frames is read from its files as the decode goes down the frame, and every method decodes
+//! it to the same bits as the frames held in memory, with the cache of the size the decode
+//! picks and with one so small (two bands of three rows) that every pass evicts.
+
+use std::path::Path;
+use std::process::Command;
+
+use slf_host::decode::baselines::{DemosaicConfig, PpidConfig, demosaic, interpolate, ppid};
+use slf_host::decode::cs::{Basis, DecodeOptions, decode_with};
+use slf_host::firmware::DisparityRange;
+use slf_host::io::capture::Capture;
+use slf_host::io::frames::Frames;
+use slf_host::sim::camera::{CameraConfig, simulate};
+use slf_host::sim::scene::{SceneSize, named};
+
+/// The depth scene at 17 x 13 lenslets, pixel mask, `k` snapshots, saved as `.npy` frames and
+/// loaded back: (held, paged).
+fn captures(dir: &Path, k: u8) -> (Capture, Capture) {
+    let truth = named("depth").unwrap().render(SceneSize { views: (5, 5), rows: 17, cols: 13 });
+    let cam = CameraConfig { frame_ext: "npy".into(), ..CameraConfig::pixel(5, k) };
+    let held = simulate(&truth, &cam).unwrap();
+    held.save(dir).unwrap();
+    let paged = Capture::load(dir).unwrap();
+    assert!(paged.frames.is_paged(), "a capture of .npy frames is read as the decode asks");
+    assert!(!held.frames.is_paged());
+    (held, paged)
+}
+
+/// `capture` with a cache of two bands of three rows per frame (every pass evicts).
+fn starved(capture: &Capture) -> Capture {
+    let Frames::Paged(frames) = &capture.frames else { panic!("not paged") };
+    let small = Frames::Paged(frames.iter().map(|f| f.with_cache(3, 2)).collect());
+    Capture::with_frames(capture.description.clone(), small).unwrap()
+}
+
+#[test]
+fn a_paged_capture_decodes_to_the_held_ones_bits_by_every_method() {
+    let dir = tempfile::tempdir().unwrap();
+    let (held, paged) = captures(dir.path(), 2);
+    let small = starved(&paged);
+    let opts = DecodeOptions {
+        disparities: Some(DisparityRange::new(-1, 1).unwrap().with_halves(true)),
+        error_estimate: true,
+        ..DecodeOptions::default()
+    };
+    let (want, want_report) = decode_with(&held, &Basis::Dct, &opts).unwrap();
+    assert!(want_report.patches.decoded > 0);
+    for (name, cap) in [("paged", &paged), ("two bands of three rows", &small)] {
+        let (got, report) = decode_with(cap, &Basis::Dct, &opts).unwrap();
+        assert!(got.data == want.data, "{name}: the decode differs from the held frames'");
+        assert_eq!(report.patches, want_report.patches, "{name}");
+        let (e, w) = (&report.error_lenslets, &want_report.error_lenslets);
+        assert!(e.len() == w.len() && e.iter().zip(w).all(|(a, b)| a.to_bits() == b.to_bits()), "{name}: error map");
+        assert!(cap.frames.read_error().is_ok());
+        assert!(cap.frames.loads() > 0, "{name}: read from the files");
+        assert_eq!(interpolate(cap).unwrap().0.data, interpolate(&held).unwrap().0.data, "{name}: interpolate");
+        let d = DemosaicConfig::default();
+        assert_eq!(demosaic(cap, &d).unwrap().0.data, demosaic(&held, &d).unwrap().0.data, "{name}: demosaic");
+        let p = PpidConfig::default();
+        assert_eq!(ppid(cap, &p).unwrap().0.data, ppid(&held, &p).unwrap().0.data, "{name}: ppid");
+    }
+    // The decode's own cache holds the frame here (17 x 5 rows): each band is read once.
+    let once = Capture::load(dir.path()).unwrap();
+    decode_with(&once, &Basis::Dct, &opts).unwrap();
+    let bands = 2 * (17 * 5usize).div_ceil(slf_host::io::paged_frame::MIN_BAND_ROWS);
+    assert!(once.frames.loads() as usize <= bands, "{} band reads for {bands} bands", once.frames.loads());
+}
+
+/// A frame file cut short during the decode: the decode fails and names the file; it is not
+/// passed off as flagged pixels.
+#[test]
+fn a_frame_cut_short_after_loading_fails_the_decode() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, paged) = captures(dir.path(), 1);
+    let small = starved(&paged);
+    std::fs::File::options().write(true).open(dir.path().join("snapshot_0.npy")).unwrap().set_len(4000).unwrap();
+    let decoded = decode_with(&small, &Basis::Dct, &DecodeOptions::default());
+    let e = small.frames.read_error().expect_err("the read failed");
+    assert!(e.to_string().contains("snapshot_0.npy"), "{e}");
+    // The streamed decode reads the frame as it goes: either it stopped, or it flagged and
+    // the error is there for the caller (the pipeline refuses the output then).
+    if let Ok((_, report)) = decoded {
+        assert!(report.patches.flagged + report.patches.failed > 0);
+    }
+    let e = demosaic(&small, &DemosaicConfig::default()).unwrap_err().to_string();
+    assert!(e.contains("snapshot_0.npy") || e.contains("cannot read row"), "{e}");
+}
+
+/// Through the command line: a capture of `.npy` frames (paged) and the same capture in PGM
+/// (held) decode to the same bytes, by the default decode and by PPID; and a frame cut short
+/// after `slf decode` checked it is an error, not an output.
+#[test]
+fn the_command_line_decodes_paged_and_held_frames_alike() {
+    let slf = env!("CARGO_BIN_EXE_slf");
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n);
+    let run = |args: &[&str]| {
+        let out = Command::new(slf).args(args).current_dir(dir.path()).output().unwrap();
+        assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    };
+    run(&["scene", "depth", "--size", "14", "-o", "lf.npy"]);
+    for f in ["npy", "pgm"] {
+        run(&["simulate", "lf.npy", "-o", &format!("cap-{f}"), "-s", "2", "--seed", "3", "--format", f]);
+    }
+    for method in ["cs", "ppid"] {
+        for f in ["npy", "pgm"] {
+            run(&["decode", &format!("cap-{f}"), "-q", "--method", method, "-o", &format!("{method}-{f}.npy")]);
+        }
+        let (a, b) = (
+            std::fs::read(p(&format!("{method}-npy.npy"))).unwrap(),
+            std::fs::read(p(&format!("{method}-pgm.npy"))).unwrap(),
+        );
+        assert!(a == b, "{method}: the paged capture's output differs from the held one's");
+    }
+}
