@@ -6,6 +6,7 @@
 use assert_cmd::Command;
 use slf_firmware::PatchShape;
 use slf_host::decode::cs::{Basis, DecodeOptions, PatchViews, decode_with, disparity_per_lenslet, tile_decoder};
+use slf_host::decode::options::Maps;
 use slf_host::eval::metrics::psnr;
 use slf_host::firmware::disparity::Disparity;
 use slf_host::firmware::{DisparityRange, FrameSource, MaskFamily, Overlap, OverlapDecoder, Workspace};
@@ -46,7 +47,7 @@ fn the_disparity_of_a_plane_is_chosen_everywhere_off_the_edges() {
     for (d, k) in [(1i8, 1u8), (-1, 1), (2, 3)] {
         let truth = planes(&[(f32::from(d), Shape::Everywhere)], 30);
         let capture = simulate(&truth, &CameraConfig::pixel(3, k)).unwrap();
-        let opts = DecodeOptions { disparities: range(-2, 2), ..DecodeOptions::default() };
+        let opts = DecodeOptions { disparities: range(-2, 2), maps: Maps::ALL, ..DecodeOptions::default() };
         let (sheared, report) = decode_with(&capture, &Basis::Dct, &opts).unwrap();
         assert_eq!(report.uncovered, 0);
         // Off the edges: the block and the lenslets its shear reaches (2 |d|) in the frame.
@@ -63,6 +64,14 @@ fn the_disparity_of_a_plane_is_chosen_everywhere_off_the_edges() {
         // The map per lenslet: the plane's disparity wherever only such blocks cover it.
         let map = disparity_per_lenslet(&report.disparity_map, 30, 30);
         assert_eq!(map[15 * 30 + 15], f32::from(d));
+        // Not asked for, the maps are not kept; the counts are, and are the map's.
+        let (_, unasked) =
+            decode_with(&capture, &Basis::Dct, &DecodeOptions { maps: Maps::default(), ..opts }).unwrap();
+        assert!(unasked.disparity_map.is_empty() && unasked.member_map.is_empty());
+        let mut counts = std::collections::BTreeMap::new();
+        report.disparity_map.iter().for_each(|(_, d)| *counts.entry(*d).or_insert(0usize) += 1);
+        assert_eq!(unasked.disparity_counts, counts.into_iter().collect::<Vec<_>>());
+        assert_eq!(unasked.disparity_counts, report.disparity_counts);
         let unsheared = DecodeOptions { disparities: Some(DisparityRange::OFF), ..DecodeOptions::default() };
         let (plain, _) = decode_with(&capture, &Basis::Dct, &unsheared).unwrap();
         let (a, b) = (psnr(&truth.data, &plain.data, 1.0), psnr(&truth.data, &sheared.data, 1.0));
@@ -76,7 +85,7 @@ fn two_planes_each_get_their_own_disparity() {
     let square = Shape::Rect { y0: 0.3, x0: 0.3, y1: 0.7, x1: 0.7 };
     let truth = planes(&[(-1.0, Shape::Everywhere), (1.0, square)], 50);
     let capture = simulate(&truth, &CameraConfig::pixel(4, 1)).unwrap();
-    let opts = DecodeOptions { disparities: range(-1, 1), ..DecodeOptions::default() };
+    let opts = DecodeOptions { disparities: range(-1, 1), maps: Maps::ALL, ..DecodeOptions::default() };
     let (_, report) = decode_with(&capture, &Basis::Dct, &opts).unwrap();
     // The square covers lenslets 15..35 in the centre view and moves by 2 lenslets in the
     // outer views; blocks with their halo (2) inside it, or clear of it by 4, and in the
@@ -115,6 +124,7 @@ fn ring_matches_the_host<const PU: usize, const PV: usize, const N: usize>(views
         patch_views: Some(views),
         stride: Overlap::DEFAULT.stride,
         window: Overlap::DEFAULT.window,
+        maps: Maps::ALL,
         ..DecodeOptions::default()
     };
     let (host, report) = decode_with(&capture, &Basis::Dct, &opts).unwrap();

@@ -15,11 +15,9 @@ use slf_host::decode::report::NO_ESTIMATE;
 use slf_host::decode::settings::DecodeSettings;
 use slf_host::io::calibration::Calibration;
 use slf_host::io::lightfield::Dtype;
-use slf_host::io::npy_rows::NpyRows;
 use slf_host::io::output::Outputs;
+use slf_host::io::output_file::{OutputFile, OutputKind};
 use slf_host::io::rows::Stoppable;
-use slf_host::io::zarr_rows::ZarrRows;
-use slf_host::io::zarr_stack::ZarrSlot;
 
 use crate::arrays::{plane, to_array};
 use crate::capture::from_parts;
@@ -50,7 +48,10 @@ pub fn decode<'py>(
     source: Option<std::path::PathBuf>,
     slot: Option<usize>,
 ) -> PyResult<Decoded<'py>> {
-    let settings = DecodeSettings::from_flags(&args).map_err(flags)?;
+    let mut settings = DecodeSettings::from_flags(&args).map_err(flags)?;
+    // The report's `disparity` plane is made from the disparity map; the member map is not
+    // returned, so not kept.
+    settings.maps.disparities = true;
     let capture = from_parts(&frames, description)?;
     if let (Some(path), None) = (&output, slot) {
         // Checked before the decode, with the command's check (paths resolved, hard links
@@ -118,36 +119,14 @@ pub fn decode<'py>(
                 Ok((outcome, Some(light_field), peak))
             }
             Some(path) => {
-                let shape = output_shape(&capture);
-                let run_into = |sink: &mut slf_host::io::rows::Rows<'_>| {
-                    settings.run_into(&capture, false, &observer, &mut Stoppable { inner: sink, stop: &stop })
-                };
-                match kind {
-                    Some(OutputKind::Zarr) => {
-                        let mut file = ZarrRows::create(path, shape, &capture.description.bands_nm, None)?;
-                        // Through its text, as capture.json holds it (as `slf decode -o OUT.zarr`).
-                        file.attr("description", serde_json::from_str(&serde_json::to_string(&capture.description)?)?);
-                        file.attr("settings", args.join(" ").into());
-                        let outcome = run_into(&mut file)?;
-                        let peak = file.max();
-                        file.finish()?;
-                        Ok((outcome, None, peak))
-                    }
-                    Some(OutputKind::Slot) => {
-                        let mut file = ZarrSlot::open(path, slot.unwrap_or_default(), shape)?;
-                        let outcome = run_into(&mut file)?;
-                        let peak = file.max();
-                        file.finish()?;
-                        Ok((outcome, None, peak))
-                    }
-                    _ => {
-                        let mut file = NpyRows::create(path, shape, Dtype::F32)?;
-                        let outcome = run_into(&mut file)?;
-                        let peak = file.max();
-                        file.finish()?;
-                        Ok((outcome, None, peak))
-                    }
-                }
+                let kind = kind.unwrap_or(OutputKind::Npy(Dtype::F32));
+                let command = args.join(" ");
+                let mut file = OutputFile::create(kind, path, output_shape(&capture), &capture.description, &command)?;
+                let outcome =
+                    settings.run_into(&capture, false, &observer, &mut Stoppable { inner: file.sink(), stop: &stop })?;
+                let peak = file.max();
+                file.finish(&command)?;
+                Ok((outcome, None, peak))
             }
         };
         match threads {
@@ -277,17 +256,6 @@ pub fn decode<'py>(
     Ok((light_field.map(|lf| to_array(py, lf)).transpose()?, report))
 }
 
-/// Where a decode's light field goes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum OutputKind {
-    /// A `.npy` file, written as the rows come.
-    Npy,
-    /// A Zarr v3 store of its own (`OUT.zarr`, a folder).
-    Zarr,
-    /// Capture `slot` of the store `slf.batch` made for many captures.
-    Slot,
-}
-
 /// The kind of `path`, by its extension, or a slot of a store.
 ///
 /// # Errors
@@ -295,9 +263,9 @@ enum OutputKind {
 fn output_kind(path: &std::path::Path, slot: Option<usize>) -> PyResult<OutputKind> {
     let ext = |e: &str| path.extension().is_some_and(|x| x.eq_ignore_ascii_case(e));
     match (slot, ext("npy"), ext("zarr")) {
-        (Some(_), ..) => Ok(OutputKind::Slot),
-        (None, true, _) => Ok(OutputKind::Npy),
-        (None, _, true) => Ok(OutputKind::Zarr),
+        (Some(index), ..) => Ok(OutputKind::Slot(index)),
+        (None, true, _) => Ok(OutputKind::Npy(Dtype::F32)),
+        (None, _, true) => Ok(OutputKind::Zarr(None)),
         _ => Err(PyValueError::new_err(format!(
             "output {}: a .npy file or a .zarr store (an HDF5 file: slf decode -o OUT.h5)",
             path.display()

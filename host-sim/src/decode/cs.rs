@@ -33,7 +33,7 @@ pub use crate::decode::report::{
     BlendReport, DecodeReport, PatchDecoder, ShearTrialReport, TrialReport, disparity_per_lenslet, error_per_lenslet,
     estimated_psnr,
 };
-use crate::decode::strip::decode_rows;
+use crate::decode::strip::{Pass, decode_rows};
 use crate::decode::trial::{DCT_LEAN, rms};
 use crate::io::capture::Capture;
 use crate::io::grid::OffSensor;
@@ -335,12 +335,13 @@ where
         false => (None, None),
     };
     let blend_seconds = blending.elapsed().as_secs_f64();
+    let pass = Pass { batch: opts.batch_tiles, progress: opts.progress, maps: opts.maps };
     let mut report = match &blend {
         Some(b) => {
             let mut rows = b.rows(sink, plan.shape);
-            decode_rows(&plan, &model, &raw, opts.batch_tiles, opts.progress, observer, &mut rows)?
+            decode_rows(&plan, &model, &raw, pass, observer, &mut rows)?
         }
-        None => decode_rows(&plan, &model, &raw, opts.batch_tiles, opts.progress, observer, sink)?,
+        None => decode_rows(&plan, &model, &raw, pass, observer, sink)?,
     };
     if opts.error_estimate && !patch_estimates(opts, &plan.decoder) {
         let held = Instant::now();

@@ -46,7 +46,7 @@ use slf_firmware::raw::Invalid;
 use slf_firmware::{Frame, HoldOut, MaskFamily, RowSink};
 
 use crate::decode::plan::FramePlan;
-use crate::decode::strip::decode_rows;
+use crate::decode::strip::{Pass, decode_rows};
 use crate::io::lightfield::LightField;
 use crate::io::patch::{HostDecoder, HostModel};
 use crate::io::rows::{RowShape, whole_width};
@@ -355,7 +355,7 @@ impl HeldOutDecode {
             tallies: vec![Tally::default(); shape.rows * shape.cols],
             other,
         };
-        decode_rows(plan, model, &hidden, batch, false, &|_, _| {}, &mut sink)?;
+        decode_rows(plan, model, &hidden, Pass { batch, ..Pass::default() }, &|_, _| {}, &mut sink)?;
         Ok(Self { tallies: sink.tallies, shape, hiding })
     }
 

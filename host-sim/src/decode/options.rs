@@ -285,6 +285,24 @@ pub struct DecodeOptions {
     /// ([`slf_firmware::ShearTrial::aliases`]). Off here, on in the default and best
     /// presets.
     pub shear_trial: bool,
+    /// The per-patch maps the report keeps ([`Maps`]): none unless asked for, so a decode
+    /// holds nothing that grows with the frame beyond its band of rows.
+    pub maps: Maps,
+}
+
+/// The per-patch maps a decode's report keeps: which decoder made each patch
+/// ([`crate::decode::report::DecodeReport::member_map`]) and each block's disparity
+/// ([`crate::decode::report::DecodeReport::disparity_map`]). The disparities' counts, which
+/// the summary prints, are kept either way.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Maps {
+    pub members: bool,
+    pub disparities: bool,
+}
+
+impl Maps {
+    /// Both maps.
+    pub const ALL: Self = Self { members: true, disparities: true };
 }
 
 /// How the model trial tells the DCT from the ensemble ([`DecodeOptions::model_trial`]).
@@ -353,6 +371,7 @@ impl Default for DecodeOptions {
             shear_check: false,
             model_trial: false,
             shear_trial: false,
+            maps: Maps::default(),
         }
     }
 }

@@ -205,7 +205,7 @@ impl DecodeSettings {
             return Ok(Outcome::Baseline { method: self.method, report });
         }
         let (basis, options) = self.resolve()?;
-        let options = DecodeOptions { progress, response, ..options };
+        let options = DecodeOptions { progress, response, maps: self.maps, ..options };
         let report = decode_into(capture, &basis, &options, observer, sink)?;
         let p = &report.patches;
         if p.decoded == 0 {

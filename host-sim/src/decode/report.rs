@@ -54,15 +54,20 @@ pub struct DecodeReport {
     /// Solves over all patches (more than one per patch with an ensemble).
     pub solves: u64,
     /// Which decoder made each decoded patch, by patch origin: the ensemble member, the
-    /// single dictionary, interpolation or the flat short path.
+    /// single dictionary, interpolation or the flat short path (empty unless asked for:
+    /// [`crate::decode::options::Maps`]).
     pub member_map: Vec<(PatchOrigin, PatchDecoder)>,
     /// Light-field values no decoded patch covered (left at 0).
     pub uncovered: usize,
     /// Values of a view no (sheared) patch covered, taken from the lenslet's other views.
     pub filled: usize,
     /// The disparity each spatial block was sheared to, by its first patch's origin
-    /// (empty when the decode searched no disparity).
+    /// (empty when the decode searched no disparity, or the map was not asked for:
+    /// [`crate::decode::options::Maps`]).
     pub disparity_map: Vec<(PatchOrigin, Disparity)>,
+    /// How many blocks were sheared to each disparity, in increasing order (kept whether
+    /// or not the map is).
+    pub disparity_counts: Vec<(Disparity, usize)>,
     /// The most lenslet rows of sums the streamed decode held at once (each row's sums, 4
     /// bytes a value, and a weight a pixel, 4 bytes for its 13 values), besides a batch's
     /// tiles: what its memory grows with, bounded by the tiles' height, not the frame's

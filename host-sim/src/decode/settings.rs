@@ -22,6 +22,7 @@ use crate::decode::baselines::Baseline;
 use crate::decode::cs::{
     Balance, Basis, DecodeOptions, EstimateBy, NoiseSource, PatchViews, SolveSchedule, TrialBy, Window, read_blob,
 };
+use crate::decode::options::Maps;
 use crate::decode::preset::Preset;
 use crate::io::message::number as show;
 use crate::io::patch::BANDS;
@@ -321,6 +322,10 @@ pub struct DecodeSettings {
     /// Decode method: compressed sensing, or a baseline without it.
     #[arg(long, value_enum, default_value_t = Method::Cs)]
     pub method: Method,
+    /// The per-patch maps the report keeps: set by the caller from the outputs it writes
+    /// (`--member-map`, `--disparity-map`; Python's report always has the disparities).
+    #[arg(skip)]
+    pub maps: Maps,
     /// A named decode: its basis, stride, window, disparities, edge fallback, sigma_min and
     /// cold start; any of those flags given as well overrides the preset's value.
     #[arg(long, value_enum, default_value_t = Preset::Default)]

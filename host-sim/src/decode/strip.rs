@@ -22,6 +22,7 @@ use slf_firmware::decode::engine::schedule::{Next, Schedule};
 use slf_firmware::decode::engine::strip::{SeedPatches, Seeds, Strip, StripShape};
 use slf_firmware::{Frame, FrameSource, TileReport};
 
+use crate::decode::options::Maps;
 use crate::decode::plan::FramePlan;
 use crate::decode::report::DecodeReport;
 use crate::decode::seams::{Spectra, seam_score};
@@ -32,6 +33,17 @@ use crate::io::rows::{RowShape, Rows};
 /// Tiles a batch holds by default, per worker thread: enough that the threads rarely wait
 /// at a batch's end, few enough that the batch's sums stay small beside the rows held.
 pub const BATCH_TILES_PER_THREAD: usize = 8;
+
+/// How [`decode_rows`] runs a pass over the frame.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Pass {
+    /// Tiles a batch (0: [`BATCH_TILES_PER_THREAD`] a thread).
+    pub batch: usize,
+    /// A progress bar on stderr once the pass has taken a second.
+    pub progress: bool,
+    /// The per-patch maps the report keeps.
+    pub maps: Maps,
+}
 
 /// The engine's seeds as the spectra the adaptive rule scores.
 struct SeedRows<'r> {
@@ -56,9 +68,9 @@ impl Spectra for SeedRows<'_> {
 /// A batch's tiles, decoded.
 type Decoded<const PU: usize, const PV: usize> = Vec<(Planned, TileSums<PU, PV>, Result<TileReport, String>)>;
 
-/// Decodes every tile of `plan` with `model` from `raw`, in batches of `batch` tiles (0:
-/// [`BATCH_TILES_PER_THREAD`] a thread), putting each finished lenslet row into `sink` in
-/// order; calls `observer` with (tiles done, tiles in all) after each tile. Returns the
+/// Decodes every tile of `plan` with `model` from `raw`, in batches of `pass.batch` tiles,
+/// putting each finished lenslet row into `sink` in
+/// order, the report keeping the per-patch maps `pass.maps` asks for; calls `observer` with (tiles done, tiles in all) after each tile. Returns the
 /// report (without the trials', which the plan holds).
 ///
 /// # Errors
@@ -67,8 +79,7 @@ pub fn decode_rows<const PU: usize, const PV: usize, const N: usize, M, F>(
     plan: &FramePlan<'_, PU, PV, N>,
     model: &M,
     raw: &[F],
-    batch: usize,
-    progress: bool,
+    pass: Pass,
     observer: &(dyn Fn(usize, usize) + Sync),
     sink: &mut Rows<'_>,
 ) -> Result<DecodeReport>
@@ -77,6 +88,7 @@ where
     F: Frame + Sync,
 {
     let start = Instant::now();
+    let Pass { batch, progress, maps: maps_asked } = pass;
     let shape = plan.shape;
     let batch = if batch == 0 { BATCH_TILES_PER_THREAD * rayon::current_num_threads() } else { batch };
     let total = plan.grids.disjoint_len() + plan.grids.shifted_len();
@@ -126,6 +138,8 @@ where
     };
     let mut report = DecodeReport::default();
     let mut maps = Vec::new();
+    let keep = maps_asked;
+    let mut counts = std::collections::BTreeMap::new();
     let mut account = |decoded: Decoded<PU, PV>, into: &mut Strip<'_, HostBands>, report: &mut DecodeReport| {
         for (planned, mut sums, r) in decoded {
             into.join(&sums.sums());
@@ -136,7 +150,12 @@ where
             report.tiles += 1;
             report.steps += sums.steps;
             report.solves += sums.solves;
-            maps.push((planned.order, sums.members, sums.disparities, sums.errors));
+            for (_, d) in &sums.disparities {
+                *counts.entry(*d).or_insert(0usize) += 1;
+            }
+            let members = if keep.members { sums.members } else { Vec::new() };
+            let disparities = if keep.disparities { sums.disparities } else { Vec::new() };
+            maps.push((planned.order, members, disparities, sums.errors));
         }
     };
     let grids = plan.grids;
@@ -208,6 +227,7 @@ where
         report.disparity_map.extend(disparities);
         report.error_map.extend(errors);
     }
+    report.disparity_counts = counts.into_iter().collect();
     report.filled = fill.filled as usize;
     report.uncovered = fill.uncovered as usize;
     Ok(report)

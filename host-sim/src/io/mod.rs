@@ -25,6 +25,7 @@
 //! - [`import`]: views, hyperspectral cubes, HDF5 light fields and band resampling;
 //! - [`message`]: an error as the one line a user reads;
 //! - [`output`]: results written whole, never over an input of the same run;
+//! - [`output_file`]: a light field's file (`.npy`, HDF5, Zarr, a batch store's slot) as the rows come;
 //! - [`patch`]: the patch the host decodes, its extents named once;
 //! - [`rows`]: a light field put a lenslet row at a time (a streamed decode's sink);
 //! - [`sensor`]: a simulated sensor's imperfections as its captures record them;
@@ -50,6 +51,7 @@ pub mod message;
 pub mod npy;
 pub mod npy_rows;
 pub mod output;
+pub mod output_file;
 pub mod paged_frame;
 pub mod patch;
 pub mod row_band;

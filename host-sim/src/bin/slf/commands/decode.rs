@@ -7,18 +7,15 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use slf_host::decode::cs::{Balance, NoiseSource, PatchDecoder, disparity_per_lenslet, estimated_psnr};
+use slf_host::decode::options::Maps;
 use slf_host::decode::pipeline::{Outcome, output_shape};
 use slf_host::decode::report::NO_ESTIMATE;
 use slf_host::decode::settings::DecodeSettings;
-use slf_host::firmware::disparity::Disparity;
 use slf_host::io::calibration::Calibration;
 use slf_host::io::capture::Capture;
-use slf_host::io::hdf5_rows::Hdf5Rows;
 use slf_host::io::lightfield::{Dtype, stage_npy_f32_2d};
-use slf_host::io::npy_rows::NpyRows;
 use slf_host::io::output::{Outputs, stage};
-use slf_host::io::rows::Rows;
-use slf_host::io::zarr_rows::ZarrRows;
+use slf_host::io::output_file::{OutputFile, OutputKind};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -79,48 +76,6 @@ pub enum Format {
     Zarr,
 }
 
-/// The file a decode writes, by format.
-enum OutputFile {
-    Npy(NpyRows),
-    Hdf5(Hdf5Rows),
-    /// Boxed: the array's description is a kilobyte, the other sinks a few hundred bytes.
-    Zarr(Box<ZarrRows>),
-}
-
-impl OutputFile {
-    fn sink(&mut self) -> &mut Rows<'static> {
-        match self {
-            Self::Npy(f) => f,
-            Self::Hdf5(f) => f,
-            Self::Zarr(f) => &mut **f,
-        }
-    }
-
-    fn max(&self) -> f32 {
-        match self {
-            Self::Npy(f) => f.max(),
-            Self::Hdf5(f) => f.max(),
-            Self::Zarr(f) => f.max(),
-        }
-    }
-
-    /// Puts the file in place, an HDF5 file or Zarr store with `settings` (the decode's,
-    /// resolved).
-    fn finish(self, settings: &str) -> Result<()> {
-        match self {
-            Self::Npy(f) => f.finish(),
-            Self::Hdf5(mut f) => {
-                f.attr("settings", settings)?;
-                f.finish()
-            }
-            Self::Zarr(mut f) => {
-                f.attr("settings", settings.into());
-                f.finish()
-            }
-        }
-    }
-}
-
 pub fn run(args: Args) -> Result<()> {
     let Args { capture, output, format, deflate, mut settings, member_map, disparity_map, error_map, dtype, quiet } =
         args;
@@ -141,6 +96,8 @@ pub fn run(args: Args) -> Result<()> {
         "--dtype u16 is for a .npy output; the HDF5 and Zarr outputs are float32"
     );
     settings.estimate |= error_map.is_some();
+    // The per-patch maps only when written: they grow with the frame.
+    settings.maps = Maps { members: member_map.is_some(), disparities: disparity_map.is_some() };
     let cap = Capture::load(&capture)?;
     // Where the results go is checked before the decode, not found unwritable after it, and
     // no result may be written over a file the decode reads or another result.
@@ -176,23 +133,13 @@ pub fn run(args: Args) -> Result<()> {
     // The light field goes to the file as its rows are decoded; the file takes its place
     // only once the decode and the maps are done. An interrupt (Ctrl-C, SIGTERM) ends the
     // run at once and removes the temporary file (`slf_host::io::interrupt`).
-    let mut file = match format {
-        Format::Npy => OutputFile::Npy(NpyRows::create(&output, output_shape(&cap), dtype)?),
-        Format::Hdf5 => {
-            let mut f = Hdf5Rows::create(&output, output_shape(&cap), &cap.description.bands_nm, deflate)?;
-            f.attr("description", &serde_json::to_string(&cap.description)?)?;
-            f.attr("command", &std::env::args().collect::<Vec<_>>().join(" "))?;
-            OutputFile::Hdf5(f)
-        }
-        Format::Zarr => {
-            let mut f = ZarrRows::create(&output, output_shape(&cap), &cap.description.bands_nm, deflate)?;
-            // Through its text, as capture.json holds it: a value from the f32 fields
-            // directly would carry their binary expansion (3691.89990234375 for 3691.9).
-            f.attr("description", serde_json::from_str(&serde_json::to_string(&cap.description)?)?);
-            f.attr("command", std::env::args().collect::<Vec<_>>().join(" ").into());
-            OutputFile::Zarr(Box::new(f))
-        }
+    let kind = match format {
+        Format::Npy => OutputKind::Npy(dtype),
+        Format::Hdf5 => OutputKind::Hdf5(deflate),
+        Format::Zarr => OutputKind::Zarr(deflate),
     };
+    let command = std::env::args().collect::<Vec<_>>().join(" ");
+    let mut file = OutputFile::create(kind, &output, output_shape(&cap), &cap.description, &command)?;
     let outcome =
         settings.run_into(&cap, !quiet, &|_, _| {}, file.sink()).with_context(|| capture.display().to_string())?;
     if let Some(w) = outcome.warning() {
@@ -266,12 +213,11 @@ pub fn run(args: Args) -> Result<()> {
         Balance::Gains(_) => outln!("white balance: given gains {}", gains.join(" ")),
     }?;
     if !opts.disparities_for(&cap).is_off() {
-        let mut counts = std::collections::BTreeMap::<Disparity, usize>::new();
-        for (_, d) in &r.disparity_map {
-            *counts.entry(*d).or_default() += 1;
-        }
-        let counts: Vec<String> =
-            counts.iter().map(|(d, n)| format!("{}{d}: {n}", if d.in_halves() > 0 { "+" } else { "" })).collect();
+        let counts: Vec<String> = r
+            .disparity_counts
+            .iter()
+            .map(|(d, n)| format!("{}{d}: {n}", if d.in_halves() > 0 { "+" } else { "" }))
+            .collect();
         outln!(
             "disparity: blocks per disparity {}; {} values of views no sheared patch reached, from their lenslet's other views",
             counts.join(", "),
@@ -289,7 +235,7 @@ pub fn run(args: Args) -> Result<()> {
         } else {
             String::new()
         };
-        let halves = if r.disparity_map.iter().any(|(_, d)| d.in_halves() % 2 != 0) {
+        let halves = if r.disparity_counts.iter().any(|(d, _)| d.in_halves() % 2 != 0) {
             "; the half-pixel sheared patches read each view at the pixel under its cell's centre"
         } else {
             ""
