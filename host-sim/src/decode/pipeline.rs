@@ -94,11 +94,10 @@ impl DecodeSettings {
         // A frame with no pixel above the black level recorded no light (a lens cap, an
         // exposure of zero): every method would decode zeros.
         let black = capture.description.black_level;
-        let mut lit = false;
-        capture.frames.visit(capture.frame_size(), |_, _, values| {
-            lit = lit || values.iter().any(|&x| f32::from(x) > black);
-        })?;
-        ensure!(lit, "every pixel of every frame is at or below the black level ({black} DN): no light was recorded");
+        ensure!(
+            capture.frames.any(capture.frame_size(), |x| f32::from(x) > black)?,
+            "every pixel of every frame is at or below the black level ({black} DN): no light was recorded"
+        );
         // The output contract, on the capture as recorded: a corrected capture's saturation
         // is the top of 16 bits.
         let (lo, hi) = capture.raw_format().range();
@@ -112,12 +111,8 @@ impl DecodeSettings {
                     .map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
                 // The same check on the corrected frames: a dark level at or above the raw
                 // values once decoded to all zeros with "0 flagged".
-                let mut lit = false;
-                calibrated.frames.visit(calibrated.frame_size(), |_, _, values| {
-                    lit = lit || values.iter().any(|&x| f32::from(x) > black && x != u16::MAX);
-                })?;
                 ensure!(
-                    lit,
+                    calibrated.frames.any(calibrated.frame_size(), |x| f32::from(x) > black && x != u16::MAX)?,
                     "{}: with its dark levels subtracted every pixel is at or below the black level ({black} DN): no \
                      light above the dark was recorded (is it this sensor's calibration?)",
                     dir.display()

@@ -122,6 +122,16 @@ impl Frames {
         Ok(())
     }
 
+    /// Whether any value of any frame (each `rows x cols`) meets `pred`, by [`Self::visit`].
+    ///
+    /// # Errors
+    /// A read that fails.
+    pub fn any(&self, size: (usize, usize), pred: impl Fn(u16) -> bool) -> Result<bool> {
+        let mut found = false;
+        self.visit(size, |_, _, values| found = found || values.iter().any(|&x| pred(x)))?;
+        Ok(found)
+    }
+
     /// The frames as the decoder reads them, each `rows x cols`.
     ///
     /// # Errors
