@@ -209,7 +209,11 @@ fn the_calibration_folder_reads_back_and_refuses_corruption() {
             files[i] = serde_json::to_value(r).unwrap();
         }
         std::fs::write(&json, serde_json::to_string(&v).unwrap()).unwrap();
-        format!("{:#}", Calibration::load(&at).unwrap_err())
+        let e = format!("{:#}", Calibration::load(&at).unwrap_err());
+        // A decode opens the calibration with its maps read by rows (issue 65): the same
+        // refusal, from a pass of bands.
+        assert_eq!(format!("{:#}", Calibration::open(&at).unwrap_err()), e);
+        e
     };
     let e = put("flat.npy", &[1.0; 6], 2, 3, false);
     assert!(e.contains("flat.npy: 152 bytes, but") && e.contains("calibration.json records"), "{e}");
@@ -228,8 +232,10 @@ fn the_calibration_folder_reads_back_and_refuses_corruption() {
     // naming its file.
     let white = cal.description.white_level;
     let hot = cal.description.hot_pixels.iter().map(|p| p[0] as usize * cols + p[1] as usize).collect::<Vec<_>>();
-    let working = (0..rows * cols).find(|p| !hot.contains(p)).unwrap();
-    for level in [white, -65535.0, f32::NAN] {
+    let first = (0..rows * cols).find(|p| !hot.contains(p)).unwrap();
+    let last = (0..rows * cols).rev().find(|p| !hot.contains(p)).unwrap();
+    assert!(last / cols >= slf_host::io::calibration::MAP_BAND_ROWS, "the last row is past the first band of rows");
+    for (level, working) in [(white, first), (-65535.0, last), (f32::NAN, first), (f32::NAN, last)] {
         let mut dark = cal.dark.clone();
         dark[working] = level;
         let e = put("dark.npy", &dark, rows, cols, true);
@@ -284,7 +290,7 @@ fn a_calibrated_decode_is_the_ideal_sensors() {
 /// (`--response-model projection`) decodes within 1 dB of it.
 #[test]
 fn the_decode_unmixes_as_the_inverse_does() {
-    use slf_host::decode::calibrate::corrected;
+    use slf_host::decode::correction::corrected;
     use slf_host::decode::settings::DecodeSettings;
     use slf_host::eval::metrics::evaluate;
     use slf_host::sim::scene::SceneSize;
@@ -302,7 +308,7 @@ fn the_decode_unmixes_as_the_inverse_does() {
     };
     // The slow path: one-hot decode of the corrected capture (the white balance the
     // calibrated decode estimates from the same frames), unmixed in f64.
-    let mut slow = run(&corrected(&real, &cal, false).unwrap().0, &[]);
+    let mut slow = run(&corrected(&real, &cal.opened(), false).unwrap().0, &[]);
     let r = nalgebra::DMatrix::from_fn(13, 13, |f, b| f64::from(cal.description.response[f][b]));
     let inv = r.try_inverse().unwrap();
     let hi = slow.data.iter().fold(0.0f32, |m, &x| m.max(x));

@@ -114,3 +114,82 @@ fn the_command_line_decodes_paged_and_held_frames_alike() {
         assert!(a == b, "{method}: the paged capture's output differs from the held one's");
     }
 }
+
+/// The calibration's correction inside the reader, and the aligned reading's crop: a paged
+/// capture stays paged through both, and reads what the slow obvious whole-frame
+/// correction and crop give (the formula in the calibration's docs, on the maps read
+/// whole); a calibrated decode, and one read as aligned, of the paged capture is the held
+/// one's to the bit.
+#[test]
+fn the_correction_and_the_aligned_crop_are_read_as_the_decode_asks() {
+    use slf_host::decode::calibrate::calibrate;
+    use slf_host::decode::correction::corrected;
+    use slf_host::decode::settings::DecodeSettings;
+    use slf_host::io::calibration::Calibration;
+    use slf_host::io::sensor::SensorDescription;
+    use slf_host::sim::calibration::calibration_captures;
+    use slf_host::sim::camera::GridSettings;
+    use slf_host::sim::flags::FromFlags;
+
+    let dir = tempfile::tempdir().unwrap();
+    let (lenslets, views) = ([70usize, 13usize], [5usize, 5usize]);
+    let truth = named("depth").unwrap().render(SceneSize { views: (5, 5), rows: lenslets[0], cols: lenslets[1] });
+    let mut cam = CameraConfig { frame_ext: "npy".into(), ..CameraConfig::pixel(5, 2) };
+    cam.sensor = SensorDescription { vignetting: 0.5, prnu: 0.02, hot_fraction: 0.003, seed: 3, ..cam.sensor };
+    cam.grid = Some(GridSettings { rotation_deg: 0.0, pitch: Some([5.04, 5.04]), offset: None });
+    let held = simulate(&truth, &cam).unwrap();
+    let capture_dir = dir.path().join("cap");
+    held.save(&capture_dir).unwrap();
+    let paged = Capture::load(&capture_dir).unwrap();
+    assert!(paged.frames.is_paged());
+    let caps = calibration_captures(&cam, lenslets, views, held.description.bands_nm.len(), 2).unwrap();
+    let (cal, _) = calibrate(&caps, None).unwrap();
+    let cal_dir = dir.path().join("cal");
+    cal.save(&cal_dir).unwrap();
+    let opened = Calibration::open(&cal_dir).unwrap();
+
+    // The slow obvious correction, whole frames and whole maps.
+    let (rows, cols) = held.frame_size();
+    assert!(rows > slf_host::io::calibration::MAP_BAND_ROWS, "the maps are read in more than one band");
+    let d = &held.description;
+    let want: Vec<Vec<u16>> = held
+        .held_frames()
+        .unwrap()
+        .iter()
+        .map(|f| {
+            (0..rows * cols)
+                .map(|p| {
+                    if f32::from(f[p]) >= d.saturation_level {
+                        u16::MAX
+                    } else {
+                        let v = d.black_level + (f32::from(f[p]) - cal.dark[p]) / cal.flat[p].max(0.1);
+                        v.round().clamp(0.0, 65534.0) as u16
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    let dead = (0..rows * cols).filter(|&p| cal.flat[p] < 0.1).count();
+    for (name, cap, c) in [("paged", &paged, &opened), ("held", &held, &cal.opened())] {
+        let (fixed, _) = corrected(cap, c, true).unwrap();
+        assert_eq!(fixed.frames.is_paged(), cap.frames.is_paged(), "{name}: corrected as it is read");
+        assert!(fixed.held_frames().unwrap().as_ref() == want.as_slice(), "{name}: the corrected frames");
+        let defects = &fixed.description.defective_pixels;
+        assert!(cal.description.hot_pixels.iter().all(|p| defects.contains(p)), "{name}: hot pixels are defects");
+        assert!(defects.len() >= cal.description.hot_pixels.len() + dead.min(1), "{name}: dead pixels are defects");
+        // Read as aligned: the top-left S*U x T*V of every frame.
+        let crop = fixed.aligned().unwrap();
+        assert_eq!(crop.frames.is_paged(), cap.frames.is_paged(), "{name}: cropped as it is read");
+        let (r, c) = (lenslets[0] * views[0], lenslets[1] * views[1]);
+        let cropped: Vec<Vec<u16>> =
+            want.iter().map(|f| (0..r * c).map(|p| f[(p / c) * cols + p % c]).collect()).collect();
+        assert!(crop.held_frames().unwrap().as_ref() == cropped.as_slice(), "{name}: the aligned crop");
+    }
+    // Whole decodes through the CLI's settings: the paged capture's are the held one's bits.
+    let at = cal_dir.display().to_string();
+    for flags in [vec!["--calibration", at.as_str()], vec!["--calibration", &at, "--grid", "aligned"]] {
+        let s = DecodeSettings::from_flags(flags.iter().copied()).unwrap();
+        let run = |cap: &Capture| s.run(cap, false, &|_, _| {}).unwrap().light_field.data;
+        assert!(run(&paged) == run(&held), "{flags:?}: the paged capture's decode differs");
+    }
+}

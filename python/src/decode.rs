@@ -122,8 +122,12 @@ pub fn decode<'py>(
                 let kind = kind.unwrap_or(OutputKind::Npy(Dtype::F32));
                 let command = args.join(" ");
                 let mut file = OutputFile::create(kind, path, output_shape(&capture), &capture.description, &command)?;
-                let outcome =
-                    settings.run_into(&capture, false, &observer, &mut Stoppable { inner: file.sink(), stop: &stop })?;
+                let outcome = settings.run_into(
+                    &capture,
+                    false,
+                    &observer,
+                    &mut Stoppable { inner: file.sink(), stop: &stop },
+                )?;
                 let peak = file.max();
                 file.finish(&command)?;
                 Ok((outcome, None, peak))

@@ -21,7 +21,6 @@ use crate::io::calibration::{
     Calibration, CalibrationDescription, FORMAT, Sources, VERSION, check_response, read_response,
 };
 use crate::io::capture::{Capture, DESCRIPTION, Light};
-use crate::io::grid::GridDescription;
 use crate::io::output::Outputs;
 
 /// A pixel whose dark level lies more than this fraction of the range (white - black) above
@@ -374,103 +373,14 @@ fn mend(flat: &[f32], bad: &[bool], (rows, cols): (usize, usize)) -> Vec<f32> {
     out
 }
 
-/// `capture` corrected by `cal` for its dark levels and flats: each raw value becomes
-/// `black + (raw - dark) / flat` (DN), so a pixel reads as an ideal, unvignetted one of the
-/// capture's black and white levels; hot, dead and saturated pixels join the defects. The
-/// corrected capture's saturation level is the top of 16 bits (a vignetted pixel corrected
-/// may read above the sensor's top code and is still a measurement). A lenslet grid the
-/// calibration found replaces the capture's, its lenslets named as the capture names
-/// them ([`GridDescription::indexed_as`]; the aligned grid's names without a stated grid):
-/// the whole lenslets it was moved by come back beside the capture. With `keep_grid` the
-/// capture keeps its own grid (`--grid capture` or `aligned`), and the calibration's is
-/// not looked at.
-///
-/// # Errors
-/// A calibration of another geometry, bands or levels, or whose lenslet grid does not say
-/// which of its lenslets is the capture's (0, 0).
-pub fn corrected(capture: &Capture, cal: &Calibration, keep_grid: bool) -> Result<(Capture, [i64; 2])> {
-    let (d, c) = (&capture.description, &cal.description);
-    ensure!(
-        d.lenslets == c.lenslets && d.views == c.views,
-        "the calibration is of {:?} lenslets and {:?} views; the capture of {:?} and {:?}",
-        c.lenslets,
-        c.views,
-        d.lenslets,
-        d.views
-    );
-    // The band centres themselves, not their count (a shift of 1 nm once read as "the same
-    // bands").
-    ensure!(
-        d.bands_nm == c.bands_nm,
-        "the calibration's band centres (bands_nm {:?} nm) are not the capture's ({:?} nm)",
-        c.bands_nm,
-        d.bands_nm
-    );
-    ensure!(
-        d.black_level == c.black_level && d.white_level == c.white_level,
-        "the calibration's levels (black {}, white {}) are not the capture's ({}, {})",
-        c.black_level,
-        c.white_level,
-        d.black_level,
-        d.white_level
-    );
-    ensure!(
-        capture.frame_size() == cal.frame_size(),
-        "the calibration is of a {:?} sensor, the capture's frames are {:?} (another lenslet grid's)",
-        cal.frame_size(),
-        capture.frame_size()
-    );
-    let (_, cols) = capture.frame_size();
-    let saturation = d.saturation_level;
-    let mut defects: std::collections::BTreeSet<[u32; 2]> = d.defective_pixels.iter().copied().collect();
-    defects.extend(c.hot_pixels.iter().copied());
-    let top = f32::from(u16::MAX);
-    let frames: Vec<Vec<u16>> = capture
-        .frames
-        .held(capture.frame_size())?
-        .iter()
-        .map(|f| {
-            f.iter()
-                .enumerate()
-                .map(|(p, &raw)| {
-                    if f32::from(raw) >= saturation {
-                        return u16::MAX; // at the corrected saturation level: left out
-                    }
-                    let v = d.black_level + (f32::from(raw) - cal.dark[p]) / cal.flat[p].max(DEAD_FLAT);
-                    v.round().clamp(0.0, top - 1.0) as u16
-                })
-                .collect()
-        })
-        .collect();
-    // A pixel the flat calls dead never reads as a measurement.
-    for (p, &f) in cal.flat.iter().enumerate() {
-        if f < DEAD_FLAT {
-            defects.insert([(p / cols) as u32, (p % cols) as u32]);
-        }
-    }
-    let mut description = d.clone();
-    description.saturation_level = top;
-    // The grid the calibration found from its flats replaces the one the capture states,
-    // with the capture's lenslet (0, 0).
-    let mut moved = [0, 0];
-    if let Some(found) = c.lenslet_grid.as_ref().filter(|_| !keep_grid) {
-        let stated = d.lenslet_grid.unwrap_or_else(|| GridDescription::aligned(d.lenslets, d.views));
-        let (grid, by) = found.indexed_as(&stated, d.lenslets, d.views)?;
-        description.lenslet_grid = Some(grid);
-        moved = by;
-    }
-    description.defective_pixels = defects.into_iter().collect();
-    Ok((Capture::new(description, frames)?, moved))
-}
-
 /// The inverse of `cal`'s response matrix, row-major `[band][filter]`.
 ///
 /// # Errors
 /// A response matrix [`check_response`] refuses.
-pub fn unmixing(cal: &Calibration) -> Result<Vec<f32>> {
-    let b = cal.description.bands_nm.len();
-    check_response(&cal.description.response)?;
-    let r = nalgebra::DMatrix::from_fn(b, b, |f, band| f64::from(cal.description.response[f][band]));
+pub fn unmixing(cal: &CalibrationDescription) -> Result<Vec<f32>> {
+    let b = cal.bands_nm.len();
+    check_response(&cal.response)?;
+    let r = nalgebra::DMatrix::from_fn(b, b, |f, band| f64::from(cal.response[f][band]));
     let inv = r.try_inverse().ok_or_else(|| anyhow::anyhow!("the response matrix is singular"))?;
     Ok((0..b).flat_map(|i| (0..b).map(move |j| (i, j))).map(|(i, j)| inv[(i, j)] as f32).collect())
 }

@@ -2,6 +2,7 @@
 //! is measured against.
 //!
 //! - [`calibrate`]: a sensor's calibration from its calibration captures (`slf calibrate`);
+//! - [`correction`]: a capture corrected by its calibration as its rows are read;
 //! - [`grid_fit`]: the lenslet grid found from the calibration's flats (micro-image
 //!   centres, then a least-squares grid);
 //! - [`cs`]: the firmware's tile decoder over a capture in parallel (rayon), with
@@ -29,6 +30,7 @@
 pub mod baselines;
 pub mod blend;
 pub mod calibrate;
+pub mod correction;
 pub mod cs;
 pub mod device;
 pub mod grid_fit;

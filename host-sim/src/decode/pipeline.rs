@@ -11,7 +11,8 @@ use slf_firmware::BandCount;
 use slf_firmware::{Response, ResponseModel};
 
 use crate::decode::baselines::BaselineReport;
-use crate::decode::calibrate::{corrected, unmix, unmixing};
+use crate::decode::calibrate::{unmix, unmixing};
+use crate::decode::correction::corrected;
 use crate::decode::cs::{DecodeOptions, DecodeReport, decode_into};
 use crate::decode::settings::{DecodeSettings, GridChoice, Method, ResponseChoice};
 use crate::io::calibration::Calibration;
@@ -101,12 +102,11 @@ impl DecodeSettings {
         // The output contract, on the capture as recorded: a corrected capture's saturation
         // is the top of 16 bits.
         let (lo, hi) = capture.raw_format().range();
-        let stated = capture.description.lenslet_grid;
         let calibrated;
         let mut grid_moved = [0, 0];
         let (capture, inverse, response) = match &self.calibration {
             Some(dir) => {
-                let cal = Calibration::load(dir)?;
+                let cal = Calibration::open(dir)?;
                 (calibrated, grid_moved) = corrected(capture, &cal, self.grid != GridChoice::Auto)
                     .map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
                 // The same check on the corrected frames: a dark level at or above the raw
@@ -117,20 +117,16 @@ impl DecodeSettings {
                      light above the dark was recorded (is it this sensor's calibration?)",
                     dir.display()
                 );
-                let inverse = unmixing(&cal).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
+                let inverse = unmixing(&cal.description).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
                 (&calibrated, Some(inverse), Some(cal.description.response))
             }
             None => (capture, None, None),
         };
+        // `--grid capture`: the calibration kept the capture's own grid (`corrected`'s
+        // `keep_grid`), so the capture is read as it is.
         let regridded;
         let capture = match self.grid {
-            GridChoice::Auto => capture,
-            GridChoice::Capture => {
-                let mut c = capture.clone();
-                c.description.lenslet_grid = stated;
-                regridded = c;
-                &regridded
-            }
+            GridChoice::Auto | GridChoice::Capture => capture,
             GridChoice::Aligned => {
                 regridded = capture.aligned()?;
                 &regridded

@@ -6,6 +6,7 @@
 //! before anything is allocated (`docs/capture-format.md`, "Calibration").
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use anyhow::{Result, anyhow, bail, ensure};
 
@@ -18,6 +19,7 @@ use crate::io::grid::GridDescription;
 use crate::io::lightfield::write_npy_f32_2d;
 use crate::io::message::number;
 use crate::io::npy::{self, Element, Values};
+use crate::io::npy_reader::NpyReader;
 use crate::io::output::write_bytes;
 
 /// The description file's name inside a calibration folder.
@@ -94,6 +96,17 @@ pub fn read_response(path: &Path, bands: usize) -> Result<Vec<Vec<f32>>> {
         Values::F32(v) => Ok(v.chunks(bands).map(<[f32]>::to_vec).collect()),
         Values::U16(_) => Err(anyhow!("{}: filter curves are floats", path.display())),
     }
+}
+
+/// A calibration map's header: the calibration's frame size, floats.
+fn map_header(s: &[usize], element: Element, (rows, cols): (usize, usize)) -> Result<(), String> {
+    if s != [rows, cols] {
+        return Err(format!("is {s:?}, the calibration's frame [{rows}, {cols}]"));
+    }
+    if element == Element::U16 {
+        return Err("holds uint16, a calibration frame float32".into());
+    }
+    Ok(())
 }
 
 /// A loaded calibration.
@@ -213,10 +226,24 @@ pub fn check_response(response: &[Vec<f32>]) -> Result<()> {
 /// working pixel (a calibration lists it in `hot_pixels`). A dark level at or above the raw
 /// values once made every output zero, and one of -65535 every value 18.05.
 fn check_dark(d: &CalibrationDescription, dark: &[f32], cols: usize) -> Result<()> {
-    let hot: std::collections::BTreeSet<usize> =
-        d.hot_pixels.iter().map(|p| p[0] as usize * cols + p[1] as usize).collect();
+    check_dark_rows(d, &hot_indices(d, cols), 0, dark, cols)
+}
+
+/// The hot pixels' row-major indices in a frame of `cols` columns.
+fn hot_indices(d: &CalibrationDescription, cols: usize) -> std::collections::BTreeSet<usize> {
+    d.hot_pixels.iter().map(|p| p[0] as usize * cols + p[1] as usize).collect()
+}
+
+/// [`check_dark`] on the rows from `first_row` on (`dark` holds whole rows).
+fn check_dark_rows(
+    d: &CalibrationDescription,
+    hot: &std::collections::BTreeSet<usize>,
+    first_row: usize,
+    dark: &[f32],
+    cols: usize,
+) -> Result<()> {
     let top = d.black_level + (d.white_level - d.black_level) / 2.0;
-    for (i, &x) in dark.iter().enumerate() {
+    for (i, &x) in dark.iter().enumerate().map(|(i, x)| (first_row * cols + i, x)) {
         let (lo, hi) = if hot.contains(&i) { (0.0, 65535.0) } else { (0.0, top) };
         if !(x.is_finite() && (lo..=hi).contains(&x)) {
             let working =
@@ -229,10 +256,87 @@ fn check_dark(d: &CalibrationDescription, dark: &[f32], cols: usize) -> Result<(
 
 /// Every flat finite in [0, 16] (a flat of 0 is a dead pixel: list it as hot).
 fn check_flat(flat: &[f32], cols: usize) -> Result<()> {
+    check_flat_rows(0, flat, cols)
+}
+
+/// [`check_flat`] on the rows from `first_row` on.
+fn check_flat_rows(first_row: usize, flat: &[f32], cols: usize) -> Result<()> {
     if let Some(i) = flat.iter().position(|x| !(x.is_finite() && (0.0..=16.0).contains(x))) {
-        bail!("flat[{}, {}] is {}: must be in [0, 16]", i / cols, i % cols, number(flat[i]));
+        let p = first_row * cols + i;
+        bail!("flat[{}, {}] is {}: must be in [0, 16]", p / cols, p % cols, number(flat[i]));
     }
     Ok(())
+}
+
+/// A calibration's dark levels or flats as a corrected decode reads them, a few rows at a
+/// time: held, or read from the calibration's file (a decode never holds its 8 bytes a
+/// pixel).
+#[derive(Clone, Debug)]
+pub enum Map {
+    /// Row-major, `cols` a row.
+    Held(Arc<[f32]>, usize),
+    File(NpyReader),
+}
+
+impl Map {
+    /// Rows `first..first + out.len() / cols` into `out`.
+    ///
+    /// # Errors
+    /// Rows past the end, or a read that fails, naming the file.
+    pub fn read_rows(&self, first: usize, out: &mut [f32]) -> Result<()> {
+        match self {
+            Self::Held(v, cols) => {
+                let at = first * cols;
+                let part = v.get(at..at + out.len()).ok_or_else(|| anyhow!("rows {first}.. past the map's end"))?;
+                out.copy_from_slice(part);
+                Ok(())
+            }
+            Self::File(f) => f.read_f32(first, out),
+        }
+    }
+
+    /// Calls `f(first row, values)` on the map's rows `rows x cols`, a band at a time.
+    ///
+    /// # Errors
+    /// A read that fails, or what `f` returns.
+    pub fn visit(&self, (rows, cols): (usize, usize), mut f: impl FnMut(usize, &[f32]) -> Result<()>) -> Result<()> {
+        let band = MAP_BAND_ROWS.min(rows.max(1));
+        let mut values = vec![0.0f32; band * cols];
+        for first in (0..rows).step_by(band) {
+            let part = &mut values[..band.min(rows - first) * cols];
+            self.read_rows(first, part)?;
+            f(first, part)?;
+        }
+        Ok(())
+    }
+}
+
+/// The rows of a map read at once where it is streamed (its checks, a corrected frame
+/// held whole).
+pub const MAP_BAND_ROWS: usize = 64;
+
+/// A calibration opened for a corrected decode: its description, checked as
+/// [`Calibration::load`] checks it, and its maps read by rows ([`Map`]).
+#[derive(Clone, Debug)]
+pub struct OpenCalibration {
+    pub description: CalibrationDescription,
+    pub dark: Map,
+    pub flat: Map,
+}
+
+impl OpenCalibration {
+    /// The frame size.
+    pub fn frame_size(&self) -> (usize, usize) {
+        frame_size(&self.description)
+    }
+}
+
+/// A calibration's frame size, from its description.
+fn frame_size(d: &CalibrationDescription) -> (usize, usize) {
+    match &d.lenslet_grid {
+        Some(g) => (g.sensor[0], g.sensor[1]),
+        None => (d.lenslets[0] * d.views[0], d.lenslets[1] * d.views[1]),
+    }
 }
 
 impl Calibration {
@@ -256,10 +360,16 @@ impl Calibration {
 
     /// The frame size.
     pub fn frame_size(&self) -> (usize, usize) {
-        let d = &self.description;
-        match &d.lenslet_grid {
-            Some(g) => (g.sensor[0], g.sensor[1]),
-            None => (d.lenslets[0] * d.views[0], d.lenslets[1] * d.views[1]),
+        frame_size(&self.description)
+    }
+
+    /// This calibration as a decode reads it, its maps held (copies).
+    pub fn opened(&self) -> OpenCalibration {
+        let (_, cols) = self.frame_size();
+        OpenCalibration {
+            description: self.description.clone(),
+            dark: Map::Held(self.dark.as_slice().into(), cols),
+            flat: Map::Held(self.flat.as_slice().into(), cols),
         }
     }
 
@@ -273,6 +383,59 @@ impl Calibration {
     /// # Errors
     /// The file and what is wrong in it.
     pub fn load(dir: &Path) -> Result<Self> {
+        let (description, (rows, cols)) = Self::description_in(dir)?;
+        let read = |name: &str| -> Result<Vec<f32>> {
+            let p: PathBuf = dir.join(name);
+            let a =
+                npy::read_checked(&p, |s, element| map_header(s, element, (rows, cols))).map_err(|e| anyhow!("{e}"))?;
+            match a.values {
+                Values::F32(v) => Ok(v),
+                Values::U16(_) => Err(anyhow!("{}: holds uint16, a calibration frame float32", p.display())),
+            }
+        };
+        // Each fault names its file.
+        let (dark, flat) = (read(DARK)?, read(FLAT)?);
+        check_dark(&description, &dark, cols).map_err(|e| anyhow!("{}: {e}", dir.join(DARK).display()))?;
+        check_flat(&flat, cols).map_err(|e| anyhow!("{}: {e}", dir.join(FLAT).display()))?;
+        // Every check of `new` is done: the description above, the frames' shapes from
+        // their headers, their values just now (each naming its file).
+        Ok(Self { description, dark, flat })
+    }
+
+    /// Opens a calibration folder for a corrected decode: every check of [`Self::load`],
+    /// the maps' values checked in one pass of bands, and then read by rows as the decode
+    /// asks ([`Map::File`]; a map stored in Fortran order is read whole).
+    ///
+    /// # Errors
+    /// As [`Self::load`].
+    pub fn open(dir: &Path) -> Result<OpenCalibration> {
+        let (description, size) = Self::description_in(dir)?;
+        let open = |name: &str| -> Result<Map> {
+            let p: PathBuf = dir.join(name);
+            match NpyReader::open(&p, |s, element| map_header(s, element, size)).map_err(|e| anyhow!("{e}"))? {
+                Some(r) => Ok(Map::File(r)),
+                None => match npy::read_checked(&p, |s, element| map_header(s, element, size))
+                    .map_err(|e| anyhow!("{e}"))?
+                    .values
+                {
+                    Values::F32(v) => Ok(Map::Held(v.into(), size.1)),
+                    Values::U16(_) => Err(anyhow!("{}: holds uint16, a calibration frame float32", p.display())),
+                },
+            }
+        };
+        let (dark, flat) = (open(DARK)?, open(FLAT)?);
+        let cols = size.1;
+        let hot = hot_indices(&description, cols);
+        dark.visit(size, |first, v| check_dark_rows(&description, &hot, first, v, cols))
+            .map_err(|e| anyhow!("{}: {e}", dir.join(DARK).display()))?;
+        flat.visit(size, |first, v| check_flat_rows(first, v, cols))
+            .map_err(|e| anyhow!("{}: {e}", dir.join(FLAT).display()))?;
+        Ok(OpenCalibration { description, dark, flat })
+    }
+
+    /// The description of the calibration in `dir`, checked, its maps' files verified
+    /// against the sizes and checksums it records; and the frame size.
+    fn description_in(dir: &Path) -> Result<(CalibrationDescription, (usize, usize))> {
         let path = dir.join(DESCRIPTION);
         let text = read_small_file(&path, MAX_DESCRIPTION)?;
         let mut description: CalibrationDescription =
@@ -287,31 +450,8 @@ impl Calibration {
                 path.display()
             ),
         }
-        let (rows, cols) = description.check().map_err(|e| anyhow!("{}: {e}", path.display()))?;
-        let read = |name: &str| -> Result<Vec<f32>> {
-            let p: PathBuf = dir.join(name);
-            let a = npy::read_checked(&p, |s, element| {
-                if s != [rows, cols] {
-                    return Err(format!("is {s:?}, the calibration's frame [{rows}, {cols}]"));
-                }
-                if element == Element::U16 {
-                    return Err("holds uint16, a calibration frame float32".into());
-                }
-                Ok(())
-            })
-            .map_err(|e| anyhow!("{e}"))?;
-            match a.values {
-                Values::F32(v) => Ok(v),
-                Values::U16(_) => Err(anyhow!("{}: holds uint16, a calibration frame float32", p.display())),
-            }
-        };
-        // Each fault names its file.
-        let (dark, flat) = (read(DARK)?, read(FLAT)?);
-        check_dark(&description, &dark, cols).map_err(|e| anyhow!("{}: {e}", dir.join(DARK).display()))?;
-        check_flat(&flat, cols).map_err(|e| anyhow!("{}: {e}", dir.join(FLAT).display()))?;
-        // Every check of `new` is done: the description above, the frames' shapes from
-        // their headers, their values just now (each naming its file).
-        Ok(Self { description, dark, flat })
+        let size = description.check().map_err(|e| anyhow!("{}: {e}", path.display()))?;
+        Ok((description, size))
     }
 
     /// The files a calibration has in folder `dir`.

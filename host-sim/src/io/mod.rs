@@ -5,6 +5,8 @@
 //!   memory order, every size checked before anything is allocated;
 //! - [`lightfield`]: the `(U, V, H, W, B)` light field and its `.npy` files;
 //! - [`npy_rows`]: a light field's `.npy` file written as its rows come;
+//! - [`npy_reader`]: a two-axis `.npy` file read a few rows at a time (paged frames,
+//!   calibration maps);
 //! - [`budget`]: the memory a command may take, checked before the work starts;
 //! - [`calibration`]: the calibration folder `slf calibrate` writes and a calibrated
 //!   decode reads;
@@ -49,6 +51,7 @@ pub mod json;
 pub mod lightfield;
 pub mod message;
 pub mod npy;
+pub mod npy_reader;
 pub mod npy_rows;
 pub mod output;
 pub mod output_file;

@@ -39,7 +39,8 @@ pub enum Element {
 }
 
 impl Element {
-    fn size(self) -> u64 {
+    /// Bytes a value.
+    pub fn size(self) -> u64 {
         match self {
             Element::F32 => 4,
             Element::F64 => 8,

@@ -1,5 +1,6 @@
 //! A raw frame read from its file a band of rows at a time ([`PagedFrame`]), so a decode
-//! holds a few bands of each snapshot, never the frame.
+//! holds a few bands of each snapshot, never the frame; or from rows made as they are read
+//! ([`FrameRows`]: a calibration's correction, the aligned reading's crop).
 //!
 //! Every pass of a decode goes down the frame (the trials' pilots, the white balance's
 //! sums, the streamed decode and its held-out twin, the baselines' lenslet rows), so the
@@ -14,16 +15,15 @@
 //! fails with it ([`PagedFrame::error`]) instead of flagging the pixels.
 
 use std::fmt;
-use std::fs::File;
-use std::io::{Read, Seek, SeekFrom};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, RwLock};
 
-use anyhow::{Result, anyhow};
+use anyhow::Result;
 use slf_firmware::Frame;
 
-use crate::io::npy::{self, NpyError, NpyErrorKind};
+use crate::io::npy::NpyError;
+use crate::io::npy_reader::NpyReader;
 
 /// A band holds at least this many rows, and at least [`BAND_BYTES`].
 pub const MIN_BAND_ROWS: usize = 32;
@@ -39,28 +39,41 @@ pub const CACHE_BYTES: usize = 8 << 20;
 /// The fewest bands the cache holds.
 pub const MIN_BANDS: usize = 8;
 
-/// Where a frame's values are in its file.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct Stored {
-    /// The first value's byte.
-    body: u64,
-    /// Big-endian `u16` values.
-    big_endian: bool,
-    rows: usize,
-    cols: usize,
+/// Where a paged frame's rows come from: its file ([`NpyReader`]), or rows made from
+/// another frame's as they are read (a calibration's correction, the aligned reading's
+/// crop), so no whole frame is made.
+pub trait FrameRows: Send + Sync + fmt::Debug {
+    /// `(rows, cols)`.
+    fn size(&self) -> (usize, usize);
+
+    /// Rows `first..first + out.len() / cols` into `out`.
+    ///
+    /// # Errors
+    /// A read that fails, naming the file and the rows.
+    fn read_rows(&self, first: usize, out: &mut [u16]) -> Result<()>;
 }
 
-/// A raw frame of `u16` values read from its file a band of rows at a time.
+impl FrameRows for NpyReader {
+    fn size(&self) -> (usize, usize) {
+        NpyReader::size(self)
+    }
+
+    fn read_rows(&self, first: usize, out: &mut [u16]) -> Result<()> {
+        self.read_u16(first, out)
+    }
+}
+
+/// A raw frame of `u16` values read from its source a band of rows at a time.
 pub struct PagedFrame {
-    path: Arc<PathBuf>,
-    file: Arc<Mutex<File>>,
-    stored: Stored,
+    source: Arc<dyn FrameRows>,
+    rows: usize,
+    cols: usize,
     band_rows: usize,
     capacity: usize,
     cache: RwLock<Cache>,
     /// Bumped at each band read: a band's `used` is the count when it was last read from.
     clock: AtomicU64,
-    /// Bands read from the file so far.
+    /// Bands read from the source so far.
     loads: AtomicU64,
     /// The first read that failed, as one line.
     error: Mutex<Option<String>>,
@@ -86,47 +99,32 @@ impl PagedFrame {
     /// a file that is valid but not stored so (Fortran order): the caller reads it whole.
     ///
     /// # Errors
-    /// The file and what is wrong with it, as [`npy::read_checked`] says it.
+    /// The file and what is wrong with it, as [`crate::io::npy::read_checked`] says it.
     pub fn open_npy(path: &Path, (rows, cols): (usize, usize)) -> Result<Option<Self>, NpyError> {
-        let err = |kind| NpyError::new(path, kind);
-        // Look before opening: opening a FIFO blocks until a writer comes.
-        let meta = std::fs::metadata(path).map_err(|e| err(NpyErrorKind::Io(e)))?;
-        if !meta.is_file() {
-            return Err(err(NpyErrorKind::NotAFile));
-        }
-        let mut file = File::open(path).map_err(|e| err(NpyErrorKind::Io(e)))?;
-        let layout = npy::read_layout(&mut std::io::BufReader::new(&mut file), meta.len(), |s, element| {
+        let reader = NpyReader::open(path, |s, element| {
             crate::io::lightfield::check_frame_header(s, element, Some((rows, cols)))
-        })
-        .map_err(err)?;
-        if layout.fortran_order && rows > 1 && cols > 1 {
-            return Ok(None);
-        }
-        let stored = Stored { body: layout.body, big_endian: layout.swap, rows, cols };
-        Ok(Some(Self::new(path, file, stored)))
+        })?;
+        Ok(reader.map(|r| Self::new(Arc::new(r))))
     }
 
-    fn new(path: &Path, file: File, stored: Stored) -> Self {
-        let row_bytes = stored.cols.max(1) * 2;
+    /// The frame `source` reads, paged, with the decode's cache.
+    pub fn new(source: Arc<dyn FrameRows>) -> Self {
+        let (_, cols) = source.size();
+        let row_bytes = cols.max(1) * 2;
         let band_rows = MIN_BAND_ROWS.max(BAND_BYTES.div_ceil(row_bytes));
         let threads = rayon::current_num_threads();
         let capacity = (MIN_BANDS + 4 * threads).max(CACHE_BYTES / (band_rows * row_bytes));
-        Self::with_bands(Arc::new(path.to_path_buf()), Arc::new(Mutex::new(file)), stored, band_rows, capacity)
+        Self::with_bands(source, band_rows, capacity)
     }
 
-    fn with_bands(
-        path: Arc<PathBuf>,
-        file: Arc<Mutex<File>>,
-        stored: Stored,
-        band_rows: usize,
-        capacity: usize,
-    ) -> Self {
+    fn with_bands(source: Arc<dyn FrameRows>, band_rows: usize, capacity: usize) -> Self {
         let band_rows = band_rows.max(1);
-        let bands = stored.rows.div_ceil(band_rows);
+        let (rows, cols) = source.size();
+        let bands = rows.div_ceil(band_rows);
         Self {
-            path,
-            file,
-            stored,
+            source,
+            rows,
+            cols,
             band_rows,
             capacity: capacity.clamp(1, bands.max(1)),
             cache: RwLock::new(Cache { slot_of: vec![NONE; bands], slots: Vec::new() }),
@@ -139,22 +137,23 @@ impl PagedFrame {
     /// This frame with bands of `band_rows` rows and at most `capacity` of them held (tests
     /// and benchmarks of the cache; a fresh cache).
     pub fn with_cache(&self, band_rows: usize, capacity: usize) -> Self {
-        Self::with_bands(self.path.clone(), self.file.clone(), self.stored, band_rows, capacity)
+        Self::with_bands(self.source.clone(), band_rows, capacity)
     }
 
-    /// The file read.
-    pub fn path(&self) -> &Path {
-        &self.path
+    /// Where the rows come from (shared: a frame made from this one reads it past its
+    /// cache).
+    pub fn source(&self) -> Arc<dyn FrameRows> {
+        self.source.clone()
     }
 
-    /// Bands read from the file so far (a pass reads each band about once).
+    /// Bands read from the source so far (a pass reads each band about once).
     pub fn loads(&self) -> u64 {
         self.loads.load(Ordering::Relaxed)
     }
 
     /// The most bytes the cache holds.
     pub fn cache_bytes(&self) -> usize {
-        self.capacity * self.band_rows * self.stored.cols * 2
+        self.capacity * self.band_rows * self.cols * 2
     }
 
     /// The first read that failed since the frame was opened, as one line naming the file.
@@ -162,37 +161,20 @@ impl PagedFrame {
         self.error.lock().ok().and_then(|e| e.clone())
     }
 
-    /// Reads rows `first..first + out.len() / cols` from the file into `out`, past the
+    /// Reads rows `first..first + out.len() / cols` from the source into `out`, past the
     /// cache (a pass that reads each row once: the no-light check, the saturation count).
     ///
     /// # Errors
     /// The file and the rows that could not be read.
     pub fn read_rows(&self, first: usize, out: &mut [u16]) -> Result<()> {
-        let Stored { body, big_endian, rows, cols } = self.stored;
-        let n = out.len() / cols.max(1);
-        if !out.len().is_multiple_of(cols.max(1)) || first + n > rows {
-            return Err(anyhow!("{}: rows {first}..{} of a {rows} x {cols} frame", self.path.display(), first + n));
-        }
-        let mut bytes = vec![0u8; out.len() * 2];
-        let mut read = || -> std::io::Result<()> {
-            let mut f = self.file.lock().map_err(|_| std::io::Error::other("a reader panicked"))?;
-            f.seek(SeekFrom::Start(body + (first * cols * 2) as u64))?;
-            f.read_exact(&mut bytes)
-        };
-        read().map_err(|e| {
-            anyhow!("{}: cannot read rows {first}..{} of the frame: {e}", self.path.display(), first + n)
-        })?;
-        for (o, b) in out.iter_mut().zip(bytes.chunks_exact(2)) {
-            *o = if big_endian { u16::from_be_bytes([b[0], b[1]]) } else { u16::from_le_bytes([b[0], b[1]]) };
-        }
-        Ok(())
+        self.source.read_rows(first, out)
     }
 
     /// Calls `f` with the held values of `row` from column `col` on, reading the row's
     /// band first if it is not held; `None` where it cannot be read (the error kept).
     fn with_row<R>(&self, row: usize, col: usize, f: impl FnOnce(&[u16]) -> R) -> Option<R> {
         let band = row / self.band_rows;
-        let at = (row - band * self.band_rows) * self.stored.cols + col;
+        let at = (row - band * self.band_rows) * self.cols + col;
         {
             let cache = self.cache.read().ok()?;
             if let Some(slot) = cache.held(band) {
@@ -206,8 +188,8 @@ impl PagedFrame {
         let mut cache = self.cache.write().ok()?;
         if cache.held(band).is_none() {
             let first = band * self.band_rows;
-            let rows = self.band_rows.min(self.stored.rows - first);
-            let mut values = vec![0u16; rows * self.stored.cols];
+            let rows = self.band_rows.min(self.rows - first);
+            let mut values = vec![0u16; rows * self.cols];
             if let Err(e) = self.read_rows(first, &mut values) {
                 if let Ok(mut kept) = self.error.lock() {
                     kept.get_or_insert_with(|| crate::io::message::one_line(&e));
@@ -243,22 +225,22 @@ impl Cache {
 
 impl Frame for PagedFrame {
     fn size(&self) -> (usize, usize) {
-        (self.stored.rows, self.stored.cols)
+        (self.rows, self.cols)
     }
 
     fn sample(&self, i: usize) -> Option<f32> {
-        let cols = self.stored.cols;
+        let cols = self.cols;
         let (row, col) = (i.checked_div(cols)?, i.checked_rem(cols)?);
-        if row >= self.stored.rows {
+        if row >= self.rows {
             return None;
         }
         self.with_row(row, col, |v| v.first().map(|&x| f32::from(x)))?
     }
 
     fn read_run(&self, start: usize, out: &mut [f32]) -> Option<()> {
-        let cols = self.stored.cols;
+        let cols = self.cols;
         let (row, col) = (start.checked_div(cols)?, start.checked_rem(cols)?);
-        if row >= self.stored.rows || col + out.len() > cols {
+        if row >= self.rows || col + out.len() > cols {
             return None;
         }
         self.with_row(row, col, |v| {
@@ -271,22 +253,24 @@ impl Frame for PagedFrame {
     }
 }
 
-/// A copy shares the open file, with a cache of its own.
+/// A copy shares the source (an open file), with a cache of its own.
 impl Clone for PagedFrame {
     fn clone(&self) -> Self {
-        Self::with_bands(self.path.clone(), self.file.clone(), self.stored, self.band_rows, self.capacity)
+        Self::with_bands(self.source.clone(), self.band_rows, self.capacity)
     }
 }
 
 impl fmt::Debug for PagedFrame {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let Stored { rows, cols, .. } = self.stored;
-        write!(f, "PagedFrame({}, {rows} x {cols}, bands of {} rows)", self.path.display(), self.band_rows)
+        write!(f, "PagedFrame({:?}, bands of {} rows)", self.source, self.band_rows)
     }
 }
 
 #[cfg(test)]
 mod tests {
+    use std::fs::File;
+    use std::path::PathBuf;
+
     use super::*;
 
     fn frame(dir: &Path, rows: usize, cols: usize) -> (PathBuf, Vec<u16>) {

@@ -1,0 +1,178 @@
+//! A two-axis `.npy` file read a few rows at a time ([`NpyReader`]; the reading twin of
+//! [`crate::io::npy_rows`]): the raw frames a decode pages ([`crate::io::paged_frame`]) and
+//! a calibration's dark and flat maps, which a corrected decode reads beside them, never
+//! whole.
+//!
+//! The file stays open from [`NpyReader::open`] on: a file renamed or deleted during the
+//! decode is still the file that was checked; one cut short reads as an error naming the
+//! rows.
+
+use std::fs::File;
+use std::io::{Read, Seek, SeekFrom};
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+
+use anyhow::{Result, anyhow};
+
+use crate::io::npy::{self, Element, NpyError, NpyErrorKind};
+
+/// A C-order two-axis `.npy` file open for reading rows; a copy shares the file.
+#[derive(Clone, Debug)]
+pub struct NpyReader {
+    path: Arc<PathBuf>,
+    file: Arc<Mutex<File>>,
+    /// The first value's byte.
+    body: u64,
+    /// Big-endian values.
+    swap: bool,
+    element: Element,
+    rows: usize,
+    cols: usize,
+}
+
+impl NpyReader {
+    /// Opens `path`: its header is read and given to `check` (shape, element type), and
+    /// its length checked; nothing of the body is read. `None` for a valid file stored in
+    /// Fortran order (rows not contiguous): the caller reads it whole.
+    ///
+    /// # Errors
+    /// The file and what is wrong with it, as [`npy::read_checked`] says it; a shape of
+    /// other than two axes.
+    pub fn open(
+        path: &Path,
+        check: impl FnOnce(&[usize], Element) -> Result<(), String>,
+    ) -> Result<Option<Self>, NpyError> {
+        let err = |kind| NpyError::new(path, kind);
+        // Look before opening: opening a FIFO blocks until a writer comes.
+        let meta = std::fs::metadata(path).map_err(|e| err(NpyErrorKind::Io(e)))?;
+        if !meta.is_file() {
+            return Err(err(NpyErrorKind::NotAFile));
+        }
+        let mut file = File::open(path).map_err(|e| err(NpyErrorKind::Io(e)))?;
+        let mut two = None;
+        let layout = npy::read_layout(&mut std::io::BufReader::new(&mut file), meta.len(), |s, element| {
+            check(s, element)?;
+            match *s {
+                [rows, cols] => {
+                    two = Some((rows, cols));
+                    Ok(())
+                }
+                _ => Err(format!("has {} axes, not 2", s.len())),
+            }
+        })
+        .map_err(err)?;
+        let Some((rows, cols)) = two else { return Err(err(NpyErrorKind::Magic)) };
+        if layout.fortran_order && rows > 1 && cols > 1 {
+            return Ok(None);
+        }
+        Ok(Some(Self {
+            path: Arc::new(path.to_path_buf()),
+            file: Arc::new(Mutex::new(file)),
+            body: layout.body,
+            swap: layout.swap,
+            element: layout.element,
+            rows,
+            cols,
+        }))
+    }
+
+    /// `(rows, cols)`.
+    pub fn size(&self) -> (usize, usize) {
+        (self.rows, self.cols)
+    }
+
+    /// The file read.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The bytes of rows `first..first + n`, `n` whole rows in `values` values.
+    fn bytes(&self, first: usize, values: usize) -> Result<Vec<u8>> {
+        let (rows, cols) = (self.rows, self.cols.max(1));
+        let n = values / cols;
+        let size = self.element.size() as usize;
+        if !values.is_multiple_of(cols) || first + n > rows {
+            return Err(anyhow!("{}: rows {first}..{} of a {rows} x {cols} array", self.path.display(), first + n));
+        }
+        let mut bytes = vec![0u8; values * size];
+        let mut read = || -> std::io::Result<()> {
+            let mut f = self.file.lock().map_err(|_| std::io::Error::other("a reader panicked"))?;
+            f.seek(SeekFrom::Start(self.body + (first * cols * size) as u64))?;
+            f.read_exact(&mut bytes)
+        };
+        read().map_err(|e| anyhow!("{}: cannot read rows {first}..{}: {e}", self.path.display(), first + n))?;
+        Ok(bytes)
+    }
+
+    /// Reads rows `first..first + out.len() / cols` of a `uint16` file into `out`.
+    ///
+    /// # Errors
+    /// Rows past the end, a file of floats, or a read that fails: the file and the rows.
+    pub fn read_u16(&self, first: usize, out: &mut [u16]) -> Result<()> {
+        if self.element != Element::U16 {
+            return Err(anyhow!("{}: holds floats, not uint16", self.path.display()));
+        }
+        let bytes = self.bytes(first, out.len())?;
+        for (o, b) in out.iter_mut().zip(bytes.chunks_exact(2)) {
+            let b = [b[0], b[1]];
+            *o = if self.swap { u16::from_be_bytes(b) } else { u16::from_le_bytes(b) };
+        }
+        Ok(())
+    }
+
+    /// Reads rows `first..first + out.len() / cols` into `out` as `f32` (`float64` values
+    /// rounded, as [`npy::read_checked`] reads them whole).
+    ///
+    /// # Errors
+    /// As [`Self::read_u16`].
+    pub fn read_f32(&self, first: usize, out: &mut [f32]) -> Result<()> {
+        let bytes = self.bytes(first, out.len())?;
+        match self.element {
+            Element::U16 => {
+                for (o, b) in out.iter_mut().zip(bytes.chunks_exact(2)) {
+                    let b = [b[0], b[1]];
+                    *o = f32::from(if self.swap { u16::from_be_bytes(b) } else { u16::from_le_bytes(b) });
+                }
+            }
+            Element::F32 => {
+                for (o, b) in out.iter_mut().zip(bytes.chunks_exact(4)) {
+                    let b = [b[0], b[1], b[2], b[3]];
+                    *o = if self.swap { f32::from_be_bytes(b) } else { f32::from_le_bytes(b) };
+                }
+            }
+            Element::F64 => {
+                for (o, b) in out.iter_mut().zip(bytes.chunks_exact(8)) {
+                    let b: [u8; 8] = [b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]];
+                    *o = (if self.swap { f64::from_be_bytes(b) } else { f64::from_le_bytes(b) }) as f32;
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Rows read from a float32 file equal the file read whole, at any row; rows past the
+    /// end are refused with the file's name.
+    #[test]
+    fn rows_equal_the_whole_read() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("m.npy");
+        let (rows, cols) = (7, 3);
+        let data: Vec<f32> = (0..rows * cols).map(|i| i as f32 * 0.37 - 2.0).collect();
+        crate::io::lightfield::write_npy_f32_2d(&path, &data, rows, cols).unwrap();
+        let m = NpyReader::open(&path, |_, _| Ok(())).unwrap().unwrap();
+        assert_eq!(m.size(), (rows, cols));
+        for first in 0..rows {
+            let mut out = vec![0.0f32; (rows - first) * cols];
+            m.read_f32(first, &mut out).unwrap();
+            assert_eq!(out, data[first * cols..], "from row {first}");
+        }
+        let e = m.read_f32(6, &mut [0.0; 6]).unwrap_err().to_string();
+        assert!(e.contains("m.npy") && e.contains("rows 6..8"), "{e}");
+        assert!(m.read_u16(0, &mut [0; 3]).is_err(), "floats read as uint16");
+    }
+}
