@@ -11,6 +11,10 @@
 # SLF_FORMATS: the outputs measured (default "npy"; "npy h5 zarr" for issue 65's table: the
 # HDF5 file and the Zarr store are written a band of rows at a time, as the .npy is).
 #
+# SLF_CALIBRATION=1: the capture simulated with vignetting 0.3 beside its calibration
+# captures (one exposure each), calibrated by `slf calibrate`, and every decode given
+# `--calibration` (the correction read with the frames, a band at a time).
+#
 # SLF_BEFORE=PATH: another slf binary (e.g. one built before the streamed decode) measured in
 # the same run beside this one, on sizes whose output is at most SLF_BEFORE_MAX_MB (default
 # 150: the whole-frame decode needed 35 x its output); SLF_BEFORE_LABEL names it in the table.
@@ -29,6 +33,7 @@ formats=${SLF_FORMATS:-npy}
 before=${SLF_BEFORE:-}
 before_max=${SLF_BEFORE_MAX_MB:-150}
 label=${SLF_BEFORE_LABEL:-$before}
+calibration=${SLF_CALIBRATION:-}
 export RAYON_NUM_THREADS=${RAYON_NUM_THREADS:-2}
 mkdir -p "$out"
 page_head "Peak memory against frame size" "bash scripts/memory-scale.sh OUT_DIR"
@@ -36,6 +41,10 @@ echo "Made by \`bash scripts/memory-scale.sh OUT_DIR > docs/results-memory.md\` 
 echo "\`slf simulate --seed 1\`; \`RAYON_NUM_THREADS=$RAYON_NUM_THREADS\`; $(nproc) cores). Peak resident memory of"
 echo "\`slf decode CAP -o OUT.npy\` (the whole process) from \`/usr/bin/time -v\`; output: the decoded light"
 echo "field's own size (f32); seconds: wall time of the same run (a shared machine: a benchmark, not a test)."
+if [ -n "$calibration" ]; then
+  echo "Calibrated: the capture simulated with \`--vignetting 0.3 --calibration-captures CC --exposures 1\`,"
+  echo "\`slf calibrate CC -o CAL\`, every decode given \`--calibration CAL\`."
+fi
 if [ -n "$before" ]; then
   echo "Before: $label, measured in the same run where its"
   echo "output is at most $before_max MB (it held about 35 x its output)."
@@ -47,6 +56,7 @@ echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"
 measure() {
   local bin=$1 cap=$2 p=$3 log=$4 ext=${5:-npy}
   local how=(--preset "$p")
+  [ -n "$calibration" ] && how+=(--calibration "$cap.cal")
   case $p in interpolate | demosaic | ppid) how=(--method "$p") ;; esac
   if /usr/bin/time -v "$bin" decode "$cap" -o "$out/rec.$ext" -q "${how[@]}" > /dev/null 2> "$log"; then
     kb=$(awk -F': ' '/Maximum resident set size/ { print $2 }' "$log")
@@ -60,12 +70,19 @@ measure() {
 for n in $sizes; do
   rows=${n%x*}; cols=${n#*x}
   lf="$out/texture-$n.npy"; cap="$out/cap-$n"
+  sim=()
+  if [ -n "$calibration" ]; then
+    cap="$out/calibrated-$n"
+    sim=(--vignetting 0.3 --calibration-captures "$cap.cc" --exposures 1)
+  fi
   if ! { [ -d "$cap" ] || [ -f "$lf" ] || "$slf" scene texture --size "$cols" --rows "$rows" -o "$lf" > /dev/null 2>&1; } ||
-     ! { [ -d "$cap" ] || "$slf" simulate "$lf" -o "$cap" --mask pixel -s 1 --seed 1 > /dev/null 2>&1; }; then
+     ! { [ -d "$cap" ] || "$slf" simulate "$lf" -o "$cap" --mask pixel -s 1 --seed 1 "${sim[@]}" > /dev/null 2>&1; } ||
+     ! { [ -z "$calibration" ] || [ -d "$cap.cal" ] || "$slf" calibrate "$cap.cc" -o "$cap.cal" > /dev/null 2>&1; }; then
     echo "| $rows x $cols | | | | could not simulate (memory?) | | | | |"
     continue
   fi
   rm -f "$lf"  # the truth is not needed to decode; keep the disk for the output
+  rm -rf "$cap.cc"  # nor the calibration captures once calibrated
   output=$(echo "$rows * $cols * 25 * 13 * 4 / 1000000" | bc -l)
   for p in $presets; do
     for f in $formats; do

@@ -5,7 +5,6 @@
 
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 
 use anyhow::{Context, Result, anyhow, bail, ensure};
 use serde::{Deserialize, Serialize};
@@ -21,7 +20,7 @@ use crate::io::frames::{Frames, SensorFrame};
 use crate::io::grid::GridDescription;
 use crate::io::message::one_line;
 use crate::io::output::write_bytes;
-use crate::io::paged_frame::{FrameRows, PagedFrame};
+use crate::io::paged_frame::PagedFrame;
 use crate::io::sensor::SensorDescription;
 
 /// The largest `capture.json` read (a long defect list fits many times over).
@@ -422,14 +421,7 @@ impl Capture {
             d.lenslets,
             d.views
         );
-        let frames = match &self.frames {
-            Frames::Paged(f) => Frames::Paged(
-                f.iter().map(|f| PagedFrame::new(Arc::new(Cropped { whole: f.source(), rows, cols }))).collect(),
-            ),
-            Frames::Held(f) => Frames::Held(
-                f.iter().map(|f| (0..rows).flat_map(|r| f[r * c0..r * c0 + cols].to_vec()).collect()).collect(),
-            ),
-        };
+        let frames = self.frames.cropped((r0, c0), (rows, cols));
         let mut description = d.clone();
         description.lenslet_grid = None;
         description.defective_pixels.retain(|p| (p[0] as usize) < rows && (p[1] as usize) < cols);
@@ -791,32 +783,5 @@ impl CaptureDescription {
             "levels: white_level - black_level is not a finite number"
         );
         Ok((rows, cols))
-    }
-}
-
-/// The top-left `rows x cols` of a paged frame, read as asked (the aligned reading of a
-/// capture behind a grid).
-#[derive(Debug)]
-struct Cropped {
-    whole: Arc<dyn FrameRows>,
-    rows: usize,
-    cols: usize,
-}
-
-impl FrameRows for Cropped {
-    fn size(&self) -> (usize, usize) {
-        (self.rows, self.cols)
-    }
-
-    fn read_rows(&self, first: usize, out: &mut [u16]) -> Result<()> {
-        let (_, wide) = self.whole.size();
-        let n = out.len() / self.cols.max(1);
-        ensure!(first + n <= self.rows, "rows {first}..{} of {} read as aligned", first + n, self.rows);
-        let mut all = vec![0u16; n * wide];
-        self.whole.read_rows(first, &mut all)?;
-        for (o, r) in out.chunks_mut(self.cols.max(1)).zip(all.chunks(wide.max(1))) {
-            o.copy_from_slice(&r[..o.len()]);
-        }
-        Ok(())
     }
 }

@@ -5,14 +5,16 @@
 //!
 //! Whole-frame work (a calibration's correction, a capture saved again, the frames handed
 //! to numpy) asks for the frames held ([`Frames::held`]), which reads paged ones whole
-//! after checking the memory cap; the decode reads them paged.
+//! after checking the memory cap; the decode reads them paged, and a frame made from a
+//! paged one (cropped here, corrected by `decode::correction`) is paged too.
 
 use std::borrow::Cow;
+use std::sync::Arc;
 
-use anyhow::{Result, anyhow};
+use anyhow::{Result, anyhow, ensure};
 use slf_firmware::{Frame, RawFrame};
 
-use crate::io::paged_frame::PagedFrame;
+use crate::io::paged_frame::{FrameRows, PagedFrame};
 
 /// A capture's frames, one per snapshot, row-major.
 #[derive(Clone, Debug)]
@@ -146,6 +148,22 @@ impl Frames {
         }
     }
 
+    /// The top-left `rows x cols` of every frame (each `whole`): paged frames cropped as
+    /// they are read, held ones copied (the aligned reading of a capture behind a grid).
+    pub fn cropped(&self, whole: (usize, usize), (rows, cols): (usize, usize)) -> Self {
+        match self {
+            Self::Paged(f) => Self::Paged(
+                f.iter().map(|f| PagedFrame::new(Arc::new(Cropped { whole: f.source(), rows, cols }))).collect(),
+            ),
+            Self::Held(f) => {
+                let c0 = whole.1;
+                Self::Held(
+                    f.iter().map(|f| (0..rows).flat_map(|r| f[r * c0..r * c0 + cols].to_vec()).collect()).collect(),
+                )
+            }
+        }
+    }
+
     /// The first read of a paged frame that failed since it was opened: a decode that read
     /// no sample there must not pass as one that flagged the pixels.
     ///
@@ -170,6 +188,32 @@ impl Frames {
     }
 }
 
+/// The top-left `rows x cols` of a paged frame, read as asked (the aligned reading of a
+/// capture behind a grid).
+#[derive(Debug)]
+struct Cropped {
+    whole: Arc<dyn FrameRows>,
+    rows: usize,
+    cols: usize,
+}
+
+impl FrameRows for Cropped {
+    fn size(&self) -> (usize, usize) {
+        (self.rows, self.cols)
+    }
+
+    fn read_rows(&self, first: usize, out: &mut [u16]) -> Result<()> {
+        let (_, wide) = self.whole.size();
+        let n = out.len() / self.cols.max(1);
+        ensure!(first + n <= self.rows, "rows {first}..{} of {} read as aligned", first + n, self.rows);
+        let mut all = vec![0u16; n * wide];
+        self.whole.read_rows(first, &mut all)?;
+        for (o, r) in out.chunks_mut(self.cols.max(1)).zip(all.chunks(wide.max(1))) {
+            o.copy_from_slice(&r[..o.len()]);
+        }
+        Ok(())
+    }
+}
 impl Frame for SensorFrame<'_> {
     fn size(&self) -> (usize, usize) {
         match self {
