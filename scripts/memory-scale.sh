@@ -56,8 +56,8 @@ echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"
 measure() {
   local bin=$1 cap=$2 p=$3 log=$4 ext=${5:-npy}
   local how=(--preset "$p")
-  [ -n "$calibration" ] && how+=(--calibration "$cap.cal")
   case $p in interpolate | demosaic | ppid) how=(--method "$p") ;; esac
+  if [ -n "$calibration" ]; then how+=(--calibration "$cap.cal"); fi
   if /usr/bin/time -v "$bin" decode "$cap" -o "$out/rec.$ext" -q "${how[@]}" > /dev/null 2> "$log"; then
     kb=$(awk -F': ' '/Maximum resident set size/ { print $2 }' "$log")
     s=$(awk -F': ' '/Elapsed \(wall clock\)/ { n = split($2, a, ":"); t = 0; for (i = 1; i <= n; i++) t = 60 * t + a[i]; print t }' "$log")

@@ -19,8 +19,8 @@ use crate::io::grid::GridDescription;
 use crate::io::lightfield::write_npy_f32_2d;
 use crate::io::message::number;
 use crate::io::npy::{self, Element, Values};
-use crate::io::npy_reader::NpyReader;
 use crate::io::output::write_bytes;
+use crate::io::row_reader::RowReader;
 
 /// The description file's name inside a calibration folder.
 pub const DESCRIPTION: &str = "calibration.json";
@@ -275,7 +275,7 @@ fn check_flat_rows(first_row: usize, flat: &[f32], cols: usize) -> Result<()> {
 pub enum Map {
     /// Row-major, `cols` a row.
     Held(Arc<[f32]>, usize),
-    File(NpyReader),
+    File(RowReader),
 }
 
 impl Map {
@@ -412,7 +412,7 @@ impl Calibration {
         let (description, size) = Self::description_in(dir)?;
         let open = |name: &str| -> Result<Map> {
             let p: PathBuf = dir.join(name);
-            match NpyReader::open(&p, |s, element| map_header(s, element, size)).map_err(|e| anyhow!("{e}"))? {
+            match RowReader::open_npy(&p, |s, element| map_header(s, element, size)).map_err(|e| anyhow!("{e}"))? {
                 Some(r) => Ok(Map::File(r)),
                 None => match npy::read_checked(&p, |s, element| map_header(s, element, size))
                     .map_err(|e| anyhow!("{e}"))?

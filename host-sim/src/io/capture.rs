@@ -504,14 +504,21 @@ impl Capture {
                 desc_path.display()
             ),
         }
-        // `.npy` frames are read as the decode asks, a band of rows at a time: their header
-        // and length are checked now. The others are read whole.
+        // `.npy` and 16-bit PGM frames are read as the decode asks, a band of rows at a time:
+        // their header and length (and a PGM's values against its MAXVAL) are checked now.
+        // The others are read whole.
         let mut paged = Vec::with_capacity(paths.len());
         for path in &paths {
-            if extension(path) != "npy" {
-                break;
-            }
-            match PagedFrame::open_npy(path, (rows, cols))? {
+            let frame = match extension(path).as_str() {
+                "npy" => PagedFrame::open_npy(path, (rows, cols))?,
+                "pgm" => {
+                    let (frame, top) = PagedFrame::open_pgm(path, (rows, cols))?;
+                    saturation_fits(&description, path, top)?;
+                    frame
+                }
+                _ => None,
+            };
+            match frame {
                 Some(frame) => paged.push(frame),
                 None => break,
             }
@@ -525,15 +532,7 @@ impl Capture {
         for path in paths {
             // Of the capture's size: read_frame refuses another from the file's header.
             let frame = read_frame(&path, Some((rows, cols)))?;
-            ensure!(
-                description.saturation_level <= frame.top as f32,
-                "{}: the file's largest value is {} (its MAXVAL or bit depth), below saturation_level {} in {}: \
-                 saturated pixels would read as measurements",
-                path.display(),
-                frame.top,
-                description.saturation_level,
-                DESCRIPTION
-            );
+            saturation_fits(&description, &path, frame.top)?;
             frames.push(frame.data);
         }
         let mut capture = Self::new(description, frames).map_err(named)?;
@@ -784,4 +783,21 @@ impl CaptureDescription {
         );
         Ok((rows, cols))
     }
+}
+
+/// A frame file whose largest value (`top`: its MAXVAL or bit depth) reaches the capture's
+/// saturation level: below it, saturated pixels would read as measurements.
+///
+/// # Errors
+/// One that does not, naming the file.
+fn saturation_fits(description: &CaptureDescription, path: &Path, top: u32) -> Result<()> {
+    ensure!(
+        description.saturation_level <= top as f32,
+        "{}: the file's largest value is {top} (its MAXVAL or bit depth), below saturation_level {} in {}: \
+         saturated pixels would read as measurements",
+        path.display(),
+        description.saturation_level,
+        DESCRIPTION
+    );
+    Ok(())
 }

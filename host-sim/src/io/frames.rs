@@ -1,6 +1,6 @@
 //! A capture's raw frames, one per snapshot ([`Frames`]): held in memory (made by the
-//! simulator, given from numpy, or read from a PNG or PGM), or read from their `.npy` files
-//! a band of rows at a time ([`PagedFrame`]); and the frame the decoder reads either way
+//! simulator, given from numpy, or read from a PNG or 8-bit PGM), or read from their
+//! `.npy` or 16-bit PGM files a band of rows at a time ([`PagedFrame`]); and the frame the decoder reads either way
 //! ([`SensorFrame`]).
 //!
 //! Whole-frame work (a calibration's correction, a capture saved again, the frames handed

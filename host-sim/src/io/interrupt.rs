@@ -49,11 +49,26 @@ pub fn remove_temporaries() -> usize {
 /// Removes the tracked temporaries `pick` picks; returns how many were removed.
 fn remove_where(pick: impl Fn(&Path) -> bool) -> usize {
     let Ok(live) = LIVE.lock() else { return 0 };
-    live.iter()
-        .filter(|(_, p)| pick(p))
-        .filter(|(_, p)| if p.is_dir() { std::fs::remove_dir_all(p).is_ok() } else { std::fs::remove_file(p).is_ok() })
-        .count()
+    live.iter().filter(|(_, p)| pick(p)).filter(|(_, p)| remove(p)).count()
 }
+
+/// Removes a temporary file or folder, trying again for up to [`REMOVE_TRIES`] x 10 ms: the
+/// command's other threads go on writing into a folder while the handler runs, and a file
+/// they add during `remove_dir_all` makes it fail ("directory not empty"; a simulate with
+/// calibration captures on a loaded machine once left both of its folders so).
+fn remove(p: &Path) -> bool {
+    for _ in 0..REMOVE_TRIES {
+        let gone = if p.is_dir() { std::fs::remove_dir_all(p) } else { std::fs::remove_file(p) };
+        if gone.is_ok() || !p.exists() {
+            return true;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    false
+}
+
+/// The most attempts [`remove`] makes at one temporary.
+const REMOVE_TRIES: usize = 50;
 
 /// Installs the handler: on the first interrupt, the temporaries are removed, one line says
 /// so, and the process exits with 130 (128 + SIGINT, as shells report an interrupt).

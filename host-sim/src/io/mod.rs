@@ -5,8 +5,8 @@
 //!   memory order, every size checked before anything is allocated;
 //! - [`lightfield`]: the `(U, V, H, W, B)` light field and its `.npy` files;
 //! - [`npy_rows`]: a light field's `.npy` file written as its rows come;
-//! - [`npy_reader`]: a two-axis `.npy` file read a few rows at a time (paged frames,
-//!   calibration maps);
+//! - [`row_reader`]: a two-axis array in a file (a `.npy`'s or a 16-bit PGM's body) read a
+//!   few rows at a time (paged frames, calibration maps);
 //! - [`budget`]: the memory a command may take, checked before the work starts;
 //! - [`calibration`]: the calibration folder `slf calibrate` writes and a calibrated
 //!   decode reads;
@@ -51,13 +51,13 @@ pub mod json;
 pub mod lightfield;
 pub mod message;
 pub mod npy;
-pub mod npy_reader;
 pub mod npy_rows;
 pub mod output;
 pub mod output_file;
 pub mod paged_frame;
 pub mod patch;
 pub mod row_band;
+pub mod row_reader;
 pub mod rows;
 pub mod sensor;
 #[macro_use]

@@ -9,7 +9,7 @@
 //! decode's threads behind one read-write lock, taken once a run of samples (the
 //! firmware's [`Frame::read_run`]), not once a sample.
 //!
-//! The file stays open from [`PagedFrame::open_npy`] on: a frame renamed or deleted during
+//! The file stays open from [`PagedFrame::open_npy`] or [`PagedFrame::open_pgm`] on: a frame renamed or deleted during
 //! the decode is still the frame that was checked. A read that fails later (a disk error,
 //! a file cut short by another program) reads as no sample and is kept; the decode then
 //! fails with it ([`PagedFrame::error`]) instead of flagging the pixels.
@@ -23,7 +23,7 @@ use anyhow::Result;
 use slf_firmware::Frame;
 
 use crate::io::npy::NpyError;
-use crate::io::npy_reader::NpyReader;
+use crate::io::row_reader::RowReader;
 
 /// A band holds at least this many rows, and at least [`BAND_BYTES`].
 pub const MIN_BAND_ROWS: usize = 32;
@@ -39,7 +39,7 @@ pub const CACHE_BYTES: usize = 8 << 20;
 /// The fewest bands the cache holds.
 pub const MIN_BANDS: usize = 8;
 
-/// Where a paged frame's rows come from: its file ([`NpyReader`]), or rows made from
+/// Where a paged frame's rows come from: its file ([`RowReader`]), or rows made from
 /// another frame's as they are read (a calibration's correction, the aligned reading's
 /// crop), so no whole frame is made.
 pub trait FrameRows: Send + Sync + fmt::Debug {
@@ -53,9 +53,9 @@ pub trait FrameRows: Send + Sync + fmt::Debug {
     fn read_rows(&self, first: usize, out: &mut [u16]) -> Result<()>;
 }
 
-impl FrameRows for NpyReader {
+impl FrameRows for RowReader {
     fn size(&self) -> (usize, usize) {
-        NpyReader::size(self)
+        RowReader::size(self)
     }
 
     fn read_rows(&self, first: usize, out: &mut [u16]) -> Result<()> {
@@ -101,10 +101,21 @@ impl PagedFrame {
     /// # Errors
     /// The file and what is wrong with it, as [`crate::io::npy::read_checked`] says it.
     pub fn open_npy(path: &Path, (rows, cols): (usize, usize)) -> Result<Option<Self>, NpyError> {
-        let reader = NpyReader::open(path, |s, element| {
+        let reader = RowReader::open_npy(path, |s, element| {
             crate::io::lightfield::check_frame_header(s, element, Some((rows, cols)))
         })?;
         Ok(reader.map(|r| Self::new(Arc::new(r))))
+    }
+
+    /// Opens a 16-bit binary PGM raw frame of `rows x cols` ([`RowReader::open_pgm`]: every
+    /// check of a whole read, now), its values read as the decode asks; `None` for one
+    /// read whole (8-bit). The file's MAXVAL beside.
+    ///
+    /// # Errors
+    /// The file and what is wrong with it.
+    pub fn open_pgm(path: &Path, size: (usize, usize)) -> Result<(Option<Self>, u32)> {
+        let (reader, top) = RowReader::open_pgm(path, size)?;
+        Ok((reader.map(|r| Self::new(Arc::new(r))), top))
     }
 
     /// The frame `source` reads, paged, with the decode's cache.

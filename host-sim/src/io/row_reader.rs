@@ -1,9 +1,9 @@
-//! A two-axis `.npy` file read a few rows at a time ([`NpyReader`]; the reading twin of
-//! [`crate::io::npy_rows`]): the raw frames a decode pages ([`crate::io::paged_frame`]) and
-//! a calibration's dark and flat maps, which a corrected decode reads beside them, never
-//! whole.
+//! A two-axis array stored row-major in a file, read a few rows at a time ([`RowReader`]):
+//! a `.npy` file's body (the reading twin of [`crate::io::npy_rows`]) or a 16-bit binary
+//! PGM's. The raw frames a decode pages ([`crate::io::paged_frame`]) and a calibration's
+//! dark and flat maps, which a corrected decode reads beside them, never whole.
 //!
-//! The file stays open from [`NpyReader::open`] on: a file renamed or deleted during the
+//! The file stays open from [`RowReader::open_npy`] or [`RowReader::open_pgm`] on: a file renamed or deleted during the
 //! decode is still the file that was checked; one cut short reads as an error naming the
 //! rows.
 
@@ -16,9 +16,9 @@ use anyhow::{Result, anyhow};
 
 use crate::io::npy::{self, Element, NpyError, NpyErrorKind};
 
-/// A C-order two-axis `.npy` file open for reading rows; a copy shares the file.
+/// A row-major two-axis array in a file, open for reading rows; a copy shares the file.
 #[derive(Clone, Debug)]
-pub struct NpyReader {
+pub struct RowReader {
     path: Arc<PathBuf>,
     file: Arc<Mutex<File>>,
     /// The first value's byte.
@@ -30,7 +30,7 @@ pub struct NpyReader {
     cols: usize,
 }
 
-impl NpyReader {
+impl RowReader {
     /// Opens `path`: its header is read and given to `check` (shape, element type), and
     /// its length checked; nothing of the body is read. `None` for a valid file stored in
     /// Fortran order (rows not contiguous): the caller reads it whole.
@@ -38,7 +38,7 @@ impl NpyReader {
     /// # Errors
     /// The file and what is wrong with it, as [`npy::read_checked`] says it; a shape of
     /// other than two axes.
-    pub fn open(
+    pub fn open_npy(
         path: &Path,
         check: impl FnOnce(&[usize], Element) -> Result<(), String>,
     ) -> Result<Option<Self>, NpyError> {
@@ -74,6 +74,75 @@ impl NpyReader {
             rows,
             cols,
         }))
+    }
+
+    /// A 16-bit binary PGM (P5, MAXVAL above 255) of `rows x cols`: its header, length and
+    /// every value against its MAXVAL checked now, in one pass of bands, as
+    /// [`crate::io::frame_file::read_frame`] checks it whole (the same messages); its values
+    /// read later as asked. `None` for an 8-bit PGM (read whole), and the MAXVAL beside.
+    ///
+    /// # Errors
+    /// The file and what is wrong with it.
+    pub fn open_pgm(path: &Path, (rows, cols): (usize, usize)) -> Result<(Option<Self>, u32)> {
+        use image::codecs::pnm::{PnmDecoder, PnmSubtype, SampleEncoding};
+        let len = crate::io::file_checks::regular_file(path, u64::MAX, "")?;
+        let file = File::open(path).map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
+        let decoder = PnmDecoder::new(std::io::BufReader::new(file))
+            .map_err(|e| anyhow!("{}: not a PGM file: {e}", path.display()))?;
+        let (mut reader, header) = decoder.into_inner();
+        if header.subtype() != PnmSubtype::Graymap(SampleEncoding::Binary) {
+            return Err(anyhow!(
+                "{}: a raw frame is a binary PGM (P5), this file is {:?}",
+                path.display(),
+                header.subtype()
+            ));
+        }
+        let (w, h, top) = (header.width(), header.height(), header.maximal_sample());
+        if top <= 255 || (h as usize, w as usize) != (rows, cols) {
+            return Ok((None, top)); // read whole, where every other fault is named
+        }
+        let body = reader.stream_position().map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
+        let need = (rows * cols * 2) as u64;
+        if need > len {
+            return Err(anyhow!("{}: {w} x {h} pixels need {need} bytes, the file has {len}", path.display()));
+        }
+        if body + need > len {
+            return Err(anyhow!("{}: truncated: {w} x {h} pixels promised", path.display()));
+        }
+        if body + need < len {
+            return Err(anyhow!(
+                "{}: bytes after the {w} x {h} pixels the header promises (the file is longer than its image)",
+                path.display()
+            ));
+        }
+        let file = reader.into_inner();
+        let this = Self {
+            path: Arc::new(path.to_path_buf()),
+            file: Arc::new(Mutex::new(file)),
+            body,
+            swap: true,
+            element: Element::U16,
+            rows,
+            cols,
+        };
+        // Every value against MAXVAL, a band at a time.
+        let band = 64.min(rows.max(1));
+        let mut values = vec![0u16; band * cols];
+        for first in (0..rows).step_by(band) {
+            let part = &mut values[..band.min(rows - first) * cols];
+            this.read_u16(first, part)?;
+            if let Some(i) = part.iter().position(|&x| u32::from(x) > top) {
+                let p = first * cols + i;
+                return Err(anyhow!(
+                    "{}: pixel ({}, {}) is {}, above MAXVAL {top}",
+                    path.display(),
+                    p / cols,
+                    p % cols,
+                    part[i]
+                ));
+            }
+        }
+        Ok((Some(this), top))
     }
 
     /// `(rows, cols)`.
@@ -164,7 +233,7 @@ mod tests {
         let (rows, cols) = (7, 3);
         let data: Vec<f32> = (0..rows * cols).map(|i| i as f32 * 0.37 - 2.0).collect();
         crate::io::lightfield::write_npy_f32_2d(&path, &data, rows, cols).unwrap();
-        let m = NpyReader::open(&path, |_, _| Ok(())).unwrap().unwrap();
+        let m = RowReader::open_npy(&path, |_, _| Ok(())).unwrap().unwrap();
         assert_eq!(m.size(), (rows, cols));
         for first in 0..rows {
             let mut out = vec![0.0f32; (rows - first) * cols];
@@ -174,5 +243,50 @@ mod tests {
         let e = m.read_f32(6, &mut [0.0; 6]).unwrap_err().to_string();
         assert!(e.contains("m.npy") && e.contains("rows 6..8"), "{e}");
         assert!(m.read_u16(0, &mut [0; 3]).is_err(), "floats read as uint16");
+    }
+
+    /// A 16-bit PGM's rows equal its whole read; a faulty one (a value above MAXVAL past the
+    /// first band, bytes after the image, a body cut short) is refused with the whole
+    /// read's message; an 8-bit one is left to the whole read.
+    #[test]
+    fn a_pgm_is_read_by_rows_and_refused_as_a_whole_read_refuses_it() {
+        use crate::io::frame_file::read_frame;
+        let dir = tempfile::tempdir().unwrap();
+        let (rows, cols) = (70, 3);
+        let pgm = |name: &str, top: u32, values: &[u16], extra: &[u8]| {
+            let mut bytes = format!("P5\n{cols} {rows}\n{top}\n").into_bytes();
+            for &v in values {
+                if top > 255 { bytes.extend(v.to_be_bytes()) } else { bytes.push(v as u8) }
+            }
+            bytes.extend(extra);
+            let path = dir.path().join(name);
+            std::fs::write(&path, bytes).unwrap();
+            path
+        };
+        let data: Vec<u16> = (0..rows * cols).map(|i| (i * 37 % 4096) as u16).collect();
+        let good = pgm("good.pgm", 4095, &data, &[]);
+        let (r, top) = RowReader::open_pgm(&good, (rows, cols)).unwrap();
+        let r = r.unwrap();
+        assert_eq!(top, 4095);
+        let mut out = vec![0u16; 5 * cols];
+        r.read_u16(66, &mut out[..4 * cols]).unwrap();
+        assert_eq!(out[..4 * cols], data[66 * cols..]);
+        r.read_u16(0, &mut out).unwrap();
+        assert_eq!(out, data[..5 * cols]);
+        let mut high = data.clone();
+        high[68 * cols + 1] = 4096;
+        let cut = &data[..data.len() - 1];
+        for (name, path) in [
+            ("above MAXVAL", pgm("high.pgm", 4095, &high, &[])),
+            ("bytes after", pgm("long.pgm", 4095, &data, &[0])),
+            ("cut short", pgm("short.pgm", 4095, cut, &[])),
+            ("half", pgm("half.pgm", 4095, &data[..data.len() / 2], &[])),
+        ] {
+            let whole = read_frame(&path, Some((rows, cols))).unwrap_err().to_string();
+            let by_rows = RowReader::open_pgm(&path, (rows, cols)).map(|_| ()).unwrap_err().to_string();
+            assert_eq!(by_rows, whole, "{name}");
+        }
+        let small = pgm("eight.pgm", 255, &vec![7; rows * cols], &[]);
+        assert!(matches!(RowReader::open_pgm(&small, (rows, cols)), Ok((None, 255))));
     }
 }
