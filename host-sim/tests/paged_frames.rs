@@ -21,7 +21,7 @@ fn captures(dir: &Path, k: u8) -> (Capture, Capture) {
     let cam = CameraConfig { frame_ext: "npy".into(), ..CameraConfig::pixel(5, k) };
     let held = simulate(&truth, &cam).unwrap();
     held.save(dir).unwrap();
-    let paged = Capture::load(dir).unwrap();
+    let paged = Capture::load_paged(dir).unwrap();
     assert!(paged.frames.is_paged(), "a capture of .npy frames is read as the decode asks");
     assert!(!held.frames.is_paged());
     (held, paged)
@@ -61,7 +61,7 @@ fn a_paged_capture_decodes_to_the_held_ones_bits_by_every_method() {
         assert_eq!(ppid(cap, &p).unwrap().0.data, ppid(&held, &p).unwrap().0.data, "{name}: ppid");
     }
     // The decode's own cache holds the frame here (17 x 5 rows): each band is read once.
-    let once = Capture::load(dir.path()).unwrap();
+    let once = Capture::load_paged(dir.path()).unwrap();
     decode_with(&once, &Basis::Dct, &opts).unwrap();
     let bands = 2 * (17 * 5usize).div_ceil(slf_host::io::paged_frame::MIN_BAND_ROWS);
     assert!(once.frames.loads() as usize <= bands, "{} band reads for {bands} bands", once.frames.loads());
@@ -140,7 +140,7 @@ fn the_correction_and_the_aligned_crop_are_read_as_the_decode_asks() {
     let held = simulate(&truth, &cam).unwrap();
     let capture_dir = dir.path().join("cap");
     held.save(&capture_dir).unwrap();
-    let paged = Capture::load(&capture_dir).unwrap();
+    let paged = Capture::load_paged(&capture_dir).unwrap();
     assert!(paged.frames.is_paged());
     let caps = calibration_captures(&cam, lenslets, views, held.description.bands_nm.len(), 2).unwrap();
     let (cal, _) = calibrate(&caps, None).unwrap();

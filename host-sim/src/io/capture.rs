@@ -15,12 +15,11 @@ use slf_firmware::{
 
 use crate::io::file_checks::read_small_file;
 use crate::io::folder::{FileRecord, Kind, WholeFolder, record, verify};
-use crate::io::frame_file::{extension, read_frame, write_frame};
+use crate::io::frame_file::{extension, write_frame};
 use crate::io::frames::{Frames, SensorFrame};
 use crate::io::grid::GridDescription;
 use crate::io::message::one_line;
 use crate::io::output::write_bytes;
-use crate::io::paged_frame::PagedFrame;
 use crate::io::sensor::SensorDescription;
 
 /// The largest `capture.json` read (a long defect list fits many times over).
@@ -467,11 +466,26 @@ impl Capture {
         DefectList::new(&self.defects).unwrap_or_default()
     }
 
-    /// Loads a capture folder.
+    /// Loads a capture folder: frames of more than [`HOLD_BYTES`] in all are paged (read a
+    /// band of rows at a time as the decode asks, where their format allows), smaller ones
+    /// held.
     ///
     /// # Errors
     /// A message with the file and what is wrong in it.
     pub fn load(dir: &Path) -> Result<Self> {
+        Self::load_with(dir, HOLD_BYTES)
+    }
+
+    /// [`Self::load`] with every `.npy` and 16-bit PGM frame paged, whatever its size
+    /// (tests and benchmarks of the paged reading).
+    ///
+    /// # Errors
+    /// As [`Self::load`].
+    pub fn load_paged(dir: &Path) -> Result<Self> {
+        Self::load_with(dir, 0)
+    }
+
+    fn load_with(dir: &Path, hold_bytes: u64) -> Result<Self> {
         let desc_path = dir.join(DESCRIPTION);
         let named = |e: anyhow::Error| anyhow!("{}: {}", desc_path.display(), one_line(&e));
         let text = read_small_file(&desc_path, MAX_DESCRIPTION)?;
@@ -504,38 +518,11 @@ impl Capture {
                 desc_path.display()
             ),
         }
-        // `.npy` and 16-bit PGM frames are read as the decode asks, a band of rows at a time:
-        // their header and length (and a PGM's values against its MAXVAL) are checked now.
-        // The others are read whole.
-        let mut paged = Vec::with_capacity(paths.len());
-        for path in &paths {
-            let frame = match extension(path).as_str() {
-                "npy" => PagedFrame::open_npy(path, (rows, cols))?,
-                "pgm" => {
-                    let (frame, top) = PagedFrame::open_pgm(path, (rows, cols))?;
-                    saturation_fits(&description, path, top)?;
-                    frame
-                }
-                _ => None,
-            };
-            match frame {
-                Some(frame) => paged.push(frame),
-                None => break,
-            }
-        }
-        if paged.len() == paths.len() {
-            let mut capture = Self::with_frames(description, Frames::Paged(paged)).map_err(named)?;
-            capture.source = Some(desc_path);
-            return Ok(capture);
-        }
-        let mut frames = Vec::with_capacity(description.frames.len());
-        for path in paths {
-            // Of the capture's size: read_frame refuses another from the file's header.
-            let frame = read_frame(&path, Some((rows, cols)))?;
-            saturation_fits(&description, &path, frame.top)?;
-            frames.push(frame.data);
-        }
-        let mut capture = Self::new(description, frames).map_err(named)?;
+        let frames = {
+            let fits = |path: &Path, top: u32| saturation_fits(&description, path, top);
+            Frames::open(&paths, (rows, cols), hold_bytes, fits)?
+        };
+        let mut capture = Self::with_frames(description, frames).map_err(named)?;
         capture.source = Some(desc_path);
         Ok(capture)
     }
@@ -784,6 +771,12 @@ impl CaptureDescription {
         Ok((rows, cols))
     }
 }
+
+/// A capture's frames of at most this many bytes in all are held when it is loaded, larger
+/// ones paged: reading through the band cache took 1.12 x the CPU time of a default decode
+/// of held frames (office, 80 x 80 lenslets, pixel k = 1, `farm-bench` paired), and holding
+/// costs at most this (a 4096 x 4096 sensor at one snapshot).
+pub const HOLD_BYTES: u64 = 32 << 20;
 
 /// A frame file whose largest value (`top`: its MAXVAL or bit depth) reaches the capture's
 /// saturation level: below it, saturated pixels would read as measurements.

@@ -9,11 +9,13 @@
 //! paged one (cropped here, corrected by `decode::correction`) is paged too.
 
 use std::borrow::Cow;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use anyhow::{Result, anyhow, ensure};
 use slf_firmware::{Frame, RawFrame};
 
+use crate::io::frame_file::{extension, read_frame};
 use crate::io::paged_frame::{FrameRows, PagedFrame};
 
 /// A capture's frames, one per snapshot, row-major.
@@ -33,6 +35,50 @@ pub enum SensorFrame<'a> {
 }
 
 impl Frames {
+    /// Opens a capture's frame files, each `rows x cols`. Past `hold_bytes` in all, `.npy`
+    /// and 16-bit PGM frames are read as the decode asks, a band of rows at a time: their
+    /// header and length (and a PGM's values against its MAXVAL) are checked now. The
+    /// others are read whole. `fits(path, top)` checks a file's largest value (its MAXVAL or
+    /// bit depth) against the capture's saturation level.
+    ///
+    /// # Errors
+    /// A file and what is wrong with it, or what `fits` says.
+    pub fn open(
+        paths: &[PathBuf],
+        (rows, cols): (usize, usize),
+        hold_bytes: u64,
+        fits: impl Fn(&Path, u32) -> Result<()>,
+    ) -> Result<Self> {
+        let mut paged = Vec::with_capacity(paths.len());
+        let held_bytes = (paths.len() * rows * cols * 2) as u64;
+        for path in paths.iter().filter(|_| held_bytes > hold_bytes) {
+            let frame = match extension(path).as_str() {
+                "npy" => PagedFrame::open_npy(path, (rows, cols))?,
+                "pgm" => {
+                    let (frame, top) = PagedFrame::open_pgm(path, (rows, cols))?;
+                    fits(path, top)?;
+                    frame
+                }
+                _ => None,
+            };
+            match frame {
+                Some(frame) => paged.push(frame),
+                None => break,
+            }
+        }
+        if !paths.is_empty() && paged.len() == paths.len() {
+            return Ok(Self::Paged(paged));
+        }
+        let mut frames = Vec::with_capacity(paths.len());
+        for path in paths {
+            // Of the capture's size: read_frame refuses another from the file's header.
+            let frame = read_frame(path, Some((rows, cols)))?;
+            fits(path, frame.top)?;
+            frames.push(frame.data);
+        }
+        Ok(Self::Held(frames))
+    }
+
     /// Snapshots.
     pub fn len(&self) -> usize {
         match self {
