@@ -37,7 +37,7 @@ calibration=${SLF_CALIBRATION:-}
 export RAYON_NUM_THREADS=${RAYON_NUM_THREADS:-2}
 mkdir -p "$out"
 page_head "Peak memory against frame size" "bash scripts/memory-scale.sh OUT_DIR"
-echo "Made by \`bash scripts/memory-scale.sh OUT_DIR > docs/results-memory.md\` (texture scene, pixel k = 1,"
+echo "Made by \`bash scripts/memory-scale.sh OUT_DIR\` with the settings above (texture scene, pixel k = 1,"
 echo "\`slf simulate --seed 1\`; \`RAYON_NUM_THREADS=$RAYON_NUM_THREADS\`; $(nproc) cores). Peak resident memory of"
 echo "\`slf decode CAP -o OUT.npy\` (the whole process) from \`/usr/bin/time -v\`; output: the decoded light"
 echo "field's own size (f32); seconds: wall time of the same run (a shared machine: a benchmark, not a test)."

@@ -773,9 +773,10 @@ impl CaptureDescription {
 }
 
 /// A capture's frames of at most this many bytes in all are held when it is loaded, larger
-/// ones paged: reading through the band cache took 1.12 x the CPU time of a default decode
-/// of held frames (office, 80 x 80 lenslets, pixel k = 1, `farm-bench` paired), and holding
-/// costs at most this (a 4096 x 4096 sensor at one snapshot).
+/// ones paged: reading through the band cache takes about 1.06 x the CPU time of a default
+/// decode of held frames (0.98-1.13 over 10 pairs; office, 80 x 80 lenslets, pixel k = 1,
+/// 2 threads, `farm-bench` paired; 1.14 x before each thread kept its last bands), and
+/// holding costs at most this (a 4096 x 4096 sensor at one snapshot).
 pub const HOLD_BYTES: u64 = 32 << 20;
 
 /// A frame file whose largest value (`top`: its MAXVAL or bit depth) reaches the capture's
