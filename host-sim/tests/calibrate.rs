@@ -234,7 +234,7 @@ fn the_calibration_folder_reads_back_and_refuses_corruption() {
     let hot = cal.description.hot_pixels.iter().map(|p| p[0] as usize * cols + p[1] as usize).collect::<Vec<_>>();
     let first = (0..rows * cols).find(|p| !hot.contains(p)).unwrap();
     let last = (0..rows * cols).rev().find(|p| !hot.contains(p)).unwrap();
-    assert!(last / cols >= slf_host::io::calibration::MAP_BAND_ROWS, "the last row is past the first band of rows");
+    assert!(last / cols >= slf_host::io::map::MAP_BAND_ROWS, "the last row is past the first band of rows");
     for (level, working) in [(white, first), (-65535.0, last), (f32::NAN, first), (f32::NAN, last)] {
         let mut dark = cal.dark.clone();
         dark[working] = level;

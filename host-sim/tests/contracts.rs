@@ -405,22 +405,38 @@ fn folders_are_written_whole_and_refused_when_mixed() {
     assert!(err.contains("records no sizes and checksums of its frames"), "{err}");
 }
 
-/// The memory a calibration's exposures take, checked before any capture is made or read
+/// The memory calibration captures take, checked before any capture is made or read
 /// (issue 51: `--exposures 256` at 100 x 100 lenslets peaked at 2.1 GB unannounced).
+/// `simulate` makes and writes them one at a time (issue 65), so a cap under the whole
+/// set's memory but over one capture's is enough, and one under a capture's is refused
+/// before anything is written; `calibrate` reads them all.
 #[test]
 fn calibration_captures_are_checked_against_the_memory_cap() {
     let tmp = tempfile::tempdir().unwrap();
     let p = |n: &str| tmp.path().join(n);
-    ok(slf().args(["scene", "smooth", "--size", "16", "-o"]).arg(p("lf.npy")));
+    // The cap's least is 0.01 GiB: a sensor of 500 x 500 pixels, whose light field (13 MB)
+    // is read under a cap of 13.3 MiB.
+    ok(slf().args(["scene", "smooth", "--size", "100", "-o"]).arg(p("lf.npy")));
+    // One capture at 3 snapshots: the light field and three frames, 14.5 MB.
     let e = failure(&mut simulate_with_captures(
         &p("lf.npy"),
         &p("cap"),
         &p("cc"),
-        &["--leakage", "0.1", "--exposures", "256", "--max-memory", "0.05"],
+        &["--leakage", "0.1", "-s", "3", "--exposures", "1", "--max-memory", "0.013"],
     ));
-    assert!(e.contains("15 kinds of calibration capture x 256 exposures of 80 x 80 pixels needs about"), "{e}");
-    assert!(e.contains("fewer --exposures"), "{e}");
+    assert!(e.contains("a calibration capture of 500 x 500 pixels needs about"), "{e}");
+    assert!(e.contains("a smaller sensor"), "{e}");
     assert!(!p("cap").exists() && !p("cc").exists());
+    // The whole set at one snapshot, 30 captures of 0.5 MB and the light field, is 28 MB;
+    // one capture 13.5 MB.
+    ok(&mut simulate_with_captures(
+        &p("lf.npy"),
+        &p("cap"),
+        &p("cc"),
+        &["--leakage", "0.1", "--exposures", "2", "--max-memory", "0.013"],
+    ));
+    assert_eq!(std::fs::read_dir(p("cc")).unwrap().count(), 30);
+    ok(slf().args(["scene", "smooth", "--size", "16", "-o"]).arg(p("lf.npy")));
     ok(&mut simulate_with_captures(&p("lf.npy"), &p("cap"), &p("cc"), &["--leakage", "0.1", "--exposures", "64"]));
     // 960 captures of 12.8 KB: 12.4 MB, over a cap of 0.01 GiB (10.7 MB).
     let e = failure(slf().arg("calibrate").arg(p("cc")).arg("-o").arg(p("cal")).args(["--max-memory", "0.01"]));

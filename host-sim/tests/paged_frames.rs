@@ -150,7 +150,7 @@ fn the_correction_and_the_aligned_crop_are_read_as_the_decode_asks() {
 
     // The slow obvious correction, whole frames and whole maps.
     let (rows, cols) = held.frame_size();
-    assert!(rows > slf_host::io::calibration::MAP_BAND_ROWS, "the maps are read in more than one band");
+    assert!(rows > slf_host::io::map::MAP_BAND_ROWS, "the maps are read in more than one band");
     let d = &held.description;
     let want: Vec<Vec<u16>> = held
         .held_frames()

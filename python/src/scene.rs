@@ -54,17 +54,16 @@ pub fn simulate<'py>(
             let simulated = settings.run(lf, "lf")?;
             if let Some(dir) = &calibration_captures {
                 let d = &simulated.capture.description;
-                let captures = slf_host::sim::calibration::calibration_captures(
+                let captures = slf_host::sim::calibration::CalibrationCaptures::new(
                     &settings.camera(),
                     d.lenslets,
                     d.views,
                     d.bands_nm.len(),
                     exposures,
                 )?;
-                let outputs =
-                    slf_host::sim::calibration::with_outputs(slf_host::io::output::Outputs::new(), &captures, dir);
+                let outputs = captures.with_outputs(slf_host::io::output::Outputs::new(), &simulated.capture, dir);
                 outputs.check_distinct()?;
-                slf_host::sim::calibration::save(&captures, dir)?;
+                captures.stage(dir)?.persist()?;
             }
             Ok(simulated)
         })

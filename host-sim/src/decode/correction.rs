@@ -14,11 +14,13 @@ use std::sync::Arc;
 use anyhow::{Result, ensure};
 
 use crate::decode::calibrate::DEAD_FLAT;
-use crate::io::calibration::{MAP_BAND_ROWS, Map, OpenCalibration};
+use crate::io::calibration::OpenCalibration;
 use crate::io::capture::Capture;
 use crate::io::frames::Frames;
 use crate::io::grid::GridDescription;
+use crate::io::map::{MAP_BAND_ROWS, Map};
 use crate::io::paged_frame::{FrameRows, PagedFrame};
+use crate::io::row_reader::by_bands;
 
 /// The correction of one sensor's raw values: its maps and levels.
 #[derive(Debug)]
@@ -28,7 +30,6 @@ struct Correction {
     black: f32,
     /// Raw values at or above it are saturated: corrected to the top of 16 bits, left out.
     saturation: f32,
-    cols: usize,
 }
 
 impl Correction {
@@ -126,7 +127,6 @@ pub fn corrected(capture: &Capture, cal: &OpenCalibration, keep_grid: bool) -> R
         flat: cal.flat.clone(),
         black: d.black_level,
         saturation: d.saturation_level,
-        cols,
     });
     let frames = match &capture.frames {
         Frames::Paged(raw) => Frames::Paged(
@@ -138,10 +138,12 @@ pub fn corrected(capture: &Capture, cal: &OpenCalibration, keep_grid: bool) -> R
             let mut all = Vec::with_capacity(raw.len());
             for f in raw {
                 let mut out = vec![0u16; rows * cols];
-                let band = MAP_BAND_ROWS * correction.cols.max(1);
-                for (i, (r, o)) in f.chunks(band).zip(out.chunks_mut(band)).enumerate() {
-                    correction.apply(i * MAP_BAND_ROWS, r, o)?;
-                }
+                let read =
+                    |first: usize, part: &mut [u16]| correction.apply(first, &f[first * cols..][..part.len()], part);
+                by_bands((rows, cols), MAP_BAND_ROWS, read, |first, part| {
+                    out[first * cols..][..part.len()].copy_from_slice(part);
+                    Ok(())
+                })?;
                 all.push(out);
             }
             Frames::Held(all)
@@ -171,5 +173,6 @@ pub fn corrected(capture: &Capture, cal: &OpenCalibration, keep_grid: bool) -> R
     description.defective_pixels = defects.into_iter().collect();
     let mut out = Capture::with_frames(description, frames)?;
     out.keep_source_of(capture);
+    out.divided_by(cal.flat.clone());
     Ok((out, moved))
 }

@@ -40,11 +40,13 @@
 //! blend's ([`crate::decode::blend`]), whose tallies then estimate the blended output.
 
 use crate::io::frames::SensorFrame;
+use crate::io::map::Map;
 use anyhow::{Result, ensure};
 use slf_firmware::holdout::noise_variance;
 use slf_firmware::raw::Invalid;
 use slf_firmware::{Frame, HoldOut, MaskFamily, RowSink};
 
+use crate::decode::calibrate::DEAD_FLAT;
 use crate::decode::plan::FramePlan;
 use crate::decode::strip::{Pass, decode_rows};
 use crate::io::lightfield::LightField;
@@ -239,6 +241,8 @@ struct Tallies<'a, const PU: usize, const PV: usize, const N: usize> {
     tallies: Vec<Tally>,
     /// A second prediction of the held-out samples, from the same samples (a baseline's).
     other: Option<&'a LightField>,
+    /// The per-pixel flat the frames were divided by ([`FramePlan::flat`]).
+    flat: Option<&'a Map>,
 }
 
 impl<const PU: usize, const PV: usize, const N: usize> RowSink for Tallies<'_, PU, PV, N> {
@@ -253,6 +257,17 @@ impl<const PU: usize, const PV: usize, const N: usize> RowSink for Tallies<'_, P
         let top = f64::from(c.raw.range().1);
         let frame = self.decoder.frame_size();
         let (lu, lv) = s.views;
+        // The lenslet row's rows of the flat: a corrected value's noise is the raw value's
+        // over its pixel's flat.
+        let mut flats = Vec::new();
+        if let Some(map) = self.flat {
+            flats = vec![1.0f32; lu * map.cols()];
+            map.read_rows(y * lu, &mut flats)?;
+        }
+        let pixel_flat = |u: usize, cc: usize| match self.flat {
+            Some(map) => flats.get(u * map.cols() + cc).map_or(1.0, |&f| f.max(DEAD_FLAT)),
+            None => 1.0,
+        };
         for x in 0..s.cols {
             let mut t = Tally::default();
             for u in 0..lu {
@@ -275,7 +290,7 @@ impl<const PU: usize, const PV: usize, const N: usize> RowSink for Tallies<'_, P
                         // value under it errs by the gap at least.
                         let (d, e) = match seen {
                             Ok(seen) => {
-                                let flat = self.decoder.view_gain(r, cc);
+                                let flat = self.decoder.view_gain(r, cc) * pixel_flat(u, cc);
                                 t.variance += f64::from(noise_variance(noise, shot, seen, flat));
                                 (predicted - f64::from(seen), other - f64::from(seen))
                             }
@@ -349,6 +364,7 @@ impl HeldOutDecode {
         }
         let mut sink = Tallies {
             decoder: &plan.decoder,
+            flat: plan.flat.as_ref(),
             raw,
             hiding,
             shape,

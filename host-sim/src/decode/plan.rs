@@ -12,6 +12,7 @@ use slf_firmware::{FrameSource, HoldOut, ModelTrial, PairedErrors, Pick, ShearTr
 use crate::decode::options::{Balance, DecodeOptions, EstimateBy};
 use crate::decode::trial::{frame_shear_trial, frame_trial, pilot_budget};
 use crate::io::capture::Capture;
+use crate::io::map::Map;
 use crate::io::patch::{BANDS, HostDecoder, HostModel};
 use crate::io::rows::RowShape;
 
@@ -40,6 +41,9 @@ pub struct FramePlan<'a, const PU: usize, const PV: usize, const N: usize> {
     pub alias: bool,
     /// The model trial, where it ran.
     pub model_trial: Option<ModelTrial>,
+    /// The per-pixel flat the frames were divided by (a calibrated capture): the error
+    /// estimate's noise term divides the raw noise by it.
+    pub flat: Option<Map>,
 }
 
 impl<'a, const PU: usize, const PV: usize, const N: usize> FramePlan<'a, PU, PV, N> {
@@ -132,6 +136,7 @@ impl<'a, const PU: usize, const PV: usize, const N: usize> FramePlan<'a, PU, PV,
             shear_trial,
             alias,
             model_trial,
+            flat: capture.flat().cloned(),
         })
     }
 }

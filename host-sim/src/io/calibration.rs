@@ -6,7 +6,6 @@
 //! before anything is allocated (`docs/capture-format.md`, "Calibration").
 
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 
 use anyhow::{Result, anyhow, bail, ensure};
 
@@ -17,6 +16,7 @@ use crate::io::capture::MAX_DESCRIPTION;
 use crate::io::file_checks::read_small_file;
 use crate::io::grid::GridDescription;
 use crate::io::lightfield::write_npy_f32_2d;
+use crate::io::map::Map;
 use crate::io::message::number;
 use crate::io::npy::{self, Element, Values};
 use crate::io::output::write_bytes;
@@ -267,53 +267,6 @@ fn check_flat_rows(first_row: usize, flat: &[f32], cols: usize) -> Result<()> {
     }
     Ok(())
 }
-
-/// A calibration's dark levels or flats as a corrected decode reads them, a few rows at a
-/// time: held, or read from the calibration's file (a decode never holds its 8 bytes a
-/// pixel).
-#[derive(Clone, Debug)]
-pub enum Map {
-    /// Row-major, `cols` a row.
-    Held(Arc<[f32]>, usize),
-    File(RowReader),
-}
-
-impl Map {
-    /// Rows `first..first + out.len() / cols` into `out`.
-    ///
-    /// # Errors
-    /// Rows past the end, or a read that fails, naming the file.
-    pub fn read_rows(&self, first: usize, out: &mut [f32]) -> Result<()> {
-        match self {
-            Self::Held(v, cols) => {
-                let at = first * cols;
-                let part = v.get(at..at + out.len()).ok_or_else(|| anyhow!("rows {first}.. past the map's end"))?;
-                out.copy_from_slice(part);
-                Ok(())
-            }
-            Self::File(f) => f.read_f32(first, out),
-        }
-    }
-
-    /// Calls `f(first row, values)` on the map's rows `rows x cols`, a band at a time.
-    ///
-    /// # Errors
-    /// A read that fails, or what `f` returns.
-    pub fn visit(&self, (rows, cols): (usize, usize), mut f: impl FnMut(usize, &[f32]) -> Result<()>) -> Result<()> {
-        let band = MAP_BAND_ROWS.min(rows.max(1));
-        let mut values = vec![0.0f32; band * cols];
-        for first in (0..rows).step_by(band) {
-            let part = &mut values[..band.min(rows - first) * cols];
-            self.read_rows(first, part)?;
-            f(first, part)?;
-        }
-        Ok(())
-    }
-}
-
-/// The rows of a map read at once where it is streamed (its checks, a corrected frame
-/// held whole).
-pub const MAP_BAND_ROWS: usize = 64;
 
 /// A calibration opened for a corrected decode: its description, checked as
 /// [`Calibration::load`] checks it, and its maps read by rows ([`Map`]).

@@ -16,8 +16,9 @@ use slf_firmware::{
 use crate::io::file_checks::read_small_file;
 use crate::io::folder::{FileRecord, Kind, WholeFolder, record, verify};
 use crate::io::frame_file::{extension, write_frame};
-use crate::io::frames::{Frames, SensorFrame};
+use crate::io::frames::{Frames, SensorFrame, frame_path, inside, is_frame_name};
 use crate::io::grid::GridDescription;
+use crate::io::map::Map;
 use crate::io::message::one_line;
 use crate::io::output::write_bytes;
 use crate::io::sensor::SensorDescription;
@@ -193,6 +194,9 @@ pub struct Capture {
     defects: Vec<Pixel>,
     /// The `capture.json` it was loaded from, if any.
     source: Option<PathBuf>,
+    /// The per-pixel flat its frames were divided by (corrected by a calibration): a
+    /// value's noise is the raw value's over it.
+    flat: Option<Map>,
 }
 
 impl Capture {
@@ -276,7 +280,7 @@ impl Capture {
                 n.full_well_electrons
             );
         }
-        let capture = Self { description, frames, tile_bands, defects, source: None };
+        let capture = Self { description, frames, tile_bands, defects, source: None, flat: None };
         let mask = capture.mask()?;
         ensure!(
             mask.snapshots() == capture.frames.len(),
@@ -430,9 +434,22 @@ impl Capture {
     }
 
     /// Names `other`'s folder as this capture's (a capture made from it: corrected, read
-    /// as aligned), so errors say which capture.
+    /// as aligned), so errors say which capture, and keeps the flat its frames were
+    /// divided by.
     pub fn keep_source_of(&mut self, other: &Self) {
         self.source.clone_from(&other.source);
+        self.flat.clone_from(&other.flat);
+    }
+
+    /// The flat this capture's frames were divided by ([`Self::divided_by`]), read at the
+    /// frame's rows and columns from the top left (a crop's too).
+    pub fn flat(&self) -> Option<&Map> {
+        self.flat.as_ref()
+    }
+
+    /// Says the frames were divided by `flat` (`decode::correction`).
+    pub fn divided_by(&mut self, flat: Map) {
+        self.flat = Some(flat);
     }
 
     /// The frames in memory, read whole if they are paged ([`Frames::held`]).
@@ -476,7 +493,7 @@ impl Capture {
         Self::load_with(dir, HOLD_BYTES)
     }
 
-    /// [`Self::load`] with every `.npy` and 16-bit PGM frame paged, whatever its size
+    /// [`Self::load`] with every `.npy` and PGM frame paged, whatever its size
     /// (tests and benchmarks of the paged reading).
     ///
     /// # Errors
@@ -596,52 +613,9 @@ impl Capture {
     }
 }
 
-/// Whether `name` is a frame's name as a capture writes it: `snapshot_N.npy`, `.pgm` or
-/// `.png` ([`crate::io::frame_file::frame_names`]); only such files of an old capture are
-/// replaced with it.
-fn is_frame_name(name: &str) -> bool {
-    let Some(rest) = name.strip_prefix("snapshot_") else { return false };
-    let Some((n, ext)) = rest.split_once('.') else { return false };
-    !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()) && matches!(ext, "npy" | "pgm" | "png")
-}
-
 /// The folder path's description file.
 pub fn description_path(dir: &Path) -> PathBuf {
     dir.join(DESCRIPTION)
-}
-
-/// A frame's path: `name` must be a relative path inside the capture folder.
-///
-/// # Errors
-/// An absolute path, `..`, or an empty name.
-pub fn frame_path(dir: &Path, name: &str) -> Result<PathBuf> {
-    use std::path::Component;
-    let rel = Path::new(name);
-    ensure!(!name.is_empty(), "an empty file name");
-    ensure!(
-        rel.components().all(|c| matches!(c, Component::Normal(_) | Component::CurDir)),
-        "{name:?} is not a path inside the capture folder (no absolute paths, no '..')"
-    );
-    Ok(dir.join(rel))
-}
-
-/// Checks that `path` (a frame of the capture folder `dir`) resolves inside `dir`: a
-/// symbolic link to a file elsewhere is not read as the capture's.
-///
-/// # Errors
-/// Where the link leads, or an I/O error resolving it.
-fn inside(dir: &Path, path: &Path) -> Result<()> {
-    let (Ok(d), Ok(p)) = (fs::canonicalize(dir), fs::canonicalize(path)) else {
-        // Missing files are named by the reader, which opens them next.
-        return Ok(());
-    };
-    ensure!(
-        p.starts_with(&d),
-        "{} leads to {}, outside the capture folder (frames are read from inside it only)",
-        path.display(),
-        p.display()
-    );
-    Ok(())
 }
 
 impl CaptureDescription {

@@ -4,7 +4,7 @@
 use std::fs;
 use std::path::Path;
 
-use anyhow::{Context, Result, ensure};
+use anyhow::{Context, Result, anyhow, ensure};
 
 /// Reads a regular file of at most `max` bytes as text; larger files, FIFOs and devices are
 /// refused before reading.
@@ -27,4 +27,18 @@ pub fn regular_file(path: &Path, max: u64, why: &str) -> Result<u64> {
     ensure!(meta.is_file(), "{}: not a regular file (a FIFO, device or folder is not read)", path.display());
     ensure!(meta.len() <= max, "{}: {} bytes, more than the {max} {why}", path.display(), meta.len());
     Ok(meta.len())
+}
+
+/// A frame file's size, `(rows, cols)` from its header, against the capture's (`expect`):
+/// checked before its pixels are read (a sparse file or a small PNG can claim gigabytes).
+///
+/// # Errors
+/// Another size, both named.
+pub fn check_size(path: &Path, (rows, cols): (u64, u64), expect: Option<(usize, usize)>) -> Result<()> {
+    match expect {
+        Some((r, c)) if (rows, cols) != (r as u64, c as u64) => {
+            Err(anyhow!("{}: frame is {rows} x {cols}, the capture's frames are {r} x {c}", path.display()))
+        }
+        _ => Ok(()),
+    }
 }

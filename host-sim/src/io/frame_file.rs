@@ -10,6 +10,7 @@ use anyhow::{Context, Result, anyhow, bail, ensure};
 use crate::io::file_checks::regular_file;
 use crate::io::lightfield::{read_npy_u16_2d, write_npy_u16_2d};
 use crate::io::output::write_whole;
+use crate::io::row_reader::RowReader;
 
 /// A raw frame as read from a file.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -31,20 +32,12 @@ pub struct FrameFile {
 /// A message with the file and what is wrong.
 pub fn read_frame(path: &Path, expect: Option<(usize, usize)>) -> Result<FrameFile> {
     let len = regular_file(path, u64::MAX, "")?;
-    // A header that claims another size is refused before its pixels are read: a sparse
-    // file or a small PNG can claim gigabytes.
-    let sized = |rows: u64, cols: u64| match expect {
-        Some((r, c)) if (rows, cols) != (r as u64, c as u64) => {
-            Err(anyhow!("{}: frame is {rows} x {cols}, the capture's frames are {r} x {c}", path.display()))
-        }
-        _ => Ok(()),
-    };
     match extension(path).as_str() {
         "npy" => {
             let (data, rows, cols) = read_npy_u16_2d(path, expect)?;
             Ok(FrameFile { data, rows, cols, top: u32::from(u16::MAX) })
         }
-        "pgm" => read_pgm(path, len, &sized),
+        "pgm" => read_pgm(path, expect),
         "png" => {
             use image::ImageDecoder;
             // As a PGM: bytes after the image's end (IEND) are refused, not ignored.
@@ -62,7 +55,7 @@ pub fn read_frame(path: &Path, expect: Option<(usize, usize)>) -> Result<FrameFi
                 .into_decoder()
                 .with_context(undecodable)?;
             let (w, h) = decoder.dimensions();
-            sized(u64::from(h), u64::from(w))?;
+            crate::io::file_checks::check_size(path, (u64::from(h), u64::from(w)), expect)?;
             let img = image::DynamicImage::from_decoder(decoder).with_context(undecodable)?;
             let color = img.color();
             let top = match color {
@@ -104,52 +97,14 @@ fn png_end(path: &Path) -> Result<u64> {
     }
 }
 
-/// A binary PGM: the header through the image library, the samples as stored.
-fn read_pgm(path: &Path, file_len: u64, sized: &dyn Fn(u64, u64) -> Result<()>) -> Result<FrameFile> {
-    use image::codecs::pnm::{PnmDecoder, PnmSubtype, SampleEncoding};
-    let file = fs::File::open(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let decoder = PnmDecoder::new(std::io::BufReader::new(file))
-        .map_err(|e| anyhow!("{}: not a PGM file: {e}", path.display()))?;
-    let (mut reader, header) = decoder.into_inner();
-    ensure!(
-        header.subtype() == PnmSubtype::Graymap(SampleEncoding::Binary),
-        "{}: a raw frame is a binary PGM (P5), this file is {:?}",
-        path.display(),
-        header.subtype()
-    );
-    let (w, h, top) = (header.width(), header.height(), header.maximal_sample());
-    ensure!((1..=65535).contains(&top), "{}: MAXVAL {top} out of 1..=65535", path.display());
-    sized(u64::from(h), u64::from(w))?;
-    let bytes_per = if top > 255 { 2u64 } else { 1 };
-    let count = u64::from(w) * u64::from(h);
-    ensure!(
-        count * bytes_per <= file_len,
-        "{}: {w} x {h} pixels need {} bytes, the file has {file_len}",
-        path.display(),
-        count * bytes_per
-    );
-    let mut raw = vec![0u8; (count * bytes_per) as usize];
-    std::io::Read::read_exact(&mut reader, &mut raw)
-        .with_context(|| format!("{}: truncated: {w} x {h} pixels promised", path.display()))?;
-    // A frame file holds one image: bytes after it mean a writer that disagrees with the
-    // header (a wrong size, a second image), so the file is refused, not half read.
-    let mut rest = [0u8; 1];
-    let extra =
-        std::io::Read::read(&mut reader, &mut rest).with_context(|| format!("cannot read {}", path.display()))?;
-    ensure!(
-        extra == 0,
-        "{}: bytes after the {w} x {h} pixels the header promises (the file is longer than its image)",
-        path.display()
-    );
-    let data: Vec<u16> = if bytes_per == 2 {
-        raw.chunks_exact(2).map(|c| u16::from_be_bytes([c[0], c[1]])).collect()
-    } else {
-        raw.iter().map(|&x| u16::from(x)).collect()
-    };
-    if let Some(i) = data.iter().position(|&x| u32::from(x) > top) {
-        bail!("{}: pixel ({}, {}) is {}, above MAXVAL {top}", path.display(), i / w as usize, i % w as usize, data[i]);
-    }
-    Ok(FrameFile { data, rows: h as usize, cols: w as usize, top })
+/// A binary PGM, checked and read by [`RowReader::open_pgm`] (the paged reading's own
+/// checks: one set), the samples as stored.
+fn read_pgm(path: &Path, expect: Option<(usize, usize)>) -> Result<FrameFile> {
+    let (reader, top) = RowReader::open_pgm(path, expect)?;
+    let (rows, cols) = reader.size();
+    let mut data = vec![0u16; rows * cols];
+    reader.read_u16(0, &mut data)?;
+    Ok(FrameFile { data, rows, cols, top })
 }
 
 /// Writes a 16-bit raw frame; the extension picks PGM, PNG or `.npy`.

@@ -1,6 +1,6 @@
 //! A capture's raw frames, one per snapshot ([`Frames`]): held in memory (made by the
-//! simulator, given from numpy, or read from a PNG or 8-bit PGM), or read from their
-//! `.npy` or 16-bit PGM files a band of rows at a time ([`PagedFrame`]); and the frame the decoder reads either way
+//! simulator, given from numpy, or read from a PNG), or read from their `.npy` or PGM
+//! files a band of rows at a time ([`PagedFrame`]); and the frame the decoder reads either way
 //! ([`SensorFrame`]).
 //!
 //! Whole-frame work (a calibration's correction, a capture saved again, the frames handed
@@ -9,6 +9,7 @@
 //! paged one (cropped here, corrected by `decode::correction`) is paged too.
 
 use std::borrow::Cow;
+use std::fs;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -17,6 +18,7 @@ use slf_firmware::{Frame, RawFrame};
 
 use crate::io::frame_file::{extension, read_frame};
 use crate::io::paged_frame::{FrameRows, PagedFrame};
+use crate::io::row_reader::by_bands;
 
 /// A capture's frames, one per snapshot, row-major.
 #[derive(Clone, Debug)]
@@ -36,7 +38,7 @@ pub enum SensorFrame<'a> {
 
 impl Frames {
     /// Opens a capture's frame files, each `rows x cols`. Past `hold_bytes` in all, `.npy`
-    /// and 16-bit PGM frames are read as the decode asks, a band of rows at a time: their
+    /// and PGM frames are read as the decode asks, a band of rows at a time: their
     /// header and length (and a PGM's values against its MAXVAL) are checked now. The
     /// others are read whole. `fits(path, top)` checks a file's largest value (its MAXVAL or
     /// bit depth) against the capture's saturation level.
@@ -57,7 +59,7 @@ impl Frames {
                 "pgm" => {
                     let (frame, top) = PagedFrame::open_pgm(path, (rows, cols))?;
                     fits(path, top)?;
-                    frame
+                    Some(frame)
                 }
                 _ => None,
             };
@@ -155,15 +157,13 @@ impl Frames {
         match self {
             Self::Held(frames) => frames.iter().enumerate().for_each(|(j, v)| f(j, 0, v)),
             Self::Paged(frames) => {
-                let band = crate::io::paged_frame::MIN_BAND_ROWS;
-                let mut values = vec![0u16; band * cols];
                 for (j, frame) in frames.iter().enumerate() {
-                    for first in (0..rows).step_by(band) {
-                        let n = band.min(rows - first);
-                        let part = &mut values[..n * cols];
-                        frame.read_rows(first, part)?;
+                    let band = crate::io::paged_frame::MIN_BAND_ROWS;
+                    let read = |first, part: &mut [u16]| frame.read_rows(first, part);
+                    by_bands((rows, cols), band, read, |first, part| {
                         f(j, first, part);
-                    }
+                        Ok(())
+                    })?;
                 }
             }
         }
@@ -283,4 +283,47 @@ impl Frame for SensorFrame<'_> {
             Self::Paged(f) => f.read_run(start, out),
         }
     }
+}
+
+/// Whether `name` is a frame's name as a capture writes it: `snapshot_N.npy`, `.pgm` or
+/// `.png` ([`crate::io::frame_file::frame_names`]); only such files of an old capture are
+/// replaced with it.
+pub(crate) fn is_frame_name(name: &str) -> bool {
+    let Some(rest) = name.strip_prefix("snapshot_") else { return false };
+    let Some((n, ext)) = rest.split_once('.') else { return false };
+    !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()) && matches!(ext, "npy" | "pgm" | "png")
+}
+
+/// A frame's path: `name` must be a relative path inside the capture folder.
+///
+/// # Errors
+/// An absolute path, `..`, or an empty name.
+pub fn frame_path(dir: &Path, name: &str) -> Result<PathBuf> {
+    use std::path::Component;
+    let rel = Path::new(name);
+    ensure!(!name.is_empty(), "an empty file name");
+    ensure!(
+        rel.components().all(|c| matches!(c, Component::Normal(_) | Component::CurDir)),
+        "{name:?} is not a path inside the capture folder (no absolute paths, no '..')"
+    );
+    Ok(dir.join(rel))
+}
+
+/// Checks that `path` (a frame of the capture folder `dir`) resolves inside `dir`: a
+/// symbolic link to a file elsewhere is not read as the capture's.
+///
+/// # Errors
+/// Where the link leads, or an I/O error resolving it.
+pub(crate) fn inside(dir: &Path, path: &Path) -> Result<()> {
+    let (Ok(d), Ok(p)) = (fs::canonicalize(dir), fs::canonicalize(path)) else {
+        // Missing files are named by the reader, which opens them next.
+        return Ok(());
+    };
+    ensure!(
+        p.starts_with(&d),
+        "{} leads to {}, outside the capture folder (frames are read from inside it only)",
+        path.display(),
+        p.display()
+    );
+    Ok(())
 }

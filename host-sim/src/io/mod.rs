@@ -5,8 +5,10 @@
 //!   memory order, every size checked before anything is allocated;
 //! - [`lightfield`]: the `(U, V, H, W, B)` light field and its `.npy` files;
 //! - [`npy_rows`]: a light field's `.npy` file written as its rows come;
-//! - [`row_reader`]: a two-axis array in a file (a `.npy`'s or a 16-bit PGM's body) read a
+//! - [`row_reader`]: a two-axis array in a file (a `.npy`'s or a binary PGM's body) read a
 //!   few rows at a time (paged frames, calibration maps);
+//! - [`map`]: a per-pixel map of the sensor (a calibration's dark levels or flats) read a
+//!   few rows at a time;
 //! - [`budget`]: the memory a command may take, checked before the work starts;
 //! - [`calibration`]: the calibration folder `slf calibrate` writes and a calibrated
 //!   decode reads;
@@ -49,6 +51,7 @@ pub mod import;
 pub mod interrupt;
 pub mod json;
 pub mod lightfield;
+pub mod map;
 pub mod message;
 pub mod npy;
 pub mod npy_rows;

@@ -137,15 +137,14 @@ impl PagedFrame {
         Ok(reader.map(|r| Self::new(Arc::new(r))))
     }
 
-    /// Opens a 16-bit binary PGM raw frame of `rows x cols` ([`RowReader::open_pgm`]: every
-    /// check of a whole read, now), its values read as the decode asks; `None` for one
-    /// read whole (8-bit). The file's MAXVAL beside.
+    /// Opens a binary PGM raw frame of `rows x cols` ([`RowReader::open_pgm`]: every check
+    /// of a whole read, now), its values read as the decode asks. The file's MAXVAL beside.
     ///
     /// # Errors
     /// The file and what is wrong with it.
-    pub fn open_pgm(path: &Path, size: (usize, usize)) -> Result<(Option<Self>, u32)> {
-        let (reader, top) = RowReader::open_pgm(path, size)?;
-        Ok((reader.map(|r| Self::new(Arc::new(r))), top))
+    pub fn open_pgm(path: &Path, size: (usize, usize)) -> Result<(Self, u32)> {
+        let (reader, top) = RowReader::open_pgm(path, Some(size))?;
+        Ok((Self::new(Arc::new(reader)), top))
     }
 
     /// The frame `source` reads, paged, with the decode's cache.

@@ -1,7 +1,9 @@
 //! A two-axis array stored row-major in a file, read a few rows at a time ([`RowReader`]):
-//! a `.npy` file's body (the reading twin of [`crate::io::npy_rows`]) or a 16-bit binary
-//! PGM's. The raw frames a decode pages ([`crate::io::paged_frame`]) and a calibration's
-//! dark and flat maps, which a corrected decode reads beside them, never whole.
+//! a `.npy` file's body (the reading twin of [`crate::io::npy_rows`]) or a binary PGM's
+//! (8- or 16-bit). The raw frames a decode pages ([`crate::io::paged_frame`]), read whole
+//! too ([`crate::io::frame_file`]: one set of checks), and a calibration's dark and flat
+//! maps, which a corrected decode reads beside them, never whole. [`by_bands`]: a pass
+//! over such an array holding one band.
 //!
 //! The file stays open from [`RowReader::open_npy`] or [`RowReader::open_pgm`] on: a file renamed or deleted during the
 //! decode is still the file that was checked; one cut short reads as an error naming the
@@ -16,6 +18,22 @@ use anyhow::{Result, anyhow};
 
 use crate::io::npy::{self, Element, NpyError, NpyErrorKind};
 
+/// How a value is stored: a `.npy` file's element, or a byte (an 8-bit PGM).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Stored {
+    Npy(Element),
+    U8,
+}
+
+impl Stored {
+    fn size(self) -> usize {
+        match self {
+            Stored::Npy(e) => e.size() as usize,
+            Stored::U8 => 1,
+        }
+    }
+}
+
 /// A row-major two-axis array in a file, open for reading rows; a copy shares the file.
 #[derive(Clone, Debug)]
 pub struct RowReader {
@@ -25,7 +43,7 @@ pub struct RowReader {
     body: u64,
     /// Big-endian values.
     swap: bool,
-    element: Element,
+    stored: Stored,
     rows: usize,
     cols: usize,
 }
@@ -70,20 +88,20 @@ impl RowReader {
             file: Arc::new(Mutex::new(file)),
             body: layout.body,
             swap: layout.swap,
-            element: layout.element,
+            stored: Stored::Npy(layout.element),
             rows,
             cols,
         }))
     }
 
-    /// A 16-bit binary PGM (P5, MAXVAL above 255) of `rows x cols`: its header, length and
-    /// every value against its MAXVAL checked now, in one pass of bands, as
-    /// [`crate::io::frame_file::read_frame`] checks it whole (the same messages); its values
-    /// read later as asked. `None` for an 8-bit PGM (read whole), and the MAXVAL beside.
+    /// A binary PGM (P5): its header (MAXVAL in 1..=65535; with `expect`, its size against
+    /// the capture's before anything else is read), its length and every value against
+    /// its MAXVAL checked now, in one pass of bands; its values read later as asked, or
+    /// whole ([`crate::io::frame_file::read_frame`] reads it so). Its MAXVAL beside.
     ///
     /// # Errors
     /// The file and what is wrong with it.
-    pub fn open_pgm(path: &Path, (rows, cols): (usize, usize)) -> Result<(Option<Self>, u32)> {
+    pub fn open_pgm(path: &Path, expect: Option<(usize, usize)>) -> Result<(Self, u32)> {
         use image::codecs::pnm::{PnmDecoder, PnmSubtype, SampleEncoding};
         let len = crate::io::file_checks::regular_file(path, u64::MAX, "")?;
         let file = File::open(path).map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
@@ -98,17 +116,22 @@ impl RowReader {
             ));
         }
         let (w, h, top) = (header.width(), header.height(), header.maximal_sample());
-        if top <= 255 || (h as usize, w as usize) != (rows, cols) {
-            return Ok((None, top)); // read whole, where every other fault is named
+        if !(1..=65535).contains(&top) {
+            return Err(anyhow!("{}: MAXVAL {top} out of 1..=65535", path.display()));
         }
+        crate::io::file_checks::check_size(path, (u64::from(h), u64::from(w)), expect)?;
+        let (rows, cols) = (h as usize, w as usize);
+        let stored = if top > 255 { Stored::Npy(Element::U16) } else { Stored::U8 };
         let body = reader.stream_position().map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
-        let need = (rows * cols * 2) as u64;
+        let need = u64::from(w) * u64::from(h) * stored.size() as u64;
         if need > len {
             return Err(anyhow!("{}: {w} x {h} pixels need {need} bytes, the file has {len}", path.display()));
         }
         if body + need > len {
             return Err(anyhow!("{}: truncated: {w} x {h} pixels promised", path.display()));
         }
+        // A frame file holds one image: bytes after it mean a writer that disagrees with
+        // the header (a wrong size, a second image), so the file is refused, not half read.
         if body + need < len {
             return Err(anyhow!(
                 "{}: bytes after the {w} x {h} pixels the header promises (the file is longer than its image)",
@@ -121,28 +144,30 @@ impl RowReader {
             file: Arc::new(Mutex::new(file)),
             body,
             swap: true,
-            element: Element::U16,
+            stored,
             rows,
             cols,
         };
         // Every value against MAXVAL, a band at a time.
-        let band = 64.min(rows.max(1));
-        let mut values = vec![0u16; band * cols];
-        for first in (0..rows).step_by(band) {
-            let part = &mut values[..band.min(rows - first) * cols];
-            this.read_u16(first, part)?;
-            if let Some(i) = part.iter().position(|&x| u32::from(x) > top) {
-                let p = first * cols + i;
-                return Err(anyhow!(
-                    "{}: pixel ({}, {}) is {}, above MAXVAL {top}",
-                    path.display(),
-                    p / cols,
-                    p % cols,
-                    part[i]
-                ));
-            }
-        }
-        Ok((Some(this), top))
+        by_bands(
+            (rows, cols),
+            64,
+            |first, part: &mut [u16]| this.read_u16(first, part),
+            |first, part| match part.iter().position(|&x| u32::from(x) > top) {
+                Some(i) => {
+                    let p = first * cols + i;
+                    Err(anyhow!(
+                        "{}: pixel ({}, {}) is {}, above MAXVAL {top}",
+                        path.display(),
+                        p / cols,
+                        p % cols,
+                        part[i]
+                    ))
+                }
+                None => Ok(()),
+            },
+        )?;
+        Ok((this, top))
     }
 
     /// `(rows, cols)`.
@@ -159,7 +184,7 @@ impl RowReader {
     fn bytes(&self, first: usize, values: usize) -> Result<Vec<u8>> {
         let (rows, cols) = (self.rows, self.cols.max(1));
         let n = values / cols;
-        let size = self.element.size() as usize;
+        let size = self.stored.size();
         if !values.is_multiple_of(cols) || first + n > rows {
             return Err(anyhow!("{}: rows {first}..{} of a {rows} x {cols} array", self.path.display(), first + n));
         }
@@ -178,13 +203,21 @@ impl RowReader {
     /// # Errors
     /// Rows past the end, a file of floats, or a read that fails: the file and the rows.
     pub fn read_u16(&self, first: usize, out: &mut [u16]) -> Result<()> {
-        if self.element != Element::U16 {
-            return Err(anyhow!("{}: holds floats, not uint16", self.path.display()));
-        }
-        let bytes = self.bytes(first, out.len())?;
-        for (o, b) in out.iter_mut().zip(bytes.chunks_exact(2)) {
-            let b = [b[0], b[1]];
-            *o = if self.swap { u16::from_be_bytes(b) } else { u16::from_le_bytes(b) };
+        match self.stored {
+            Stored::Npy(Element::U16) => {
+                let bytes = self.bytes(first, out.len())?;
+                for (o, b) in out.iter_mut().zip(bytes.chunks_exact(2)) {
+                    let b = [b[0], b[1]];
+                    *o = if self.swap { u16::from_be_bytes(b) } else { u16::from_le_bytes(b) };
+                }
+            }
+            Stored::U8 => {
+                let bytes = self.bytes(first, out.len())?;
+                for (o, &b) in out.iter_mut().zip(&bytes) {
+                    *o = u16::from(b);
+                }
+            }
+            Stored::Npy(_) => return Err(anyhow!("{}: holds floats, not uint16", self.path.display())),
         }
         Ok(())
     }
@@ -196,20 +229,25 @@ impl RowReader {
     /// As [`Self::read_u16`].
     pub fn read_f32(&self, first: usize, out: &mut [f32]) -> Result<()> {
         let bytes = self.bytes(first, out.len())?;
-        match self.element {
-            Element::U16 => {
+        match self.stored {
+            Stored::U8 => {
+                for (o, &b) in out.iter_mut().zip(&bytes) {
+                    *o = f32::from(b);
+                }
+            }
+            Stored::Npy(Element::U16) => {
                 for (o, b) in out.iter_mut().zip(bytes.chunks_exact(2)) {
                     let b = [b[0], b[1]];
                     *o = f32::from(if self.swap { u16::from_be_bytes(b) } else { u16::from_le_bytes(b) });
                 }
             }
-            Element::F32 => {
+            Stored::Npy(Element::F32) => {
                 for (o, b) in out.iter_mut().zip(bytes.chunks_exact(4)) {
                     let b = [b[0], b[1], b[2], b[3]];
                     *o = if self.swap { f32::from_be_bytes(b) } else { f32::from_le_bytes(b) };
                 }
             }
-            Element::F64 => {
+            Stored::Npy(Element::F64) => {
                 for (o, b) in out.iter_mut().zip(bytes.chunks_exact(8)) {
                     let b: [u8; 8] = [b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]];
                     *o = (if self.swap { f64::from_be_bytes(b) } else { f64::from_le_bytes(b) }) as f32;
@@ -218,6 +256,28 @@ impl RowReader {
         }
         Ok(())
     }
+}
+
+/// A pass over a `rows x cols` array a band of `band` rows at a time, holding one band:
+/// `read(first, values)` fills the band of rows from `first` on, `f(first, values)` is given
+/// it. The shape of every streamed check and copy of a frame or a map.
+///
+/// # Errors
+/// The first that `read` or `f` returns.
+pub fn by_bands<T: Copy + Default>(
+    (rows, cols): (usize, usize),
+    band: usize,
+    mut read: impl FnMut(usize, &mut [T]) -> Result<()>,
+    mut f: impl FnMut(usize, &[T]) -> Result<()>,
+) -> Result<()> {
+    let band = band.clamp(1, rows.max(1));
+    let mut values = vec![T::default(); band * cols];
+    for first in (0..rows).step_by(band) {
+        let part = &mut values[..band.min(rows - first) * cols];
+        read(first, part)?;
+        f(first, part)?;
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -245,12 +305,11 @@ mod tests {
         assert!(m.read_u16(0, &mut [0; 3]).is_err(), "floats read as uint16");
     }
 
-    /// A 16-bit PGM's rows equal its whole read; a faulty one (a value above MAXVAL past the
-    /// first band, bytes after the image, a body cut short) is refused with the whole
-    /// read's message; an 8-bit one is left to the whole read.
+    /// A PGM's rows, 16- or 8-bit, equal the values written; a faulty one is refused, naming
+    /// the file and the fault: another size than the capture's, a value above MAXVAL past
+    /// the first band, bytes after the image, a body cut short by one value and by half.
     #[test]
-    fn a_pgm_is_read_by_rows_and_refused_as_a_whole_read_refuses_it() {
-        use crate::io::frame_file::read_frame;
+    fn a_pgm_is_read_by_rows_and_refused_where_it_is_faulty() {
         let dir = tempfile::tempdir().unwrap();
         let (rows, cols) = (70, 3);
         let pgm = |name: &str, top: u32, values: &[u16], extra: &[u8]| {
@@ -265,28 +324,32 @@ mod tests {
         };
         let data: Vec<u16> = (0..rows * cols).map(|i| (i * 37 % 4096) as u16).collect();
         let good = pgm("good.pgm", 4095, &data, &[]);
-        let (r, top) = RowReader::open_pgm(&good, (rows, cols)).unwrap();
-        let r = r.unwrap();
+        let (r, top) = RowReader::open_pgm(&good, Some((rows, cols))).unwrap();
         assert_eq!(top, 4095);
         let mut out = vec![0u16; 5 * cols];
         r.read_u16(66, &mut out[..4 * cols]).unwrap();
         assert_eq!(out[..4 * cols], data[66 * cols..]);
         r.read_u16(0, &mut out).unwrap();
         assert_eq!(out, data[..5 * cols]);
+        let bytes: Vec<u16> = data.iter().map(|&v| v % 251).collect();
+        let small = pgm("eight.pgm", 250, &bytes, &[]);
+        let (r, top) = RowReader::open_pgm(&small, None).unwrap();
+        assert_eq!((top, r.size()), (250, (rows, cols)));
+        let mut floats = vec![0.0f32; 2 * cols];
+        r.read_f32(68, &mut floats).unwrap();
+        assert_eq!(floats, bytes[68 * cols..].iter().map(|&v| f32::from(v)).collect::<Vec<_>>());
         let mut high = data.clone();
         high[68 * cols + 1] = 4096;
         let cut = &data[..data.len() - 1];
-        for (name, path) in [
-            ("above MAXVAL", pgm("high.pgm", 4095, &high, &[])),
-            ("bytes after", pgm("long.pgm", 4095, &data, &[0])),
-            ("cut short", pgm("short.pgm", 4095, cut, &[])),
-            ("half", pgm("half.pgm", 4095, &data[..data.len() / 2], &[])),
+        for (path, size, want) in [
+            (good.clone(), (cols, rows), "frame is 70 x 3, the capture's frames are 3 x 70"),
+            (pgm("high.pgm", 4095, &high, &[]), (rows, cols), "pixel (68, 1) is 4096, above MAXVAL 4095"),
+            (pgm("long.pgm", 4095, &data, &[0]), (rows, cols), "bytes after the 3 x 70 pixels the header promises"),
+            (pgm("short.pgm", 4095, cut, &[]), (rows, cols), "truncated: 3 x 70 pixels promised"),
+            (pgm("half.pgm", 4095, &data[..data.len() / 2], &[]), (rows, cols), "3 x 70 pixels need 420 bytes"),
         ] {
-            let whole = read_frame(&path, Some((rows, cols))).unwrap_err().to_string();
-            let by_rows = RowReader::open_pgm(&path, (rows, cols)).map(|_| ()).unwrap_err().to_string();
-            assert_eq!(by_rows, whole, "{name}");
+            let e = RowReader::open_pgm(&path, Some(size)).map(|_| ()).unwrap_err().to_string();
+            assert!(e.starts_with(&path.display().to_string()) && e.contains(want), "{e}");
         }
-        let small = pgm("eight.pgm", 255, &vec![7; rows * cols], &[]);
-        assert!(matches!(RowReader::open_pgm(&small, (rows, cols)), Ok((None, 255))));
     }
 }

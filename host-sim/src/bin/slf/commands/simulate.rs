@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 use slf_host::io::lightfield::read_npy;
 use slf_host::io::output::Outputs;
-use slf_host::sim::calibration::{self, calibration_captures as calibration_captures_for};
+use slf_host::sim::calibration::{self, CalibrationCaptures};
 use slf_host::sim::settings::SimulateSettings;
 
 #[derive(clap::Args)]
@@ -36,15 +36,13 @@ pub fn run(args: Args) -> Result<()> {
         eprintln!("{n}");
     }
     let d = &simulated.capture.description;
-    let calibration = match &calibration_captures {
-        Some(_) => calibration_captures_for(&settings.camera(), d.lenslets, d.views, d.bands_nm.len(), exposures)?,
-        None => Vec::new(),
-    };
+    // Made one at a time as they are written (one capture's memory, whatever the sensor).
+    let calibration = CalibrationCaptures::new(&settings.camera(), d.lenslets, d.views, d.bands_nm.len(), exposures)?;
     let mut outputs = Outputs::new()
         .input(&input, "the light field")
         .outputs(simulated.capture.files_in(&output), "a file of the capture -o");
     if let Some(dir) = &calibration_captures {
-        outputs = calibration::with_outputs(outputs, &calibration, dir);
+        outputs = calibration.with_outputs(outputs, &simulated.capture, dir);
     }
     outputs.check_distinct()?;
     if let Some(dir) = &calibration_captures {
@@ -53,8 +51,7 @@ pub fn run(args: Args) -> Result<()> {
     // Both folders written before either is put in place: a refused or failed calibration
     // folder leaves no new capture either.
     let capture_folder = simulated.capture.stage(&output)?;
-    let calibration_folder =
-        calibration_captures.as_deref().map(|dir| calibration::stage(&calibration, dir)).transpose()?;
+    let calibration_folder = calibration_captures.as_deref().map(|dir| calibration.stage(dir)).transpose()?;
     capture_folder.persist()?;
     outln!("wrote {} ({} snapshots)", output.display(), simulated.capture.frames.len())?;
     if let (Some(folder), Some(dir)) = (calibration_folder, &calibration_captures) {
