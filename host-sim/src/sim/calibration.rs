@@ -83,8 +83,8 @@ impl CalibrationCaptures {
         self.len() == 0
     }
 
-    /// The sensor's pixels, and a light field's and a capture's bytes.
-    fn sizes(&self) -> (u64, u64, u64) {
+    /// A light field's and a capture's bytes.
+    fn sizes(&self) -> (u64, u64) {
         let pixels = match &self.cam.grid {
             Some(g) => g.grid(self.lenslets, self.views).sensor.iter().map(|&n| n as u64).product(),
             None => (self.lenslets[0] * self.views[0]) as u64 * (self.lenslets[1] * self.views[1]) as u64,
@@ -96,7 +96,7 @@ impl CalibrationCaptures {
             }
         };
         let field = self.lenslets.iter().chain(&self.views).map(|&n| n as u64).product::<u64>() * self.bands as u64 * 4;
-        (pixels, field, snapshots * pixels * 2)
+        (field, snapshots * pixels * 2)
     }
 
     fn what(&self, count: &str) -> String {
@@ -111,7 +111,7 @@ impl CalibrationCaptures {
     /// # Errors
     /// Over the memory cap; the camera's own errors ([`simulate_under`]); what `f` says.
     pub fn for_each(&self, mut f: impl FnMut(String, Capture) -> Result<()>) -> Result<()> {
-        let (_, field, capture) = self.sizes();
+        let (field, capture) = self.sizes();
         crate::io::budget::check(field + capture, &self.what("a calibration capture"), "a smaller sensor")?;
         for (i, (name, light, band, level)) in self.kinds().into_iter().enumerate() {
             let (views, [rows, cols]) = ((self.views[0], self.views[1]), self.lenslets);
@@ -134,7 +134,7 @@ impl CalibrationCaptures {
     /// # Errors
     /// As [`Self::for_each`].
     pub fn collect(&self) -> Result<Vec<(String, Capture)>> {
-        let (_, field, capture) = self.sizes();
+        let (field, capture) = self.sizes();
         let what =
             self.what(&format!("{} kinds of calibration capture x {} exposures", 2 + self.bands, self.exposures));
         crate::io::budget::check(field + self.len() as u64 * capture, &what, "fewer --exposures")?;
