@@ -17,12 +17,17 @@ use slf_host::sim::scene::{SceneSize, named};
 /// The depth scene at 17 x 13 lenslets, pixel mask, `k` snapshots, saved as `.npy` frames and
 /// loaded back: (held, paged).
 fn captures(dir: &Path, k: u8) -> (Capture, Capture) {
+    captures_as(dir, k, "npy")
+}
+
+/// As [`captures`], the frames saved as `ext`.
+fn captures_as(dir: &Path, k: u8, ext: &str) -> (Capture, Capture) {
     let truth = named("depth").unwrap().render(SceneSize { views: (5, 5), rows: 17, cols: 13 });
-    let cam = CameraConfig { frame_ext: "npy".into(), ..CameraConfig::pixel(5, k) };
+    let cam = CameraConfig { frame_ext: ext.into(), ..CameraConfig::pixel(5, k) };
     let held = simulate(&truth, &cam).unwrap();
     held.save(dir).unwrap();
     let paged = Capture::load_paged(dir).unwrap();
-    assert!(paged.frames.is_paged(), "a capture of .npy frames is read as the decode asks");
+    assert!(paged.frames.is_paged(), "a capture of .{ext} frames is read as the decode asks");
     assert!(!held.frames.is_paged());
     (held, paged)
 }
@@ -67,6 +72,26 @@ fn a_paged_capture_decodes_to_the_held_ones_bits_by_every_method() {
     assert!(once.frames.loads() as usize <= bands, "{} band reads for {bands} bands", once.frames.loads());
 }
 
+/// PNG frames are paged too (one decoder going down each file, started again for a band
+/// above it): the default decode with its error estimate and PPID read them to the held
+/// frames' bits, with the decode's cache and with two bands of three rows (every pass
+/// starts the decoders again).
+#[test]
+fn png_frames_are_paged_and_decode_to_the_held_bits() {
+    let dir = tempfile::tempdir().unwrap();
+    let (held, paged) = captures_as(dir.path(), 2, "png");
+    let opts = DecodeOptions { error_estimate: true, ..DecodeOptions::default() };
+    let (want, want_report) = decode_with(&held, &Basis::Dct, &opts).unwrap();
+    for (name, cap) in [("paged", &paged), ("two bands of three rows", &starved(&paged))] {
+        let (got, report) = decode_with(cap, &Basis::Dct, &opts).unwrap();
+        assert!(got.data == want.data, "{name}: the decode differs from the held frames'");
+        assert_eq!(report.patches, want_report.patches, "{name}");
+        assert!(cap.frames.read_error().is_ok() && cap.frames.loads() > 0, "{name}");
+        let p = PpidConfig::default();
+        assert_eq!(ppid(cap, &p).unwrap().0.data, ppid(&held, &p).unwrap().0.data, "{name}: ppid");
+    }
+}
+
 /// A frame file cut short during the decode: the decode fails and names the file; it is not
 /// passed off as flagged pixels.
 #[test]
@@ -87,8 +112,8 @@ fn a_frame_cut_short_after_loading_fails_the_decode() {
     assert!(e.contains("snapshot_0.npy") || e.contains("cannot read row"), "{e}");
 }
 
-/// Through the command line: a capture of `.npy` frames (paged) and the same capture in PGM
-/// (held) decode to the same bytes, by the default decode and by PPID; and a frame cut short
+/// Through the command line: a capture of `.npy` frames and the same capture in PGM and in
+/// PNG (small: held, the PNG read through its row reader) decode to the same bytes, by the default decode and by PPID; and a frame cut short
 /// after `slf decode` checked it is an error, not an output.
 #[test]
 fn the_command_line_decodes_paged_and_held_frames_alike() {
@@ -100,18 +125,18 @@ fn the_command_line_decodes_paged_and_held_frames_alike() {
         assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
     };
     run(&["scene", "depth", "--size", "14", "-o", "lf.npy"]);
-    for f in ["npy", "pgm"] {
+    for f in ["npy", "pgm", "png"] {
         run(&["simulate", "lf.npy", "-o", &format!("cap-{f}"), "-s", "2", "--seed", "3", "--format", f]);
     }
     for method in ["cs", "ppid"] {
-        for f in ["npy", "pgm"] {
+        for f in ["npy", "pgm", "png"] {
             run(&["decode", &format!("cap-{f}"), "-q", "--method", method, "-o", &format!("{method}-{f}.npy")]);
         }
-        let (a, b) = (
-            std::fs::read(p(&format!("{method}-npy.npy"))).unwrap(),
-            std::fs::read(p(&format!("{method}-pgm.npy"))).unwrap(),
-        );
-        assert!(a == b, "{method}: the paged capture's output differs from the held one's");
+        let a = std::fs::read(p(&format!("{method}-npy.npy"))).unwrap();
+        for f in ["pgm", "png"] {
+            let b = std::fs::read(p(&format!("{method}-{f}.npy"))).unwrap();
+            assert!(a == b, "{method}: the {f} capture's output differs from the .npy one's");
+        }
     }
 }
 

@@ -2,14 +2,14 @@
 //! read as the values stored (DN) with its size checked against the capture's before the
 //! pixels are read, and written as `.npy`, `.pgm` or `.png`.
 
-use std::fs;
 use std::path::Path;
 
-use anyhow::{Context, Result, anyhow, bail, ensure};
+use anyhow::{Context, Result, bail, ensure};
 
 use crate::io::file_checks::regular_file;
 use crate::io::lightfield::{read_npy_u16_2d, write_npy_u16_2d};
 use crate::io::output::write_whole;
+use crate::io::png_rows::PngRows;
 use crate::io::row_reader::RowReader;
 
 /// A raw frame as read from a file.
@@ -31,70 +31,51 @@ pub struct FrameFile {
 /// # Errors
 /// A message with the file and what is wrong.
 pub fn read_frame(path: &Path, expect: Option<(usize, usize)>) -> Result<FrameFile> {
-    let len = regular_file(path, u64::MAX, "")?;
+    regular_file(path, u64::MAX, "")?;
     match extension(path).as_str() {
         "npy" => {
             let (data, rows, cols) = read_npy_u16_2d(path, expect)?;
             Ok(FrameFile { data, rows, cols, top: u32::from(u16::MAX) })
         }
         "pgm" => read_pgm(path, expect),
-        "png" => {
-            use image::ImageDecoder;
-            // As a PGM: bytes after the image's end (IEND) are refused, not ignored.
-            let end = png_end(path)?;
-            ensure!(
-                end == len,
-                "{}: {} bytes after the PNG's end chunk (IEND) (the file is longer than its image)",
-                path.display(),
-                len.saturating_sub(end)
-            );
-            let undecodable = || format!("{}: cannot decode image", path.display());
-            let decoder = image::ImageReader::open(path)
-                .and_then(image::ImageReader::with_guessed_format)
-                .with_context(|| format!("cannot read {}", path.display()))?
-                .into_decoder()
-                .with_context(undecodable)?;
-            let (w, h) = decoder.dimensions();
-            crate::io::file_checks::check_size(path, (u64::from(h), u64::from(w)), expect)?;
-            let img = image::DynamicImage::from_decoder(decoder).with_context(undecodable)?;
-            let color = img.color();
-            let top = match color {
-                image::ColorType::L8 => 255,
-                image::ColorType::L16 => 65535,
-                _ => bail!("{}: raw frame must be single-channel grey, found {color:?}", path.display()),
-            };
-            let g = img.into_luma16();
-            let (w, h) = g.dimensions();
-            let data = if top == 255 { g.into_raw().iter().map(|&x| x / 257).collect() } else { g.into_raw() };
-            Ok(FrameFile { data, rows: h as usize, cols: w as usize, top })
-        }
+        "png" => match PngRows::open(path, expect)? {
+            Some((reader, top)) => {
+                let (rows, cols) = reader.size();
+                let mut data = vec![0u16; rows * cols];
+                reader.read_rows(0, &mut data)?;
+                Ok(FrameFile { data, rows, cols, top })
+            }
+            // Interlaced, another depth or colour: the image library reads it, and
+            // refuses what is not grey.
+            None => read_png_whole(path, expect),
+        },
         other => bail!("{}: unknown frame format {other:?} (use .pgm, .png or .npy)", path.display()),
     }
 }
 
-/// Where a PNG file's image ends: the byte after its IEND chunk, found by walking the
-/// chunks' headers (length, type; each chunk is length + 12 bytes). Chunks are not read.
-///
-/// # Errors
-/// A file that is not a PNG, or ends before IEND.
-fn png_end(path: &Path) -> Result<u64> {
-    use std::io::{Read, Seek, SeekFrom};
-    let bad = |what: &str| anyhow!("{}: cannot decode image: {what}", path.display());
-    let mut f = fs::File::open(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let mut signature = [0u8; 8];
-    f.read_exact(&mut signature).map_err(|_| bad("not a PNG file"))?;
-    ensure!(signature == *b"\x89PNG\r\n\x1a\n", bad("not a PNG file"));
-    let mut at = 8u64;
-    loop {
-        let mut head = [0u8; 8];
-        f.read_exact(&mut head).map_err(|_| bad("the file ends before its end chunk (IEND)"))?;
-        let length = u64::from(u32::from_be_bytes([head[0], head[1], head[2], head[3]]));
-        at += 12 + length;
-        if &head[4..] == b"IEND" {
-            return Ok(at);
-        }
-        f.seek(SeekFrom::Start(at)).with_context(|| format!("cannot read {}", path.display()))?;
-    }
+/// A PNG that [`PngRows`] does not read by rows (its end and size were checked by
+/// [`PngRows::open`]), decoded whole by the image library.
+fn read_png_whole(path: &Path, expect: Option<(usize, usize)>) -> Result<FrameFile> {
+    use image::ImageDecoder;
+    let undecodable = || format!("{}: cannot decode image", path.display());
+    let decoder = image::ImageReader::open(path)
+        .and_then(image::ImageReader::with_guessed_format)
+        .with_context(|| format!("cannot read {}", path.display()))?
+        .into_decoder()
+        .with_context(undecodable)?;
+    let (w, h) = decoder.dimensions();
+    crate::io::file_checks::check_size(path, (u64::from(h), u64::from(w)), expect)?;
+    let img = image::DynamicImage::from_decoder(decoder).with_context(undecodable)?;
+    let color = img.color();
+    let top = match color {
+        image::ColorType::L8 => 255,
+        image::ColorType::L16 => 65535,
+        _ => bail!("{}: raw frame must be single-channel grey, found {color:?}", path.display()),
+    };
+    let g = img.into_luma16();
+    let (w, h) = g.dimensions();
+    let data = if top == 255 { g.into_raw().iter().map(|&x| x / 257).collect() } else { g.into_raw() };
+    Ok(FrameFile { data, rows: h as usize, cols: w as usize, top })
 }
 
 /// A binary PGM, checked and read by [`RowReader::open_pgm`] (the paged reading's own

@@ -1,6 +1,6 @@
 //! A capture's raw frames, one per snapshot ([`Frames`]): held in memory (made by the
-//! simulator, given from numpy, or read from a PNG), or read from their `.npy` or PGM
-//! files a band of rows at a time ([`PagedFrame`]); and the frame the decoder reads either way
+//! simulator, given from numpy, or a small capture's files read whole), or read from their
+//! `.npy`, PGM or grey PNG files a band of rows at a time ([`PagedFrame`]); and the frame the decoder reads either way
 //! ([`SensorFrame`]).
 //!
 //! Whole-frame work (a calibration's correction, a capture saved again, the frames handed
@@ -37,8 +37,8 @@ pub enum SensorFrame<'a> {
 }
 
 impl Frames {
-    /// Opens a capture's frame files, each `rows x cols`. Past `hold_bytes` in all, `.npy`
-    /// and PGM frames are read as the decode asks, a band of rows at a time: their
+    /// Opens a capture's frame files, each `rows x cols`. Past `hold_bytes` in all, `.npy`,
+    /// PGM and grey PNG frames are read as the decode asks, a band of rows at a time: their
     /// header and length (and a PGM's values against its MAXVAL) are checked now. The
     /// others are read whole. `fits(path, top)` checks a file's largest value (its MAXVAL or
     /// bit depth) against the capture's saturation level.
@@ -61,6 +61,13 @@ impl Frames {
                     fits(path, top)?;
                     Some(frame)
                 }
+                "png" => match PagedFrame::open_png(path, (rows, cols))? {
+                    Some((frame, top)) => {
+                        fits(path, top)?;
+                        Some(frame)
+                    }
+                    None => None,
+                },
                 _ => None,
             };
             match frame {

@@ -7,6 +7,7 @@
 //! - [`npy_rows`]: a light field's `.npy` file written as its rows come;
 //! - [`row_reader`]: a two-axis array in a file (a `.npy`'s or a binary PGM's body) read a
 //!   few rows at a time (paged frames, calibration maps);
+//! - [`png_rows`]: a grey PNG raw frame read a few rows at a time, one decoder going down it;
 //! - [`map`]: a per-pixel map of the sensor (a calibration's dark levels or flats) read a
 //!   few rows at a time;
 //! - [`budget`]: the memory a command may take, checked before the work starts;
@@ -59,6 +60,7 @@ pub mod output;
 pub mod output_file;
 pub mod paged_frame;
 pub mod patch;
+pub mod png_rows;
 pub mod row_band;
 pub mod row_reader;
 pub mod rows;

@@ -13,7 +13,8 @@
 //! (the lock's count is written by every reader: its cache line moved between the cores at
 //! every run).
 //!
-//! The file stays open from [`PagedFrame::open_npy`] or [`PagedFrame::open_pgm`] on: a frame renamed or deleted during
+//! The file stays open from [`PagedFrame::open_npy`], [`PagedFrame::open_pgm`] or
+//! [`PagedFrame::open_png`] on: a frame renamed or deleted during
 //! the decode is still the frame that was checked. A read that fails later (a disk error,
 //! a file cut short by another program) reads as no sample and is kept; the decode then
 //! fails with it ([`PagedFrame::error`]) instead of flagging the pixels.
@@ -29,6 +30,7 @@ use slf_firmware::Frame;
 use thread_local::ThreadLocal;
 
 use crate::io::npy::NpyError;
+use crate::io::png_rows::PngRows;
 use crate::io::row_reader::RowReader;
 
 /// A band holds at least this many rows, and at least [`BAND_BYTES`].
@@ -70,6 +72,16 @@ impl FrameRows for RowReader {
 
     fn read_rows(&self, first: usize, out: &mut [u16]) -> Result<()> {
         self.read_u16(first, out)
+    }
+}
+
+impl FrameRows for PngRows {
+    fn size(&self) -> (usize, usize) {
+        PngRows::size(self)
+    }
+
+    fn read_rows(&self, first: usize, out: &mut [u16]) -> Result<()> {
+        PngRows::read_rows(self, first, out)
     }
 }
 
@@ -145,6 +157,20 @@ impl PagedFrame {
     pub fn open_pgm(path: &Path, size: (usize, usize)) -> Result<(Self, u32)> {
         let (reader, top) = RowReader::open_pgm(path, Some(size))?;
         Ok((Self::new(Arc::new(reader)), top))
+    }
+
+    /// Opens a grey 8- or 16-bit PNG raw frame of `rows x cols` ([`PngRows`]): its header
+    /// checked and every row decoded once now (a damaged stream is refused before the
+    /// decode), its rows decoded again as the decode asks, one pass down the file for each
+    /// pass of the decode. `None` for a PNG read whole (interlaced, another depth). Its
+    /// largest value (255 or 65535) beside.
+    ///
+    /// # Errors
+    /// The file and what is wrong with it.
+    pub fn open_png(path: &Path, size: (usize, usize)) -> Result<Option<(Self, u32)>> {
+        let Some((reader, top)) = PngRows::open(path, Some(size))? else { return Ok(None) };
+        reader.check_all()?;
+        Ok(Some((Self::new(Arc::new(reader)), top)))
     }
 
     /// The frame `source` reads, paged, with the decode's cache.
