@@ -516,6 +516,60 @@ fn view_gains_divide_each_view_of_each_region() {
     assert!(Decoder::new(config(mask)).unwrap().with_view_gains(None).unwrap().view_gains().is_none());
 }
 
+/// `FrameSource::with_flat` (issue 65, item 12): frames a host had already divided by a
+/// per-pixel flat, with that flat given to the source, carry the same error estimate as the
+/// raw frames decoded with the flat as view gains, bit for bit (gains of powers of two: every
+/// division exact). The noise term is what the flat changes: without it the divided frames'
+/// estimates differ (the noise of a pixel at gain 4 counted 16 times too small). A flat of
+/// another size than the frames' is refused.
+#[test]
+fn a_sources_flat_counts_in_the_error_estimate_as_the_view_gains_do() {
+    let l = light_field();
+    let mask = Mask::pixel(3, 3, 13, L5).unwrap();
+    let frames = capture(&l, &mask);
+    let gain = |p: usize| [1.0f32, 2.0, 4.0][(p / 75 % 5 + 3 * (p % 75 % 5)) % 3];
+    // One region: the table is one gain a view.
+    let table: Vec<f32> = (0..25).map(|i| gain((i / 5) * 75 + i % 5)).collect();
+    let flat: Vec<f32> = (0..50 * 75).map(gain).collect();
+    let divided: Vec<Vec<f32>> =
+        frames.iter().map(|f| f.iter().enumerate().map(|(p, &x)| x / gain(p)).collect()).collect();
+    let noisy = |mask| {
+        let mut c = config(mask);
+        c.sl0.noise = 0.004;
+        c.sl0.shot = 0.002;
+        Decoder::new(c).unwrap().with_error_estimate(Some(HoldOut::DEFAULT)).unwrap()
+    };
+    let dict = Dictionary::dct();
+    let run = |dec: &Decoder, frames: &[Vec<f32>], flat: Option<&[f32]>| {
+        let raw: Vec<RawFrame<f32>> = frames.iter().map(|f| RawFrame::new(f, 50, 75).unwrap()).collect();
+        let flat = flat.map(|f| RawFrame::new(f, 50, 75).unwrap());
+        let mut src = FrameSource::new(&raw);
+        if let Some(f) = &flat {
+            src = src.with_flat(f).unwrap();
+        }
+        let mut sink = Collect::default();
+        let r = dec.decode_frame(&dict, (1, 2), &mut src, &mut sink, &mut Box::new(PaperWorkspace::new()));
+        assert_eq!(r.failed_tiles, 0);
+        sink.accepted.iter().map(|(o, _, rep)| (*o, rep.error)).collect::<Vec<_>>()
+    };
+    let gained = noisy(mask).with_view_gains(Some((&table, (1, 1)))).unwrap();
+    let want = run(&gained, &frames, None);
+    assert_eq!(want.len(), 24);
+    assert!(want.iter().all(|(_, e)| e.is_some_and(|e| e > 0.0)), "every patch estimated");
+    let got = run(&noisy(mask), &divided, Some(&flat));
+    for ((oa, ea), (ob, eb)) in want.iter().zip(&got) {
+        assert_eq!(oa, ob);
+        assert_eq!(ea.map(f32::to_bits), eb.map(f32::to_bits), "{oa:?}: {ea:?} against {eb:?}");
+    }
+    let without = run(&noisy(mask), &divided, None);
+    let moved = want.iter().zip(&without).filter(|((_, a), (_, b))| a != b).count();
+    assert!(moved > 12, "the flat moves the estimate: {moved} of 24 patches");
+    let raw: Vec<RawFrame<f32>> = frames.iter().map(|f| RawFrame::new(f, 50, 75).unwrap()).collect();
+    let small = RawFrame::new(&flat[..75 * 49], 49, 75).unwrap();
+    let e = FrameSource::new(&raw).with_flat(&small).err();
+    assert_eq!(e, Some(SensingError::FrameSize { expected: 3750, found: 3675 }));
+}
+
 /// `with_response`: a response that mixes bands, placed in the projection, is refused on a
 /// kronecker mask (its patches measure whole blocks in one band); unmixing is not.
 #[test]

@@ -154,6 +154,39 @@ fn the_noise_term_sees_the_flat_the_frames_were_divided_by() {
     assert!(apart * 2 > slow.len(), "the flat moved {apart} of {} lenslets' estimates", slow.len());
 }
 
+/// The patches' own estimates (`EstimateBy::Patches`, the firmware's `estimate_error`) see
+/// the flat too, through the source (`FrameSource::with_flat`, the host's `MapFrame`): a
+/// flat of 1 everywhere leaves every estimate as it was, bit for bit; a flat from 0.3 to 1
+/// raises each held-out sample's noise variance, which at one snapshot (1 value in 13
+/// measured) only lowers a patch's estimate: none rises, and more than half move. (The firmware's
+/// `tile.rs` checks the flat against view gains bit for bit.)
+#[test]
+fn the_patches_estimates_see_the_flat_the_frames_were_divided_by() {
+    use slf_host::io::map::Map;
+    let lf = common::small_smooth(5);
+    let plain = simulate(&lf, &CameraConfig::pixel(3, 1)).unwrap();
+    let (rows, cols) = plain.frame_size();
+    let opts = DecodeOptions { estimate_by: EstimateBy::Patches, ..estimating() };
+    let map = |flat: Vec<f32>| {
+        let mut cap = plain.clone();
+        cap.divided_by(Map::Held(flat.into(), cols));
+        decode_with(&cap, &Basis::Dct, &opts).unwrap().1.error_map.iter().map(|p| p.1).collect::<Vec<_>>()
+    };
+    let before: Vec<f32> = decode_with(&plain, &Basis::Dct, &opts).unwrap().1.error_map.iter().map(|p| p.1).collect();
+    assert!(before.len() > 20 && before.iter().all(|&e| e > 0.0), "every patch estimated");
+    let ones = map(vec![1.0; rows * cols]);
+    assert!(ones.iter().zip(&before).all(|(a, b)| a.to_bits() == b.to_bits()), "a flat of 1 moved an estimate");
+    let flat: Vec<f32> = (0..rows * cols).map(|i| 0.3 + 0.7 * ((i * 7 + i / cols * 3) % 10) as f32 / 9.0).collect();
+    let vignetted = map(flat);
+    assert_eq!(vignetted.len(), before.len());
+    let mut lower = 0;
+    for (i, (&fast, &raw)) in vignetted.iter().zip(&before).enumerate() {
+        assert!(fast <= raw, "patch {i}: {fast} above the flat-less {raw}");
+        lower += usize::from(fast < raw * (1.0 - 1e-4));
+    }
+    assert!(lower * 2 > before.len(), "the flat lowered {lower} of {} patches' estimates", before.len());
+}
+
 #[test]
 fn the_estimate_leaves_the_decode_as_it_was() {
     let lf = common::small_smooth(5);

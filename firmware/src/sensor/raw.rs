@@ -7,6 +7,8 @@
 //! level are dark noise and are kept. Anything else is left out of the constraints and
 //! the patch is flagged (see [`crate::decode::tile::PatchFlags`]).
 
+use core::fmt;
+
 use crate::sensor::mask::SensingError;
 use crate::sensor::source::TileSource;
 
@@ -216,20 +218,58 @@ impl Frame for LeU16Frame<'_> {
     }
 }
 
-/// A [`TileSource`] over raw frames in RAM or flash, one per snapshot.
-#[derive(Clone, Copy, Debug)]
+/// A [`TileSource`] over raw frames in RAM or flash, one per snapshot; with
+/// [`Self::with_flat`], frames already divided by a per-pixel flat field.
+#[derive(Clone, Copy)]
 pub struct FrameSource<'a, F: Frame> {
     frames: &'a [F],
+    flat: Option<&'a dyn Frame>,
+}
+
+impl<F: Frame> fmt::Debug for FrameSource<'_, F> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("FrameSource").field("frames", &self.frames.len()).field("flat", &self.flat.is_some()).finish()
+    }
 }
 
 impl<'a, F: Frame> FrameSource<'a, F> {
     pub fn new(frames: &'a [F]) -> Self {
-        Self { frames }
+        Self { frames, flat: None }
+    }
+
+    /// These frames as already divided by `flat` (one value a sensor pixel, the frames'
+    /// size): the error estimate's noise term reads it ([`TileSource::flat`]).
+    ///
+    /// # Errors
+    /// [`SensingError::FrameSize`] if `flat` is not of every frame's size.
+    pub fn with_flat(self, flat: &'a dyn Frame) -> Result<Self, SensingError> {
+        let (rows, cols) = flat.size();
+        if let Some(f) = self.frames.iter().find(|f| f.size() != (rows, cols)) {
+            let (r, c) = f.size();
+            return Err(SensingError::FrameSize {
+                expected: r.saturating_mul(c).min(u32::MAX as usize) as u32,
+                found: rows.saturating_mul(cols).min(u32::MAX as usize) as u32,
+            });
+        }
+        Ok(Self { flat: Some(flat), ..self })
     }
 }
 
 impl<F: Frame> TileSource for FrameSource<'_, F> {
     type Error = ReadError;
+
+    #[inline]
+    fn flat(&self, row: usize, col: usize) -> f32 {
+        let Some(flat) = self.flat else { return 1.0 };
+        let (rows, cols) = flat.size();
+        if row >= rows || col >= cols {
+            return 1.0;
+        }
+        match flat.sample(row * cols + col) {
+            Some(f) if f > 0.0 && f.is_finite() => f,
+            _ => 1.0,
+        }
+    }
 
     fn read(&mut self, snapshot: usize, row: usize, col: usize, out: &mut [f32]) -> Result<(), ReadError> {
         let frame = self.frames.get(snapshot).ok_or(ReadError::NoSuchSnapshot { snapshot: snapshot.min(255) as u8 })?;

@@ -19,4 +19,17 @@ pub trait TileSource {
     /// # Errors
     /// The source's own error; the decoder then abandons the current tile only.
     fn read(&mut self, snapshot: usize, row: usize, col: usize, out: &mut [f32]) -> Result<(), Self::Error>;
+
+    /// The flat field sensor pixel `(row, col)`'s samples were already divided by when this
+    /// source hands them out (a host's per-pixel calibration corrects a frame before the
+    /// decoder reads it), on top of the decoder's own view gains. Only the error estimate
+    /// reads it: a corrected sample's noise is its raw value's over this flat
+    /// ([`crate::solver::holdout::noise_variance`]), so a vignetted pixel's noise is not
+    /// under-counted. 1 (the default) for a source of raw samples; a value that is not
+    /// positive and finite counts as 1.
+    #[inline]
+    fn flat(&self, row: usize, col: usize) -> f32 {
+        let _ = (row, col);
+        1.0
+    }
 }

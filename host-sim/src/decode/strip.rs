@@ -22,6 +22,8 @@ use slf_firmware::decode::engine::schedule::{Next, Schedule};
 use slf_firmware::decode::engine::strip::{SeedPatches, Seeds, Strip, StripShape};
 use slf_firmware::{Frame, FrameSource, TileReport};
 
+use crate::io::map::MapFrame;
+
 use crate::decode::options::Maps;
 use crate::decode::plan::FramePlan;
 use crate::decode::report::DecodeReport;
@@ -114,22 +116,29 @@ where
         tiles
             .par_iter()
             .map_init(
-                || Box::new(HostWorkspace::<PU, PV, N>::new()),
-                |ws, &planned| {
+                || (Box::new(HostWorkspace::<PU, PV, N>::new()), plan.flat.as_ref().map(MapFrame::new)),
+                |(ws, flat), &planned| {
                     let mut sums = TileSums::new(planned.tile, shape.views, plan.window, plan.grids.halo());
-                    let mut source = FrameSource::new(raw);
-                    let r = match seeds {
-                        Some(seeds) => plan.decoder.decode_tile_seeded(
-                            model,
-                            planned.tile,
-                            &mut source,
-                            &mut SeedPatches::<HostShape<PU, PV, N>> { seeds, lenslets },
-                            &mut sums,
-                            ws,
-                        ),
-                        None => plan.decoder.decode_tile(model, planned.tile, &mut source, &mut sums, ws),
-                    }
-                    .map_err(|e| e.to_string());
+                    // A corrected capture's flat, for the per-patch error estimate's noise
+                    // (read only by it).
+                    let source = match flat.as_ref() {
+                        Some(f) => FrameSource::new(raw).with_flat(f),
+                        None => Ok(FrameSource::new(raw)),
+                    };
+                    let r = source.map_err(|e| format!("the flat map: {e:?}")).and_then(|mut source| {
+                        match seeds {
+                            Some(seeds) => plan.decoder.decode_tile_seeded(
+                                model,
+                                planned.tile,
+                                &mut source,
+                                &mut SeedPatches::<HostShape<PU, PV, N>> { seeds, lenslets },
+                                &mut sums,
+                                ws,
+                            ),
+                            None => plan.decoder.decode_tile(model, planned.tile, &mut source, &mut sums, ws),
+                        }
+                        .map_err(|e| e.to_string())
+                    });
                     tick(1);
                     (planned, sums, r)
                 },

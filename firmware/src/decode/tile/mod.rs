@@ -462,19 +462,17 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
         let Workspace { signal, coeffs, measurements, .. } = ws;
         shares::to_sensor::<S>(measurements, signal, coeffs);
         let cfg = &self.config.sl0;
-        // Each entry's view flat, at the pixel the patch read it from (the shear's lenslet).
+        // Each entry's flat, at the pixel the patch read it from (the shear's lenslet): its
+        // view's gain, times the flat the source had already divided it by.
         let views = (usize::from(self.config.sensor.lenslet.rows), usize::from(self.config.sensor.lenslet.cols));
+        let source = &*source;
         let flat = |i: usize| {
-            // Without view gains every flat is 1: no pixel to look up.
-            if self.view_gains.is_none() {
-                return 1.0;
-            }
             let [s, t, u, v, _] = S::coordinates(i);
             let (vr, vc) = (usize::from(origin.view_row) + u, usize::from(origin.view_col) + v);
             origin
                 .lenslet::<S>(s, t, u, v, views)
                 .and_then(|l| self.sensor_pixel(l, vr, vc))
-                .map_or(1.0, |(row, col)| self.view_gain(row, col))
+                .map_or(1.0, |(row, col)| self.view_gain(row, col) * source.flat(row, col))
         };
         Ok((estimate::<S>(hold, ws.measurements(), ws.patch(), (cfg.noise, cfg.shot), flat), solves))
     }
