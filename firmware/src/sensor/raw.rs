@@ -259,6 +259,11 @@ impl<F: Frame> TileSource for FrameSource<'_, F> {
     type Error = ReadError;
 
     #[inline]
+    fn divided(&self) -> bool {
+        self.flat.is_some()
+    }
+
+    #[inline]
     fn flat(&self, row: usize, col: usize) -> f32 {
         let Some(flat) = self.flat else { return 1.0 };
         let (rows, cols) = flat.size();

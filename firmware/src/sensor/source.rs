@@ -32,4 +32,11 @@ pub trait TileSource {
         let _ = (row, col);
         1.0
     }
+
+    /// Whether [`Self::flat`] can be other than 1: where neither it nor the decoder's view
+    /// gains can, the error estimate does not look up each held-out sample's pixel.
+    #[inline]
+    fn divided(&self) -> bool {
+        false
+    }
 }

@@ -466,7 +466,12 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
         // view's gain, times the flat the source had already divided it by.
         let views = (usize::from(self.config.sensor.lenslet.rows), usize::from(self.config.sensor.lenslet.cols));
         let source = &*source;
+        let pixels = self.view_gains.is_some() || source.divided();
         let flat = |i: usize| {
+            // Without view gains or a source's flat every flat is 1: no pixel to look up.
+            if !pixels {
+                return 1.0;
+            }
             let [s, t, u, v, _] = S::coordinates(i);
             let (vr, vc) = (usize::from(origin.view_row) + u, usize::from(origin.view_col) + v);
             origin
