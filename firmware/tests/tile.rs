@@ -520,8 +520,9 @@ fn view_gains_divide_each_view_of_each_region() {
 /// per-pixel flat, with that flat given to the source, carry the same error estimate as the
 /// raw frames decoded with the flat as view gains, bit for bit (gains of powers of two: every
 /// division exact). The noise term is what the flat changes: without it the divided frames'
-/// estimates differ (the noise of a pixel at gain 4 counted 16 times too small). A flat of
-/// another size than the frames' is refused.
+/// estimates differ (the noise of a pixel at gain 4 counted 16 times too small). A flat that
+/// does not cover the frames is refused; one larger (frames cropped to its top-left corner)
+/// is read at the frames' pixels.
 #[test]
 fn a_sources_flat_counts_in_the_error_estimate_as_the_view_gains_do() {
     let l = light_field();
@@ -568,6 +569,14 @@ fn a_sources_flat_counts_in_the_error_estimate_as_the_view_gains_do() {
     let small = RawFrame::new(&flat[..75 * 49], 49, 75).unwrap();
     let e = FrameSource::new(&raw).with_flat(&small).err();
     assert_eq!(e, Some(SensingError::FrameSize { expected: 3750, found: 3675 }));
+    // Frames cropped to their top-left corner read the whole sensor's flat at their pixels.
+    let crops: Vec<Vec<f32>> = divided.iter().map(|f| f[..75 * 40].to_vec()).collect();
+    let crop: Vec<RawFrame<f32>> = crops.iter().map(|f| RawFrame::new(f, 40, 75).unwrap()).collect();
+    let whole = RawFrame::new(&flat, 50, 75).unwrap();
+    let src = FrameSource::new(&crop).with_flat(&whole).unwrap();
+    assert!(src.divided());
+    assert!((0..40 * 75).all(|p| src.flat(p / 75, p % 75) == flat[p]));
+    assert!(!FrameSource::new(&crop).divided());
 }
 
 /// `with_response`: a response that mixes bands, placed in the projection, is refused on a

@@ -237,14 +237,16 @@ impl<'a, F: Frame> FrameSource<'a, F> {
         Self { frames, flat: None }
     }
 
-    /// These frames as already divided by `flat` (one value a sensor pixel, the frames'
-    /// size): the error estimate's noise term reads it ([`TileSource::flat`]).
+    /// These frames as already divided by `flat` (one value a sensor pixel, frame pixel
+    /// `(row, col)` at the flat's `(row, col)`: the flat of frames cropped to their top-left
+    /// corner is the whole sensor's): the error estimate's noise term reads it
+    /// ([`TileSource::flat`]).
     ///
     /// # Errors
-    /// [`SensingError::FrameSize`] if `flat` is not of every frame's size.
+    /// [`SensingError::FrameSize`] if `flat` does not cover every frame.
     pub fn with_flat(self, flat: &'a dyn Frame) -> Result<Self, SensingError> {
         let (rows, cols) = flat.size();
-        if let Some(f) = self.frames.iter().find(|f| f.size() != (rows, cols)) {
+        if let Some(f) = self.frames.iter().find(|f| f.size().0 > rows || f.size().1 > cols) {
             let (r, c) = f.size();
             return Err(SensingError::FrameSize {
                 expected: r.saturating_mul(c).min(u32::MAX as usize) as u32,
