@@ -1,29 +1,48 @@
-//! How much of a turned lenslet grid's loss is the decode's model (issue 52)?
+//! How much of a turned lenslet grid's loss is the light's, the model's and the solver's
+//! (issues 52 and 66)?
 //!
 //! Behind a turned, non-integer-pitch grid a pixel records the view cells its square covers,
 //! each by its share (`sim/footprint.rs`): up to half of a neighbouring view, or of the
-//! neighbouring lenslet's. The decoder today reads each view from the pixel under its cell's
+//! neighbouring lenslet's. The decoder reads each view from the pixel under its cell's
 //! centre and takes it as that view's value (a selection). This decodes the same patches of
-//! a noiseless pixel k = 1 capture (16 bits, so the frames hold the light to 1/65535) three
-//! ways, each with the same f64 SL0 (16 disjoint 5 x 5-lenslet full-view patches of a 30 x
-//! 30-lenslet scene; the 5D DCT; the hand-set schedule's mu 2, sigma_f 0.7, 3 steps, down to
-//! sigma 1e-3; grey-world gains from the light field's band means; the projection
-//! `x - M^T (M M^T)^+ (M x - y)` in the signal domain):
+//! a noiseless capture (16 bits, so the frames hold the light to 1/65535) at `k` snapshots
+//! (pixel mask), from three sets of measurements:
 //!
 //! - **aligned**: the aligned sensor's capture, a selection (the reference);
-//! - **nearest**: the grid's capture read as the decoder reads it today, a selection;
+//! - **nearest**: the grid's capture read as the decoder reads it, a selection;
 //! - **exact**: the grid's capture with each pixel's measurement the shares of the view
-//!   cells it covers (pixels reaching outside the patch left out): the projection the
-//!   decoder would need.
+//!   cells it covers (pixels reaching outside the patch left out): the box-share model.
 //!
-//! Usage (prints one line per grid with the PSNR over the patches' values together, all 13
-//! bands, peak the light field's maximum):
+//! and by two solvers, each in f64 on 5 x 5-lenslet full-view patches (25 x 25 cells x 13
+//! bands, 8,125 values; disjoint, away from the frame's edge) of a 30 x 30-lenslet scene:
 //!
-//!     cargo run --release -p slf-host --example grid_model -- office 0.3:5.04 1:5.1 0:5.02
+//! - **SL0**: the 5D DCT, the hand-set schedule's numbers (mu 2, sigma_f 0.7, 3 steps, down
+//!   to sigma 1e-3), grey-world gains from the light field's band means, the projection
+//!   `x - M^T (M M^T)^+ (M x - y)` exact for the patch's own `M`;
+//! - **oracle**: least squares on the true signal's largest DCT coefficients (`K` of them,
+//!   the best of `K` = m/8 to m for `m` measurements, picked by the truth): what a decoder
+//!   that knew the support could do from these measurements. It is the bound in the sense
+//!   the field uses (an oracle-support estimator): a decoder may beat it only by a support
+//!   other than the largest coefficients, which no sparse prior finds.
+//!
+//! So `aligned oracle - exact oracle` is what the light loses behind the grid, `exact
+//! oracle - exact SL0` the solver's share there, `exact SL0 - nearest SL0` what the exact
+//! model gains over the selection.
+//!
+//! Usage (one markdown row per grid: PSNR over the patches' values together, all 13 bands,
+//! peak the light field's maximum):
+//!
+//!     cargo run --release -p slf-host --example grid_model -- office 3 0.3:5.04 1:5.1 0:5.02
+//!
+//! (a scene slf names, or a light field's `.npy` of 5 x 5 views and 13 bands whose middle
+//! 30 x 30 lenslets are taken; snapshots; then `ROTATION:PITCH` grids). `scripts/grid-bound.sh` runs it over
+//! scenes and writes `docs/results-grid-bound.md`.
 
 use anyhow::{Context, Result, ensure};
 use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
 use slf_host::decode::paper_1d::{Factors, analyze_5d, synthesize_5d};
+use slf_host::io::capture::Capture;
 use slf_host::io::lightfield::LightField;
 use slf_host::io::sensor::SensorDescription;
 use slf_host::sim::camera::{CameraConfig, GridSettings, simulate};
@@ -34,46 +53,53 @@ const P: usize = 25; // cells along each axis of a patch: 5 lenslets x 5 views
 const B: usize = 13;
 const N: usize = P * P * B;
 
+/// A patch's measurements: rows of `(entry, weight)` and the values they measured.
+struct Measured {
+    rows: Vec<Vec<(usize, f64)>>,
+    y: Vec<f64>,
+}
+
 /// Patch entry `(s, t, u, v, b)` from the patch's cell `(i, j)` (`i = s * 5 + u`).
 fn entry(i: usize, j: usize, b: usize) -> usize {
     let (s, u, t, v) = (i / 5, i % 5, j / 5, j % 5);
     (((s * 5 + t) * 5 + u) * 5 + v) * B + b
 }
 
-/// SL0 onto `M x = y` (rows of `(entry, weight)`), the 5D DCT, the hand-set schedule's
-/// numbers, white-balanced by `gains` (band `b`'s values divided by `gains[b]` before the
-/// solve and multiplied back, as the decoder's grey balance does).
-fn sl0(f: &Factors<f64>, rows: &[Vec<(usize, f64)>], y: &[f64], gains: &[f64; B]) -> Vec<f64> {
-    let y: Vec<f64> = rows.iter().zip(y).map(|(r, &v)| v / gains[r[0].0 % B]).collect();
-    let mut x = sl0_balanced(f, rows, &y);
-    for (i, v) in x.iter_mut().enumerate() {
-        *v *= gains[i % B];
-    }
-    x
+/// `M x`.
+fn apply(rows: &[Vec<(usize, f64)>], x: &[f64]) -> DVector<f64> {
+    DVector::from_iterator(rows.len(), rows.iter().map(|r| r.iter().map(|&(i, w)| w * x[i]).sum::<f64>()))
 }
 
-fn sl0_balanced(f: &Factors<f64>, rows: &[Vec<(usize, f64)>], y: &[f64]) -> Vec<f64> {
-    let m = rows.len();
-    let g = DMatrix::<f64>::from_fn(m, m, |a, b| {
+/// SL0 onto `M x = y`, the 5D DCT, the hand-set schedule's numbers, white-balanced by
+/// `gains` (band `b`'s values divided by `gains[b]` before the solve and multiplied back, as
+/// the decoder's grey balance does: a measurement's weights scale with its band's gain).
+fn sl0(f: &Factors<f64>, m: &Measured, gains: &[f64; B]) -> Vec<f64> {
+    let rows: Vec<Vec<(usize, f64)>> =
+        m.rows.iter().map(|r| r.iter().map(|&(i, w)| (i, w * gains[i % B])).collect()).collect();
+    let n = rows.len();
+    let g = DMatrix::<f64>::from_fn(n, n, |a, b| {
         rows[a]
             .iter()
             .map(|&(i, w)| rows[b].iter().filter(|&&(j, _)| j == i).map(|&(_, v)| w * v).sum::<f64>())
             .sum::<f64>()
     });
-    let inv = g.pseudo_inverse(1e-10).expect("pseudo-inverse");
-    let apply =
-        |x: &[f64]| DVector::from_iterator(m, rows.iter().map(|r| r.iter().map(|&(i, w)| w * x[i]).sum::<f64>()));
-    let back = |z: &DVector<f64>, x: &mut [f64]| {
+    // `(M M^T)^-1` by Cholesky (full row rank: each pixel's own measurement), else the
+    // pseudo-inverse.
+    let chol = g.clone().cholesky();
+    let inv = if chol.is_none() { Some(g.pseudo_inverse(1e-10).expect("pseudo-inverse")) } else { None };
+    let yv = DVector::from_column_slice(&m.y);
+    let project = |x: &mut Vec<f64>| {
+        let r = apply(&rows, x) - &yv;
+        let z = match (&chol, &inv) {
+            (Some(c), _) => c.solve(&r),
+            (None, Some(inv)) => inv * r,
+            (None, None) => unreachable!(),
+        };
         for (r, &zr) in rows.iter().zip(z.iter()) {
             for &(i, w) in r {
                 x[i] -= w * zr;
             }
         }
-    };
-    let yv = DVector::from_column_slice(y);
-    let project = |x: &mut Vec<f64>| {
-        let r = apply(x) - &yv;
-        back(&(&inv * r), x);
     };
     let mut x = vec![0.0; N];
     project(&mut x);
@@ -91,11 +117,50 @@ fn sl0_balanced(f: &Factors<f64>, rows: &[Vec<(usize, f64)>], y: &[f64]) -> Vec<
         }
         sigma *= sigma_f;
     }
+    for (i, v) in x.iter_mut().enumerate() {
+        *v *= gains[i % B];
+    }
     x
 }
 
+/// The oracle: least squares on `truth`'s `K` largest DCT coefficients, the best `K` of
+/// m/8, m/4, m/2, 3m/4, 7m/8 and m for `m` measurements by the squared error against
+/// `truth` (returned). Solved by the normal equations (Cholesky of the leading `K x K`
+/// block of `A^T A`, made once for the largest `K`; a `K` whose block is singular is
+/// skipped).
+fn oracle(f: &Factors<f64>, m: &Measured, truth: &[f64]) -> f64 {
+    let c = analyze_5d(f, truth);
+    let mut order: Vec<usize> = (0..N).collect();
+    order.sort_by(|&a, &b| c[b].abs().total_cmp(&c[a].abs()));
+    let rows = m.rows.len();
+    let top = rows.min(N);
+    // The measurements of each of the `top` largest atoms, once.
+    let mut atoms = DMatrix::<f64>::zeros(rows, top);
+    let mut unit = vec![0.0; N];
+    for (col, &k) in order[..top].iter().enumerate() {
+        unit[k] = 1.0;
+        let atom = synthesize_5d(f, &unit);
+        unit[k] = 0.0;
+        atoms.set_column(col, &apply(&m.rows, &atom));
+    }
+    let gram = atoms.tr_mul(&atoms);
+    let aty = atoms.tr_mul(&DVector::from_column_slice(&m.y));
+    [rows / 8, rows / 4, rows / 2, rows * 3 / 4, rows * 7 / 8, top]
+        .iter()
+        .filter(|&&k| k > 0 && k <= top)
+        .filter_map(|&k| {
+            let coef = gram.view((0, 0), (k, k)).into_owned().cholesky()?.solve(&aty.rows(0, k).into_owned());
+            let mut full = vec![0.0; N];
+            for (j, &atom) in order[..k].iter().enumerate() {
+                full[atom] = coef[j];
+            }
+            Some(sq_err(truth, &synthesize_5d(f, &full)))
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// The squared error of `x` against `truth`, summed.
-fn psnr(truth: &[f64], x: &[f64], _peak: f64) -> f64 {
+fn sq_err(truth: &[f64], x: &[f64]) -> f64 {
     truth.iter().zip(x).map(|(a, b)| (a - b).powi(2)).sum::<f64>()
 }
 
@@ -104,17 +169,33 @@ fn db(sum: f64, patches: usize, peak: f64) -> f64 {
     10.0 * (peak * peak / (sum / (patches * N) as f64)).log10()
 }
 
+/// Snapshot `j`'s normalised value at pixel `(r, c)`.
+fn value(cap: &Capture, j: usize, r: usize, c: usize) -> f64 {
+    let cols = cap.frame_size().1;
+    f64::from(cap.held_frames().unwrap()[j][r * cols + c]) / 65535.0
+}
+
 fn main() -> Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    ensure!(args.len() >= 2, "usage: grid_model SCENE ROTATION:PITCH...");
+    ensure!(args.len() >= 3, "usage: grid_model SCENE|LIGHT_FIELD.npy SNAPSHOTS ROTATION:PITCH...");
+    let k: u8 = args[1].parse().context("SNAPSHOTS: 1 to 13")?;
     let size = 30;
-    let lf: LightField = slf_host::sim::realistic::named(&args[0])
-        .or_else(|| slf_host::sim::scene::named(&args[0]))
-        .context("a scene slf names")?
-        .render(SceneSize { views: (5, 5), rows: size, cols: size });
+    let (lf, name): (LightField, String) = if args[0].ends_with(".npy") {
+        // A light field's file (an HCI crop): its middle 30 x 30 lenslets.
+        let whole = slf_host::io::lightfield::read_npy(std::path::Path::new(&args[0]))?;
+        ensure!(whole.views == (5, 5) && whole.bands == B, "{}: 5 x 5 views and 13 bands", args[0]);
+        ensure!(whole.rows >= size && whole.cols >= size, "{}: at least {size} x {size} lenslets", args[0]);
+        let name = std::path::Path::new(&args[0]).file_stem().map_or(String::new(), |s| s.to_string_lossy().into());
+        (whole.window((whole.rows - size) / 2, (whole.cols - size) / 2, size, size), name)
+    } else {
+        let scene = slf_host::sim::realistic::named(&args[0])
+            .or_else(|| slf_host::sim::scene::named(&args[0]))
+            .context("a scene slf names, or a light field's .npy")?;
+        (scene.render(SceneSize { views: (5, 5), rows: size, cols: size }), args[0].clone())
+    };
     let peak = f64::from(lf.max());
     let camera = |grid: Option<GridSettings>| {
-        let mut cam = CameraConfig::pixel(5, 1).noiseless();
+        let mut cam = CameraConfig::pixel(5, k).noiseless();
         (cam.bits, cam.black_level, cam.white_fraction) = (16, 0, 1.0);
         cam.sensor = SensorDescription::IDEAL;
         cam.grid = grid;
@@ -141,25 +222,38 @@ fn main() -> Result<()> {
         }
         x
     };
-    // The aligned sensor, a selection.
+    // (SL0, oracle) summed squared errors over the patches of one set of measurements.
+    let score = |measure: &(dyn Fn((usize, usize)) -> Measured + Sync)| -> (f64, f64) {
+        origins
+            .par_iter()
+            .map(|&o| {
+                let (m, want) = (measure(o), truth(o));
+                (sq_err(&want, &sl0(&f, &m, &gains)), oracle(&f, &m, &want))
+            })
+            .reduce(|| (0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1))
+    };
+    let n = origins.len();
     let aligned = simulate(&lf, &camera(None))?;
     let mask = aligned.mask()?;
-    let cols = size * 5;
-    let mut sum = 0.0;
-    for &(s0, t0) in &origins {
+    let a = score(&|(s0, t0)| {
         let (mut rows, mut y) = (Vec::new(), Vec::new());
-        for i in 0..P {
-            for j in 0..P {
-                let (r, c) = (s0 * 5 + i, t0 * 5 + j);
-                let b = mask.bands_at(r, c)[0] as usize;
-                rows.push(vec![(entry(i, j, b), 1.0)]);
-                y.push(f64::from(aligned.held_frames().unwrap()[0][r * cols + c]) / 65535.0);
+        for j in 0..usize::from(k) {
+            for i in 0..P {
+                for jj in 0..P {
+                    let (r, c) = (s0 * 5 + i, t0 * 5 + jj);
+                    rows.push(vec![(entry(i, jj, mask.bands_at(r, c)[j] as usize), 1.0)]);
+                    y.push(value(&aligned, j, r, c));
+                }
             }
         }
-        sum += psnr(&truth((s0, t0)), &sl0(&f, &rows, &y, &gains), peak);
-    }
-    println!("{}: aligned sensor {:.2} dB over {} patches", args[0], db(sum, origins.len(), peak), origins.len());
-    for g in &args[1..] {
+        Measured { rows, y }
+    });
+    println!(
+        "| scene | k | grid (deg:px) | aligned SL0 | aligned oracle | nearest SL0 | exact SL0 | exact oracle | \
+         nearest - aligned, SL0 | exact - aligned, SL0 | exact - aligned, oracle (the light) |"
+    );
+    println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
+    for g in &args[2..] {
         let (rot, pitch) = g.split_once(':').context("ROTATION:PITCH")?;
         let settings = GridSettings { rotation_deg: rot.parse()?, pitch: Some([pitch.parse()?; 2]), offset: None };
         let cap = simulate(&lf, &camera(Some(settings)))?;
@@ -167,24 +261,24 @@ fn main() -> Result<()> {
         let fw = desc.firmware([5, 5])?;
         let (rows_n, cols_n) = cap.frame_size();
         let mask = cap.mask()?;
-        let (mut nearest, mut exact) = (0.0, 0.0);
-        let mut cells = Vec::new();
-        for &(s0, t0) in &origins {
-            let want = truth((s0, t0));
-            // Nearest: each cell from the pixel under its centre.
+        // Nearest: each cell from the pixel under its centre.
+        let near = score(&|(s0, t0)| {
             let (mut rows, mut y) = (Vec::new(), Vec::new());
-            for i in 0..P {
-                for j in 0..P {
-                    let l = ((s0 + i / 5) as isize, (t0 + j / 5) as isize);
-                    let Some((r, c)) = fw.pixel(l, (i % 5, j % 5)) else { continue };
-                    let b = mask.bands_at(r, c)[0] as usize;
-                    rows.push(vec![(entry(i, j, b), 1.0)]);
-                    y.push(f64::from(cap.held_frames().unwrap()[0][r * cols_n + c]) / 65535.0);
+            for j in 0..usize::from(k) {
+                for i in 0..P {
+                    for jj in 0..P {
+                        let l = ((s0 + i / 5) as isize, (t0 + jj / 5) as isize);
+                        let Some((r, c)) = fw.pixel(l, (i % 5, jj % 5)) else { continue };
+                        rows.push(vec![(entry(i, jj, mask.bands_at(r, c)[j] as usize), 1.0)]);
+                        y.push(value(&cap, j, r, c));
+                    }
                 }
             }
-            nearest += psnr(&want, &sl0(&f, &rows, &y, &gains), peak);
-            // Exact: every pixel whose square lies in the patch's cells, by its shares.
-            let (mut rows, mut y) = (Vec::new(), Vec::new());
+            Measured { rows, y }
+        });
+        // Exact: every pixel whose square lies in the patch's cells, by its shares.
+        let exact = score(&|(s0, t0)| {
+            let (mut rows, mut y, mut cells) = (Vec::new(), Vec::new(), Vec::new());
             let (lo_r, lo_c) = ((s0 * 5) as i64, (t0 * 5) as i64);
             for r in 0..rows_n {
                 for c in 0..cols_n {
@@ -195,23 +289,26 @@ fn main() -> Result<()> {
                     if cells.is_empty() || !inside {
                         continue;
                     }
-                    let b = mask.bands_at(r, c)[0] as usize;
-                    rows.push(
-                        cells
-                            .iter()
-                            .map(|&([i, j], w)| (entry((i - lo_r) as usize, (j - lo_c) as usize, b), w))
-                            .collect(),
-                    );
-                    y.push(f64::from(cap.held_frames().unwrap()[0][r * cols_n + c]) / 65535.0);
+                    for j in 0..usize::from(k) {
+                        let b = mask.bands_at(r, c)[j] as usize;
+                        rows.push(
+                            cells
+                                .iter()
+                                .map(|&([i, jj], w)| (entry((i - lo_r) as usize, (jj - lo_c) as usize, b), w))
+                                .collect(),
+                        );
+                        y.push(value(&cap, j, r, c));
+                    }
                 }
             }
-            exact += psnr(&want, &sl0(&f, &rows, &y, &gains), peak);
-        }
-        let n = origins.len();
+            Measured { rows, y }
+        });
+        let [a_sl0, a_or, n_sl0, e_sl0, e_or] = [a.0, a.1, near.0, exact.0, exact.1].map(|e| db(e, n, peak));
         println!(
-            "  rotation {rot}, pitch {pitch}: nearest {:.2} dB, exact {:.2} dB",
-            db(nearest, n, peak),
-            db(exact, n, peak)
+            "| {name} | {k} | {rot}:{pitch} | {a_sl0:.2} | {a_or:.2} | {n_sl0:.2} | {e_sl0:.2} | {e_or:.2} | {:+.2} | {:+.2} | {:+.2} |",
+            n_sl0 - a_sl0,
+            e_sl0 - a_sl0,
+            e_or - a_or
         );
     }
     Ok(())

@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# The bound behind a turned lenslet array (issue 66), docs/results-grid-bound.md: for each
+# scene, k = 1 and 3 (pixel mask) and each grid, 16 disjoint 5 x 5-lenslet full-view
+# patches of a noiseless 16-bit capture decoded in f64 from the aligned sensor's
+# measurements, from the grid's read as the decoder reads them (nearest: the pixel under
+# each view cell's centre), and from the grid's with the exact box-share model, by SL0 and
+# by the oracle (least squares on the truth's largest DCT coefficients). Everything is
+# `host-sim/examples/grid_model.rs`; this script runs it over scenes and writes the page.
+#
+#   bash scripts/grid-bound.sh > docs/results-grid-bound.md
+#   SLF_SCENES=office SLF_KS=3 SLF_GRIDS=0.3:5.04 bash scripts/grid-bound.sh   # faster
+#
+# HCI crops (`SLF_REAL`, default /tmp/hci/real/*_128.npy, made as scripts/scene-tables.sh
+# says) are added where present: evaluation only, never committed.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+. scripts/stamp.sh
+cargo build --release -q -p slf-host --example grid_model
+bin=./target/release/examples/grid_model
+scenes=${SLF_SCENES:-outdoor tungsten office led}
+for f in "${SLF_REAL:-/tmp/hci/real}"/*_128.npy; do
+  [ -f "$f" ] && scenes="$scenes $f"
+done
+ks=${SLF_KS:-1 3}
+read -r -a grids <<< "${SLF_GRIDS:-0.3:5.04 1:5.1}"
+
+page_head "The bound behind a turned lenslet array" "bash scripts/grid-bound.sh"
+cat <<'TEXT'
+How much of the turned array's loss is the light's, and how much the decoder's (issue 66)?
+Each row: 16 disjoint 5 x 5-lenslet full-view patches (25 x 25 view cells x 13 bands) of a
+30 x 30-lenslet scene, pixel mask, noiseless 16-bit frames, decoded in f64. PSNR in dB over
+the patches' values together, peak the light field's maximum.
+
+- **aligned**: the aligned sensor's capture (each pixel one view cell's value);
+- **nearest**: the grid's capture read as the decoder reads it today (each view cell from the
+  pixel under its centre, taken as that cell's value);
+- **exact**: the grid's capture with each pixel's measurement the shares of the view cells
+  its square covers (`sim/footprint.rs`, the simulator's own model), pixels reaching outside
+  the patch left out.
+- **SL0**: the hand-set schedule on the 5D DCT with an exact projection onto the patch's own
+  measurements (Cholesky of `M M^T`), grey-world balanced.
+- **oracle**: least squares on the truth's K largest DCT coefficients, the best K from m/8
+  to m (m measurements). SL0 beats it on some rows: it is the field's oracle-support
+  reference, not a strict bound; where SL0 is above it, SL0 is the better figure.
+
+"exact - aligned, oracle" is what the light itself loses behind the grid; "nearest -
+aligned, SL0" is today's decoder's loss on these patches; "exact - aligned, SL0" is what is
+left of it with the exact model.
+
+TEXT
+first=1
+for scene in $scenes; do
+  for k in $ks; do
+    if [ $first = 1 ]; then
+      "$bin" "$scene" "$k" "${grids[@]}"
+      first=0
+    else
+      "$bin" "$scene" "$k" "${grids[@]}" | tail -n +3
+    fi
+  done
+done
