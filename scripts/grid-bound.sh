@@ -37,15 +37,18 @@ the patches' values together, peak the light field's maximum.
 - **exact**: the grid's capture with each pixel's measurement the shares of the view cells
   its square covers (`sim/footprint.rs`, the simulator's own model), pixels reaching outside
   the patch left out.
-- **SL0**: the hand-set schedule on the 5D DCT with an exact projection onto the patch's own
-  measurements (Cholesky of `M M^T`), grey-world balanced.
+- **SL0**: the hand-set schedule on the 5D DCT, grey-world balanced, projecting onto the
+  patch's own measurements `M x = y` by solving `(M M^T) z = M x - y`: exactly (Cholesky),
+  by the firmware's step today (each residual over its row of `M M^T` summed,
+  `solver/shares.rs`: exact for a measurement alone), or by 4 conjugate-gradient steps
+  preconditioned by those row sums.
 - **oracle**: least squares on the truth's K largest DCT coefficients, the best K from m/8
   to m (m measurements). SL0 beats it on some rows: it is the field's oracle-support
   reference, not a strict bound; where SL0 is above it, SL0 is the better figure.
 
 "exact - aligned, oracle" is what the light itself loses behind the grid; "nearest -
-aligned, SL0" is today's decoder's loss on these patches; "exact - aligned, SL0" is what is
-left of it with the exact model.
+aligned, SL0" is what a selection loses; "row-sum - aligned" what the firmware's model and
+step lose here; "exact - aligned, SL0" what is left with the exact projection.
 
 TEXT
 first=1

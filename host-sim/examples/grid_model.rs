@@ -70,35 +70,91 @@ fn apply(rows: &[Vec<(usize, f64)>], x: &[f64]) -> DVector<f64> {
     DVector::from_iterator(rows.len(), rows.iter().map(|r| r.iter().map(|&(i, w)| w * x[i]).sum::<f64>()))
 }
 
-/// SL0 onto `M x = y`, the 5D DCT, the hand-set schedule's numbers, white-balanced by
-/// `gains` (band `b`'s values divided by `gains[b]` before the solve and multiplied back, as
-/// the decoder's grey balance does: a measurement's weights scale with its band's gain).
-fn sl0(f: &Factors<f64>, m: &Measured, gains: &[f64; B]) -> Vec<f64> {
+/// How SL0's projection onto `M x = y` solves `(M M^T) z = M x - y` for the correction
+/// `M^T z`.
+#[derive(Clone, Copy, Debug)]
+enum Projection {
+    /// Exactly: Cholesky of `M M^T` (the pseudo-inverse where it is singular).
+    Exact,
+    /// One step scaled by each row of `M M^T` summed: the firmware's behind a grid
+    /// (`solver/shares.rs`), exact for a measurement alone.
+    RowSum,
+    /// This many conjugate-gradient steps from zero, preconditioned by the row sums.
+    Cg(usize),
+}
+
+/// SL0 onto `M x = y` by `projection`, the 5D DCT, the hand-set schedule's numbers,
+/// white-balanced by `gains` (band `b`'s values divided by `gains[b]` before the solve and
+/// multiplied back, as the decoder's grey balance does: a measurement's weights scale with
+/// its band's gain).
+fn sl0(f: &Factors<f64>, m: &Measured, gains: &[f64; B], projection: Projection) -> Vec<f64> {
     let rows: Vec<Vec<(usize, f64)>> =
         m.rows.iter().map(|r| r.iter().map(|&(i, w)| (i, w * gains[i % B])).collect()).collect();
-    let n = rows.len();
-    let g = DMatrix::<f64>::from_fn(n, n, |a, b| {
-        rows[a]
-            .iter()
-            .map(|&(i, w)| rows[b].iter().filter(|&&(j, _)| j == i).map(|&(_, v)| w * v).sum::<f64>())
-            .sum::<f64>()
-    });
-    // `(M M^T)^-1` by Cholesky (full row rank: each pixel's own measurement), else the
-    // pseudo-inverse.
-    let chol = g.clone().cholesky();
-    let inv = if chol.is_none() { Some(g.pseudo_inverse(1e-10).expect("pseudo-inverse")) } else { None };
-    let yv = DVector::from_column_slice(&m.y);
-    let project = |x: &mut Vec<f64>| {
-        let r = apply(&rows, x) - &yv;
-        let z = match (&chol, &inv) {
-            (Some(c), _) => c.solve(&r),
-            (None, Some(inv)) => inv * r,
-            (None, None) => unreachable!(),
-        };
+    let back = |z: &DVector<f64>| {
+        let mut x = vec![0.0; N];
         for (r, &zr) in rows.iter().zip(z.iter()) {
             for &(i, w) in r {
-                x[i] -= w * zr;
+                x[i] += w * zr;
             }
+        }
+        x
+    };
+    // `M M^T z`, applied through `M^T`.
+    let gram = |z: &DVector<f64>| apply(&rows, &back(z));
+    let sums = gram(&DVector::from_element(rows.len(), 1.0));
+    let n = rows.len();
+    let (chol, inv) = match projection {
+        Projection::Exact => {
+            let g = DMatrix::<f64>::from_fn(n, n, |a, b| {
+                rows[a]
+                    .iter()
+                    .map(|&(i, w)| rows[b].iter().filter(|&&(j, _)| j == i).map(|&(_, v)| w * v).sum::<f64>())
+                    .sum::<f64>()
+            });
+            // Full row rank (each pixel's own measurement): Cholesky; else the pseudo-inverse.
+            match g.clone().cholesky() {
+                Some(c) => (Some(c), None),
+                None => (None, Some(g.pseudo_inverse(1e-10).expect("pseudo-inverse"))),
+            }
+        }
+        _ => (None, None),
+    };
+    let solve = |r: DVector<f64>| -> DVector<f64> {
+        match projection {
+            Projection::Exact => match (&chol, &inv) {
+                (Some(c), _) => c.solve(&r),
+                (None, Some(inv)) => inv * r,
+                (None, None) => unreachable!(),
+            },
+            Projection::RowSum => r.component_div(&sums),
+            Projection::Cg(steps) => {
+                let mut z = DVector::zeros(n);
+                let mut res = r;
+                let mut p = res.component_div(&sums);
+                let mut rz = res.dot(&p);
+                for _ in 0..steps {
+                    let gp = gram(&p);
+                    let pgp = p.dot(&gp);
+                    if pgp <= 0.0 || rz == 0.0 {
+                        break;
+                    }
+                    let alpha = rz / pgp;
+                    z.axpy(alpha, &p, 1.0);
+                    res.axpy(-alpha, &gp, 1.0);
+                    let q = res.component_div(&sums);
+                    let rz_next = res.dot(&q);
+                    p = &q + (rz_next / rz) * &p;
+                    rz = rz_next;
+                }
+                z
+            }
+        }
+    };
+    let yv = DVector::from_column_slice(&m.y);
+    let project = |x: &mut Vec<f64>| {
+        let z = solve(apply(&rows, x) - &yv);
+        for (xi, c) in x.iter_mut().zip(back(&z)) {
+            *xi -= c;
         }
     };
     let mut x = vec![0.0; N];
@@ -222,37 +278,48 @@ fn main() -> Result<()> {
         }
         x
     };
-    // (SL0, oracle) summed squared errors over the patches of one set of measurements.
-    let score = |measure: &(dyn Fn((usize, usize)) -> Measured + Sync)| -> (f64, f64) {
+    // Summed squared errors over the patches of one set of measurements: the oracle's (with
+    // `with_oracle`, else 0), then SL0's by each of `projections`.
+    let score = |measure: &(dyn Fn((usize, usize)) -> Measured + Sync),
+                 with_oracle: bool,
+                 projections: &[Projection]|
+     -> Vec<f64> {
         origins
             .par_iter()
             .map(|&o| {
                 let (m, want) = (measure(o), truth(o));
-                (sq_err(&want, &sl0(&f, &m, &gains)), oracle(&f, &m, &want))
+                let mut e = vec![if with_oracle { oracle(&f, &m, &want) } else { 0.0 }];
+                e.extend(projections.iter().map(|&p| sq_err(&want, &sl0(&f, &m, &gains, p))));
+                e
             })
-            .reduce(|| (0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1))
+            .reduce(|| vec![0.0; projections.len() + 1], |a, b| a.iter().zip(&b).map(|(x, y)| x + y).collect())
     };
     let n = origins.len();
     let aligned = simulate(&lf, &camera(None))?;
     let mask = aligned.mask()?;
-    let a = score(&|(s0, t0)| {
-        let (mut rows, mut y) = (Vec::new(), Vec::new());
-        for j in 0..usize::from(k) {
-            for i in 0..P {
-                for jj in 0..P {
-                    let (r, c) = (s0 * 5 + i, t0 * 5 + jj);
-                    rows.push(vec![(entry(i, jj, mask.bands_at(r, c)[j] as usize), 1.0)]);
-                    y.push(value(&aligned, j, r, c));
+    let a = score(
+        &|(s0, t0)| {
+            let (mut rows, mut y) = (Vec::new(), Vec::new());
+            for j in 0..usize::from(k) {
+                for i in 0..P {
+                    for jj in 0..P {
+                        let (r, c) = (s0 * 5 + i, t0 * 5 + jj);
+                        rows.push(vec![(entry(i, jj, mask.bands_at(r, c)[j] as usize), 1.0)]);
+                        y.push(value(&aligned, j, r, c));
+                    }
                 }
             }
-        }
-        Measured { rows, y }
-    });
-    println!(
-        "| scene | k | grid (deg:px) | aligned SL0 | aligned oracle | nearest SL0 | exact SL0 | exact oracle | \
-         nearest - aligned, SL0 | exact - aligned, SL0 | exact - aligned, oracle (the light) |"
+            Measured { rows, y }
+        },
+        true,
+        &[Projection::Exact],
     );
-    println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
+    println!(
+        "| scene | k | grid (deg:px) | aligned SL0 | aligned oracle | nearest SL0 | exact model, SL0 by: \
+         row-sum step | CG 4 | exact projection | exact model, oracle | nearest - aligned, SL0 | \
+         row-sum - aligned | CG 4 - aligned | exact - aligned, SL0 | exact - aligned, oracle (the light) |"
+    );
+    println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
     for g in &args[2..] {
         let (rot, pitch) = g.split_once(':').context("ROTATION:PITCH")?;
         let settings = GridSettings { rotation_deg: rot.parse()?, pitch: Some([pitch.parse()?; 2]), offset: None };
@@ -262,51 +329,64 @@ fn main() -> Result<()> {
         let (rows_n, cols_n) = cap.frame_size();
         let mask = cap.mask()?;
         // Nearest: each cell from the pixel under its centre.
-        let near = score(&|(s0, t0)| {
-            let (mut rows, mut y) = (Vec::new(), Vec::new());
-            for j in 0..usize::from(k) {
-                for i in 0..P {
-                    for jj in 0..P {
-                        let l = ((s0 + i / 5) as isize, (t0 + jj / 5) as isize);
-                        let Some((r, c)) = fw.pixel(l, (i % 5, jj % 5)) else { continue };
-                        rows.push(vec![(entry(i, jj, mask.bands_at(r, c)[j] as usize), 1.0)]);
-                        y.push(value(&cap, j, r, c));
+        let near = score(
+            &|(s0, t0)| {
+                let (mut rows, mut y) = (Vec::new(), Vec::new());
+                for j in 0..usize::from(k) {
+                    for i in 0..P {
+                        for jj in 0..P {
+                            let l = ((s0 + i / 5) as isize, (t0 + jj / 5) as isize);
+                            let Some((r, c)) = fw.pixel(l, (i % 5, jj % 5)) else { continue };
+                            rows.push(vec![(entry(i, jj, mask.bands_at(r, c)[j] as usize), 1.0)]);
+                            y.push(value(&cap, j, r, c));
+                        }
                     }
                 }
-            }
-            Measured { rows, y }
-        });
+                Measured { rows, y }
+            },
+            false,
+            &[Projection::Exact],
+        );
         // Exact: every pixel whose square lies in the patch's cells, by its shares.
-        let exact = score(&|(s0, t0)| {
-            let (mut rows, mut y, mut cells) = (Vec::new(), Vec::new(), Vec::new());
-            let (lo_r, lo_c) = ((s0 * 5) as i64, (t0 * 5) as i64);
-            for r in 0..rows_n {
-                for c in 0..cols_n {
-                    footprint(&desc, [5, 5], r, c, &mut cells);
-                    let inside = cells.iter().all(|&([i, j], _)| {
-                        (lo_r..lo_r + P as i64).contains(&i) && (lo_c..lo_c + P as i64).contains(&j)
-                    });
-                    if cells.is_empty() || !inside {
-                        continue;
-                    }
-                    for j in 0..usize::from(k) {
-                        let b = mask.bands_at(r, c)[j] as usize;
-                        rows.push(
-                            cells
-                                .iter()
-                                .map(|&([i, jj], w)| (entry((i - lo_r) as usize, (jj - lo_c) as usize, b), w))
-                                .collect(),
-                        );
-                        y.push(value(&cap, j, r, c));
+        let exact = score(
+            &|(s0, t0)| {
+                let (mut rows, mut y, mut cells) = (Vec::new(), Vec::new(), Vec::new());
+                let (lo_r, lo_c) = ((s0 * 5) as i64, (t0 * 5) as i64);
+                for r in 0..rows_n {
+                    for c in 0..cols_n {
+                        footprint(&desc, [5, 5], r, c, &mut cells);
+                        let inside = cells.iter().all(|&([i, j], _)| {
+                            (lo_r..lo_r + P as i64).contains(&i) && (lo_c..lo_c + P as i64).contains(&j)
+                        });
+                        if cells.is_empty() || !inside {
+                            continue;
+                        }
+                        for j in 0..usize::from(k) {
+                            let b = mask.bands_at(r, c)[j] as usize;
+                            rows.push(
+                                cells
+                                    .iter()
+                                    .map(|&([i, jj], w)| (entry((i - lo_r) as usize, (jj - lo_c) as usize, b), w))
+                                    .collect(),
+                            );
+                            y.push(value(&cap, j, r, c));
+                        }
                     }
                 }
-            }
-            Measured { rows, y }
-        });
-        let [a_sl0, a_or, n_sl0, e_sl0, e_or] = [a.0, a.1, near.0, exact.0, exact.1].map(|e| db(e, n, peak));
+                Measured { rows, y }
+            },
+            true,
+            &[Projection::RowSum, Projection::Cg(4), Projection::Exact],
+        );
+        let db = |e: f64| db(e, n, peak);
+        let (a_or, a_sl0, n_sl0) = (db(a[0]), db(a[1]), db(near[1]));
+        let (e_or, e_row, e_cg, e_sl0) = (db(exact[0]), db(exact[1]), db(exact[2]), db(exact[3]));
         println!(
-            "| {name} | {k} | {rot}:{pitch} | {a_sl0:.2} | {a_or:.2} | {n_sl0:.2} | {e_sl0:.2} | {e_or:.2} | {:+.2} | {:+.2} | {:+.2} |",
+            "| {name} | {k} | {rot}:{pitch} | {a_sl0:.2} | {a_or:.2} | {n_sl0:.2} | {e_row:.2} | {e_cg:.2} | {e_sl0:.2} | \
+             {e_or:.2} | {:+.2} | {:+.2} | {:+.2} | {:+.2} | {:+.2} |",
             n_sl0 - a_sl0,
+            e_row - a_sl0,
+            e_cg - a_sl0,
             e_sl0 - a_sl0,
             e_or - a_or
         );
