@@ -143,3 +143,29 @@ pub(crate) fn extension(path: &Path) -> String {
 pub fn frame_names(k: usize, ext: &str) -> Vec<String> {
     (0..k).map(|j| format!("snapshot_{j}.{ext}")).collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::png_rows::tests::write_png;
+
+    /// A PNG read whole: 16- and 8-bit grey through the row reader, the values as written
+    /// and the top their depth holds; a 4-bit one by the image library, every pixel there.
+    #[test]
+    fn a_png_is_read_whole_as_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let (rows, cols) = (33, 8); // even: the helper packs 4-bit pixels two a byte across rows
+        for (depth, top) in [(png::BitDepth::Sixteen, 65535u32), (png::BitDepth::Eight, 255)] {
+            let data: Vec<u16> = (0..rows * cols).map(|i| (i * 7919 % (top as usize + 1)) as u16).collect();
+            let path = dir.path().join(format!("{top}.png"));
+            write_png(&path, (rows, cols), depth, &data);
+            let whole = read_frame(&path, Some((rows, cols))).unwrap();
+            assert_eq!((whole.data, whole.top, whole.rows, whole.cols), (data, top, rows, cols), "{top}");
+        }
+        let four = dir.path().join("four.png");
+        let nibbles: Vec<u16> = (0..rows * cols).map(|i| (i % 16) as u16).collect();
+        write_png(&four, (rows, cols), png::BitDepth::Four, &nibbles);
+        let whole = read_frame(&four, Some((rows, cols))).unwrap();
+        assert_eq!((whole.rows, whole.cols, whole.data.len(), whole.top), (rows, cols, rows * cols, 255));
+    }
+}
