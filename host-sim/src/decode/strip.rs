@@ -22,13 +22,12 @@ use slf_firmware::decode::engine::schedule::{Next, Schedule};
 use slf_firmware::decode::engine::strip::{SeedPatches, Seeds, Strip, StripShape};
 use slf_firmware::{Frame, FrameSource, TileReport};
 
-use crate::io::map::MapFrame;
-
 use crate::decode::options::Maps;
 use crate::decode::plan::FramePlan;
 use crate::decode::report::DecodeReport;
 use crate::decode::seams::{Spectra, seam_score};
 use crate::decode::tile_sums::TileSums;
+use crate::io::map::MapFrame;
 use crate::io::patch::{HostBands, HostModel, HostShape, HostWorkspace};
 use crate::io::rows::{RowShape, Rows};
 
