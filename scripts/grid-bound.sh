@@ -47,10 +47,12 @@ the patches' values together, peak the light field's maximum.
   reference, not a strict bound; where SL0 is above it, SL0 is the better figure.
 
 "exact - aligned, oracle" is what the light itself loses behind the grid; "nearest -
-aligned, SL0" is what a selection loses; "row-sum - aligned" what the firmware's model and
-step lose here; "exact - aligned, SL0" what is left with the exact projection.
+aligned, SL0" is what a selection loses; "row-sum - aligned" what the firmware's step loses
+on the exact model; "exact - aligned, SL0" what is left with the exact projection.
 
 TEXT
+table=$(mktemp)
+trap 'rm -f "$table"' EXIT
 first=1
 for scene in $scenes; do
   for k in $ks; do
@@ -61,4 +63,6 @@ for scene in $scenes; do
       "$bin" "$scene" "$k" "${grids[@]}" | tail -n +3
     fi
   done
-done
+done | tee "$table"
+echo
+python3 scripts/grid-bound-summary.py "$table"

@@ -35,7 +35,11 @@
 //!     cargo run --release -p slf-host --example grid_model -- office 3 0.3:5.04 1:5.1 0:5.02
 //!
 //! (a scene slf names, or a light field's `.npy` of 5 x 5 views and 13 bands whose middle
-//! 30 x 30 lenslets are taken; snapshots; then `ROTATION:PITCH` grids). `scripts/grid-bound.sh` runs it over
+//! 30 x 30 lenslets are taken; snapshots; then `ROTATION:PITCH` grids). With
+//! `--decoder-model` last, a second table: the pixels the decoder reads (the one under
+//! each cell's centre) modelled as the decoder models them (`solver/shares.rs`: a separable
+//! box, the turn left out, a share outside the patch given to the pixel's own cell), and
+//! the same pixels by their exact footprints, each by the row-sum step and exactly. `scripts/grid-bound.sh` runs it over
 //! scenes and writes `docs/results-grid-bound.md`.
 
 use anyhow::{Context, Result, ensure};
@@ -235,6 +239,10 @@ fn main() -> Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     ensure!(args.len() >= 3, "usage: grid_model SCENE|LIGHT_FIELD.npy SNAPSHOTS ROTATION:PITCH...");
     let k: u8 = args[1].parse().context("SNAPSHOTS: 1 to 13")?;
+    // `--decoder-model` after the grids: a second table, the decoder's own model of the
+    // grid against the exact footprints on the same pixels.
+    let decoder_model = args.last().is_some_and(|a| a == "--decoder-model");
+    let grids: Vec<&String> = args[2..].iter().filter(|a| *a != "--decoder-model").collect();
     let size = 30;
     let (lf, name): (LightField, String) = if args[0].ends_with(".npy") {
         // A light field's file (an HCI crop): its middle 30 x 30 lenslets.
@@ -320,7 +328,8 @@ fn main() -> Result<()> {
          row-sum - aligned | CG 4 - aligned | exact - aligned, SL0 | exact - aligned, oracle (the light) |"
     );
     println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
-    for g in &args[2..] {
+    let mut model_rows = Vec::new();
+    for g in &grids {
         let (rot, pitch) = g.split_once(':').context("ROTATION:PITCH")?;
         let settings = GridSettings { rotation_deg: rot.parse()?, pitch: Some([pitch.parse()?; 2]), offset: None };
         let cap = simulate(&lf, &camera(Some(settings)))?;
@@ -378,6 +387,99 @@ fn main() -> Result<()> {
             true,
             &[Projection::RowSum, Projection::Cg(4), Projection::Exact],
         );
+        if decoder_model {
+            // The pixels the decoder reads: the one under each view cell's centre.
+            let nearest = |(s0, t0): (usize, usize), row: &mut dyn FnMut(usize, usize, (usize, usize), usize)| {
+                for j in 0..usize::from(k) {
+                    for i in 0..P {
+                        for jj in 0..P {
+                            let l = ((s0 + i / 5) as isize, (t0 + jj / 5) as isize);
+                            if let Some(rc) = fw.pixel(l, (i % 5, jj % 5)) {
+                                row(i, jj, rc, j);
+                            }
+                        }
+                    }
+                }
+            };
+            // The decoder's model (`solver/shares.rs`): a separable box `views / pitch`
+            // cells wide about the pixel's centre, the turn left out, a share outside the
+            // patch given to the pixel's own cell.
+            let width = [5.0 / desc.pitch[0], 5.0 / desc.pitch[1]];
+            let boxed = score(
+                &|(s0, t0)| {
+                    let (mut rows, mut y) = (Vec::new(), Vec::new());
+                    nearest((s0, t0), &mut |i, jj, (r, c), j| {
+                        let centre = desc.cell([5, 5], [r as f64 + 0.5, c as f64 + 0.5]);
+                        let own = [(s0 * 5 + i) as f64 + 0.5, (t0 * 5 + jj) as f64 + 0.5];
+                        let axis = |a: usize, at: usize| -> [(usize, f64); 3] {
+                            let (delta, w) = (centre[a] - own[a], width[a]);
+                            let before = ((-0.5 - (delta - w / 2.0)) / w).max(0.0);
+                            let after = ((delta + w / 2.0 - 0.5) / w).max(0.0);
+                            let mut shares =
+                                [(at.wrapping_sub(1), before), (at, 1.0 - before - after), (at + 1, after)];
+                            for side in [0, 2] {
+                                if shares[side].0 >= P {
+                                    shares[1].1 += shares[side].1;
+                                    shares[side].1 = 0.0;
+                                }
+                            }
+                            shares
+                        };
+                        let b = mask.bands_at(r, c)[j] as usize;
+                        let mut taps = Vec::new();
+                        for (ri, wr) in axis(0, i) {
+                            for (ci, wc) in axis(1, jj) {
+                                if wr * wc > 0.0 {
+                                    taps.push((entry(ri, ci, b), wr * wc));
+                                }
+                            }
+                        }
+                        rows.push(taps);
+                        y.push(value(&cap, j, r, c));
+                    });
+                    Measured { rows, y }
+                },
+                false,
+                &[Projection::RowSum, Projection::Exact],
+            );
+            // The same pixels by their exact footprints (a pixel reaching outside the
+            // patch left out).
+            let exact_nearest = score(
+                &|(s0, t0)| {
+                    let (mut rows, mut y, mut cells) = (Vec::new(), Vec::new(), Vec::new());
+                    let (lo_r, lo_c) = ((s0 * 5) as i64, (t0 * 5) as i64);
+                    nearest((s0, t0), &mut |_, _, (r, c), j| {
+                        footprint(&desc, [5, 5], r, c, &mut cells);
+                        let inside = cells.iter().all(|&([i, jj], _)| {
+                            (lo_r..lo_r + P as i64).contains(&i) && (lo_c..lo_c + P as i64).contains(&jj)
+                        });
+                        if cells.is_empty() || !inside {
+                            return;
+                        }
+                        let b = mask.bands_at(r, c)[j] as usize;
+                        rows.push(
+                            cells
+                                .iter()
+                                .map(|&([i, jj], w)| (entry((i - lo_r) as usize, (jj - lo_c) as usize, b), w))
+                                .collect(),
+                        );
+                        y.push(value(&cap, j, r, c));
+                    });
+                    Measured { rows, y }
+                },
+                false,
+                &[Projection::RowSum, Projection::Exact],
+            );
+            let d = |e: f64| db(e, n, peak);
+            model_rows.push(format!(
+                "| {name} | {k} | {rot}:{pitch} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} |",
+                d(a[1]),
+                d(boxed[1]),
+                d(boxed[2]),
+                d(exact_nearest[1]),
+                d(exact_nearest[2])
+            ));
+        }
         let db = |e: f64| db(e, n, peak);
         let (a_or, a_sl0, n_sl0) = (db(a[0]), db(a[1]), db(near[1]));
         let (e_or, e_row, e_cg, e_sl0) = (db(exact[0]), db(exact[1]), db(exact[2]), db(exact[3]));
@@ -390,6 +492,18 @@ fn main() -> Result<()> {
             e_sl0 - a_sl0,
             e_or - a_or
         );
+    }
+    if decoder_model {
+        println!();
+        println!(
+            "| scene | k | grid (deg:px) | aligned SL0 | decoder's model (separable box), row-sum step | \
+             decoder's model, exact projection | exact footprints of the same pixels, row-sum step | \
+             exact footprints of the same pixels, exact projection |"
+        );
+        println!("| --- | --- | --- | --- | --- | --- | --- | --- |");
+        for r in &model_rows {
+            println!("{r}");
+        }
     }
     Ok(())
 }
