@@ -229,6 +229,18 @@ fn db(sum: f64, patches: usize, peak: f64) -> f64 {
     10.0 * (peak * peak / (sum / (patches * N) as f64)).log10()
 }
 
+/// Pixel `(r, c)`'s measurement in snapshot `j` by its exact footprint (`cells`, filled by
+/// [`footprint`]) on the patch whose first cell is `lo`: its row and value; `None` for a
+/// pixel that reaches outside the patch.
+fn exact_row(cells: &[([i64; 2], f64)], lo: (i64, i64), band: usize, value: f64) -> Option<(Vec<(usize, f64)>, f64)> {
+    let inside =
+        |&([i, j], _): &([i64; 2], f64)| (lo.0..lo.0 + P as i64).contains(&i) && (lo.1..lo.1 + P as i64).contains(&j);
+    if cells.is_empty() || !cells.iter().all(inside) {
+        return None;
+    }
+    Some((cells.iter().map(|&([i, j], w)| (entry((i - lo.0) as usize, (j - lo.1) as usize, band), w)).collect(), value))
+}
+
 /// Snapshot `j`'s normalised value at pixel `(r, c)`.
 fn value(cap: &Capture, j: usize, r: usize, c: usize) -> f64 {
     let cols = cap.frame_size().1;
@@ -364,21 +376,13 @@ fn main() -> Result<()> {
                 for r in 0..rows_n {
                     for c in 0..cols_n {
                         footprint(&desc, [5, 5], r, c, &mut cells);
-                        let inside = cells.iter().all(|&([i, j], _)| {
-                            (lo_r..lo_r + P as i64).contains(&i) && (lo_c..lo_c + P as i64).contains(&j)
-                        });
-                        if cells.is_empty() || !inside {
-                            continue;
-                        }
                         for j in 0..usize::from(k) {
-                            let b = mask.bands_at(r, c)[j] as usize;
-                            rows.push(
-                                cells
-                                    .iter()
-                                    .map(|&([i, jj], w)| (entry((i - lo_r) as usize, (jj - lo_c) as usize, b), w))
-                                    .collect(),
-                            );
-                            y.push(value(&cap, j, r, c));
+                            let band = mask.bands_at(r, c)[j] as usize;
+                            let Some((row, v)) = exact_row(&cells, (lo_r, lo_c), band, value(&cap, j, r, c)) else {
+                                break;
+                            };
+                            rows.push(row);
+                            y.push(v);
                         }
                     }
                 }
@@ -450,20 +454,11 @@ fn main() -> Result<()> {
                     let (lo_r, lo_c) = ((s0 * 5) as i64, (t0 * 5) as i64);
                     nearest((s0, t0), &mut |_, _, (r, c), j| {
                         footprint(&desc, [5, 5], r, c, &mut cells);
-                        let inside = cells.iter().all(|&([i, jj], _)| {
-                            (lo_r..lo_r + P as i64).contains(&i) && (lo_c..lo_c + P as i64).contains(&jj)
-                        });
-                        if cells.is_empty() || !inside {
-                            return;
+                        let band = mask.bands_at(r, c)[j] as usize;
+                        if let Some((row, v)) = exact_row(&cells, (lo_r, lo_c), band, value(&cap, j, r, c)) {
+                            rows.push(row);
+                            y.push(v);
                         }
-                        let b = mask.bands_at(r, c)[j] as usize;
-                        rows.push(
-                            cells
-                                .iter()
-                                .map(|&([i, jj], w)| (entry((i - lo_r) as usize, (jj - lo_c) as usize, b), w))
-                                .collect(),
-                        );
-                        y.push(value(&cap, j, r, c));
                     });
                     Measured { rows, y }
                 },
