@@ -47,24 +47,22 @@ pub fn read_frame(path: &Path, expect: Option<(usize, usize)>) -> Result<FrameFi
             }
             // Interlaced, another depth or colour: the image library reads it, and
             // refuses what is not grey.
-            None => read_png_whole(path, expect),
+            None => read_png_whole(path),
         },
         other => bail!("{}: unknown frame format {other:?} (use .pgm, .png or .npy)", path.display()),
     }
 }
 
-/// A PNG that [`PngRows`] does not read by rows (its end and size were checked by
-/// [`PngRows::open`]), decoded whole by the image library.
-fn read_png_whole(path: &Path, expect: Option<(usize, usize)>) -> Result<FrameFile> {
-    use image::ImageDecoder;
+/// A PNG that [`PngRows`] does not read by rows (its end and its size against the
+/// capture's were checked by [`PngRows::open`] from the same header), decoded whole by the
+/// image library.
+fn read_png_whole(path: &Path) -> Result<FrameFile> {
     let undecodable = || format!("{}: cannot decode image", path.display());
     let decoder = image::ImageReader::open(path)
         .and_then(image::ImageReader::with_guessed_format)
         .with_context(|| format!("cannot read {}", path.display()))?
         .into_decoder()
         .with_context(undecodable)?;
-    let (w, h) = decoder.dimensions();
-    crate::io::file_checks::check_size(path, (u64::from(h), u64::from(w)), expect)?;
     let img = image::DynamicImage::from_decoder(decoder).with_context(undecodable)?;
     let color = img.color();
     let top = match color {

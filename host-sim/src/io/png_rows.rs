@@ -167,7 +167,7 @@ fn start(path: &Path, file: &File) -> Result<png::Reader<BufReader<File>>> {
 ///
 /// # Errors
 /// A file that is not a PNG, or ends before IEND.
-pub fn png_end(path: &Path) -> Result<u64> {
+fn png_end(path: &Path) -> Result<u64> {
     let bad = |what: &str| anyhow!("{}: cannot decode image: {what}", path.display());
     let mut f = File::open(path).map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
     let mut signature = [0u8; 8];
