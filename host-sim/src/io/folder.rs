@@ -78,12 +78,11 @@ impl WholeFolder {
         };
         fs::create_dir_all(&parent).with_context(|| format!("cannot create {}", parent.display()))?;
         let name = target.file_name().map_or_else(|| "out".into(), |n| n.to_string_lossy().into_owned());
-        let temp = tempfile::Builder::new()
-            .prefix(&format!(".{name}."))
-            .suffix(".part")
-            .tempdir_in(&parent)
-            .with_context(|| format!("cannot create a folder in {}", parent.display()))?;
-        let _tracked = crate::io::interrupt::track(temp.path());
+        let (temp, _tracked) = crate::io::interrupt::make(
+            || tempfile::Builder::new().prefix(&format!(".{name}.")).suffix(".part").tempdir_in(&parent),
+            |t| t.path(),
+        )
+        .with_context(|| format!("cannot create a folder in {}", parent.display()))?;
         Ok(Self { temp, target: target.to_path_buf(), kind, _tracked })
     }
 

@@ -116,8 +116,8 @@ impl WholeFile {
         // umask as `File::create` makes it (as uv's `tempfile_in` does).
         #[cfg(unix)]
         builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
-        let tmp = builder.tempfile_in(parent(path)).with_context(failed)?;
-        let _tracked = crate::io::interrupt::track(tmp.path());
+        let (tmp, _tracked) =
+            crate::io::interrupt::make(|| builder.tempfile_in(parent(path)), |t| t.path()).with_context(failed)?;
         Ok(Self { tmp, path: path.to_path_buf(), _tracked })
     }
 
@@ -341,7 +341,8 @@ fn folder_writable(path: &Path) -> Result<()> {
     }
     let dir = parent(path);
     ensure!(dir.is_dir(), "the folder {} does not exist", dir.display());
-    tempfile::Builder::new().prefix(".slf-check.").tempdir_in(dir).context("the folder takes no new folder")?;
+    crate::io::interrupt::make(|| tempfile::Builder::new().prefix(".slf-check.").tempdir_in(dir), |t| t.path())
+        .context("the folder takes no new folder")?;
     Ok(())
 }
 
@@ -351,7 +352,8 @@ fn writable(path: &Path) -> Result<()> {
     ensure!(!path.is_dir(), "a folder, not a file");
     let dir = parent(path);
     ensure!(dir.is_dir(), "the folder {} does not exist", dir.display());
-    tempfile::Builder::new().prefix(".slf-check.").tempfile_in(dir).context("the folder takes no new file")?;
+    crate::io::interrupt::make(|| tempfile::Builder::new().prefix(".slf-check.").tempfile_in(dir), |t| t.path())
+        .context("the folder takes no new file")?;
     if let Some(meta) = regular_if_there(path)? {
         ensure!(!meta.permissions().readonly(), "read-only");
     }

@@ -104,7 +104,11 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    match run(cli) {
+    let result = run(cli);
+    // An interrupt's handler, removing the temporaries, may have made the command fail:
+    // its exit 130 is how the run ended.
+    slf_host::io::interrupt::settle();
+    match result {
         Ok(()) => ExitCode::SUCCESS,
         // The reader of our output went away (`| head`): it has what it wanted.
         Err(e) if slf_host::io::stdout::closed_pipe(&e) => ExitCode::SUCCESS,
