@@ -7,7 +7,8 @@
 //! unsheared and sheared; where no measurement shares a cell, the exact projection; the
 //! prediction `to_sensor` against `M x`; on a band measured everywhere, half a cell off,
 //! the residual shrinks where a step by the diagonal alone would grow it; a second step
-//! with the row sums the first one found and kept ([`RowSums`]) against the reference too.
+//! with the row sums the first one found and kept ([`RowSums`]) against the reference too;
+//! the share of a pixel's square outside the patch ([`Reach`]) against the definition's.
 
 mod common;
 
@@ -17,7 +18,7 @@ use rand::Rng;
 use slf_firmware::Shape as _;
 use slf_firmware::ball::Ball;
 use slf_firmware::shape::ValueCount;
-use slf_firmware::shares::{RowSums, project_shares, to_sensor};
+use slf_firmware::shares::{Reach, RowSums, project_shares, to_sensor};
 use slf_firmware::workspace::{CellShares, MAX_SHARE_VIEWS, Measurements, PLACE_UNIT};
 use slf_firmware::*;
 
@@ -235,4 +236,47 @@ fn on_a_band_measured_everywhere_the_residual_shrinks() {
         plain = &plain + a.transpose() * (&y - &a * &plain).component_div(&diagonal);
     }
     assert!(norm(&plain) > 10.0 * norm(&start), "the diagonal's steps did not diverge: {}", norm(&plain));
+}
+
+/// `Reach::outside` is the share of the definition's box that lies over cells outside the
+/// patch (`1 -` the inside parts of the two axes multiplied), for every pixel of patches
+/// unsheared and sheared both ways, pixels narrower and wider than a cell, at random places;
+/// sheared, some pixel reaches further outside than unsheared (the micro-image borders the
+/// shear moves apart: what it is for).
+#[test]
+fn the_share_outside_the_patch_is_the_definitions() {
+    let mut r = rng(66);
+    for (width, rows, cols) in [
+        ((1.008f32, 1.02f32), [0i8, 0, 0], [0i8, 0, 0]),
+        ((1.02, 0.9), [1, 0, -1], [0, 0, 0]),
+        ((0.8, 1.25), [-1, 0, 1], [1, 0, -1]),
+    ] {
+        let shares = shares_of(width, rows, cols);
+        let reach = Reach::<Shape>::new(&shares);
+        let unsheared = Reach::<Shape>::new(&CellShares::unsheared(width));
+        let mut further = false;
+        for (s, t, u, v) in (0..PS)
+            .flat_map(|s| (0..PT).flat_map(move |t| (0..PU).flat_map(move |u| (0..PV).map(move |v| (s, t, u, v)))))
+        {
+            let place = (r.random_range(-0.5f64..0.5), r.random_range(-0.5f64..0.5));
+            let p = (s as i64 + i64::from(shares.shift.0[u])) * PU as i64 + u as i64;
+            let q = (t as i64 + i64::from(shares.shift.1[v])) * PV as i64 + v as i64;
+            let inside = |cells: [f64; 3], at: i64, views: usize, len: usize, shift: &[i8]| {
+                cells[1]
+                    + [(0usize, -1i64), (2, 1)]
+                        .iter()
+                        .filter(|&&(_, d)| find(at + d, views, len, shift).is_some())
+                        .map(|&(k, _)| cells[k])
+                        .sum::<f64>()
+            };
+            let ir = inside(box_1d(p as f64 + 0.5 + place.0, p, f64::from(width.0)), p, PU, PS, &shares.shift.0);
+            let ic = inside(box_1d(q as f64 + 0.5 + place.1, q, f64::from(width.1)), q, PV, PT, &shares.shift.1);
+            let want = 1.0 - ir * ic;
+            let got = f64::from(reach.outside((s, t, u, v), (place.0 as f32, place.1 as f32)));
+            assert!((got - want).abs() < 1e-5, "{shares:?} pixel {:?} at {place:?}: {got} vs {want}", (s, t, u, v));
+            further |= got > f64::from(unsheared.outside((s, t, u, v), (place.0 as f32, place.1 as f32))) + 1e-3;
+        }
+        let sheared = rows != [0; 3] || cols != [0; 3];
+        assert_eq!(further, sheared, "{shares:?}: a pixel further outside than unsheared");
+    }
 }

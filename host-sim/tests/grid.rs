@@ -330,6 +330,60 @@ fn behind_a_grid_the_default_disparities_are_whole() {
     assert!(halves(&aligned, &["--shear-trial", "false"]) > 0);
 }
 
+/// Behind a turned grid a patch sheared by whole lenslets finds the cell across a
+/// micro-image border outside itself, and the read leaves out, at k = 3, the pixels whose
+/// square lies largely there (`slf_firmware::shares::MAX_OUTSIDE_SHARE`, whose shares are
+/// tested against their definition in the firmware's `shares.rs`): only pixels of the outer
+/// views or lenslets (the patch's rim, where a shear puts the next view's lenslet), on some
+/// patch. At k = 1 every pixel stays, and an unsheared patch reads the same pixels at k = 1
+/// and 3.
+#[test]
+fn a_sheared_patch_behind_a_grid_leaves_out_pixels_mostly_outside_it() {
+    use slf_firmware::{Disparity, FrameSource, FullViewWorkspace, PatchOrigin, Shape};
+    use slf_host::sim::scene::SceneSize;
+    let lf = slf_host::sim::realistic::named("office").unwrap().render(SceneSize { views: (5, 5), rows: 24, cols: 24 });
+    let read = |k: u8, d: i8, origin: (u16, u16)| {
+        let mut cam = CameraConfig::pixel(5, k).noiseless();
+        cam.grid = Some(GridSettings { rotation_deg: 1.0, pitch: Some([5.1, 5.1]), offset: None });
+        let cap = simulate(&lf, &cam).unwrap();
+        let dec = cap.decoder::<5, 5, 8125>(slf_firmware::Sl0Config::DEFAULT).unwrap();
+        let raw = cap.raw_frames().unwrap();
+        let mut ws = Box::new(FullViewWorkspace::new());
+        let o = PatchOrigin {
+            lenslet_row: origin.0,
+            lenslet_col: origin.1,
+            view_row: 0,
+            view_col: 0,
+            disparity: Disparity::pixels(d),
+        };
+        dec.read_patch(o, &mut FrameSource::new(&raw), &mut ws).unwrap();
+        let m = ws.measurements();
+        let mut pixels = Vec::new();
+        for (s, t, u, v) in
+            (0..5).flat_map(|s| (0..5).flat_map(move |t| (0..5).flat_map(move |u| (0..5).map(move |v| (s, t, u, v)))))
+        {
+            let i = FullViewShape::pixel_index(s, t, u, v);
+            if (0..13).any(|b| m.get(i + b).is_some()) {
+                pixels.push((s, t, u, v));
+            }
+        }
+        pixels
+    };
+    let mut left_out = 0;
+    for origin in [(4u16, 4u16), (6, 12), (12, 6), (12, 12)] {
+        assert_eq!(read(1, 0, origin), read(3, 0, origin), "unsheared at {origin:?}");
+        for d in [-1i8, 1] {
+            let (all, kept) = (read(1, d, origin), read(3, d, origin));
+            assert!(kept.iter().all(|p| all.contains(p)), "{origin:?} d {d}: a pixel k = 1 does not read");
+            let gone: Vec<_> = all.iter().filter(|p| !kept.contains(p)).collect();
+            let edge = |&&(s, t, u, v): &&(usize, usize, usize, usize)| [s, t, u, v].iter().any(|x| [0, 4].contains(x));
+            assert!(gone.iter().all(edge), "{origin:?} d {d}: {gone:?}");
+            left_out += gone.len();
+        }
+    }
+    assert!(left_out > 0, "no sheared patch left a pixel out");
+}
+
 /// Every accepted patch's values, in order.
 struct Collect<'a>(&'a mut Vec<Vec<u32>>);
 

@@ -4,6 +4,7 @@
 use super::*;
 use crate::operators::shape::{PerBand, Shape};
 use crate::sensor::extent::{Array, Bands, Per};
+use crate::solver::shares::{MAX_OUTSIDE_SHARE, Reach};
 
 impl<'a, S: Shape> TileDecoder<'a, S> {
     /// Grey-world band gains of a frame: every valid sample of the sensor (defects and
@@ -103,6 +104,9 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
             let _ = m.set_shares(None);
         }
         let shared = m.shares().is_some();
+        // A sheared patch's pixels that lie largely outside it are left out at k >= 2
+        // (`MAX_OUTSIDE_SHARE`).
+        let reach = m.shares().filter(|_| origin.disparity != Disparity::ZERO && k >= 2).map(Reach::<S>::new);
         for s in 0..S::PS {
             for u in 0..S::PU {
                 for t in 0..S::PT {
@@ -135,6 +139,9 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
                                 // The pixel's place in its cell; a pixel whose centre lies
                                 // in another cell is that cell's measurement, not this one's.
                                 let Some(place) = self.place_in_cell(lenslet, (vr, vc), (row, col)) else { continue };
+                                if reach.as_ref().is_some_and(|r| r.outside((s, t, u, v), place) > MAX_OUTSIDE_SHARE) {
+                                    continue;
+                                }
                                 let _ = m.set_place(at / S::B, place);
                             }
                             for (j, r) in run.iter_mut().enumerate().take(k) {
