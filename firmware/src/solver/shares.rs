@@ -183,21 +183,20 @@ impl<S: Shape> Layout<S> {
 /// more: a pixel past it is not the patch's measurement ([`Reach`]).
 ///
 /// A share of a cell outside the patch goes to the pixel's own cell (module docs). On an
-/// unsheared patch that happens at the patch's rim only, where the cell given is the next
-/// one on the sensor's neighbour. A patch sheared by whole lenslets holds neighbouring views
+/// unsheared patch that happens at the patch's rim only. A patch sheared by whole lenslets holds neighbouring views
 /// at neighbouring grid positions (`shift` differs by `d` from view to view), so every view
 /// of its rim lenslets reaches outside, and across a micro-image border (view `U - 1` of
 /// sensor lenslet `L` beside view 0 of `L + 1`) the neighbour is `1 - (U - 1) d` grid
 /// positions away: outside for `d = 1` (and for `d = -1` from the rim's three lenslets).
 /// The value given for it is then that of a point about five lenslets away.
-/// Measured behind grids of 0.3 degrees / 5.04 px and 1 degree / 5.1 px (office, outdoor,
-/// tungsten and led at 64 x 64 lenslets, calibrated, noisy), pixel k = 3: leaving out the
-/// pixels more than this outside raised every decode, +0.5 to +2.3 dB; a limit of 0.05
-/// lowered two of them (it leaves out more measurements than model error), 0.2 to 0.3 were
-/// within 0.15 dB of each other; the same rule on unsheared patches changed no decode by 0.02
-/// dB, so they keep every pixel (and their decodes stay as they were). At k = 1, where the decode is short of measurements more than
-/// of a fit, the same rule lost up to 2.2 dB (tungsten, 0.3 degrees), so one snapshot keeps
-/// every pixel.
+/// Measured (`docs/results-grid-shear.md`, `scripts/grid-shear.sh`: calibrated, noisy
+/// sensors behind grids of 0.3 degrees / 5.04 px and 1 degree / 5.1 px, pixel k = 3):
+/// leaving out the pixels more than this outside raised every decode. The limit was picked
+/// on office alone: 0.05 lowered a decode by 0.5 dB (it leaves out more measurements than
+/// model error), 0.2 and 0.3 were within 0.11 dB of 0.25, 0.4 0.5 to 0.6 dB below. On unsheared
+/// patches the rule moved office's decodes by 0.01 dB, so they keep every pixel (their
+/// decodes stay as they were). At k = 1, short of measurements more than of a fit, it lost
+/// up to 2.2 dB (and won up to 1.5), so one snapshot keeps every pixel.
 pub const MAX_OUTSIDE_SHARE: f32 = 0.25;
 
 /// How much of each pixel's square lies over cells outside a patch: built once a patch from

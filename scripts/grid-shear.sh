@@ -1,0 +1,107 @@
+#!/usr/bin/env bash
+# Issue 66, the sheared patch behind a grid (docs/results-grid-shear.md): for each scene at
+# pixel k = 1 and 3, behind grids of 0.3 degrees / 5.04 px and 1 degree / 5.1 px, the default
+# decode by the binary BEFORE (SLF_BEFORE: every pixel a sheared patch reads is its
+# measurement) and by this one (at k >= 2 a sheared patch leaves out the pixels more than
+# `MAX_OUTSIDE_SHARE` over cells outside it), against the aligned sensor's default decode.
+# Every sensor has 30 % vignetting and 1 % PRNU, shot and read noise, and is calibrated from
+# its own captures (2 exposures each), as `scripts/grid-results.sh` makes them. PSNR without
+# the 2 lenslets at each edge (`slf eval --border 2`: a turned array's corners reach past the
+# sensor), SSIM and SA of the whole frame.
+#
+#   git worktree add /tmp/before b55cdfe~1 && CARGO_TARGET_DIR=/tmp/before-target \
+#     cargo build --release -p slf-host --manifest-path /tmp/before/Cargo.toml
+#   SLF_BEFORE=/tmp/before-target/release/slf bash scripts/grid-shear.sh OUT > docs/results-grid-shear.md
+#
+# SLF_SCENES (default outdoor tungsten office led, 64 x 64 lenslets, and the HCI crops in
+# SLF_REAL when present), SLF_KS (1 3), SLF_GRIDS (0.3:5.04 1:5.1). OUT/rows.tsv keeps each row.
+set -euo pipefail
+out=${1:?usage: grid-shear.sh OUT_DIR}
+before=${SLF_BEFORE:?SLF_BEFORE: the binary to compare with}
+cd "$(dirname "$0")/.."
+. scripts/scene-tables.sh
+SLF_SIZE=${SLF_SIZE:-64} SLF_SCENES=${SLF_SCENES:-outdoor tungsten office led} table_setup
+add_real_scenes
+ks=${SLF_KS:-1 3}
+grids=${SLF_GRIDS:-0.3:5.04 1:5.1}
+sensor=(--vignetting 0.3 --prnu 0.01)
+rows="$out/rows.tsv"
+: > "$rows"
+
+# calibration GRID_FLAGS...: sets $cal, the calibration of this scene's sensor (once per scene and grid).
+calibration() {
+  cal="$out/cal-$scene-$label"
+  if [ ! -d "$cal" ]; then
+    rm -rf "$out/cc" "$out/cc-cap"
+    "$slf" simulate "$lf" -o "$out/cc-cap" "${sensor[@]}" "$@" --calibration-captures "$out/cc" --exposures 2 > /dev/null 2>&1
+    "$slf" calibrate "$out/cc" -o "$cal" > /dev/null
+    rm -rf "$out/cc" "$out/cc-cap"
+  fi
+}
+
+# measure BIN CAPTURE: PSNR (interior) / SSIM / SA and seconds of BIN's default decode.
+measure() {
+  local bin=$1 cap=$2 start end
+  start=$(date +%s.%N)
+  "$bin" decode "$cap" -o "$out/rec.npy" --quiet --calibration "$cal" > /dev/null
+  end=$(date +%s.%N)
+  psnr=$("$slf" eval "$lf" "$out/rec.npy" --border 2 | awk '/^PSNR/ { print $2 }')
+  read -r q a < <("$slf" eval "$lf" "$out/rec.npy" | awk '/^SSIM/ { q = $2 } /^SA/ { a = $2 } END { print q, a }')
+  secs=$(python3 -c "print(f'{$end - $start:.1f}')")
+  echo "$psnr $q $a $secs"
+}
+
+for token in $scenes; do
+  scene_light_field "$token"
+  for k in $ks; do
+    label=aligned
+    calibration
+    cap="$out/cap-$scene-$k-aligned"
+    [ -d "$cap" ] || "$slf" simulate "$lf" -o "$cap" -s "$k" --seed 1 "${sensor[@]}" > /dev/null 2>&1
+    ref=$(measure "$slf" "$cap")
+    for g in $grids; do
+      label=$g
+      calibration --rotation "${g%:*}" --pitch "${g#*:}"
+      cap="$out/cap-$scene-$k-$g"
+      [ -d "$cap" ] || "$slf" simulate "$lf" -o "$cap" -s "$k" --seed 1 "${sensor[@]}" \
+        --rotation "${g%:*}" --pitch "${g#*:}" > /dev/null 2>&1
+      printf '%s\t%s\t%s\t%s\t%s\t%s\n' "$scene" "$k" "$g" "$ref" "$(measure "$before" "$cap")" \
+        "$(measure "$slf" "$cap")" >> "$rows"
+    done
+  done
+done
+
+page_head "A sheared patch behind a lenslet grid" "SLF_BEFORE=... bash scripts/grid-shear.sh OUT_DIR"
+python3 - "$rows" "$before" <<'PY'
+import statistics, sys
+rows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1]) if l.strip()]
+print(f"Made by `SLF_BEFORE={sys.argv[2]} bash scripts/grid-shear.sh OUT_DIR`. Each cell: PSNR dB without")
+print("the 2 edge lenslets / SSIM / SA degrees, then the decode's seconds (one run on a shared")
+print("machine: compare within a row). *before*: a patch sheared by whole lenslets behind the grid")
+print("takes every pixel it reads as its measurement, a share of its square over a cell outside the")
+print("patch given to the pixel's own cell; *after*: at k >= 2 it leaves out the pixels more than")
+print("a quarter outside (`MAX_OUTSIDE_SHARE`, `firmware/src/solver/shares.rs`). Calibrated sensors")
+print("with 30 % vignetting, 1 % PRNU, shot and read noise, seed 1.")
+print()
+print("| scene | k | grid (deg:px) | aligned sensor | before | after | after - before dB | after - aligned dB |")
+print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+gains, gaps = {}, {}
+for scene, k, g, *v in rows:
+    ref, b, a = v[0].split(), v[1].split(), v[2].split()
+    cell = lambda x: f"{float(x[0]):.2f} / {float(x[1]):.4f} / {float(x[2]):.2f}, {x[3]} s"
+    d, gap = float(a[0]) - float(b[0]), float(a[0]) - float(ref[0])
+    gains.setdefault(k, []).append(d)
+    gaps.setdefault(k, []).append((gap, float(b[0]) - float(ref[0])))
+    print(f"| {scene} | {k} | {g} | {cell(ref)} | {cell(b)} | {cell(a)} | {d:+.2f} | {gap:+.2f} |")
+print()
+print("## Summary")
+print()
+print("| k | decodes | after - before: worst / median / best dB | against the aligned sensor, before: worst / median | after: worst / median |")
+print("| --- | --- | --- | --- | --- |")
+for k in sorted(gains):
+    g = gains[k]
+    after = [x for x, _ in gaps[k]]
+    bef = [y for _, y in gaps[k]]
+    print(f"| {k} | {len(g)} | {min(g):+.2f} / {statistics.median(g):+.2f} / {max(g):+.2f} | "
+          f"{min(bef):+.2f} / {statistics.median(bef):+.2f} | {min(after):+.2f} / {statistics.median(after):+.2f} |")
+PY
