@@ -211,7 +211,7 @@ impl<S: Shape> Reach<S> {
 
     /// The share of patch pixel `(s, t, u, v)`'s square, its centre `place` cells off its
     /// cell's (rows, columns), that covers cells outside the patch (given to its own cell
-    /// by the projection): the footprint's own arithmetic ([`axis`]), per axis, the two
+    /// by the projection): the footprint's own arithmetic (`axis`), per axis, the two
     /// axes' inside parts multiplied.
     pub fn outside(&self, (s, t, u, v): (usize, usize, usize, usize), place: (f32, f32)) -> f32 {
         let l = &self.0;
