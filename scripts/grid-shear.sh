@@ -14,7 +14,8 @@
 #   SLF_BEFORE=/tmp/before-target/release/slf bash scripts/grid-shear.sh OUT > docs/results-grid-shear.md
 #
 # SLF_SCENES (default outdoor tungsten office led, 64 x 64 lenslets, and the HCI crops in
-# SLF_REAL when present), SLF_KS (1 3), SLF_GRIDS (0.3:5.04 1:5.1). OUT/rows.tsv keeps each row.
+# SLF_REAL when present), SLF_KS (1 3), SLF_GRIDS (0.3:5.04 1:5.1). OUT/rows.tsv keeps each row;
+# scripts/grid-shear-page.py makes the page's tables from one or more of them.
 set -euo pipefail
 out=${1:?usage: grid-shear.sh OUT_DIR}
 before=${SLF_BEFORE:?SLF_BEFORE: the binary to compare with}
@@ -72,36 +73,4 @@ for token in $scenes; do
 done
 
 page_head "A sheared patch behind a lenslet grid" "SLF_BEFORE=... bash scripts/grid-shear.sh OUT_DIR"
-python3 - "$rows" "$before" <<'PY'
-import statistics, sys
-rows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1]) if l.strip()]
-print(f"Made by `SLF_BEFORE={sys.argv[2]} bash scripts/grid-shear.sh OUT_DIR`. Each cell: PSNR dB without")
-print("the 2 edge lenslets / SSIM / SA degrees, then the decode's seconds (one run on a shared")
-print("machine: compare within a row). *before*: a patch sheared by whole lenslets behind the grid")
-print("takes every pixel it reads as its measurement, a share of its square over a cell outside the")
-print("patch given to the pixel's own cell; *after*: at k >= 2 it leaves out the pixels more than")
-print("a quarter outside (`MAX_OUTSIDE_SHARE`, `firmware/src/solver/shares.rs`). Calibrated sensors")
-print("with 30 % vignetting, 1 % PRNU, shot and read noise, seed 1.")
-print()
-print("| scene | k | grid (deg:px) | aligned sensor | before | after | after - before dB | after - aligned dB |")
-print("| --- | --- | --- | --- | --- | --- | --- | --- |")
-gains, gaps = {}, {}
-for scene, k, g, *v in rows:
-    ref, b, a = v[0].split(), v[1].split(), v[2].split()
-    cell = lambda x: f"{float(x[0]):.2f} / {float(x[1]):.4f} / {float(x[2]):.2f}, {x[3]} s"
-    d, gap = float(a[0]) - float(b[0]), float(a[0]) - float(ref[0])
-    gains.setdefault(k, []).append(d)
-    gaps.setdefault(k, []).append((gap, float(b[0]) - float(ref[0])))
-    print(f"| {scene} | {k} | {g} | {cell(ref)} | {cell(b)} | {cell(a)} | {d:+.2f} | {gap:+.2f} |")
-print()
-print("## Summary")
-print()
-print("| k | decodes | after - before: worst / median / best dB | against the aligned sensor, before: worst / median | after: worst / median |")
-print("| --- | --- | --- | --- | --- |")
-for k in sorted(gains):
-    g = gains[k]
-    after = [x for x, _ in gaps[k]]
-    bef = [y for _, y in gaps[k]]
-    print(f"| {k} | {len(g)} | {min(g):+.2f} / {statistics.median(g):+.2f} / {max(g):+.2f} | "
-          f"{min(bef):+.2f} / {statistics.median(bef):+.2f} | {min(after):+.2f} / {statistics.median(after):+.2f} |")
-PY
+python3 scripts/grid-shear-page.py "$rows" "$before"
