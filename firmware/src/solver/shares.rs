@@ -211,16 +211,14 @@ impl<S: Shape> Reach<S> {
 
     /// The share of patch pixel `(s, t, u, v)`'s square, its centre `place` cells off its
     /// cell's (rows, columns), that covers cells outside the patch (given to its own cell
-    /// by the projection): the footprint's own arithmetic (`axis`), per axis, the two
+    /// by the projection): the footprint's own overhangs (`overhang`), per axis, the two
     /// axes' inside parts multiplied.
     pub fn outside(&self, (s, t, u, v): (usize, usize, usize, usize), place: (f32, f32)) -> f32 {
         let l = &self.0;
         let side = |delta: f32, half: f32, inv: f32, nb: Option<&[u16; 2]>| {
             let [b, a] = nb.copied().unwrap_or([OUTSIDE, OUTSIDE]);
-            let (lo, hi) = (delta - half, delta + half);
-            let before = if lo < -0.5 && b == OUTSIDE { (-0.5 - lo) * inv } else { 0.0 };
-            let after = if hi > 0.5 && a == OUTSIDE { (hi - 0.5) * inv } else { 0.0 };
-            before + after
+            let (before, after) = overhang(delta, half, inv);
+            (if b == OUTSIDE { before } else { 0.0 }) + (if a == OUTSIDE { after } else { 0.0 })
         };
         let r = side(place.0, l.half.0, l.inv.0, l.rows.get(s * S::PU + u));
         let c = side(place.1, l.half.1, l.inv.1, l.cols.get(t * S::PV + v));
@@ -246,9 +244,7 @@ fn along(p: isize, views: usize, len: usize, shift: &[i8; MAX_SHARE_VIEWS]) -> O
 /// against unit cells: `half <= 1` and `|delta| <= 1/2`, so it reaches no further.
 #[inline(always)]
 fn axis(delta: f32, half: f32, inv: f32, parts: [u16; 3]) -> ([u16; 3], [f32; 3]) {
-    let (a, b) = (delta - half, delta + half);
-    let mut before = if a < -0.5 { (-0.5 - a) * inv } else { 0.0 };
-    let mut after = if b > 0.5 { (b - 0.5) * inv } else { 0.0 };
+    let (mut before, mut after) = overhang(delta, half, inv);
     let mut own = 1.0 - before - after;
     if parts[0] == OUTSIDE {
         own += before;
@@ -259,6 +255,16 @@ fn axis(delta: f32, half: f32, inv: f32, parts: [u16; 3]) -> ([u16; 3], [f32; 3]
         after = 0.0;
     }
     (parts, [before, own, after])
+}
+
+/// The shares of a pixel `2 half` cells wide (`inv` its inverse), its centre `delta` cells
+/// off its own cell's centre, over the cells before and after its own along one axis.
+#[inline(always)]
+fn overhang(delta: f32, half: f32, inv: f32) -> (f32, f32) {
+    let (a, b) = (delta - half, delta + half);
+    let before = if a < -0.5 { (-0.5 - a) * inv } else { 0.0 };
+    let after = if b > 0.5 { (b - 0.5) * inv } else { 0.0 };
+    (before, after)
 }
 
 /// Each measurement's step scale behind a lenslet grid: one over its row of `M M^T` summed
