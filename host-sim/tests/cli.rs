@@ -1330,10 +1330,44 @@ fn the_decode_names_its_lenslet_grid() {
         )
     };
     sim("cap", &["--rotation", "1", "--pitch", "5.1"]);
-    let out = stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("x.npy")).arg("-q"));
+    let out = stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("x.npy")).arg("-q").args([
+        "--coverage-map",
+        &p("cov.npy").display().to_string(),
+        "--error-map",
+        &p("em.npy").display().to_string(),
+    ]));
     let line = out.lines().find(|l| l.starts_with("lenslet grid:")).unwrap_or_else(|| panic!("{out}"));
     assert!(line.starts_with("lenslet grid: turned 1.0000 degrees, pitch 5.1000 x 5.1000 px"), "{line}");
     assert!(line.contains("lenslets reach past the sensor's edges") && !line.contains("half-pixel"), "{line}");
+    // Issue 66, item 4: the lenslets past the sensor in the coverage map, and left out of
+    // the estimated PSNR, which is the map's over the rest.
+    let number = |text: &str, after: &str| -> f64 {
+        let rest = &text[text.find(after).unwrap_or_else(|| panic!("{after:?} in {text}")) + after.len()..];
+        rest.split(|c: char| !(c.is_ascii_digit() || c == '.')).next().unwrap().parse().unwrap()
+    };
+    let past = number(line, "; ") as usize;
+    let coverage = slf_host::io::lightfield::read_npy_f32_2d(&p("cov.npy"), (30, 30)).unwrap();
+    assert_eq!(coverage.iter().filter(|&&c| c < 1.0).count(), past, "{line}");
+    assert!(coverage.iter().all(|&c| (0.0..=1.0).contains(&c) && (c * 25.0).fract() == 0.0), "not shares of 25 views");
+    let estimate = out.lines().find(|l| l.starts_with("error estimate:")).unwrap_or_else(|| panic!("{out}"));
+    assert!(estimate.contains(&format!("the {past} lenslets that reach past the sensor left out")), "{estimate}");
+    let errors = slf_host::io::lightfield::read_npy_f32_2d(&p("em.npy"), (30, 30)).unwrap();
+    let kept: Vec<f64> =
+        errors.iter().zip(&coverage).filter(|(e, c)| **c == 1.0 && e.is_finite()).map(|(e, _)| f64::from(*e)).collect();
+    let range = number(estimate, "data range ");
+    let want = 10.0 * (range * range / (kept.iter().map(|e| e * e).sum::<f64>() / kept.len() as f64)).log10();
+    let got = number(estimate, "estimated PSNR ");
+    assert!((got - want).abs() < 0.01, "estimated PSNR {got} dB, {want} over the lenslets on the sensor");
+    let e = failure(
+        slf()
+            .arg("decode")
+            .arg(p("cap"))
+            .args(["--method", "demosaic", "--grid", "aligned", "-o"])
+            .arg(p("y.npy"))
+            .arg("--coverage-map")
+            .arg(p("c2.npy")),
+    );
+    assert!(e.contains("--coverage-map needs --method cs"), "{e}");
     let out = stdout(slf().arg("decode").arg(p("cap")).arg("-o").arg(p("x.npy")).args([
         "-q",
         "--disparities",

@@ -406,7 +406,9 @@ def decode(
     patches started from the disjoint grid's decode), ``patch_views`` (4 or 5: the views per
     axis of the patch it decoded with), ``off_sensor_lenslets`` and ``off_sensor_views`` (what
     the lenslet grid puts past the sensor's edges: views never measured, guessed from their
-    neighbours; ``evaluate(..., border=2)`` scores without the edge lenslets) and a
+    neighbours; ``evaluate(..., border=2)`` scores without the edge lenslets), ``coverage``
+    (each lenslet's share of views on the sensor, an ``(H, W)`` array: 1 but at those
+    lenslets, which ``estimated_psnr`` leaves out) and a
     ``warning`` when over 1 % of the patches failed or were flagged.
 
     ``method``: cs (compressed sensing), interpolate, demosaic or ppid (baselines).

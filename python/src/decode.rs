@@ -199,6 +199,8 @@ pub fn decode<'py>(
             report.set_item("rows_held", r.rows_held)?;
             report.set_item("off_sensor_lenslets", r.off_sensor.lenslets)?;
             report.set_item("off_sensor_views", r.off_sensor.views)?;
+            let [rows, cols] = d.lenslets;
+            report.set_item("coverage", plane(py, r.off_sensor.coverage([rows, cols]), rows, cols)?)?;
             report.set_item("stride", options.stride.0)?;
             report.set_item("seeded", options.seeds())?;
             report.set_item("patch_views", r.patch_views.map(PatchViews::count))?;
@@ -251,7 +253,9 @@ pub fn decode<'py>(
                 report.set_item("estimate_note", NO_ESTIMATE)?;
             }
             if let Some(map) = r.error_map(rows, cols, settings.estimate) {
-                report.set_item("estimated_psnr", estimated_psnr(&map, f64::from(peak)))?;
+                // The lenslets that reach past the sensor are guesses, not figures of the decode.
+                report
+                    .set_item("estimated_psnr", estimated_psnr(&r.off_sensor.left_out(&map, cols), f64::from(peak)))?;
                 report.set_item("error_map", plane(py, map, rows, cols)?)?;
                 report.set_item("estimate_seconds", r.estimate_seconds)?;
             }

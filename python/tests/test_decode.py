@@ -165,6 +165,7 @@ def test_output_streams_to_a_file_and_returns_its_memory_map(capture, tmp_path):
     assert 0 < report["rows_held"] <= 20
     # An aligned sensor puts no view past its edges.
     assert (report["off_sensor_lenslets"], report["off_sensor_views"]) == (0, 0)
+    assert report["coverage"].shape == mapped.shape[2:4] and np.all(report["coverage"] == 1)
     # A baseline too (decoded whole, then written by rows).
     base = slf.decode(capture, method="demosaic", output=tmp_path / "d.npy")
     assert np.array_equal(base, slf.decode(capture, method="demosaic"))
@@ -304,3 +305,15 @@ def test_a_shear_trial_with_nothing_to_try_says_so(depth):
     assert "no half-pixel step to try" in report["shear_trial_skipped"]
     _, report = slf.decode(cap, shear_trial=True, disparities="0:0", report=True)
     assert report["shear_trial_skipped"] == "the decode searches no disparity"
+
+
+def test_behind_a_turned_array_the_report_marks_the_lenslets_past_the_sensor(depth):
+    # Issue 66, item 4: the lenslets whose views reach past the sensor's edges have their
+    # share of views on it in report["coverage"], the rest 1.
+    cap = slf.simulate(depth, k=1, seed=1, rotation=1.0, pitch=5.1)
+    _, report = slf.decode(cap, report=True, preset="preview")
+    coverage = report["coverage"]
+    assert coverage.shape == depth.shape[2:4]
+    assert 0 < report["off_sensor_lenslets"] == np.count_nonzero(coverage < 1)
+    assert np.all((coverage >= 0) & (coverage <= 1))
+    assert round(float(np.sum(1 - coverage)) * 25) == report["off_sensor_views"]

@@ -184,8 +184,6 @@ pub fn calibrate(captures: &[(String, Capture)], response: Option<Vec<Vec<f32>>>
             bad[r as usize * cols + col as usize] = true;
         }
     }
-    let hot_pixels: Vec<[u32; 2]> =
-        (0..rows * cols).filter(|&p| bad[p]).map(|p| [(p / cols) as u32, (p % cols) as u32]).collect();
 
     // Behind a lenslet grid, the grid from the flats, hot pixels replaced by their working
     // neighbours' mean.
@@ -201,6 +199,15 @@ pub fn calibrate(captures: &[(String, Capture)], response: Option<Vec<Vec<f32>>>
     // grid, the view cell a pixel's centre lies in as the decode maps it, the firmware's
     // `LensletGrid::view_of`; pixels off the light field left out).
     let mapping = fit.as_ref().map(|f| f.grid.firmware(d0.views)).transpose()?;
+    // A turned array leaves pixels at the sensor's edges that no lenslet of the array
+    // lights: dark in the flats, but not dead. They are listed apart (no patch reads them).
+    let in_array = |p: usize| match &mapping {
+        None => true,
+        Some(g) => g.view_of(p / cols, p % cols).is_some_and(|((s, t), _)| s < d0.lenslets[0] && t < d0.lenslets[1]),
+    };
+    let at = |p: usize| [(p / cols) as u32, (p % cols) as u32];
+    let hot_pixels: Vec<[u32; 2]> = (0..rows * cols).filter(|&p| bad[p] && in_array(p)).map(at).collect();
+    let outside_pixels: Vec<[u32; 2]> = (0..rows * cols).filter(|&p| bad[p] && !in_array(p)).map(at).collect();
     let mut sums = vec![(0.0f64, 0usize); u_n * v_n];
     for p in (0..rows * cols).filter(|&p| !bad[p]) {
         let (u, v) = match &mapping {
@@ -308,6 +315,7 @@ pub fn calibrate(captures: &[(String, Capture)], response: Option<Vec<Vec<f32>>>
         response,
         vignetting,
         hot_pixels,
+        outside_pixels,
         sources: Sources { dark: darks.len(), flat: flats.len(), band: band_count },
         lenslet_grid: fit.map(|f| f.grid),
         files: None,
@@ -325,9 +333,13 @@ pub fn calibrate(captures: &[(String, Capture)], response: Option<Vec<Vec<f32>>>
                 v_n
             ),
             format!(
-                "{} hot, dead or defective pixels of {}; vignetting: the darkest view gets {:.3} of the brightest's",
+                "{} hot, dead or defective pixels of {}{}; vignetting: the darkest view gets {:.3} of the brightest's",
                 description.hot_pixels.len(),
                 rows * cols,
+                match description.outside_pixels.len() {
+                    0 => String::new(),
+                    n => format!(" ({n} more outside the lenslet array: no lenslet lights them, no patch reads them)"),
+                },
                 description.vignetting.iter().flatten().fold(1.0f32, |m, &x| m.min(x))
             ),
         ],

@@ -150,7 +150,7 @@ pub fn corrected(capture: &Capture, cal: &OpenCalibration, keep_grid: bool) -> R
         }
     };
     let mut defects: BTreeSet<[u32; 2]> = d.defective_pixels.iter().copied().collect();
-    defects.extend(c.hot_pixels.iter().copied());
+    defects.extend(c.hot_pixels.iter().chain(&c.outside_pixels).copied());
     // A pixel the flat calls dead never reads as a measurement.
     cal.flat.visit(size, |first, flat| {
         for (i, _) in flat.iter().enumerate().filter(|&(_, &f)| f < DEAD_FLAT) {

@@ -205,11 +205,15 @@ impl Compact {
             .map(|&[r, c]| Ok((u16::try_from(r)?, u16::try_from(c)?)))
             .collect::<Result<_, std::num::TryFromIntError>>()?;
         let (_, cols) = cal.frame_size();
+        // Pixels outside the lenslet array are no working pixels (their darks are left out of
+        // the black) but no defects either: the decoder never reads them.
+        let outside: std::collections::BTreeSet<usize> =
+            d.outside_pixels.iter().map(|p| p[0] as usize * cols + p[1] as usize).collect();
         let working: Vec<f32> = cal
             .dark
             .iter()
             .enumerate()
-            .filter(|(p, _)| !hot.contains(&((p / cols) as u16, (p % cols) as u16)))
+            .filter(|(p, _)| !hot.contains(&((p / cols) as u16, (p % cols) as u16)) && !outside.contains(p))
             .map(|(_, &x)| x)
             .collect();
         let black = (working.iter().map(|&x| f64::from(x)).sum::<f64>() / working.len().max(1) as f64) as f32;

@@ -64,6 +64,11 @@ pub struct CalibrationDescription {
     pub vignetting: Vec<Vec<f32>>,
     /// `[row, col]` of pixels whose dark level or flat is no working pixel's.
     pub hot_pixels: Vec<[u32; 2]>,
+    /// `[row, col]` of pixels behind a lenslet grid that no lenslet of the array lights
+    /// (their centres lie in no view cell of the array: a turned array's sensor edges):
+    /// dark in the flats, yet not dead. No patch reads them. Absent when empty.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub outside_pixels: Vec<[u32; 2]>,
     pub sources: Sources,
     /// The lenslet grid found from the flats ([`crate::io::grid`]), when the captures were
     /// taken behind one; the frames are then its sensor's size.
@@ -174,6 +179,13 @@ impl CalibrationDescription {
         if let Some(p) = self.hot_pixels.iter().find(|p| p[0] as usize >= rows || p[1] as usize >= cols) {
             return Err(anyhow!("hot pixel {p:?} outside the {rows} x {cols} frame"));
         }
+        ensure!(
+            self.outside_pixels.is_empty() || self.lenslet_grid.is_some(),
+            "outside_pixels listed without a lenslet_grid: only a grid leaves pixels outside the array"
+        );
+        if let Some(p) = self.outside_pixels.iter().find(|p| p[0] as usize >= rows || p[1] as usize >= cols) {
+            return Err(anyhow!("outside pixel {p:?} outside the {rows} x {cols} frame"));
+        }
         Ok((rows, cols))
     }
 }
@@ -229,9 +241,10 @@ fn check_dark(d: &CalibrationDescription, dark: &[f32], cols: usize) -> Result<(
     check_dark_rows(d, &hot_indices(d, cols), 0, dark, cols)
 }
 
-/// The hot pixels' row-major indices in a frame of `cols` columns.
+/// The hot and outside pixels' row-major indices in a frame of `cols` columns (neither is a
+/// working pixel whose dark level is checked).
 fn hot_indices(d: &CalibrationDescription, cols: usize) -> std::collections::BTreeSet<usize> {
-    d.hot_pixels.iter().map(|p| p[0] as usize * cols + p[1] as usize).collect()
+    d.hot_pixels.iter().chain(&d.outside_pixels).map(|p| p[0] as usize * cols + p[1] as usize).collect()
 }
 
 /// [`check_dark`] on the rows from `first_row` on (`dark` holds whole rows).

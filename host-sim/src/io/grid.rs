@@ -271,13 +271,17 @@ impl GridDescription {
 /// What of a light field a grid puts off its sensor: view cells whose centres no pixel
 /// holds, never measured (the decode's guesses from their neighbours). A turned array
 /// centred on a sensor its own size ([`GridDescription::centred`]) puts its corners past
-/// the sensor's edges.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+/// the sensor's edges. Such lenslets are marked in `slf decode --coverage-map` and left out
+/// of the decode's estimated PSNR ([`OffSensor::left_out`]).
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct OffSensor {
     /// Lenslets with at least one view off the sensor.
     pub lenslets: usize,
     /// Their views off the sensor, all told.
     pub views: usize,
+    /// Each such lenslet `[s, t]`, with the share of its views on the sensor (below 1): a
+    /// turned array's edges, so about its perimeter's length.
+    pub partial: Vec<([usize; 2], f32)>,
 }
 
 impl OffSensor {
@@ -285,6 +289,7 @@ impl OffSensor {
     /// whose centre [`LensletGrid::pixel`] finds no pixel under.
     pub fn of(grid: &LensletGrid, lenslets: [usize; 2]) -> Self {
         let (nu, nv) = grid.views();
+        let all = usize::from(nu) * usize::from(nv);
         let mut off = Self::default();
         for s in 0..lenslets[0] {
             for t in 0..lenslets[1] {
@@ -292,11 +297,38 @@ impl OffSensor {
                     .flat_map(|u| (0..usize::from(nv)).map(move |v| (u, v)))
                     .filter(|&uv| grid.pixel((s as isize, t as isize), uv).is_none())
                     .count();
-                off.views += cells;
-                off.lenslets += usize::from(cells > 0);
+                if cells > 0 {
+                    off.views += cells;
+                    off.lenslets += 1;
+                    off.partial.push(([s, t], (all - cells) as f32 / all as f32));
+                }
             }
         }
         off
+    }
+
+    /// Each of the `[rows, cols]` lenslets' share of views on the sensor, row-major: 1 but
+    /// for the lenslets that reach past it (`slf decode --coverage-map`).
+    pub fn coverage(&self, [rows, cols]: [usize; 2]) -> Vec<f32> {
+        let mut map = vec![1.0; rows * cols];
+        for &([s, t], share) in &self.partial {
+            if let Some(m) = map.get_mut(s * cols + t) {
+                *m = share;
+            }
+        }
+        map
+    }
+
+    /// A per-lenslet map (`cols` lenslets a row) with the lenslets that reach past the sensor
+    /// NaN: their guessed views are no figure of the decode's.
+    pub fn left_out(&self, map: &[f32], cols: usize) -> Vec<f32> {
+        let mut out = map.to_vec();
+        for &([s, t], _) in &self.partial {
+            if let Some(m) = out.get_mut(s * cols + t) {
+                *m = f32::NAN;
+            }
+        }
+        out
     }
 }
 
@@ -359,12 +391,19 @@ mod tests {
         // last column's right neighbour would be on it (no lenslet there to count).
         let mut g = GridDescription::aligned([4, 6], [5, 5]);
         g.offset[1] -= 5.0;
-        assert_eq!(off(&g, [4, 6]), OffSensor { lenslets: 4, views: 4 * 25 });
+        let column: Vec<_> = (0..4).map(|s| ([s, 0], 0.0)).collect();
+        assert_eq!(off(&g, [4, 6]), OffSensor { lenslets: 4, views: 4 * 25, partial: column });
         // Moved 2.2 px up: the first lenslet row's top two view rows (centres at 0.5 and 1.5
         // px, now above the top edge) of every lenslet in it.
         let mut g = GridDescription::aligned([4, 6], [5, 5]);
         g.offset[0] -= 2.2;
-        assert_eq!(off(&g, [4, 6]), OffSensor { lenslets: 6, views: 6 * 2 * 5 });
+        let row: Vec<_> = (0..6).map(|t| ([0, t], 0.6)).collect();
+        assert_eq!(off(&g, [4, 6]), OffSensor { lenslets: 6, views: 6 * 2 * 5, partial: row });
+        // Marked in the coverage map, and left out of a per-lenslet map's figures.
+        let coverage = off(&g, [4, 6]).coverage([4, 6]);
+        assert!(coverage.iter().enumerate().all(|(i, &c)| c == if i < 6 { 0.6 } else { 1.0 }), "{coverage:?}");
+        let left = off(&g, [4, 6]).left_out(&[0.5; 24], 6);
+        assert!(left.iter().enumerate().all(|(i, e)| e.is_nan() == (i < 6)), "{left:?}");
         // Turned a degree on a sensor its own size: some corner views are off, and only
         // lenslets near the edges have any.
         let g = GridDescription::centred([64, 64], 1.0, [5.1, 5.1]);

@@ -35,7 +35,7 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
                 }
                 for dc in 0..len {
                     let col = col0 + dc;
-                    if c.defects.contains(row, col) {
+                    if c.defects.contains(row, col) || !self.in_array(row, col) {
                         continue;
                     }
                     // One band list per pixel, every snapshot's sample against it.
@@ -66,6 +66,17 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
             return Ok(crate::sensor::gains::gains_from_sums(&means, &ones));
         }
         Ok(crate::sensor::gains::gains_from_sums(&sums, &counts))
+    }
+
+    /// Whether sensor pixel `(row, col)` belongs to the light field: on the aligned sensor
+    /// every pixel does; behind a lenslet grid, a pixel whose centre lies in no view cell of
+    /// the array's lenslets is outside it (a turned array leaves such pixels at the
+    /// sensor's edges). No patch reads one, and the grey world leaves them out: they record
+    /// no light of the scene.
+    pub fn in_array(&self, row: usize, col: usize) -> bool {
+        let Some(g) = &self.grid else { return true };
+        let (s_n, t_n) = self.config.sensor.lenslets;
+        g.view_of(row, col).is_some_and(|((s, t), _)| s < usize::from(s_n) && t < usize::from(t_n))
     }
 
     /// Reads the patch at `origin` into the workspace's measurements (each divided by its

@@ -52,6 +52,12 @@ pub struct Args {
     /// --estimate.
     #[arg(long)]
     pub error_map: Option<PathBuf>,
+    /// Also write each lenslet's share of views that lie on the sensor (.npy, lenslet rows x
+    /// cols, f32): 1 but where a turned lenslet array's corner lenslets reach past the
+    /// sensor's edges, whose views there are guessed from their neighbours, not measured.
+    /// The decode's estimated PSNR leaves those lenslets out.
+    #[arg(long)]
+    pub coverage_map: Option<PathBuf>,
     /// Stored dtype.
     #[arg(long, value_enum, default_value_t = Dtype::F32)]
     pub dtype: Dtype,
@@ -77,8 +83,19 @@ pub enum Format {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let Args { capture, output, format, deflate, mut settings, member_map, disparity_map, error_map, dtype, quiet } =
-        args;
+    let Args {
+        capture,
+        output,
+        format,
+        deflate,
+        mut settings,
+        member_map,
+        disparity_map,
+        error_map,
+        coverage_map,
+        dtype,
+        quiet,
+    } = args;
     let named = |ext: &[&str]| output.extension().is_some_and(|e| ext.iter().any(|x| e.eq_ignore_ascii_case(x)));
     let format = format.unwrap_or(if named(&["h5", "hdf5"]) {
         Format::Hdf5
@@ -111,12 +128,17 @@ pub fn run(args: Args) -> Result<()> {
         .outputs(member_map.as_deref(), "--member-map")
         .outputs(disparity_map.as_deref(), "--disparity-map")
         .outputs(error_map.as_deref(), "--error-map")
+        .outputs(coverage_map.as_deref(), "--coverage-map")
         .check()?;
     let cs = settings.method.baseline().is_none();
     anyhow::ensure!(cs || member_map.is_none(), "--member-map needs --method cs (baselines use no ensemble)");
     anyhow::ensure!(
         cs || !settings.estimate,
         "--error-map and --estimate need --method cs (baselines solve nothing to hold out of)"
+    );
+    anyhow::ensure!(
+        cs || coverage_map.is_none(),
+        "--coverage-map needs --method cs (the baselines read a grid's frames as an aligned array)"
     );
     anyhow::ensure!(
         cs || disparity_map.is_none(),
@@ -189,6 +211,9 @@ pub fn run(args: Args) -> Result<()> {
     if let (Some(path), Some(map)) = (&error_map, &errors) {
         staged.push(stage_npy_f32_2d(path, map, rows, cols)?);
     }
+    if let Some(path) = &coverage_map {
+        staged.push(stage_npy_f32_2d(path, &r.off_sensor.coverage([rows, cols]), rows, cols)?);
+    }
     let peak = f64::from(file.max());
     file.finish(&format!("{opts:?}"))?;
     for map in staged {
@@ -225,7 +250,7 @@ pub fn run(args: Args) -> Result<()> {
         )?;
     }
     if let Some(g) = &r.grid {
-        let off = r.off_sensor;
+        let off = &r.off_sensor;
         let edges = if off.lenslets > 0 {
             format!(
                 "; {} lenslets reach past the sensor's edges ({} of their views unmeasured, guessed from their \
@@ -326,7 +351,12 @@ pub fn run(args: Args) -> Result<()> {
         )?;
     }
     if let Some(map) = &errors {
-        let psnr = estimated_psnr(map, peak).map_or("none".into(), |p| format!("{p:.2} dB"));
+        let psnr =
+            estimated_psnr(&r.off_sensor.left_out(map, cols), peak).map_or("none".into(), |p| format!("{p:.2} dB"));
+        let left_out = match r.off_sensor.lenslets {
+            0 => String::new(),
+            n => format!(", the {n} lenslets that reach past the sensor left out"),
+        };
         let by = if !r.estimated() {
             NO_ESTIMATE.to_string()
         } else if r.error_lenslets.is_empty() {
@@ -336,7 +366,7 @@ pub fn run(args: Args) -> Result<()> {
         } else {
             format!("the frame decoded again from seven samples in eight ({:.2} s)", r.estimate_seconds)
         };
-        outln!("error estimate: {by}; estimated PSNR {psnr} (data range {peak:.4} = the decode's maximum)")?;
+        outln!("error estimate: {by}; estimated PSNR {psnr} (data range {peak:.4} = the decode's maximum{left_out})")?;
     }
     let per = |n: u64| n as f64 / f64::from(r.patches.decoded.max(1));
     outln!(
