@@ -30,7 +30,8 @@ calibrate() {
   shift 2
   rm -rf "$out/cc" "$out/cc-cap" "$out/$name"
   "$bin" simulate "$lf" -o "$out/cc-cap" "${sensor[@]}" "$@" --calibration-captures "$out/cc" --exposures 2 > /dev/null 2>&1
-  "$bin" calibrate "$out/cc" -o "$out/$name" | grep 'hot, dead or defective'
+  # The report goes to standard error.
+  "$bin" calibrate "$out/cc" -o "$out/$name" 2>&1 > /dev/null | grep 'hot, dead or defective'
   rm -rf "$out/cc" "$out/cc-cap"
 }
 
