@@ -448,6 +448,8 @@ def main():
         for v in ["yes", "", "1", "x"]:
             s.run(["decode", "cap", "-o", "x.npy", "-q", f"{flag}={v}"], f"decode {flag}={v}", keep=capture_files)
     for extra in [["--error-map", "cap/capture.json"], ["--error-map", "x.npy"], ["--method", "ppid", "--estimate"],
+                  ["--coverage-map", "cap/snapshot_0.npy"], ["--coverage-map", "x.npy"],
+                  ["--method", "demosaic", "--coverage-map", "c.npy"],
                   ["--model-trial", "true", "--dictionary", "dct"], ["--model-trial", "true", "--preset", "preview"],
                   ["--sheared-fallback", "true", "--disparities", "0:0"], ["--sheared-fallback", "true", "--stride", "1"],
                   ["--format", "hdf5"], ["--format", "x"], ["--deflate", "4"], ["--format", "hdf5", "--deflate", "0"],
