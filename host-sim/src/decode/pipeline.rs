@@ -132,14 +132,6 @@ impl DecodeSettings {
                 &regridded
             }
         };
-        // The baselines interpolate the aligned mosaic: behind a grid its pixels are not
-        // where they assume.
-        ensure!(
-            self.method.baseline().is_none() || capture.description.lenslet_grid.is_none(),
-            "{}: the baseline methods read the aligned grid, and this capture has a lenslet_grid: give --grid \
-             aligned to decode it as aligned, or --method cs",
-            capture.source()
-        );
         // Compressed sensing puts the response in the firmware's decode; baselines unmix
         // their spectra here.
         let rows: Option<Vec<[f32; BANDS]>> =
