@@ -34,7 +34,7 @@ calibrate() {
   fi
 }
 
-# measure CAL CAPTURE FLAGS...: PSNR (interior) / SSIM / SA of the decode; sets $psnr too.
+# measure CAL CAPTURE FLAGS...: PSNR (interior) / SSIM / SA of the decode.
 measure() {
   local cal=$1 cap=$2
   shift 2
@@ -69,10 +69,9 @@ for token in $scenes; do
       cs=$(measure "$out/cal-$scene-$g" "$cap")
       for method in demosaic ppid; do
         self=$(measure "$out/cal-$scene-aligned" "$ref" --method "$method")
-        base=$psnr
         as=$(measure "$out/cal-$scene-$g" "$cap" --method "$method" --grid aligned)
         through=$(measure "$out/cal-$scene-$g" "$cap" --method "$method")
-        gap=$(python3 -c "print(f'{$psnr - $base:+.2f}')")
+        gap=$(python3 -c "print(f'{${through%% *} - ${self%% *}:+.2f}')")
         echo "| $scene | $k | $g | $method | $self | $as | $through | $gap | $cs |"
       done
     done
