@@ -16,22 +16,13 @@ set -euo pipefail
 out=${1:?usage: grid-baselines.sh OUT_DIR}
 cd "$(dirname "$0")/.."
 . scripts/scene-tables.sh
-SLF_SIZE=${SLF_SIZE:-64} SLF_SCENES=${SLF_SCENES:-outdoor tungsten office led} table_setup
-add_real_scenes
-ks=${SLF_KS:-1 3}
-grids=${SLF_GRIDS:-0.3:5.04 1:5.1}
-sensor=(--vignetting 0.3 --prnu 0.01)
+grid_table_setup
 
 # calibrate NAME GRID_FLAGS...: the calibration of this scene's sensor into $out/NAME.
 calibrate() {
   local name=$1
   shift
-  if [ ! -d "$out/$name" ]; then
-    rm -rf "$out/cc" "$out/cc-cap"
-    "$slf" simulate "$lf" -o "$out/cc-cap" "${sensor[@]}" "$@" --calibration-captures "$out/cc" --exposures 2 > /dev/null 2>&1
-    "$slf" calibrate "$out/cc" -o "$out/$name" > /dev/null 2>&1
-    rm -rf "$out/cc" "$out/cc-cap"
-  fi
+  grid_calibration "$slf" "$out/$name" "$@" > /dev/null
 }
 
 # measure CAL CAPTURE FLAGS...: PSNR (interior) / SSIM / SA of the decode.

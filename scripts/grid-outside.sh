@@ -17,22 +17,15 @@ out=${1:?usage: grid-outside.sh OUT_DIR}
 before=${SLF_BEFORE:?SLF_BEFORE: the binary to compare with}
 cd "$(dirname "$0")/.."
 . scripts/scene-tables.sh
-SLF_SIZE=${SLF_SIZE:-64} SLF_SCENES=${SLF_SCENES:-outdoor tungsten office led} table_setup
-add_real_scenes
-ks=${SLF_KS:-1 3}
-grids=${SLF_GRIDS:-0.3:5.04 1:5.1}
-sensor=(--vignetting 0.3 --prnu 0.01)
+grid_table_setup
 
-# calibrate BIN NAME GRID_FLAGS...: BIN's calibration of this scene's sensor into $out/NAME;
-# prints its hot-pixel line.
+# calibrate BIN NAME GRID_FLAGS...: BIN's calibration of this scene's sensor into $out/NAME,
+# made again; prints its hot-pixel line.
 calibrate() {
   local bin=$1 name=$2
   shift 2
-  rm -rf "$out/cc" "$out/cc-cap" "$out/$name"
-  "$bin" simulate "$lf" -o "$out/cc-cap" "${sensor[@]}" "$@" --calibration-captures "$out/cc" --exposures 2 > /dev/null 2>&1
-  # The report goes to standard error.
-  "$bin" calibrate "$out/cc" -o "$out/$name" 2>&1 > /dev/null | grep 'hot, dead or defective'
-  rm -rf "$out/cc" "$out/cc-cap"
+  rm -rf "${out:?}/$name"
+  grid_calibration "$bin" "$out/$name" "$@" | grep 'hot, dead or defective'
 }
 
 # measure BIN CAL CAPTURE: PSNR (interior) / SSIM / SA of BIN's default decode with CAL.

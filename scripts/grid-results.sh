@@ -33,13 +33,7 @@ calibration_for() {
   local n
   n=$(python3 -c "import numpy as np, sys; print(np.load(sys.argv[1], mmap_mode='r').shape[2])" "$lf")
   cal="$out/cal-$n-$label"
-  if [ ! -d "$cal" ]; then
-    rm -rf "$out/cc-$n-$label" "$out/cc-cap"
-    "$slf" simulate "$lf" -o "$out/cc-cap" "${sensor[@]}" "$@" --calibration-captures "$out/cc-$n-$label" \
-      --exposures 2 > /dev/null 2>&1
-    "$slf" calibrate "$out/cc-$n-$label" -o "$cal" > /dev/null
-    rm -rf "$out/cc-$n-$label" "$out/cc-cap"
-  fi
+  grid_calibration "$slf" "$cal" "$@" > /dev/null
 }
 
 cell() { printf ' %.2f / %.4f / %.2f |' "$p" "$q" "$a"; }

@@ -21,30 +21,25 @@ out=${1:?usage: grid-shear.sh OUT_DIR}
 before=${SLF_BEFORE:?SLF_BEFORE: the binary to compare with}
 cd "$(dirname "$0")/.."
 . scripts/scene-tables.sh
-SLF_SIZE=${SLF_SIZE:-64} SLF_SCENES=${SLF_SCENES:-outdoor tungsten office led} table_setup
-add_real_scenes
-ks=${SLF_KS:-1 3}
-grids=${SLF_GRIDS:-0.3:5.04 1:5.1}
-sensor=(--vignetting 0.3 --prnu 0.01)
+grid_table_setup
 rows="$out/rows.tsv"
 : > "$rows"
 
-# calibration GRID_FLAGS...: sets $cal, the calibration of this scene's sensor (once per scene and grid).
+# calibration GRID_FLAGS...: sets $cal and $cal_before, this binary's and BEFORE's
+# calibrations of this scene's sensor (once per scene and grid; each binary decodes with its
+# own: one before e411fe7 does not read a later calibration's `outside_pixels`).
 calibration() {
-  cal="$out/cal-$scene-$label"
-  if [ ! -d "$cal" ]; then
-    rm -rf "$out/cc" "$out/cc-cap"
-    "$slf" simulate "$lf" -o "$out/cc-cap" "${sensor[@]}" "$@" --calibration-captures "$out/cc" --exposures 2 > /dev/null 2>&1
-    "$slf" calibrate "$out/cc" -o "$cal" > /dev/null
-    rm -rf "$out/cc" "$out/cc-cap"
-  fi
+  cal="$out/cal-$scene-$label" cal_before="$out/cal-before-$scene-$label"
+  grid_calibration "$slf" "$cal" "$@" > /dev/null
+  grid_calibration "$before" "$cal_before" "$@" > /dev/null
 }
 
-# measure BIN CAPTURE: PSNR (interior) / SSIM / SA and seconds of BIN's default decode.
+# measure BIN CALIBRATION CAPTURE: PSNR (interior) / SSIM / SA and seconds of BIN's default
+# decode.
 measure() {
-  local bin=$1 cap=$2 start end
+  local bin=$1 calibration=$2 cap=$3 start end
   start=$(date +%s.%N)
-  "$bin" decode "$cap" -o "$out/rec.npy" --quiet --calibration "$cal" > /dev/null
+  "$bin" decode "$cap" -o "$out/rec.npy" --quiet --calibration "$calibration" > /dev/null
   end=$(date +%s.%N)
   psnr=$("$slf" eval "$lf" "$out/rec.npy" --border 2 | awk '/^PSNR/ { print $2 }')
   read -r q a < <("$slf" eval "$lf" "$out/rec.npy" | awk '/^SSIM/ { q = $2 } /^SA/ { a = $2 } END { print q, a }')
@@ -59,15 +54,15 @@ for token in $scenes; do
     calibration
     cap="$out/cap-$scene-$k-aligned"
     [ -d "$cap" ] || "$slf" simulate "$lf" -o "$cap" -s "$k" --seed 1 "${sensor[@]}" > /dev/null 2>&1
-    ref=$(measure "$slf" "$cap")
+    ref=$(measure "$slf" "$cal" "$cap")
     for g in $grids; do
       label=$g
       calibration --rotation "${g%:*}" --pitch "${g#*:}"
       cap="$out/cap-$scene-$k-$g"
       [ -d "$cap" ] || "$slf" simulate "$lf" -o "$cap" -s "$k" --seed 1 "${sensor[@]}" \
         --rotation "${g%:*}" --pitch "${g#*:}" > /dev/null 2>&1
-      printf '%s\t%s\t%s\t%s\t%s\t%s\n' "$scene" "$k" "$g" "$ref" "$(measure "$before" "$cap")" \
-        "$(measure "$slf" "$cap")" >> "$rows"
+      printf '%s\t%s\t%s\t%s\t%s\t%s\n' "$scene" "$k" "$g" "$ref" "$(measure "$before" "$cal_before" "$cap")" \
+        "$(measure "$slf" "$cal" "$cap")" >> "$rows"
     done
   done
 done

@@ -29,6 +29,31 @@ add_real_scenes() {
   return 0
 }
 
+# grid_table_setup: table_setup for the tables behind a turned lenslet array (issue 66):
+# 64 x 64-lenslet scenes (SLF_SCENES, default outdoor tungsten office led) and the HCI crops
+# when present; $ks (SLF_KS, default 1 3), $grids (SLF_GRIDS, deg:px each, default 0.3:5.04
+# 1:5.1) and $sensor, the sensor's flags (30 % vignetting, 1 % PRNU).
+grid_table_setup() {
+  SLF_SIZE=${SLF_SIZE:-64} SLF_SCENES=${SLF_SCENES:-outdoor tungsten office led} table_setup
+  add_real_scenes
+  ks=${SLF_KS:-1 3}
+  grids=${SLF_GRIDS:-0.3:5.04 1:5.1}
+  sensor=(--vignetting 0.3 --prnu 0.01)
+}
+
+# grid_calibration BIN DIR FLAGS...: BIN's calibration into DIR of the sensor $sensor and
+# FLAGS (a grid's) describe, from its own calibration captures of $lf (2 exposures each; a
+# flat does not see the mask), made once; prints calibrate's report (from its standard error).
+grid_calibration() {
+  local bin=$1 dir=$2
+  shift 2
+  [ -d "$dir" ] && return 0
+  rm -rf "$out/cc" "$out/cc-cap"
+  "$bin" simulate "$lf" -o "$out/cc-cap" "${sensor[@]}" "$@" --calibration-captures "$out/cc" --exposures 2 > /dev/null 2>&1
+  "$bin" calibrate "$out/cc" -o "$dir" 2>&1 > /dev/null
+  rm -rf "$out/cc" "$out/cc-cap"
+}
+
 # scene_light_field TOKEN: sets $scene (its name) and $lf (its light field: a real crop, or
 # `slf scene` rendered into $out once).
 scene_light_field() {
