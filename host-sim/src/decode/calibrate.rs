@@ -1,7 +1,8 @@
 //! A sensor's calibration from its calibration captures (issue 43, `slf calibrate`): dark
 //! frames give each pixel's dark level, flat frames its flat (gain times vignetting), a band
 //! sweep the filters' response matrix, and pixels whose dark level or flat no working pixel
-//! has are listed as hot.
+//! has are listed as hot (behind a turned lenslet array, those whose centres lie outside the
+//! array are listed apart, as outside it: unlit, not dead).
 //!
 //! Every capture is checked against the first (geometry, bands, levels, mask): a calibration
 //! belongs to one camera. Exposures of a kind are averaged, and so are a capture's
