@@ -30,8 +30,7 @@ measure() {
   local cal=$1 cap=$2
   shift 2
   "$slf" decode "$cap" -o "$out/rec.npy" --quiet --calibration "$cal" "$@" > /dev/null
-  psnr=$("$slf" eval "$lf" "$out/rec.npy" --border 2 | awk '/^PSNR/ { print $2 }')
-  read -r q a < <("$slf" eval "$lf" "$out/rec.npy" | awk '/^SSIM/ { q = $2 } /^SA/ { a = $2 } END { print q, a }')
+  grid_scores
   echo "$psnr / $q / $a"
 }
 

@@ -31,8 +31,7 @@ calibrate() {
 # measure BIN CAL CAPTURE: PSNR (interior) / SSIM / SA of BIN's default decode with CAL.
 measure() {
   "$1" decode "$3" -o "$out/rec.npy" --quiet --calibration "$2" > "$out/summary.txt"
-  psnr=$("$slf" eval "$lf" "$out/rec.npy" --border 2 | awk '/^PSNR/ { print $2 }')
-  read -r q a < <("$slf" eval "$lf" "$out/rec.npy" | awk '/^SSIM/ { q = $2 } /^SA/ { a = $2 } END { print q, a }')
+  grid_scores
   echo "$psnr / $q / $a"
 }
 

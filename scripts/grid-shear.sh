@@ -41,8 +41,7 @@ measure() {
   start=$(date +%s.%N)
   "$bin" decode "$cap" -o "$out/rec.npy" --quiet --calibration "$calibration" > /dev/null
   end=$(date +%s.%N)
-  psnr=$("$slf" eval "$lf" "$out/rec.npy" --border 2 | awk '/^PSNR/ { print $2 }')
-  read -r q a < <("$slf" eval "$lf" "$out/rec.npy" | awk '/^SSIM/ { q = $2 } /^SA/ { a = $2 } END { print q, a }')
+  grid_scores
   secs=$(python3 -c "print(f'{$end - $start:.1f}')")
   echo "$psnr $q $a $secs"
 }

@@ -54,6 +54,13 @@ grid_calibration() {
   rm -rf "$out/cc" "$out/cc-cap"
 }
 
+# grid_scores: sets $psnr (without the 2 edge lenslets: a turned array's corners reach past
+# the sensor), $q (SSIM) and $a (SA) of the decode in $out/rec.npy against $lf.
+grid_scores() {
+  psnr=$("$slf" eval "$lf" "$out/rec.npy" --border 2 | awk '/^PSNR/ { print $2 }')
+  read -r q a < <("$slf" eval "$lf" "$out/rec.npy" | awk '/^SSIM/ { q = $2 } /^SA/ { a = $2 } END { print q, a }')
+}
+
 # scene_light_field TOKEN: sets $scene (its name) and $lf (its light field: a real crop, or
 # `slf scene` rendered into $out once).
 scene_light_field() {
