@@ -9,7 +9,7 @@ use numpy::{PyArrayDyn, PyReadonlyArrayDyn};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use slf_host::decode::cs::{PatchViews, disparity_per_lenslet, estimated_psnr};
+use slf_host::decode::cs::{PatchViews, disparity_per_lenslet};
 use slf_host::decode::pipeline::{Outcome, output_shape};
 use slf_host::decode::report::NO_ESTIMATE;
 use slf_host::decode::settings::DecodeSettings;
@@ -253,9 +253,7 @@ pub fn decode<'py>(
                 report.set_item("estimate_note", NO_ESTIMATE)?;
             }
             if let Some(map) = r.error_map(rows, cols, settings.estimate) {
-                // The lenslets that reach past the sensor are guesses, not figures of the decode.
-                report
-                    .set_item("estimated_psnr", estimated_psnr(&r.off_sensor.left_out(&map, cols), f64::from(peak)))?;
+                report.set_item("estimated_psnr", r.estimated_psnr(&map, cols, f64::from(peak)))?;
                 report.set_item("error_map", plane(py, map, rows, cols)?)?;
                 report.set_item("estimate_seconds", r.estimate_seconds)?;
             }

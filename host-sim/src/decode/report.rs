@@ -223,6 +223,13 @@ impl DecodeReport {
         self.error_per_lenslet(rows, cols).or_else(|| asked.then(|| vec![f32::NAN; rows * cols]))
     }
 
+    /// The PSNR error map `map` (`cols` lenslets a row) estimates for a light field spanning
+    /// `data_range`, the lenslets that reach past the sensor left out ([`OffSensor::left_out`]:
+    /// their guessed views are no figure of the decode's).
+    pub fn estimated_psnr(&self, map: &[f32], cols: usize, data_range: f64) -> Option<f64> {
+        estimated_psnr(&self.off_sensor.left_out(map, cols), data_range)
+    }
+
     /// Whether an estimate was made: a patch's or a held-out decode's.
     pub fn estimated(&self) -> bool {
         !self.error_lenslets.is_empty() || !self.error_map.is_empty()

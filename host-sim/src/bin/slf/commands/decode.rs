@@ -6,7 +6,7 @@ use slf_host::outln;
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use slf_host::decode::cs::{Balance, NoiseSource, PatchDecoder, disparity_per_lenslet, estimated_psnr};
+use slf_host::decode::cs::{Balance, NoiseSource, PatchDecoder, disparity_per_lenslet};
 use slf_host::decode::options::Maps;
 use slf_host::decode::pipeline::{Outcome, output_shape};
 use slf_host::decode::report::NO_ESTIMATE;
@@ -138,7 +138,7 @@ pub fn run(args: Args) -> Result<()> {
     );
     anyhow::ensure!(
         cs || coverage_map.is_none(),
-        "--coverage-map needs --method cs (the baselines read a grid's frames as an aligned array)"
+        "--coverage-map needs --method cs (a baseline's decode reports no lenslets past the sensor)"
     );
     anyhow::ensure!(
         cs || disparity_map.is_none(),
@@ -351,8 +351,7 @@ pub fn run(args: Args) -> Result<()> {
         )?;
     }
     if let Some(map) = &errors {
-        let psnr =
-            estimated_psnr(&r.off_sensor.left_out(map, cols), peak).map_or("none".into(), |p| format!("{p:.2} dB"));
+        let psnr = r.estimated_psnr(map, cols, peak).map_or("none".into(), |p| format!("{p:.2} dB"));
         let left_out = match r.off_sensor.lenslets {
             0 => String::new(),
             n => format!(", the {n} lenslets that reach past the sensor left out"),
