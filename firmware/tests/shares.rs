@@ -17,6 +17,7 @@ use nalgebra::{DMatrix, DVector};
 use rand::Rng;
 use slf_firmware::Shape as _;
 use slf_firmware::ball::Ball;
+use slf_firmware::projection::weigh;
 use slf_firmware::shape::ValueCount;
 use slf_firmware::shares::{Reach, RowSums, project_shares, to_sensor};
 use slf_firmware::workspace::{CellShares, MAX_SHARE_VIEWS, Measurements, PLACE_UNIT};
@@ -169,7 +170,7 @@ fn the_projection_matches_the_dense_definition() {
         let mut scratch = [0.0f32; N];
         let mut sums = RowSums::new();
         let exact = Ball::new(0.0, 0.0, m.count() as u32, 0);
-        let before = project_shares(&dict, &mut coeffs, &mut scratch, &m, &exact, &mut sums);
+        let before = project_shares(&dict, &mut coeffs, &mut scratch, &m, &exact, &mut sums, None);
         let residual = (&a * &s - &y).norm();
         assert!((f64::from(before) - residual).abs() < 1e-4 * residual.max(1.0), "case {case}: residual norm");
         let err = coeffs.iter().zip(want.iter()).map(|(&g, w)| (f64::from(g) - w).abs()).fold(0.0, f64::max);
@@ -180,7 +181,7 @@ fn the_projection_matches_the_dense_definition() {
         let t = DVector::from_iterator(n, s1.iter().map(|&v| f64::from(v)));
         let want = &t + a.transpose() * (&y - &a * &t).component_div(&w);
         let mut again = s1;
-        project_shares(&dict, &mut again, &mut scratch, &m, &exact, &mut sums);
+        project_shares(&dict, &mut again, &mut scratch, &m, &exact, &mut sums, None);
         let err = again.iter().zip(want.iter()).map(|(&g, w)| (f64::from(g) - w).abs()).fold(0.0, f64::max);
         assert!(err < 5e-5, "case {case}: a step with kept row sums differs from the dense one by {err}");
         if case == 4 {
@@ -223,7 +224,15 @@ fn on_a_band_measured_everywhere_the_residual_shrinks() {
     let mut last = norm(&start);
     let mut sums = RowSums::new();
     for step in 0..20 {
-        project_shares(&dict, &mut coeffs, &mut scratch, &m, &Ball::new(0.0, 0.0, m.count() as u32, 0), &mut sums);
+        project_shares(
+            &dict,
+            &mut coeffs,
+            &mut scratch,
+            &m,
+            &Ball::new(0.0, 0.0, m.count() as u32, 0),
+            &mut sums,
+            None,
+        );
         let now = norm(&DVector::from_iterator(n, coeffs.iter().map(|&v| f64::from(v))));
         assert!(now <= last * (1.0 + 1e-4), "step {step}: residual {last} grew to {now}");
         last = now;
@@ -278,5 +287,49 @@ fn the_share_outside_the_patch_is_the_definitions() {
         }
         let sheared = rows != [0; 3] || cols != [0; 3];
         assert_eq!(further, sheared, "{shares:?}: a pixel further outside than unsheared");
+    }
+}
+
+/// A noise ball weighted by each measurement's variance (shot noise: it grows with the
+/// value): the step reading the solve's table of weights (`projection::weigh`, what a
+/// descent passes) moves the patch to the same bits as the step computing each weight,
+/// and both move it by less than the exact projection (the ball's surface, not its
+/// centre). Fails if the table were read at another entry than the measurement's.
+#[test]
+fn a_weighted_ball_reads_its_weights_from_the_table_to_the_same_bits() {
+    let dict = random_dictionary::<PatchShape<PS, PT, PU, PV, B, N>>(7);
+    for (case, shares, per_band) in [
+        (0u64, shares_of((3.0 / 3.06, 3.0 / 3.06), [0; 3], [0; 3]), 20),
+        (1, shares_of((3.0 / 3.1, 3.0 / 3.02), [1, 0, -1], [-1, 0, 1]), 30),
+    ] {
+        let (mut m, _, _) = measure(&shares, per_band, 40 + case, None);
+        // Positive values, unequal gains: every weight its own.
+        for e in 0..N {
+            if let Some(v) = m.get(e) {
+                m.set(e, 0.2 + v.abs()).unwrap();
+            }
+        }
+        m.set_gains(&[0.7, 1.9]).unwrap();
+        let ball = Ball::new(0.01, 0.02, m.count() as u32, 0);
+        assert!(ball.is_weighted());
+        let mut table = [0.0f32; N];
+        weigh::<Shape>(&m, &ball, &mut table);
+        let mut r = rng(50 + case);
+        let s0: [f32; N] = core::array::from_fn(|_| r.random_range(-1.0f32..1.0));
+        let mut scratch = [0.0f32; N];
+        let (mut computed, mut read, mut exact) = (s0, s0, s0);
+        let mut sums = RowSums::new();
+        let n0 = project_shares(&dict, &mut computed, &mut scratch, &m, &ball, &mut sums, None);
+        let mut sums = RowSums::new();
+        let n1 = project_shares(&dict, &mut read, &mut scratch, &m, &ball, &mut sums, Some(&table));
+        assert_eq!(n0.to_bits(), n1.to_bits(), "case {case}: residual norms");
+        assert!(computed.iter().zip(&read).all(|(a, b)| a.to_bits() == b.to_bits()), "case {case}: the moves differ");
+        let mut sums = RowSums::new();
+        project_shares(&dict, &mut exact, &mut scratch, &m, &Ball::new(0.0, 0.0, m.count() as u32, 0), &mut sums, None);
+        let dist = |x: &[f32; N]| x.iter().zip(&s0).map(|(a, b)| (a - b) * (a - b)).sum::<f32>();
+        assert!(
+            dist(&read) > 0.0 && dist(&read) < dist(&exact),
+            "case {case}: the ball's move is not short of the exact one"
+        );
     }
 }

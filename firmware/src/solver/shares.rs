@@ -38,14 +38,20 @@
 //! Against the aligned sensor's band step this costs, per measurement, the sum of the
 //! two to nine cells it covers before its dot product with `D5`'s band row and the scatter
 //! of its correction back to them, and two patches on the stack (32 KB each for the
-//! full-view patch): the step's residuals, and the solve's row sums ([`RowSums`]), found by
-//! its first projection. Keeping the sums took office at pixel k = 3 behind a grid turned
+//! full-view patch): the step's residuals, and the solve's row sums, both in [`RowSums`]
+//! with the patch's `Layout` (4.6 KB), found by its first projection. Keeping the sums took office at pixel k = 3 behind a grid turned
 //! 0.3 degrees at 5.04 px from 3.1 to 2.6 s on one thread (the aligned sensor 1.3 s; the
 //! output within 2.1e-7 of the division's, the same 39.36 dB); their coverage pass adds each measured
 //! band's share alone (not a test of every band), which took it from 4.0 to 3.1 s. Tried
 //! and dropped: every footprint's cells without a branch on which neighbours it reaches
 //! (nine cells, slower; or the own cell and the neighbour on the centre's side, four, no
-//! faster: 2.6 s both).
+//! faster: 2.6 s both). Counted by callgrind on office at 32 x 32 lenslets, pixel k = 3,
+//! behind 0.3 degrees / 5.04 px, the DCT: the weights of a weighted ball read from the
+//! solve's table as the aligned sensor's step does (not two divisions a measurement a step),
+//! the residuals kept in [`RowSums`] (not a patch cleared each step) and the layout with its
+//! overhangs built once a solve took the decode from 4.93 to 4.48 G instructions; the
+//! aligned sensor's takes 2.72 G. Caching each pixel's footprint for the step's second
+//! pass saved 1.7 % more for 22 KB of stack: not kept.
 
 use crate::operators::dictionary::Dictionary;
 use crate::operators::mode::ModeMatrix;
@@ -114,8 +120,10 @@ const OUTSIDE: u16 = u16::MAX;
 /// A patch's cells on the sensor: for each grid row and view row `(s, u)` (at `s * PU +
 /// u`), the row part of the pixel index (`pixel = row part + column part`) of the cells
 /// before and after it on the sensor, found through the shear's whole-lenslet shifts
-/// ([`OUTSIDE`] beyond the patch); likewise for columns. Built once a projection: the
-/// lookups cost more than the shares.
+/// ([`OUTSIDE`] beyond the patch); likewise for columns: the lookups cost more than the
+/// shares. With it, each place's overhangs ([`overhang`]) per axis, by the place's `i8`
+/// (offset by 128): a solve builds its layout once ([`RowSums`]), and a lookup costs less
+/// than the arithmetic for each pixel, axis and pass.
 struct Layout<S: Shape> {
     shape: core::marker::PhantomData<S>,
     rows: [[u16; 2]; MAX_AXIS],
@@ -123,33 +131,74 @@ struct Layout<S: Shape> {
     /// One over a pixel's side in cells, rows and columns; the side over 2.
     inv: (f32, f32),
     half: (f32, f32),
+    /// [`overhang`] of each place (rows, columns), at index `place + 128`.
+    over: ([[f32; 2]; PLACES], [[f32; 2]; PLACES]),
+}
+
+/// The values of a place (an `i8`).
+const PLACES: usize = 256;
+
+/// A place in cells off its cell's centre.
+#[inline(always)]
+fn place(x: i8) -> f32 {
+    f32::from(x) * (1.0 / PLACE_UNIT)
 }
 
 impl<S: Shape> Layout<S> {
-    fn new(shares: &CellShares) -> Self {
-        let mut layout = Self {
+    /// No patch yet ([`RowSums::new`]): every neighbour outside, no overhang. Built in code,
+    /// not a constant: as a `const` its 4.6 KB were copied from flash.
+    fn empty() -> Self {
+        Self {
             shape: core::marker::PhantomData,
             rows: [[OUTSIDE; 2]; MAX_AXIS],
             cols: [[OUTSIDE; 2]; MAX_AXIS],
-            inv: (1.0 / shares.width.0, 1.0 / shares.width.1),
-            half: (0.5 * shares.width.0, 0.5 * shares.width.1),
-        };
+            inv: (1.0, 1.0),
+            half: (0.5, 0.5),
+            over: ([[0.0; 2]; PLACES], [[0.0; 2]; PLACES]),
+        }
+    }
+
+    fn new(shares: &CellShares) -> Self {
+        let mut layout = Self::empty();
+        layout.fill(shares);
+        layout
+    }
+
+    /// This layout made the one of a patch whose pixels share cells as `shares` says, in
+    /// place (a solve's [`RowSums`] holds it: no second copy on the stack).
+    fn fill(&mut self, shares: &CellShares) {
+        self.inv = (1.0 / shares.width.0, 1.0 / shares.width.1);
+        self.half = (0.5 * shares.width.0, 0.5 * shares.width.1);
+        let (half, inv) = (self.half, self.inv);
+        for (i, (r, c)) in self.over.0.iter_mut().zip(self.over.1.iter_mut()).enumerate() {
+            let x = place((i as i16 - 128) as i8);
+            let (rb, ra) = overhang(x, half.0, inv.0);
+            let (cb, ca) = overhang(x, half.1, inv.1);
+            (*r, *c) = ([rb, ra], [cb, ca]);
+        }
         let part = |x: Option<usize>| x.and_then(|x| u16::try_from(x).ok()).unwrap_or(OUTSIDE);
-        for (i, o) in layout.rows.iter_mut().enumerate().take(S::PS * S::PU) {
+        for (i, o) in self.rows.iter_mut().enumerate() {
+            *o = [OUTSIDE; 2];
+            if i >= S::PS * S::PU {
+                continue;
+            }
             let (s, u) = (i / S::PU, i % S::PU);
             let p = (s as isize + shares.shift.0.get(u).copied().unwrap_or(0) as isize) * S::PU as isize + u as isize;
             for (d, x) in [-1isize, 1].into_iter().zip(o.iter_mut()) {
                 *x = part(along(p + d, S::PU, S::PS, &shares.shift.0).map(|(s, u)| (s * S::PT * S::PU + u) * S::PV));
             }
         }
-        for (i, o) in layout.cols.iter_mut().enumerate().take(S::PT * S::PV) {
+        for (i, o) in self.cols.iter_mut().enumerate() {
+            *o = [OUTSIDE; 2];
+            if i >= S::PT * S::PV {
+                continue;
+            }
             let (t, v) = (i / S::PV, i % S::PV);
             let q = (t as isize + shares.shift.1.get(v).copied().unwrap_or(0) as isize) * S::PV as isize + v as isize;
             for (d, x) in [-1isize, 1].into_iter().zip(o.iter_mut()) {
                 *x = part(along(q + d, S::PV, S::PT, &shares.shift.1).map(|(t, v)| t * S::PU * S::PV + v));
             }
         }
-        layout
     }
 
     /// The footprint of the measurements of patch pixel `(s, t, u, v)` (index `pixel`).
@@ -161,7 +210,8 @@ impl<S: Shape> Layout<S> {
         pixel: usize,
     ) -> Footprint {
         let [pr, pc] = m.place.get(pixel).copied().unwrap_or([0, 0]);
-        let place = |x: i8| f32::from(x) * (1.0 / PLACE_UNIT);
+        let over =
+            |table: &[[f32; 2]; PLACES], x: i8| table.get((i16::from(x) + 128) as usize).copied().unwrap_or([0.0; 2]);
         let (before, after) = match self.rows.get(s * S::PU + u) {
             Some(&[b, a]) => (b, a),
             None => (OUTSIDE, OUTSIDE),
@@ -172,10 +222,7 @@ impl<S: Shape> Layout<S> {
             None => (OUTSIDE, OUTSIDE),
         };
         let col_parts = [before, (t * S::PU * S::PV + v) as u16, after];
-        Footprint {
-            rows: axis(place(pr), self.half.0, self.inv.0, row_parts),
-            cols: axis(place(pc), self.half.1, self.inv.1, col_parts),
-        }
+        Footprint { rows: axis(over(&self.over.0, pr), row_parts), cols: axis(over(&self.over.1, pc), col_parts) }
     }
 }
 
@@ -238,13 +285,12 @@ fn along(p: isize, views: usize, len: usize, shift: &[i8; MAX_SHARE_VIEWS]) -> O
     usize::try_from(s).ok().filter(|&s| s < len).map(|s| (s, view))
 }
 
-/// One axis of a footprint: the shares of a pixel `2 half` cells wide (`inv` its inverse),
-/// its centre `delta` cells off its own cell's centre, in the cells before, at and after
-/// its own (`parts`, [`OUTSIDE`] beyond the patch: that share goes to its own cell). A box
-/// against unit cells: `half <= 1` and `|delta| <= 1/2`, so it reaches no further.
+/// One axis of a footprint: the shares of a pixel whose square overhangs its own cell by
+/// `[before, after]` ([`overhang`]), in the cells before, at and after its own (`parts`,
+/// [`OUTSIDE`] beyond the patch: that share goes to its own cell). A box against unit
+/// cells: `half <= 1` and `|delta| <= 1/2`, so it reaches no further.
 #[inline(always)]
-fn axis(delta: f32, half: f32, inv: f32, parts: [u16; 3]) -> ([u16; 3], [f32; 3]) {
-    let (mut before, mut after) = overhang(delta, half, inv);
+fn axis([mut before, mut after]: [f32; 2], parts: [u16; 3]) -> ([u16; 3], [f32; 3]) {
     let mut own = 1.0 - before - after;
     if parts[0] == OUTSIDE {
         own += before;
@@ -272,15 +318,30 @@ fn overhang(delta: f32, half: f32, inv: f32) -> (f32, f32) {
 /// which entries are measured and where their pixels sit, not on the iterate: a solve's
 /// first projection finds them and its other projections reuse them (half of a step's
 /// passes). A fresh one for each solve: the measurements must not change while it is kept.
+///
+/// It also holds the step's residuals (`res`), by patch entry, so a step does not clear a
+/// patch of them: each step writes every measured entry before it reads it, and the
+/// measurements are the solve's throughout. Cleared each step, they were 4 % of a decode's
+/// instructions behind a grid (office 32 x 32 lenslets, pixel k = 3, the DCT: callgrind).
+///
+/// And the patch's `Layout` (its cells' neighbours and overhangs), built by the same
+/// first projection.
 pub struct RowSums<S: Shape> {
     inv: PerValue<S, f32>,
+    res: PerValue<S, f32>,
+    layout: Layout<S>,
     ready: bool,
 }
 
 impl<S: Shape> RowSums<S> {
     /// Not yet found: the next projection finds them.
-    pub const fn new() -> Self {
-        Self { inv: <S::Values as Extent>::ZEROS, ready: false }
+    pub fn new() -> Self {
+        Self {
+            inv: <S::Values as Extent>::ZEROS,
+            res: <S::Values as Extent>::ZEROS,
+            layout: Layout::empty(),
+            ready: false,
+        }
     }
 }
 
@@ -295,7 +356,9 @@ impl<S: Shape> Default for RowSums<S> {
 /// exactly, or onto the noise [`Ball`]. `scratch` is clobbered. Returns the residual norm
 /// before the move. [`crate::solver::projection::project_coefficients`] behind a lenslet
 /// grid. `rows` is found by the first
-/// projection of a solve and kept for its others ([`RowSums`]).
+/// projection of a solve and kept for its others ([`RowSums`]). A weighted ball's weights
+/// are read from `weights` when given ([`crate::solver::projection::weigh`] of the same
+/// measurements and ball), else computed (two divisions a measurement): the same sums.
 pub fn project_shares<S: Shape>(
     dict: &Dictionary<S>,
     coeffs: &mut PerValue<S, f32>,
@@ -303,11 +366,12 @@ pub fn project_shares<S: Shape>(
     m: &Measurements<S::Values>,
     ball: &Ball,
     rows: &mut RowSums<S>,
+    weights: Option<&PerValue<S, f32>>,
 ) -> f32 {
     // The pixel modes' synthesis, every slice back in place (the half-pixel projection's
     // frame, `crate::solver::fractional`): each pixel's band coefficients.
     let mut step = |scratch: &mut PerValue<S, f32>| match &m.shares {
-        Some(shares) => share_step::<S>(&dict.d.m5, scratch, m, ball, shares, rows),
+        Some(shares) => share_step::<S>(&dict.d.m5, scratch, m, (ball, weights), shares, rows),
         None => (0.0, 0.0),
     };
     project_whole(dict, coeffs, scratch, ball, &mut step)
@@ -345,14 +409,21 @@ fn share_step<S: Shape>(
     m5: &ModeMatrix<S::Bands>,
     scratch: &mut PerValue<S, f32>,
     m: &Measurements<S::Values>,
-    ball: &Ball,
+    (ball, weights): (&Ball, Option<&PerValue<S, f32>>),
     shares: &CellShares,
     rows: &mut RowSums<S>,
 ) -> (f32, f32) {
-    let layout = Layout::<S>::new(shares);
+    if !rows.ready {
+        // The layout and the row sums, once a solve (the residuals' buffer is the sums'
+        // scratch: every measured entry is written below before it is read).
+        rows.layout.fill(shares);
+        row_sums::<S>(S::Bands::chunks_mut(rows.res.as_mut()), m, &rows.layout, &mut rows.inv);
+        rows.ready = true;
+    }
+    let layout = &rows.layout;
     let fibres = S::Bands::chunks_mut(scratch.as_mut());
     // Each measurement's residual, in its patch entry.
-    let mut res = <PerValue<S, f32>>::splat(0.0);
+    let res = &mut rows.res;
     let (mut r2, mut w2) = (0.0f32, 0.0f32);
     let weighted = ball.is_weighted();
     each_measured::<S>(m, |at, pixel, bits| {
@@ -371,14 +442,15 @@ fn share_step<S: Shape>(
             *r = y - dot(row.as_ref(), sum.as_ref());
             r2 += *r * *r;
             if weighted {
-                w2 += *r * *r * ball.weight(y, m.gains.get(b).copied().unwrap_or(1.0));
+                let w = match weights {
+                    Some(t) => t.get(i).copied().unwrap_or(0.0),
+                    None => ball.weight(y, m.gains.get(b).copied().unwrap_or(1.0)),
+                };
+                w2 += *r * *r * w;
             }
         }
     });
-    if !rows.ready {
-        row_sums::<S>(fibres, m, &layout, &mut rows.inv);
-        rows.ready = true;
-    }
+    let res = &rows.res;
     // The correction: each measurement's step (its residual over its row sum) times its
     // band's row of `D5`, spread over the cells it covers by their shares.
     for f in fibres.iter_mut() {

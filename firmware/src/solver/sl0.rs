@@ -226,7 +226,7 @@ fn cold<S: Shape>(
         } else {
             coeffs.fill(0.0);
         }
-        project_interpolating(dict, coeffs, signal, m, &Ball::new(0.0, 0.0, m.count, 0), None);
+        project_interpolating(dict, coeffs, signal, m, &Ball::new(0.0, 0.0, m.count, 0), None, None);
         synthesize(dict, coeffs, signal);
         return descend(&Descent { dict, cfg, ball: &ball, plan }, ws);
     }
@@ -379,7 +379,7 @@ pub fn seed<S: Shape>(
         }
         let Workspace { coeffs, signal, measurements: m, .. } = ws;
         analyze(dict, signal, coeffs);
-        project_interpolating(dict, coeffs, signal, m, &exact, None);
+        project_interpolating(dict, coeffs, signal, m, &exact, None, None);
         synthesize(dict, coeffs, signal);
         return Ok(None);
     }
@@ -403,12 +403,13 @@ fn project_interpolating<S: Shape>(
     m: &Measurements<S::Values>,
     ball: &Ball,
     rows: Option<&mut RowSums<S>>,
+    weights: Option<&PerValue<S, f32>>,
 ) -> f32 {
     if m.shares.is_none() {
         return project_fractional(dict, coeffs, scratch, m, ball);
     }
     match rows {
-        Some(rows) => project_shares(dict, coeffs, scratch, m, ball, rows),
+        Some(rows) => project_shares(dict, coeffs, scratch, m, ball, rows, weights),
         None => project_shares_once(dict, coeffs, scratch, m, ball),
     }
 }
@@ -423,7 +424,7 @@ fn project_shares_once<S: Shape>(
     m: &Measurements<S::Values>,
     ball: &Ball,
 ) -> f32 {
-    project_shares(dict, coeffs, scratch, m, ball, &mut RowSums::new())
+    project_shares(dict, coeffs, scratch, m, ball, &mut RowSums::new(), None)
 }
 
 /// How a descent walks sigma down: the hand-set schedule of the config from `scale` times
@@ -518,8 +519,9 @@ fn descend_with<S: Shape>(
     let selection = !m.interpolates();
     analyze(dict, signal, coeffs);
     let top = max_abs(coeffs.as_ref());
-    // The measurements' weights once a solve, not once a step (one-hot measurements only).
-    let table = if selection && mixing.is_none() && ball.is_weighted() {
+    // The measurements' weights once a solve, not once a step (one-hot measurements and
+    // shares behind a lenslet grid; not the half-pixel or mixed projections).
+    let table = if (selection || m.shares.is_some()) && mixing.is_none() && ball.is_weighted() {
         weigh::<S>(m, ball, weights);
         Some(&*weights)
     } else {
@@ -535,7 +537,7 @@ fn descend_with<S: Shape>(
         } else if selection {
             project_coefficients(dict, coeffs, signal, m, ball, table)
         } else {
-            project_interpolating(dict, coeffs, signal, m, ball, rows.as_deref_mut())
+            project_interpolating(dict, coeffs, signal, m, ball, rows.as_deref_mut(), table)
         };
         // From a point that meets the measurements, the step d moves the patch by D d on
         // the unmeasured values only (the projection puts the measured ones back), and D
