@@ -16,7 +16,8 @@
 #
 # SLF_SCENES (default outdoor tungsten office led, 64 x 64 lenslets, and the HCI crops in
 # SLF_REAL when present), SLF_KS (1 3), SLF_GRIDS (0.3:5.04 1:5.1), SLF_REPS (3).
-# OUT/time-rows.tsv keeps each row.
+# OUT/time-rows.tsv keeps each row. The page ends with scripts/grid-instructions.sh's table
+# (instructions by callgrind), made by it here or read from SLF_COUNTS.
 set -euo pipefail
 out=${1:?usage: grid-time.sh OUT_DIR}
 before=${SLF_BEFORE:?SLF_BEFORE: the binary to compare with}
@@ -94,3 +95,15 @@ done
 
 page_head "The time behind a lenslet grid" "SLF_BEFORE=... bash scripts/grid-time.sh OUT_DIR"
 python3 scripts/grid-time-page.py "$rows" "$before" "$reps"
+# The instructions: SLF_COUNTS names scripts/grid-instructions.sh's table when it was made
+# apart (it takes about 20 minutes; callgrind's counts do not depend on the machine's load).
+printf '\n## Instructions\n\n'
+echo "Counted by callgrind in one-thread decodes (\`scripts/grid-instructions.sh\`), repeatable where"
+echo "the seconds above are not: the same binaries, calibrated sensors as above at 32 x 32 lenslets,"
+echo "the grid of 0.3 degrees / 5.04 px, each model against itself."
+echo
+if [ -n "${SLF_COUNTS:-}" ]; then
+  cat "$SLF_COUNTS"
+else
+  bash scripts/grid-instructions.sh "$out/instructions"
+fi
