@@ -30,17 +30,9 @@ echo "| scene | k | grid (deg:px) | model | aligned: before / after | grid: befo
 echo "| --- | --- | --- | --- | --- | --- | --- |"
 for token in $scenes; do
   scene_light_field "$token"
-  cal_aligned="$out/cal-$scene-aligned"
-  grid_calibration "$slf" "$cal_aligned" > /dev/null
   for k in $ks; do
-    aligned="$out/cap-$scene-$k-aligned"
-    [ -d "$aligned" ] || "$slf" simulate "$lf" -o "$aligned" -s "$k" --seed 1 "${sensor[@]}" > /dev/null 2>&1
     for g in $grids; do
-      cal="$out/cal-$scene-$g"
-      grid_calibration "$slf" "$cal" --rotation "${g%:*}" --pitch "${g#*:}" > /dev/null
-      cap="$out/cap-$scene-$k-$g"
-      [ -d "$cap" ] || "$slf" simulate "$lf" -o "$cap" -s "$k" --seed 1 "${sensor[@]}" \
-        --rotation "${g%:*}" --pitch "${g#*:}" > /dev/null 2>&1
+      grid_captures "$k" "$g"
       for model in dct ensemble; do
         a0=$(count "$before" "$cal_aligned" "$aligned" "$model")
         g0=$(count "$before" "$cal" "$cap" "$model")

@@ -54,17 +54,8 @@ median() {
 for token in $scenes; do
   scene_light_field "$token"
   for k in $ks; do
-    label=aligned
-    cal_aligned="$out/cal-$scene-aligned"
-    grid_calibration "$slf" "$cal_aligned" > /dev/null
-    aligned="$out/cap-$scene-$k-aligned"
-    [ -d "$aligned" ] || "$slf" simulate "$lf" -o "$aligned" -s "$k" --seed 1 "${sensor[@]}" > /dev/null 2>&1
     for g in $grids; do
-      cal="$out/cal-$scene-$g"
-      grid_calibration "$slf" "$cal" --rotation "${g%:*}" --pitch "${g#*:}" > /dev/null
-      cap="$out/cap-$scene-$k-$g"
-      [ -d "$cap" ] || "$slf" simulate "$lf" -o "$cap" -s "$k" --seed 1 "${sensor[@]}" \
-        --rotation "${g%:*}" --pitch "${g#*:}" > /dev/null 2>&1
+      grid_captures "$k" "$g"
       for model in $models; do
         # shellcheck disable=SC2046 # the flags are words
         set -- $(flags "$model")

@@ -54,6 +54,22 @@ grid_calibration() {
   rm -rf "$out/cc" "$out/cc-cap"
 }
 
+# grid_captures K G: the captures of $lf at pixel K snapshots on the sensor $sensor, aligned
+# and behind grid G (deg:px), each with this binary's calibration of its sensor (all made once):
+# sets $cal_aligned, $aligned, $cal and $cap.
+grid_captures() {
+  local k=$1 g=$2
+  cal_aligned="$out/cal-$scene-aligned"
+  grid_calibration "$slf" "$cal_aligned" > /dev/null
+  aligned="$out/cap-$scene-$k-aligned"
+  [ -d "$aligned" ] || "$slf" simulate "$lf" -o "$aligned" -s "$k" --seed 1 "${sensor[@]}" > /dev/null 2>&1
+  cal="$out/cal-$scene-$g"
+  grid_calibration "$slf" "$cal" --rotation "${g%:*}" --pitch "${g#*:}" > /dev/null
+  cap="$out/cap-$scene-$k-$g"
+  [ -d "$cap" ] || "$slf" simulate "$lf" -o "$cap" -s "$k" --seed 1 "${sensor[@]}" \
+    --rotation "${g%:*}" --pitch "${g#*:}" > /dev/null 2>&1
+}
+
 # grid_scores: sets $psnr (without the 2 edge lenslets: a turned array's corners reach past
 # the sensor), $q (SSIM) and $a (SA) of the decode in $out/rec.npy against $lf.
 grid_scores() {
