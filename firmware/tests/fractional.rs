@@ -142,7 +142,7 @@ fn half_pixel_read_and_projection_match_the_dense_definition() {
         let mut coeffs: [f32; 144] = s0.clone().try_into().unwrap();
         let mut scratch = [0.0f32; 144];
         let exact = Ball::new(0.0, 0.0, m.count() as u32, 0);
-        let before = project_fractional(&dict, &mut coeffs, &mut scratch, m, &exact);
+        let before = project_fractional(&dict, &mut coeffs, &mut scratch, m, &exact, None);
         let err = coeffs.iter().zip(want.iter()).map(|(&g, w)| (f64::from(g) - w).abs()).fold(0.0, f64::max);
         assert!(err < 2e-5, "case {seed}: projection differs from the dense one by {err}");
         let residual = (&a * &s - &y).norm();
@@ -202,7 +202,7 @@ fn full_blocks_project_like_the_dense_definition() {
         let want = &s - a.transpose() * chol.solve(&(&a * &s - &y));
         let mut coeffs = s0;
         let mut scratch = [0.0f32; 200];
-        project_fractional(&dict, &mut coeffs, &mut scratch, &m, &Ball::new(0.0, 0.0, m.count() as u32, 0));
+        project_fractional(&dict, &mut coeffs, &mut scratch, &m, &Ball::new(0.0, 0.0, m.count() as u32, 0), None);
         let err = coeffs.iter().zip(want.iter()).map(|(&g, w)| (f64::from(g) - w).abs()).fold(0.0, f64::max);
         assert!(err < 2e-5, "case {case}: projection differs from the dense one by {err}");
     }
@@ -222,9 +222,9 @@ fn the_noise_ball_moves_a_fraction_of_the_exact_projection() {
     let s0: [f32; 144] = core::array::from_fn(|_| r.random_range(-1.0f32..1.0));
     let mut scratch = [0.0f32; 144];
     let mut exact = s0;
-    project_fractional(&dict, &mut exact, &mut scratch, &m, &Ball::new(0.0, 0.0, m.count() as u32, 0));
+    project_fractional(&dict, &mut exact, &mut scratch, &m, &Ball::new(0.0, 0.0, m.count() as u32, 0), None);
     let mut ball = s0;
-    project_fractional(&dict, &mut ball, &mut scratch, &m, &Ball::new(0.05, 0.0, m.count() as u32, 4));
+    project_fractional(&dict, &mut ball, &mut scratch, &m, &Ball::new(0.05, 0.0, m.count() as u32, 4), None);
     // ball - s0 = scale (exact - s0), one scale in (0, 1) for every coefficient.
     let (num, den) = ball.iter().zip(&exact).zip(&s0).fold((0.0f64, 0.0f64), |(n, d), ((&b, &e), &s)| {
         (n + f64::from(b - s) * f64::from(e - s), d + f64::from(e - s).powi(2))
@@ -235,6 +235,36 @@ fn the_noise_ball_moves_a_fraction_of_the_exact_projection() {
         let want = f64::from(s) + scale * f64::from(e - s);
         assert!((f64::from(b) - want).abs() < 1e-5, "{b} vs {want}");
     }
+}
+
+/// A ball weighted by each measurement's variance (shot noise, unequal gains): the half-pixel
+/// step reading the solve's table of weights (`projection::weigh`, what a descent passes)
+/// moves the patch to the same bits as the step computing each weight. Fails if the table
+/// were read at another entry than the measurement's.
+#[test]
+fn a_weighted_ball_reads_its_weights_from_the_table_to_the_same_bits() {
+    let mask = Mask::pixel(7, 2, 4, L3).unwrap();
+    let defined = rows_of(&mask, (3, 3), (0, 0), 1);
+    let dict = random_dictionary::<PatchShape<3, 3, 2, 2, 4, 144>>(32);
+    let mut m = Measurements::<ValueCount<144>>::new();
+    let mut r = rng(8);
+    for (row, ..) in &defined {
+        m.set(row.slot, r.random_range(0.1f32..1.0)).unwrap();
+    }
+    m.set_gains(&[0.6, 1.3, 2.1, 0.9]).unwrap();
+    m.set_half_views(HalfViews { rows: 0b01, cols: 0b01 });
+    let ball = Ball::new(0.01, 0.02, m.count() as u32, 4);
+    assert!(ball.is_weighted());
+    let mut table = [0.0f32; 144];
+    slf_firmware::projection::weigh::<PatchShape<3, 3, 2, 2, 4, 144>>(&m, &ball, &mut table);
+    let s0: [f32; 144] = core::array::from_fn(|_| r.random_range(-1.0f32..1.0));
+    let mut scratch = [0.0f32; 144];
+    let (mut computed, mut read) = (s0, s0);
+    let n0 = project_fractional(&dict, &mut computed, &mut scratch, &m, &ball, None);
+    let n1 = project_fractional(&dict, &mut read, &mut scratch, &m, &ball, Some(&table));
+    assert_eq!(n0.to_bits(), n1.to_bits(), "residual norms");
+    assert!(computed.iter().zip(&read).all(|(a, b)| a.to_bits() == b.to_bits()), "the moves differ");
+    assert!(read.iter().zip(&s0).any(|(a, b)| a != b), "the ball did not move the patch");
 }
 
 #[test]

@@ -25,7 +25,7 @@ use crate::operators::mode::ModeMatrix;
 use crate::operators::shape::{PerBand, PerValue, Shape};
 use crate::sensor::extent::{Array, Extent};
 use crate::solver::ball::Ball;
-use crate::solver::projection::{band_bits, dot, project_whole};
+use crate::solver::projection::{band_bits, dot, measured_weight, project_whole};
 use crate::solver::workspace::Measurements;
 
 /// The largest view grid (`PS * PT`) a half-pixel patch may have: one band's system of a
@@ -36,13 +36,16 @@ pub const MAX_GRID: usize = 25;
 /// Moves the coefficients `coeffs` (of `dict`) onto the interpolating measurements `m`
 /// (exactly, or onto the noise [`Ball`]); `scratch` is clobbered. Returns the residual
 /// norm before the move. [`crate::solver::projection::project_coefficients`] for patches with
-/// half views ([`Measurements::half_views`]).
+/// half views ([`Measurements::half_views`]). A weighted ball's weights are read from
+/// `weights` when given ([`crate::solver::projection::weigh`] of the same measurements and
+/// ball), else computed (two divisions a measurement): the same sums.
 pub fn project_fractional<S: Shape>(
     dict: &Dictionary<S>,
     coeffs: &mut PerValue<S, f32>,
     scratch: &mut PerValue<S, f32>,
     m: &Measurements<S::Values>,
     ball: &Ball,
+    weights: Option<&PerValue<S, f32>>,
 ) -> f32 {
     // The pixel modes' synthesis (the fast path's), every slice back in place: each
     // pixel's band coefficients; then the band step view by view.
@@ -50,7 +53,7 @@ pub fn project_fractional<S: Shape>(
         let (mut r2, mut w2) = (0.0f32, 0.0f32);
         for u in 0..S::PU {
             for v in 0..S::PV {
-                let (r, w) = view_step::<S>(&dict.d.m5, scratch, m, ball, (u, v));
+                let (r, w) = view_step::<S>(&dict.d.m5, scratch, m, (ball, weights), (u, v));
                 (r2, w2) = (r2 + r, w2 + w);
             }
         }
@@ -74,7 +77,7 @@ fn view_step<S: Shape>(
     m5: &ModeMatrix<S::Bands>,
     scratch: &mut PerValue<S, f32>,
     m: &Measurements<S::Values>,
-    ball: &Ball,
+    (ball, weights): (&Ball, Option<&PerValue<S, f32>>),
     (u, v): (usize, usize),
 ) -> (f32, f32) {
     let (hs, ht) = (usize::from(m.half.row(u)), usize::from(m.half.col(v)));
@@ -116,7 +119,7 @@ fn view_step<S: Shape>(
                 let res = y - weight * dot(row.as_ref(), sum.as_ref());
                 r2 += res * res;
                 if weighted {
-                    w2 += res * res * ball.weight(y, m.gains.get(b).copied().unwrap_or(1.0));
+                    w2 += res * res * measured_weight::<S>(weights, base + b, ball, y, m.gains.get(b));
                 }
                 let (Some(p), Some(q), Ok(pos)) = (
                     at.get_mut(b).and_then(|x| x.get_mut(*n)),

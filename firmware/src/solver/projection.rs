@@ -83,6 +83,25 @@ pub fn weigh<S: Shape>(m: &Measurements<S::Values>, ball: &Ball, weights: &mut P
     }
 }
 
+/// The weight in a weighted `ball` of the measurement `y` at patch entry `entry` in a band
+/// of gain `gain`: read from the solve's table `weights` ([`weigh`]) when given, else
+/// computed ([`Ball::weight`], two divisions); the same value either way. The interpolating
+/// projections' steps ([`crate::solver::shares`], [`crate::solver::fractional`]) call it
+/// per measurement.
+#[inline(always)]
+pub(crate) fn measured_weight<S: Shape>(
+    weights: Option<&PerValue<S, f32>>,
+    entry: usize,
+    ball: &Ball,
+    y: f32,
+    gain: Option<&f32>,
+) -> f32 {
+    match weights {
+        Some(t) => t.get(entry).copied().unwrap_or(0.0),
+        None => ball.weight(y, gain.copied().unwrap_or(1.0)),
+    }
+}
+
 /// A band step: one spatial slice's pixels, their band coefficients in `fibres` (after the
 /// pixel modes' synthesis), become the correction's; `values` / `measured` are the
 /// slice's measurements in patch order. Returns the sums of squared residuals, plain and

@@ -39,17 +39,18 @@
 //! two to nine cells it covers before its dot product with `D5`'s band row and the scatter
 //! of its correction back to them, and two patches on the stack (32 KB each for the
 //! full-view patch): the step's residuals, and the solve's row sums, both in [`RowSums`]
-//! with the patch's `Layout` (4.6 KB), found by its first projection. Keeping the sums took office at pixel k = 3 behind a grid turned
-//! 0.3 degrees at 5.04 px from 3.1 to 2.6 s on one thread (the aligned sensor 1.3 s; the
-//! output within 2.1e-7 of the division's, the same 39.36 dB); their coverage pass adds each measured
-//! band's share alone (not a test of every band), which took it from 4.0 to 3.1 s. Tried
+//! with the patch's `Layout` (4.6 KB), found by its first projection. Keeping the sums took
+//! office at pixel k = 3 behind a grid turned 0.3 degrees at 5.04 px from 3.1 to 2.6 s on
+//! one thread (the aligned sensor 1.3 s; the output within 2.1e-7 of the division's, the
+//! same 39.36 dB); their coverage pass adds each measured band's share alone (not a test of
+//! every band), which took it from 4.0 to 3.1 s. Tried
 //! and dropped: every footprint's cells without a branch on which neighbours it reaches
 //! (nine cells, slower; or the own cell and the neighbour on the centre's side, four, no
 //! faster: 2.6 s both). Counted by callgrind on office at 32 x 32 lenslets, pixel k = 3,
 //! behind 0.3 degrees / 5.04 px, the DCT: the weights of a weighted ball read from the
 //! solve's table as the aligned sensor's step does (not two divisions a measurement a step),
 //! the residuals kept in [`RowSums`] (not a patch cleared each step) and the layout with its
-//! overhangs built once a solve took the decode from 4.93 to 4.48 G instructions; the
+//! overhangs built once a solve took the decode from 4.93 to 4.49 G instructions; the
 //! aligned sensor's takes 2.72 G. Caching each pixel's footprint for the step's second
 //! pass saved 1.7 % more for 22 KB of stack: not kept.
 
@@ -58,7 +59,7 @@ use crate::operators::mode::ModeMatrix;
 use crate::operators::shape::{PerBand, PerValue, Shape};
 use crate::sensor::extent::{Array, Bands, Extent};
 use crate::solver::ball::Ball;
-use crate::solver::projection::{band_bits, dot, project_whole};
+use crate::solver::projection::{band_bits, dot, measured_weight, project_whole};
 use crate::solver::workspace::{CellShares, MAX_SHARE_VIEWS, Measurements, PLACE_UNIT};
 
 /// The cells a measurement covers (at most 3 x 3), with their shares: per axis (rows,
@@ -442,11 +443,7 @@ fn share_step<S: Shape>(
             *r = y - dot(row.as_ref(), sum.as_ref());
             r2 += *r * *r;
             if weighted {
-                let w = match weights {
-                    Some(t) => t.get(i).copied().unwrap_or(0.0),
-                    None => ball.weight(y, m.gains.get(b).copied().unwrap_or(1.0)),
-                };
-                w2 += *r * *r * w;
+                w2 += *r * *r * measured_weight::<S>(weights, i, ball, y, m.gains.get(b));
             }
         }
     });

@@ -406,7 +406,7 @@ fn project_interpolating<S: Shape>(
     weights: Option<&PerValue<S, f32>>,
 ) -> f32 {
     if m.shares.is_none() {
-        return project_fractional(dict, coeffs, scratch, m, ball);
+        return project_fractional(dict, coeffs, scratch, m, ball, weights);
     }
     match rows {
         Some(rows) => project_shares(dict, coeffs, scratch, m, ball, rows, weights),
@@ -519,9 +519,9 @@ fn descend_with<S: Shape>(
     let selection = !m.interpolates();
     analyze(dict, signal, coeffs);
     let top = max_abs(coeffs.as_ref());
-    // The measurements' weights once a solve, not once a step (one-hot measurements and
-    // shares behind a lenslet grid; not the half-pixel or mixed projections).
-    let table = if (selection || m.shares.is_some()) && mixing.is_none() && ball.is_weighted() {
+    // The measurements' weights once a solve, not once a step (every projection but the
+    // mixed one, whose measurements are not the patch's entries).
+    let table = if mixing.is_none() && ball.is_weighted() {
         weigh::<S>(m, ball, weights);
         Some(&*weights)
     } else {
