@@ -17,6 +17,7 @@ use nalgebra::{DMatrix, DVector};
 use rand::Rng;
 use slf_firmware::Shape as _;
 use slf_firmware::ball::Ball;
+use slf_firmware::disparity::HalfViews;
 use slf_firmware::projection::weigh;
 use slf_firmware::shape::ValueCount;
 use slf_firmware::shares::{Reach, RowSums, project_shares, to_sensor};
@@ -48,18 +49,36 @@ fn box_1d(c: f64, k: i64, w: f64) -> [f64; 3] {
     })
 }
 
-/// Measurement rows of pixel `(s, t, u, v)` from the definition: `(entry of band 0, weight)`.
-fn taps((s, t, u, v): (usize, usize, usize, usize), place: (f64, f64), shares: &CellShares) -> Vec<(usize, f64)> {
+/// The grid positions (with their weights) that sensor cell `p`'s value is along an axis:
+/// its own, or for a half view the mean of its own and the next; `None` outside the patch
+/// (not found, or a half view's next position past it).
+fn cell(p: i64, views: usize, len: usize, shift: &[i8], half: u32) -> Option<Vec<(usize, usize, f64)>> {
+    let (s, u) = find(p, views, len, shift)?;
+    if half >> u & 1 == 0 {
+        return Some(vec![(s, u, 1.0)]);
+    }
+    (s + 1 < len).then(|| vec![(s, u, 0.5), (s + 1, u, 0.5)])
+}
+
+/// Measurement rows of pixel `(s, t, u, v)` from the definition: `(entry of band 0,
+/// weight)`; a view of `half` (rows, columns) is half a lenslet off the grid, its cell the
+/// mean of two grid positions.
+fn taps(
+    (s, t, u, v): (usize, usize, usize, usize),
+    place: (f64, f64),
+    shares: &CellShares,
+    half: HalfViews,
+) -> Vec<(usize, f64)> {
     let p = (s as i64 + i64::from(shares.shift.0[u])) * PU as i64 + u as i64;
     let q = (t as i64 + i64::from(shares.shift.1[v])) * PV as i64 + v as i64;
     let mut rows = box_1d(p as f64 + 0.5 + place.0, p, f64::from(shares.width.0));
     let mut cols = box_1d(q as f64 + 0.5 + place.1, q, f64::from(shares.width.1));
     for (k, d) in [(0usize, -1i64), (2, 1)] {
-        if find(p + d, PU, PS, &shares.shift.0).is_none() {
+        if cell(p + d, PU, PS, &shares.shift.0, half.rows).is_none() {
             rows[1] += rows[k];
             rows[k] = 0.0;
         }
-        if find(q + d, PV, PT, &shares.shift.1).is_none() {
+        if cell(q + d, PV, PT, &shares.shift.1, half.cols).is_none() {
             cols[1] += cols[k];
             cols[k] = 0.0;
         }
@@ -68,9 +87,11 @@ fn taps((s, t, u, v): (usize, usize, usize, usize), place: (f64, f64), shares: &
     for (i, wr) in rows.iter().enumerate() {
         for (j, wc) in cols.iter().enumerate() {
             if wr * wc > 0.0 {
-                let (s2, u2) = find(p + i as i64 - 1, PU, PS, &shares.shift.0).unwrap();
-                let (t2, v2) = find(q + j as i64 - 1, PV, PT, &shares.shift.1).unwrap();
-                out.push((Shape::index(s2, t2, u2, v2, 0), wr * wc));
+                for (s2, u2, a) in cell(p + i as i64 - 1, PU, PS, &shares.shift.0, half.rows).unwrap() {
+                    for (t2, v2, b) in cell(q + j as i64 - 1, PV, PT, &shares.shift.1, half.cols).unwrap() {
+                        out.push((Shape::index(s2, t2, u2, v2, 0), wr * wc * a * b));
+                    }
+                }
             }
         }
     }
@@ -89,11 +110,28 @@ fn measure(
     seed: u64,
     place: Option<f64>,
 ) -> (Measurements<ValueCount<N>>, Rows, Vec<f64>) {
+    measure_half(shares, HalfViews::NONE, per_band, seed, place)
+}
+
+/// [`measure`] with the views of `half` half a lenslet off the grid: only pixels whose own
+/// cell lies in the patch are measured.
+fn measure_half(
+    shares: &CellShares,
+    half: HalfViews,
+    per_band: usize,
+    seed: u64,
+    place: Option<f64>,
+) -> (Measurements<ValueCount<N>>, Rows, Vec<f64>) {
     let mut r = rng(seed);
     let mut m = Measurements::<ValueCount<N>>::new();
     m.set_shares(Some(*shares)).unwrap();
+    m.set_half_views(half);
+    let own = |s: usize, t: usize, u: usize, v: usize| {
+        (half.rows >> u & 1 == 0 || s + 1 < PS) && (half.cols >> v & 1 == 0 || t + 1 < PT)
+    };
     let pixels: Vec<(usize, usize, usize, usize)> = (0..PS)
         .flat_map(|s| (0..PT).flat_map(move |t| (0..PU).flat_map(move |u| (0..PV).map(move |v| (s, t, u, v)))))
+        .filter(|&(s, t, u, v)| own(s, t, u, v))
         .collect();
     let mut places = Vec::new();
     for &(s, t, u, v) in &pixels {
@@ -112,7 +150,7 @@ fn measure(
             let value = r.random_range(-1.0f32..1.0);
             let entry = Shape::pixel_index(pixels[i].0, pixels[i].1, pixels[i].2, pixels[i].3) + b;
             m.set(entry, value).unwrap();
-            rows.push((entry, taps(pixels[i], places[i], shares).into_iter().map(|(e, w)| (e + b, w)).collect()));
+            rows.push((entry, taps(pixels[i], places[i], shares, half).into_iter().map(|(e, w)| (e + b, w)).collect()));
             y.push(f64::from(value));
         }
     }
@@ -202,6 +240,67 @@ fn the_projection_matches_the_dense_definition() {
     }
 }
 
+/// A patch sheared to a half disparity behind the grid: every other view is half a lenslet
+/// off its grid, its cell the mean of two grid positions (`fractional.rs`'s model), and a
+/// pixel's measurement the shares of its cells so read (a cell whose next position lies past
+/// the patch outside it). The step against the dense definition, a second step with the
+/// kept row sums, the prediction `to_sensor`; a value set at the last grid position of a
+/// half view (no cell in the patch) is no measurement: ignored, as `set_half_views` says.
+#[test]
+fn half_views_match_the_dense_definition() {
+    let dict = random_dictionary::<PatchShape<PS, PT, PU, PV, B, N>>(8);
+    let (kd, n) = dense_kronecker(dict.synthesis());
+    for (case, shares, half, per_band) in [
+        // d = +1/2 on 3 x 3 views: views 0 and 2 half, view 0 one lenslet on.
+        (0u64, shares_of((3.0 / 3.06, 3.0 / 3.02), [1, 0, 0], [1, 0, 0]), HalfViews { rows: 0b101, cols: 0b101 }, 14),
+        // d = -1/2: views 0 and 2 half, view 2 one lenslet on; pixels wider than a cell.
+        (1, shares_of((3.0 / 2.9, 3.0 / 2.95), [0, 0, 1], [0, 0, 1]), HalfViews { rows: 0b101, cols: 0b101 }, 14),
+        // Half rows only, whole columns sheared; every pixel measures both bands.
+        (2, shares_of((3.0 / 3.1, 3.0 / 3.04), [0, 0, 1], [-1, 0, 1]), HalfViews { rows: 0b101, cols: 0 }, 99),
+    ] {
+        let (mut m, rows, y) = measure_half(&shares, half, per_band, 60 + case, None);
+        assert_eq!(m.count(), rows.len());
+        let half_row = |e: usize| half.rows >> (e / B / PV % PU) & 1 != 0;
+        assert!(
+            rows.iter().any(|(_, t)| t.iter().filter(|&&(e, _)| half_row(e)).count() >= 2),
+            "case {case}: no measurement reads a half view's two positions"
+        );
+        // A value at the last grid position of half view row 0: no cell in the patch.
+        let gone = Shape::index(PS - 1, 0, 0, 1, 0);
+        if m.get(gone).is_none() {
+            m.set(gone, 0.75).unwrap();
+        }
+        let (a, w) = dense(&rows, &kd, n);
+        let mut r = rng(70 + case);
+        let y = DVector::from_vec(y);
+        let mut sums = RowSums::new();
+        let exact = Ball::new(0.0, 0.0, m.count() as u32, 0);
+        let mut scratch = [0.0f32; N];
+        for step in 0..2 {
+            let s0: [f32; N] = core::array::from_fn(|_| r.random_range(-1.0f32..1.0));
+            let s = DVector::from_iterator(n, s0.iter().map(|&v| f64::from(v)));
+            let want = &s + a.transpose() * (&y - &a * &s).component_div(&w);
+            let mut coeffs = s0;
+            let before = project_shares(&dict, &mut coeffs, &mut scratch, &m, &exact, &mut sums, None);
+            let residual = (&a * &s - &y).norm();
+            assert!(
+                (f64::from(before) - residual).abs() < 1e-4 * residual.max(1.0),
+                "case {case} step {step}: residual"
+            );
+            let err = coeffs.iter().zip(want.iter()).map(|(&g, w)| (f64::from(g) - w).abs()).fold(0.0, f64::max);
+            assert!(err < 5e-5, "case {case} step {step}: differs from the dense step by {err}");
+        }
+        let x: [f32; N] = core::array::from_fn(|_| r.random_range(-1.0f32..1.0));
+        let mut predicted = x;
+        to_sensor::<Shape>(&m, &mut predicted, &mut scratch);
+        for (entry, row) in &rows {
+            let want: f64 = row.iter().map(|&(e, w)| w * f64::from(x[e])).sum();
+            assert!((f64::from(predicted[*entry]) - want).abs() < 1e-5, "case {case}: prediction at {entry}");
+        }
+        assert_eq!(predicted[gone], x[gone], "case {case}: the last position of a half view was predicted");
+    }
+}
+
 /// Every pixel measures both bands and sits half a cell off its cell's centre (less one
 /// place unit), the same phase everywhere: `M M^T`'s diagonal is about a quarter of its
 /// rows' sums away from the patch's edges. Twenty steps by the rows' sums shrink the residual (in the `W^-1` norm, where
@@ -261,8 +360,8 @@ fn the_share_outside_the_patch_is_the_definitions() {
         ((0.8, 1.25), [-1, 0, 1], [1, 0, -1]),
     ] {
         let shares = shares_of(width, rows, cols);
-        let reach = Reach::<Shape>::new(&shares);
-        let unsheared = Reach::<Shape>::new(&CellShares::unsheared(width));
+        let reach = Reach::<Shape>::new(&shares, HalfViews::NONE);
+        let unsheared = Reach::<Shape>::new(&CellShares::unsheared(width), HalfViews::NONE);
         let mut further = false;
         for (s, t, u, v) in (0..PS)
             .flat_map(|s| (0..PT).flat_map(move |t| (0..PU).flat_map(move |u| (0..PV).map(move |v| (s, t, u, v)))))

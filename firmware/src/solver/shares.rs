@@ -35,6 +35,16 @@
 //! unsheared, at micro-image borders too when sheared; there a pixel largely outside the
 //! patch is left out of its measurements ([`MAX_OUTSIDE_SHARE`]).
 //!
+//! A patch sheared to a half disparity has every other view half a lenslet off its grid
+//! ([`crate::solver::fractional`]): such a view's cell is the mean of two grid positions, so
+//! a measurement reads its cells' one or two positions each, at half a cell's share for a
+//! half view's (up to 36 entries, not 9: a second footprint kind, the whole case's loops
+//! unchanged). A cell whose second position lies past the patch is outside it, and the last
+//! grid position of a half view is no measurement. On a textured plane at half a pixel of
+//! disparity behind a grid turned 0.3 degrees at 5.04 px this beats whole disparities by 7
+//! dB, where reading each half view at the pixel under its cell's centre lost to them
+//! (`host-sim/tests/grid.rs`).
+//!
 //! Against the aligned sensor's band step this costs, per measurement, the sum of the
 //! two to nine cells it covers before its dot product with `D5`'s band row and the scatter
 //! of its correction back to them, and two patches on the stack (32 KB each for the
@@ -55,6 +65,7 @@
 //! pass saved 1.7 % more for 22 KB of stack: not kept.
 
 use crate::operators::dictionary::Dictionary;
+use crate::operators::disparity::HalfViews;
 use crate::operators::mode::ModeMatrix;
 use crate::operators::shape::{PerBand, PerValue, Shape};
 use crate::sensor::extent::{Array, Bands, Extent};
@@ -62,18 +73,20 @@ use crate::solver::ball::Ball;
 use crate::solver::projection::{band_bits, dot, measured_weight, project_whole};
 use crate::solver::workspace::{CellShares, MAX_SHARE_VIEWS, Measurements, PLACE_UNIT};
 
-/// The cells a measurement covers (at most 3 x 3), with their shares: per axis (rows,
-/// columns), the cells before, at and after the pixel's own, each its part of a pixel index
-/// (`pixel = row part + column part`) and its share (0: not covered); a cell's share is the
-/// product of its row's and its column's.
+/// The patch entries a measurement reads, with their weights: per axis (rows, columns), `N`
+/// parts of a pixel index (`pixel = row part + column part`) and their weights (0: none);
+/// an entry's weight is the product of its row's and its column's. With whole views
+/// (`N = 3`) the parts are the cells before, at and after the pixel's own, each weighted by
+/// its share; with half views (`N = 6`) each cell is its one or two grid positions, a half
+/// view's two each taking half its share ([`Layout`]).
 #[derive(Clone, Copy)]
-struct Footprint {
-    rows: ([u16; 3], [f32; 3]),
-    cols: ([u16; 3], [f32; 3]),
+struct Footprint<const N: usize> {
+    rows: ([u16; N], [f32; N]),
+    cols: ([u16; N], [f32; N]),
 }
 
-impl Footprint {
-    /// `f(cell, share)` for each cell covered.
+impl<const N: usize> Footprint<N> {
+    /// `f(entry, weight)` for each entry read.
     #[inline(always)]
     fn each(&self, mut f: impl FnMut(usize, f32)) {
         let ((rp, rw), (cp, cw)) = (&self.rows, &self.cols);
@@ -89,13 +102,96 @@ impl Footprint {
         }
     }
 
-    /// Band `b` of the cells covered, each by its share, summed (`cells` by patch pixel).
+    /// Band `b` of the entries read, each by its weight, summed (`cells` by patch pixel).
     #[inline(always)]
     fn band_sum<C: Bands>(&self, cells: &[C::Per<f32>], b: usize) -> f32 {
         let mut sum = 0.0f32;
         self.each(|c, w| sum += w * cells.get(c).and_then(|f| f.get(b)).copied().unwrap_or(0.0));
         sum
     }
+}
+
+/// One axis of the cells a measurement covers: the cells before, at and after the pixel's
+/// own, each its part of a pixel index and its share (0: not covered).
+type AxisCells = ([u16; 3], [f32; 3]);
+
+/// How a step finds a measurement's footprint: whole views only (`Footprint<3>`, the cells
+/// themselves) or with half views (`Footprint<6>`). Two kinds so that the common whole
+/// case keeps its nine-entry loops.
+trait Cover: Copy {
+    fn of<S: Shape>(
+        layout: &Layout<S>,
+        m: &Measurements<S::Values>,
+        at: (usize, usize, usize, usize),
+        pixel: usize,
+    ) -> Self;
+    fn each(&self, f: impl FnMut(usize, f32));
+    fn band_sum<C: Bands>(&self, cells: &[C::Per<f32>], b: usize) -> f32;
+}
+
+impl Cover for Footprint<3> {
+    #[inline(always)]
+    fn of<S: Shape>(
+        layout: &Layout<S>,
+        m: &Measurements<S::Values>,
+        at: (usize, usize, usize, usize),
+        pixel: usize,
+    ) -> Self {
+        let (rows, cols) = layout.cells(m, at, pixel);
+        Self { rows, cols }
+    }
+    #[inline(always)]
+    fn each(&self, f: impl FnMut(usize, f32)) {
+        Footprint::each(self, f)
+    }
+    #[inline(always)]
+    fn band_sum<C: Bands>(&self, cells: &[C::Per<f32>], b: usize) -> f32 {
+        Footprint::band_sum::<C>(self, cells, b)
+    }
+}
+
+impl Cover for Footprint<6> {
+    #[inline(always)]
+    fn of<S: Shape>(
+        layout: &Layout<S>,
+        m: &Measurements<S::Values>,
+        at: (usize, usize, usize, usize),
+        pixel: usize,
+    ) -> Self {
+        let (s, t, u, v) = at;
+        let (rows, cols) = layout.cells(m, at, pixel);
+        let halves = |h: Option<&[bool; 3]>| h.copied().unwrap_or([false; 3]);
+        Self {
+            rows: split(rows, halves(layout.halves.0.get(s * S::PU + u)), S::PT * S::PU * S::PV),
+            cols: split(cols, halves(layout.halves.1.get(t * S::PV + v)), S::PU * S::PV),
+        }
+    }
+    #[inline(always)]
+    fn each(&self, f: impl FnMut(usize, f32)) {
+        Footprint::each(self, f)
+    }
+    #[inline(always)]
+    fn band_sum<C: Bands>(&self, cells: &[C::Per<f32>], b: usize) -> f32 {
+        Footprint::band_sum::<C>(self, cells, b)
+    }
+}
+
+/// One axis of a footprint with half views: each of the three cells (`parts`, shares)
+/// its grid position, or for a half view (`half`) that position and the next (`next` on
+/// in the pixel index) at half its share each.
+#[inline(always)]
+fn split((parts, shares): AxisCells, half: [bool; 3], next: usize) -> ([u16; 6], [f32; 6]) {
+    let (mut p, mut w) = ([0u16; 6], [0.0f32; 6]);
+    let pairs = p.chunks_exact_mut(2).zip(w.chunks_exact_mut(2));
+    for ((pp, ww), ((&part, &share), &h)) in pairs.zip(parts.iter().zip(&shares).zip(&half)) {
+        if let ([p0, p1], [w0, w1]) = (pp, ww) {
+            (*p0, *w0) = (part, share);
+            if h {
+                (*p1, *w0, *w1) = (part.wrapping_add(next as u16), 0.5 * share, 0.5 * share);
+            }
+        }
+    }
+    (p, w)
 }
 
 /// The bands set in `bits`, lowest first.
@@ -125,10 +221,21 @@ const OUTSIDE: u16 = u16::MAX;
 /// shares. With it, each place's overhangs ([`overhang`]) per axis, by the place's `i8`
 /// (offset by 128): a solve builds its layout once ([`RowSums`]), and a lookup costs less
 /// than the arithmetic for each pixel, axis and pass.
+///
+/// In a patch sheared to a half disparity every other view is half a lenslet off its grid
+/// ([`HalfViews`]): such a view's cell at grid position `s` is the mean of positions `s`
+/// and `s + 1` ([`crate::solver::fractional`]), so a cell whose next position lies past
+/// the patch is outside it, and a pixel whose own cell is (the last position of a half
+/// view) is no measurement (`gone`).
 struct Layout<S: Shape> {
     shape: core::marker::PhantomData<S>,
     rows: [[u16; 2]; MAX_AXIS],
     cols: [[u16; 2]; MAX_AXIS],
+    /// Per axis index, whether the cells before, at and after it are half views; whether
+    /// any is; whether the own cell lies past the patch.
+    halves: ([[bool; 3]; MAX_AXIS], [[bool; 3]; MAX_AXIS]),
+    any_half: bool,
+    gone: ([bool; MAX_AXIS], [bool; MAX_AXIS]),
     /// One over a pixel's side in cells, rows and columns; the side over 2.
     inv: (f32, f32),
     half: (f32, f32),
@@ -153,21 +260,25 @@ impl<S: Shape> Layout<S> {
             shape: core::marker::PhantomData,
             rows: [[OUTSIDE; 2]; MAX_AXIS],
             cols: [[OUTSIDE; 2]; MAX_AXIS],
+            halves: ([[false; 3]; MAX_AXIS], [[false; 3]; MAX_AXIS]),
+            any_half: false,
+            gone: ([false; MAX_AXIS], [false; MAX_AXIS]),
             inv: (1.0, 1.0),
             half: (0.5, 0.5),
             over: ([[0.0; 2]; PLACES], [[0.0; 2]; PLACES]),
         }
     }
 
-    fn new(shares: &CellShares) -> Self {
+    fn new(shares: &CellShares, half: HalfViews) -> Self {
         let mut layout = Self::empty();
-        layout.fill(shares);
+        layout.fill(shares, half);
         layout
     }
 
-    /// This layout made the one of a patch whose pixels share cells as `shares` says, in
-    /// place (a solve's [`RowSums`] holds it: no second copy on the stack).
-    fn fill(&mut self, shares: &CellShares) {
+    /// This layout made the one of a patch whose pixels share cells as `shares` says, its
+    /// views half off the grid as `halves` says, in place (a solve's [`RowSums`] holds it:
+    /// no second copy on the stack).
+    fn fill(&mut self, shares: &CellShares, halves: HalfViews) {
         self.inv = (1.0 / shares.width.0, 1.0 / shares.width.1);
         self.half = (0.5 * shares.width.0, 0.5 * shares.width.1);
         let (half, inv) = (self.half, self.inv);
@@ -178,38 +289,64 @@ impl<S: Shape> Layout<S> {
             (*r, *c) = ([rb, ra], [cb, ca]);
         }
         let part = |x: Option<usize>| x.and_then(|x| u16::try_from(x).ok()).unwrap_or(OUTSIDE);
-        for (i, o) in self.rows.iter_mut().enumerate() {
-            *o = [OUTSIDE; 2];
+        self.any_half = !halves.is_none();
+        // A cell of a half view needs the grid position after its own too.
+        let whole = |(s, u): (usize, usize), len: usize, is_half: &dyn Fn(usize) -> bool| !is_half(u) || s + 1 < len;
+        let row_half = |u: usize| halves.row(u);
+        let col_half = |v: usize| halves.col(v);
+        let axis = (&mut self.rows, &mut self.halves.0, &mut self.gone.0);
+        for (i, ((o, h), g)) in axis.0.iter_mut().zip(axis.1.iter_mut()).zip(axis.2.iter_mut()).enumerate() {
+            (*o, *h, *g) = ([OUTSIDE; 2], [false; 3], false);
             if i >= S::PS * S::PU {
                 continue;
             }
             let (s, u) = (i / S::PU, i % S::PU);
+            (h[1], *g) = (row_half(u), !whole((s, u), S::PS, &row_half));
             let p = (s as isize + shares.shift.0.get(u).copied().unwrap_or(0) as isize) * S::PU as isize + u as isize;
-            for (d, x) in [-1isize, 1].into_iter().zip(o.iter_mut()) {
-                *x = part(along(p + d, S::PU, S::PS, &shares.shift.0).map(|(s, u)| (s * S::PT * S::PU + u) * S::PV));
+            for (d, (x, hx)) in [-1isize, 1].into_iter().zip(o.iter_mut().zip([0usize, 2])) {
+                let cell = along(p + d, S::PU, S::PS, &shares.shift.0).filter(|&c| whole(c, S::PS, &row_half));
+                *x = part(cell.map(|(s, u)| (s * S::PT * S::PU + u) * S::PV));
+                if let (Some((_, u)), Some(f)) = (cell, h.get_mut(hx)) {
+                    *f = row_half(u);
+                }
             }
         }
-        for (i, o) in self.cols.iter_mut().enumerate() {
-            *o = [OUTSIDE; 2];
+        let axis = (&mut self.cols, &mut self.halves.1, &mut self.gone.1);
+        for (i, ((o, h), g)) in axis.0.iter_mut().zip(axis.1.iter_mut()).zip(axis.2.iter_mut()).enumerate() {
+            (*o, *h, *g) = ([OUTSIDE; 2], [false; 3], false);
             if i >= S::PT * S::PV {
                 continue;
             }
             let (t, v) = (i / S::PV, i % S::PV);
+            (h[1], *g) = (col_half(v), !whole((t, v), S::PT, &col_half));
             let q = (t as isize + shares.shift.1.get(v).copied().unwrap_or(0) as isize) * S::PV as isize + v as isize;
-            for (d, x) in [-1isize, 1].into_iter().zip(o.iter_mut()) {
-                *x = part(along(q + d, S::PV, S::PT, &shares.shift.1).map(|(t, v)| t * S::PU * S::PV + v));
+            for (d, (x, hx)) in [-1isize, 1].into_iter().zip(o.iter_mut().zip([0usize, 2])) {
+                let cell = along(q + d, S::PV, S::PT, &shares.shift.1).filter(|&c| whole(c, S::PT, &col_half));
+                *x = part(cell.map(|(t, v)| t * S::PU * S::PV + v));
+                if let (Some((_, v)), Some(f)) = (cell, h.get_mut(hx)) {
+                    *f = col_half(v);
+                }
             }
         }
     }
 
-    /// The footprint of the measurements of patch pixel `(s, t, u, v)` (index `pixel`).
+    /// Whether patch pixel `(s, t, u, v)` can be a measurement: its own cell lies in the
+    /// patch (not the last grid position of a half view).
     #[inline(always)]
-    fn footprint(
+    fn measures(&self, (s, t, u, v): (usize, usize, usize, usize)) -> bool {
+        !self.gone.0.get(s * S::PU + u).copied().unwrap_or(true)
+            && !self.gone.1.get(t * S::PV + v).copied().unwrap_or(true)
+    }
+
+    /// The cells the measurements of patch pixel `(s, t, u, v)` (index `pixel`) cover, per
+    /// axis: their parts of the pixel index and their shares.
+    #[inline(always)]
+    fn cells(
         &self,
         m: &Measurements<S::Values>,
         (s, t, u, v): (usize, usize, usize, usize),
         pixel: usize,
-    ) -> Footprint {
+    ) -> (AxisCells, AxisCells) {
         let [pr, pc] = m.place.get(pixel).copied().unwrap_or([0, 0]);
         let over =
             |table: &[[f32; 2]; PLACES], x: i8| table.get((i16::from(x) + 128) as usize).copied().unwrap_or([0.0; 2]);
@@ -223,7 +360,7 @@ impl<S: Shape> Layout<S> {
             None => (OUTSIDE, OUTSIDE),
         };
         let col_parts = [before, (t * S::PU * S::PV + v) as u16, after];
-        Footprint { rows: axis(over(&self.over.0, pr), row_parts), cols: axis(over(&self.over.1, pc), col_parts) }
+        (axis(over(&self.over.0, pr), row_parts), axis(over(&self.over.1, pc), col_parts))
     }
 }
 
@@ -252,9 +389,10 @@ pub const MAX_OUTSIDE_SHARE: f32 = 0.25;
 pub struct Reach<S: Shape>(Layout<S>);
 
 impl<S: Shape> Reach<S> {
-    /// The reach of a patch whose pixels share cells as `shares` says.
-    pub fn new(shares: &CellShares) -> Self {
-        Self(Layout::new(shares))
+    /// The reach of a patch whose pixels share cells as `shares` says, its views half off the
+    /// grid as `half` says.
+    pub fn new(shares: &CellShares, half: HalfViews) -> Self {
+        Self(Layout::new(shares, half))
     }
 
     /// The share of patch pixel `(s, t, u, v)`'s square, its centre `place` cells off its
@@ -291,7 +429,7 @@ fn along(p: isize, views: usize, len: usize, shift: &[i8; MAX_SHARE_VIEWS]) -> O
 /// [`OUTSIDE`] beyond the patch: that share goes to its own cell). A box against unit
 /// cells: `half <= 1` and `|delta| <= 1/2`, so it reaches no further.
 #[inline(always)]
-fn axis([mut before, mut after]: [f32; 2], parts: [u16; 3]) -> ([u16; 3], [f32; 3]) {
+fn axis([mut before, mut after]: [f32; 2], parts: [u16; 3]) -> AxisCells {
     let mut own = 1.0 - before - after;
     if parts[0] == OUTSIDE {
         own += before;
@@ -378,13 +516,21 @@ pub fn project_shares<S: Shape>(
     project_whole(dict, coeffs, scratch, ball, &mut step)
 }
 
-/// Calls `f((s, t, u, v), pixel, band bits)` for every patch pixel with a measurement.
+/// Calls `f((s, t, u, v), pixel, band bits)` for every patch pixel with a measurement (one
+/// whose own cell lies in the patch, `layout`).
 #[inline(always)]
-fn each_measured<S: Shape>(m: &Measurements<S::Values>, mut f: impl FnMut((usize, usize, usize, usize), usize, u64)) {
+fn each_measured<S: Shape>(
+    m: &Measurements<S::Values>,
+    layout: &Layout<S>,
+    mut f: impl FnMut((usize, usize, usize, usize), usize, u64),
+) {
     for s in 0..S::PS {
         for t in 0..S::PT {
             for u in 0..S::PU {
                 for v in 0..S::PV {
+                    if layout.any_half && !layout.measures((s, t, u, v)) {
+                        continue;
+                    }
                     let pixel = ((s * S::PT + t) * S::PU + u) * S::PV + v;
                     let Some(flags) = m.measured.get(pixel * S::B..pixel * S::B + S::B) else { continue };
                     let bits = band_bits(flags);
@@ -417,18 +563,39 @@ fn share_step<S: Shape>(
     if !rows.ready {
         // The layout and the row sums, once a solve (the residuals' buffer is the sums'
         // scratch: every measured entry is written below before it is read).
-        rows.layout.fill(shares);
-        row_sums::<S>(S::Bands::chunks_mut(rows.res.as_mut()), m, &rows.layout, &mut rows.inv);
+        rows.layout.fill(shares, m.half);
+        let fibres = S::Bands::chunks_mut(rows.res.as_mut());
+        if rows.layout.any_half {
+            row_sums::<S, Footprint<6>>(fibres, m, &rows.layout, &mut rows.inv);
+        } else {
+            row_sums::<S, Footprint<3>>(fibres, m, &rows.layout, &mut rows.inv);
+        }
         rows.ready = true;
     }
+    if rows.layout.any_half {
+        step_with::<S, Footprint<6>>(m5, scratch, m, (ball, weights), rows)
+    } else {
+        step_with::<S, Footprint<3>>(m5, scratch, m, (ball, weights), rows)
+    }
+}
+
+/// [`share_step`] once its layout and row sums are found, with footprints of kind `F`.
+#[inline(always)]
+fn step_with<S: Shape, F: Cover>(
+    m5: &ModeMatrix<S::Bands>,
+    scratch: &mut PerValue<S, f32>,
+    m: &Measurements<S::Values>,
+    (ball, weights): (&Ball, Option<&PerValue<S, f32>>),
+    rows: &mut RowSums<S>,
+) -> (f32, f32) {
     let layout = &rows.layout;
     let fibres = S::Bands::chunks_mut(scratch.as_mut());
     // Each measurement's residual, in its patch entry.
     let res = &mut rows.res;
     let (mut r2, mut w2) = (0.0f32, 0.0f32);
     let weighted = ball.is_weighted();
-    each_measured::<S>(m, |at, pixel, bits| {
-        let fp = layout.footprint(m, at, pixel);
+    each_measured::<S>(m, layout, |at, pixel, bits| {
+        let fp = F::of(layout, m, at, pixel);
         let mut sum = <PerBand<S, f32>>::splat(0.0);
         fp.each(|c, w| {
             if let Some(f) = fibres.get(c) {
@@ -453,7 +620,7 @@ fn share_step<S: Shape>(
     for f in fibres.iter_mut() {
         *f = <PerBand<S, f32>>::splat(0.0);
     }
-    each_measured::<S>(m, |at, pixel, bits| {
+    each_measured::<S>(m, layout, |at, pixel, bits| {
         let mut correction = <PerBand<S, f32>>::splat(0.0);
         for b in bands(bits) {
             let i = pixel * S::B + b;
@@ -463,7 +630,7 @@ fn share_step<S: Shape>(
                 *o += z * w;
             }
         }
-        let fp = layout.footprint(m, at, pixel);
+        let fp = F::of(layout, m, at, pixel);
         fp.each(|c, w| {
             if let Some(f) = fibres.get_mut(c) {
                 for (o, &x) in f.iter_mut().zip(correction.iter()) {
@@ -479,7 +646,7 @@ fn share_step<S: Shape>(
 /// nothing is covered): each band's coverage of each cell first (in `fibres`, clobbered),
 /// then each measurement's shares of its cells' coverage.
 #[inline(never)]
-fn row_sums<S: Shape>(
+fn row_sums<S: Shape, F: Cover>(
     fibres: &mut [PerBand<S, f32>],
     m: &Measurements<S::Values>,
     layout: &Layout<S>,
@@ -488,8 +655,8 @@ fn row_sums<S: Shape>(
     for f in fibres.iter_mut() {
         *f = <PerBand<S, f32>>::splat(0.0);
     }
-    each_measured::<S>(m, |at, pixel, bits| {
-        let fp = layout.footprint(m, at, pixel);
+    each_measured::<S>(m, layout, |at, pixel, bits| {
+        let fp = F::of(layout, m, at, pixel);
         fp.each(|c, w| {
             if let Some(f) = fibres.get_mut(c) {
                 for b in bands(bits) {
@@ -500,8 +667,8 @@ fn row_sums<S: Shape>(
             }
         });
     });
-    each_measured::<S>(m, |at, pixel, bits| {
-        let fp = layout.footprint(m, at, pixel);
+    each_measured::<S>(m, layout, |at, pixel, bits| {
+        let fp = F::of(layout, m, at, pixel);
         for b in bands(bits) {
             let row = fp.band_sum::<S::Bands>(fibres, b);
             if let Some(x) = inv.get_mut(pixel * S::B + b) {
@@ -517,11 +684,25 @@ fn row_sums<S: Shape>(
 /// clobbered (a copy of the patch).
 pub fn to_sensor<S: Shape>(m: &Measurements<S::Values>, patch: &mut PerValue<S, f32>, scratch: &mut PerValue<S, f32>) {
     let Some(shares) = &m.shares else { return };
-    let layout = Layout::<S>::new(shares);
+    let layout = Layout::<S>::new(shares, m.half);
     scratch.copy_from_slice(patch.as_ref());
-    let cells = S::Bands::chunks(scratch.as_ref());
-    each_measured::<S>(m, |at, pixel, bits| {
-        let fp = layout.footprint(m, at, pixel);
+    if layout.any_half {
+        predict::<S, Footprint<6>>(m, &layout, patch, scratch);
+    } else {
+        predict::<S, Footprint<3>>(m, &layout, patch, scratch);
+    }
+}
+
+/// [`to_sensor`]'s measured entries from the patch's copy `cells`, footprints of kind `F`.
+fn predict<S: Shape, F: Cover>(
+    m: &Measurements<S::Values>,
+    layout: &Layout<S>,
+    patch: &mut PerValue<S, f32>,
+    cells: &PerValue<S, f32>,
+) {
+    let cells = S::Bands::chunks(cells.as_ref());
+    each_measured::<S>(m, layout, |at, pixel, bits| {
+        let fp = F::of(layout, m, at, pixel);
         for b in bands(bits) {
             let x = fp.band_sum::<S::Bands>(cells, b);
             if let Some(y) = patch.get_mut(pixel * S::B + b) {

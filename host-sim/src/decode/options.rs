@@ -387,11 +387,14 @@ impl DecodeOptions {
     /// The disparities a decode of `capture` searches: [`Self::disparities`], or the
     /// capture's default: [`DisparityRange::for_capture`] on the aligned sensor, whole
     /// disparities only behind a lenslet grid. There a patch at a half-pixel disparity reads
-    /// each view at the pixel under its cell's centre (its interpolation is not built with
-    /// the view cells' shares, [`slf_firmware::shares`]): at pixel k = 1 the default's
-    /// halves lost 0.2 to 2.0 dB to whole disparities alone in each of the 7 decodes where
-    /// the shear trial kept them (outdoor, tungsten and led behind grids turned 0.3 degrees
-    /// at 5.04 px and 1 degree at 5.1 px, office at 1 degree; 64 x 64 lenslets).
+    /// the grid by the view cells' shares, a half view's cell the mean of two grid positions
+    /// ([`slf_firmware::shares`]): on a plane at half a pixel it beats whole disparities by
+    /// 7 dB (`tests/grid.rs`), but on the realistic scenes at pixel k = 1 the halves lost to
+    /// whole disparities on 6 of 8 decodes, by up to 0.45 dB, and won up to 0.24 (outdoor,
+    /// tungsten, office and led at 64 x 64 lenslets behind grids turned 0.3 degrees at 5.04
+    /// px and 1 degree at 5.1 px, `docs/results-grid-halves.md`); the shear trial kept them
+    /// on every one. Read at the cells' centres, as before the shares, they lost 0.35 to 2.1 dB
+    /// more.
     pub fn disparities_for(&self, capture: &Capture) -> DisparityRange {
         let d = &capture.description;
         let snapshots = u8::try_from(d.frames.len()).unwrap_or(u8::MAX);

@@ -454,11 +454,11 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
         self.read_patch(origin, source, ws)?;
         let Ok(solves) = solved else { return Ok((None, 0)) };
         let half = ws.measurements().half_views();
-        if !half.is_none() {
+        if !half.is_none() && ws.measurements().shares().is_none() {
             to_sensor::<S>(half, &mut ws.signal);
         }
-        // Behind a lenslet grid, the held-out pixels as they measured the decode (the
-        // coefficients are not needed after the solve).
+        // Behind a lenslet grid, the held-out pixels as they measured the decode, half views
+        // by their two grid positions (the coefficients are not needed after the solve).
         let Workspace { signal, coeffs, measurements, .. } = ws;
         shares::to_sensor::<S>(measurements, signal, coeffs);
         let cfg = &self.config.sl0;

@@ -108,16 +108,18 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
         let mut run = <PerBand<S, Per<S::V, f32>>>::splat(S::V::ZEROS);
         let half = HalfViews::of(origin.disparity, (origin.view_row as usize, origin.view_col as usize), (lu, lv));
         m.set_half_views(half);
-        // Behind a lenslet grid each pixel is the shares of the cells it covers; with a
-        // half-pixel shear or a response that mixes bands, the cell under its centre.
-        let shares = self.cell_shares(origin, half);
+        // Behind a lenslet grid each pixel is the shares of the cells it covers (a half view's
+        // cell the mean of two grid positions); with a response that mixes bands, the cell
+        // under its centre.
+        let shares = self.cell_shares(origin);
         if m.set_shares(shares).is_err() {
             let _ = m.set_shares(None);
         }
         let shared = m.shares().is_some();
         // A sheared patch's pixels that lie largely outside it are left out at k >= 2
         // (`MAX_OUTSIDE_SHARE`).
-        let reach = m.shares().filter(|_| origin.disparity != Disparity::ZERO && k >= 2).map(Reach::<S>::new);
+        let reach =
+            m.shares().filter(|_| origin.disparity != Disparity::ZERO && k >= 2).map(|c| Reach::<S>::new(c, half));
         for s in 0..S::PS {
             for u in 0..S::PU {
                 for t in 0..S::PT {
@@ -168,13 +170,14 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
     }
 
     /// How the pixels of a patch at `origin` share view cells behind the lenslet grid:
-    /// `None` on the aligned sensor (each pixel its cell, the selection's bits), for a
-    /// half-pixel shear (its own interpolation) and for a solved response that mixes bands
-    /// (neither projection is built with shares).
-    pub(super) fn cell_shares(&self, origin: PatchOrigin, half: HalfViews) -> Option<CellShares> {
+    /// `None` on the aligned sensor (each pixel its cell, the selection's bits) and for a
+    /// solved response that mixes bands (its projection is not built with shares). A
+    /// half-pixel shear's half views are the measurements' (`Measurements::half_views`):
+    /// the shares read each such cell as the mean of its two grid positions.
+    pub(super) fn cell_shares(&self, origin: PatchOrigin) -> Option<CellShares> {
         let g = self.grid.as_ref().filter(|g| !g.is_aligned())?;
         let fits = S::PU <= MAX_SHARE_VIEWS && S::PV <= MAX_SHARE_VIEWS && S::PS * S::PT * S::PU * S::PV <= MAX_PLACES;
-        if !half.is_none() || !self.solved_response().is_identity() || !fits {
+        if !self.solved_response().is_identity() || !fits {
             return None;
         }
         let (lu, lv) = (usize::from(self.config.sensor.lenslet.rows), usize::from(self.config.sensor.lenslet.cols));

@@ -260,11 +260,6 @@ pub fn run(args: Args) -> Result<()> {
         } else {
             String::new()
         };
-        let halves = if r.disparity_counts.iter().any(|(d, _)| d.in_halves() % 2 != 0) {
-            "; the half-pixel sheared patches read each view at the pixel under its cell's centre"
-        } else {
-            ""
-        };
         let moved = match r.grid_moved {
             [0, 0] => String::new(),
             [s, t] => format!(
@@ -275,7 +270,7 @@ pub fn run(args: Args) -> Result<()> {
         };
         outln!(
             "lenslet grid: turned {:.4} degrees, pitch {:.4} x {:.4} px, each pixel the shares of the view cells it \
-             covers{moved}{edges}{halves}",
+             covers{moved}{edges}",
             g.rotation_deg,
             g.pitch[0],
             g.pitch[1]
