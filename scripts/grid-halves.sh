@@ -24,28 +24,15 @@ grid_table_setup
 rows="$out/rows.tsv"
 : > "$rows"
 
-# measure BIN CALIBRATION CAPTURE ARGS...: PSNR (interior) / SSIM / SA and seconds of BIN's
-# decode with ARGS.
-measure() {
-  local bin=$1 calibration=$2 cap=$3 start end
-  shift 3
-  start=$(date +%s.%N)
-  "$bin" decode "$cap" -o "$out/rec.npy" --quiet --calibration "$calibration" "$@" > /dev/null
-  end=$(date +%s.%N)
-  grid_scores
-  secs=$(python3 -c "print(f'{$end - $start:.1f}')")
-  echo "$psnr $q $a $secs"
-}
-
 for token in $scenes; do
   scene_light_field "$token"
   for k in $ks; do
     for g in $grids; do
       grid_captures "$k" "$g"
-      printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$scene" "$k" "$g" "$(measure "$slf" "$cal_aligned" "$aligned")" \
-        "$(measure "$slf" "$cal" "$cap" --disparities -1:1)" \
-        "$(measure "$before" "$cal" "$cap" --disparities -1:1:0.5)" \
-        "$(measure "$slf" "$cal" "$cap" --disparities -1:1:0.5)" >> "$rows"
+      printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$scene" "$k" "$g" "$(grid_measure "$slf" "$cal_aligned" "$aligned")" \
+        "$(grid_measure "$slf" "$cal" "$cap" --disparities -1:1)" \
+        "$(grid_measure "$before" "$cal" "$cap" --disparities -1:1:0.5)" \
+        "$(grid_measure "$slf" "$cal" "$cap" --disparities -1:1:0.5)" >> "$rows"
     done
   done
 done

@@ -34,18 +34,6 @@ calibration() {
   grid_calibration "$before" "$cal_before" "$@" > /dev/null
 }
 
-# measure BIN CALIBRATION CAPTURE: PSNR (interior) / SSIM / SA and seconds of BIN's default
-# decode.
-measure() {
-  local bin=$1 calibration=$2 cap=$3 start end
-  start=$(date +%s.%N)
-  "$bin" decode "$cap" -o "$out/rec.npy" --quiet --calibration "$calibration" > /dev/null
-  end=$(date +%s.%N)
-  grid_scores
-  secs=$(python3 -c "print(f'{$end - $start:.1f}')")
-  echo "$psnr $q $a $secs"
-}
-
 for token in $scenes; do
   scene_light_field "$token"
   for k in $ks; do
@@ -53,15 +41,15 @@ for token in $scenes; do
     calibration
     cap="$out/cap-$scene-$k-aligned"
     [ -d "$cap" ] || "$slf" simulate "$lf" -o "$cap" -s "$k" --seed 1 "${sensor[@]}" > /dev/null 2>&1
-    ref=$(measure "$slf" "$cal" "$cap")
+    ref=$(grid_measure "$slf" "$cal" "$cap")
     for g in $grids; do
       label=$g
       calibration --rotation "${g%:*}" --pitch "${g#*:}"
       cap="$out/cap-$scene-$k-$g"
       [ -d "$cap" ] || "$slf" simulate "$lf" -o "$cap" -s "$k" --seed 1 "${sensor[@]}" \
         --rotation "${g%:*}" --pitch "${g#*:}" > /dev/null 2>&1
-      printf '%s\t%s\t%s\t%s\t%s\t%s\n' "$scene" "$k" "$g" "$ref" "$(measure "$before" "$cal_before" "$cap")" \
-        "$(measure "$slf" "$cal" "$cap")" >> "$rows"
+      printf '%s\t%s\t%s\t%s\t%s\t%s\n' "$scene" "$k" "$g" "$ref" "$(grid_measure "$before" "$cal_before" "$cap")" \
+        "$(grid_measure "$slf" "$cal" "$cap")" >> "$rows"
     done
   done
 done

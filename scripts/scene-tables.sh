@@ -77,6 +77,19 @@ grid_scores() {
   read -r q a < <("$slf" eval "$lf" "$out/rec.npy" | awk '/^SSIM/ { q = $2 } /^SA/ { a = $2 } END { print q, a }')
 }
 
+# grid_measure BIN CALIBRATION CAPTURE ARGS...: prints PSNR (interior) / SSIM / SA and seconds
+# of BIN's decode of CAPTURE with ARGS (grid-shear.sh, grid-halves.sh).
+grid_measure() {
+  local bin=$1 calibration=$2 cap=$3 start end secs
+  shift 3
+  start=$(date +%s.%N)
+  "$bin" decode "$cap" -o "$out/rec.npy" --quiet --calibration "$calibration" "$@" > /dev/null
+  end=$(date +%s.%N)
+  grid_scores
+  secs=$(python3 -c "print(f'{$end - $start:.1f}')")
+  echo "$psnr $q $a $secs"
+}
+
 # scene_light_field TOKEN: sets $scene (its name) and $lf (its light field: a real crop, or
 # `slf scene` rendered into $out once).
 scene_light_field() {

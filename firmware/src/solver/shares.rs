@@ -118,15 +118,13 @@ type AxisCells = ([u16; 3], [f32; 3]);
 /// How a step finds a measurement's footprint: whole views only (`Footprint<3>`, the cells
 /// themselves) or with half views (`Footprint<6>`). Two kinds so that the common whole
 /// case keeps its nine-entry loops.
-trait Cover: Copy {
+trait Cover {
     fn of<S: Shape>(
         layout: &Layout<S>,
         m: &Measurements<S::Values>,
         at: (usize, usize, usize, usize),
         pixel: usize,
     ) -> Self;
-    fn each(&self, f: impl FnMut(usize, f32));
-    fn band_sum<C: Bands>(&self, cells: &[C::Per<f32>], b: usize) -> f32;
 }
 
 impl Cover for Footprint<3> {
@@ -139,14 +137,6 @@ impl Cover for Footprint<3> {
     ) -> Self {
         let (rows, cols) = layout.cells(m, at, pixel);
         Self { rows, cols }
-    }
-    #[inline(always)]
-    fn each(&self, f: impl FnMut(usize, f32)) {
-        Footprint::each(self, f)
-    }
-    #[inline(always)]
-    fn band_sum<C: Bands>(&self, cells: &[C::Per<f32>], b: usize) -> f32 {
-        Footprint::band_sum::<C>(self, cells, b)
     }
 }
 
@@ -165,14 +155,6 @@ impl Cover for Footprint<6> {
             rows: split(rows, halves(layout.halves.0.get(s * S::PU + u)), S::PT * S::PU * S::PV),
             cols: split(cols, halves(layout.halves.1.get(t * S::PV + v)), S::PU * S::PV),
         }
-    }
-    #[inline(always)]
-    fn each(&self, f: impl FnMut(usize, f32)) {
-        Footprint::each(self, f)
-    }
-    #[inline(always)]
-    fn band_sum<C: Bands>(&self, cells: &[C::Per<f32>], b: usize) -> f32 {
-        Footprint::band_sum::<C>(self, cells, b)
     }
 }
 
@@ -566,28 +548,32 @@ fn share_step<S: Shape>(
         rows.layout.fill(shares, m.half);
         let fibres = S::Bands::chunks_mut(rows.res.as_mut());
         if rows.layout.any_half {
-            row_sums::<S, Footprint<6>>(fibres, m, &rows.layout, &mut rows.inv);
+            row_sums::<S, 6>(fibres, m, &rows.layout, &mut rows.inv);
         } else {
-            row_sums::<S, Footprint<3>>(fibres, m, &rows.layout, &mut rows.inv);
+            row_sums::<S, 3>(fibres, m, &rows.layout, &mut rows.inv);
         }
         rows.ready = true;
     }
     if rows.layout.any_half {
-        step_with::<S, Footprint<6>>(m5, scratch, m, (ball, weights), rows)
+        step_with::<S, 6>(m5, scratch, m, (ball, weights), rows)
     } else {
-        step_with::<S, Footprint<3>>(m5, scratch, m, (ball, weights), rows)
+        step_with::<S, 3>(m5, scratch, m, (ball, weights), rows)
     }
 }
 
-/// [`share_step`] once its layout and row sums are found, with footprints of kind `F`.
+/// [`share_step`] once its layout and row sums are found, with footprints of `N` entries an
+/// axis.
 #[inline(always)]
-fn step_with<S: Shape, F: Cover>(
+fn step_with<S: Shape, const N: usize>(
     m5: &ModeMatrix<S::Bands>,
     scratch: &mut PerValue<S, f32>,
     m: &Measurements<S::Values>,
     (ball, weights): (&Ball, Option<&PerValue<S, f32>>),
     rows: &mut RowSums<S>,
-) -> (f32, f32) {
+) -> (f32, f32)
+where
+    Footprint<N>: Cover,
+{
     let layout = &rows.layout;
     let fibres = S::Bands::chunks_mut(scratch.as_mut());
     // Each measurement's residual, in its patch entry.
@@ -595,7 +581,7 @@ fn step_with<S: Shape, F: Cover>(
     let (mut r2, mut w2) = (0.0f32, 0.0f32);
     let weighted = ball.is_weighted();
     each_measured::<S>(m, layout, |at, pixel, bits| {
-        let fp = F::of(layout, m, at, pixel);
+        let fp = Footprint::<N>::of(layout, m, at, pixel);
         let mut sum = <PerBand<S, f32>>::splat(0.0);
         fp.each(|c, w| {
             if let Some(f) = fibres.get(c) {
@@ -630,7 +616,7 @@ fn step_with<S: Shape, F: Cover>(
                 *o += z * w;
             }
         }
-        let fp = F::of(layout, m, at, pixel);
+        let fp = Footprint::<N>::of(layout, m, at, pixel);
         fp.each(|c, w| {
             if let Some(f) = fibres.get_mut(c) {
                 for (o, &x) in f.iter_mut().zip(correction.iter()) {
@@ -646,17 +632,19 @@ fn step_with<S: Shape, F: Cover>(
 /// nothing is covered): each band's coverage of each cell first (in `fibres`, clobbered),
 /// then each measurement's shares of its cells' coverage.
 #[inline(never)]
-fn row_sums<S: Shape, F: Cover>(
+fn row_sums<S: Shape, const N: usize>(
     fibres: &mut [PerBand<S, f32>],
     m: &Measurements<S::Values>,
     layout: &Layout<S>,
     inv: &mut PerValue<S, f32>,
-) {
+) where
+    Footprint<N>: Cover,
+{
     for f in fibres.iter_mut() {
         *f = <PerBand<S, f32>>::splat(0.0);
     }
     each_measured::<S>(m, layout, |at, pixel, bits| {
-        let fp = F::of(layout, m, at, pixel);
+        let fp = Footprint::<N>::of(layout, m, at, pixel);
         fp.each(|c, w| {
             if let Some(f) = fibres.get_mut(c) {
                 for b in bands(bits) {
@@ -668,7 +656,7 @@ fn row_sums<S: Shape, F: Cover>(
         });
     });
     each_measured::<S>(m, layout, |at, pixel, bits| {
-        let fp = F::of(layout, m, at, pixel);
+        let fp = Footprint::<N>::of(layout, m, at, pixel);
         for b in bands(bits) {
             let row = fp.band_sum::<S::Bands>(fibres, b);
             if let Some(x) = inv.get_mut(pixel * S::B + b) {
@@ -687,22 +675,25 @@ pub fn to_sensor<S: Shape>(m: &Measurements<S::Values>, patch: &mut PerValue<S, 
     let layout = Layout::<S>::new(shares, m.half);
     scratch.copy_from_slice(patch.as_ref());
     if layout.any_half {
-        predict::<S, Footprint<6>>(m, &layout, patch, scratch);
+        predict::<S, 6>(m, &layout, patch, scratch);
     } else {
-        predict::<S, Footprint<3>>(m, &layout, patch, scratch);
+        predict::<S, 3>(m, &layout, patch, scratch);
     }
 }
 
-/// [`to_sensor`]'s measured entries from the patch's copy `cells`, footprints of kind `F`.
-fn predict<S: Shape, F: Cover>(
+/// [`to_sensor`]'s measured entries from the patch's copy `cells`, footprints of `N`
+/// entries an axis.
+fn predict<S: Shape, const N: usize>(
     m: &Measurements<S::Values>,
     layout: &Layout<S>,
     patch: &mut PerValue<S, f32>,
     cells: &PerValue<S, f32>,
-) {
+) where
+    Footprint<N>: Cover,
+{
     let cells = S::Bands::chunks(cells.as_ref());
     each_measured::<S>(m, layout, |at, pixel, bits| {
-        let fp = F::of(layout, m, at, pixel);
+        let fp = Footprint::<N>::of(layout, m, at, pixel);
         for b in bands(bits) {
             let x = fp.band_sum::<S::Bands>(cells, b);
             if let Some(y) = patch.get_mut(pixel * S::B + b) {
