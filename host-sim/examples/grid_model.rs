@@ -39,7 +39,12 @@
 //! `--decoder-model` last, a second table: the pixels the decoder reads (the one under
 //! each cell's centre) modelled as the decoder models them (`solver/shares.rs`: a separable
 //! box, the turn left out, a share outside the patch given to the pixel's own cell), and
-//! the same pixels by their exact footprints, each by the row-sum step and exactly. `scripts/grid-bound.sh` runs it over
+//! the same pixels by their exact footprints, each by the row-sum step and exactly. With
+//! `--noise`, the captures carry the sensor noise of the decode tables (`scripts/scene-tables.sh`:
+//! shot noise of a 20,000-electron well, 2 DN of read noise on a 12-bit range, scaled to the
+//! 16-bit frames) and only the oracles are found: what the light loses behind the grid when
+//! the measurements are noisy (office, k = 3, 0.3 degrees / 5.04 px: aligned 37.42, exact
+//! 35.66 dB, -1.76 against -1.33 noiseless; 3.4 minutes a grid on 2 cores). `scripts/grid-bound.sh` runs it over
 //! scenes and writes `docs/results-grid-bound.md`.
 
 use anyhow::{Context, Result, ensure};
@@ -253,8 +258,11 @@ fn main() -> Result<()> {
     let k: u8 = args[1].parse().context("SNAPSHOTS: 1 to 13")?;
     // `--decoder-model` after the grids: a second table, the decoder's own model of the
     // grid against the exact footprints on the same pixels.
-    let decoder_model = args.last().is_some_and(|a| a == "--decoder-model");
-    let grids: Vec<&String> = args[2..].iter().filter(|a| *a != "--decoder-model").collect();
+    let decoder_model = args.iter().any(|a| a == "--decoder-model");
+    // `--noise`: the decoder tables' sensor noise (shot noise of a 20,000-electron well,
+    // read noise of 2 DN of a 12-bit range 90 % full), the oracle alone.
+    let noise = args.iter().any(|a| a == "--noise");
+    let grids: Vec<&String> = args[2..].iter().filter(|a| !a.starts_with("--")).collect();
     let size = 30;
     let (lf, name): (LightField, String) = if args[0].ends_with(".npy") {
         // A light field's file (an HCI crop): its middle 30 x 30 lenslets.
@@ -271,7 +279,14 @@ fn main() -> Result<()> {
     };
     let peak = f64::from(lf.max());
     let camera = |grid: Option<GridSettings>| {
-        let mut cam = CameraConfig::pixel(5, k).noiseless();
+        let mut cam = CameraConfig::pixel(5, k);
+        if noise {
+            // The same noise relative to white on the 16-bit range below.
+            let range = ((1u32 << cam.bits) - 1) as f32 - f32::from(cam.black_level);
+            cam.read_noise *= 65535.0 / (range * cam.white_fraction);
+        } else {
+            cam = cam.noiseless();
+        }
         (cam.bits, cam.black_level, cam.white_fraction) = (16, 0, 1.0);
         cam.sensor = SensorDescription::IDEAL;
         cam.grid = grid;
@@ -332,14 +347,22 @@ fn main() -> Result<()> {
             Measured { rows, y }
         },
         true,
-        &[Projection::Exact],
+        if noise { &[] } else { &[Projection::Exact] },
     );
-    println!(
-        "| scene | k | grid (deg:px) | aligned SL0 | aligned oracle | nearest SL0 | exact model, SL0 by: \
+    if noise {
+        println!(
+            "| scene | k | grid (deg:px) | aligned oracle | exact model, oracle | exact - aligned, oracle (the light) |"
+        );
+        println!("| --- | --- | --- | --- | --- | --- |");
+    }
+    if !noise {
+        println!(
+            "| scene | k | grid (deg:px) | aligned SL0 | aligned oracle | nearest SL0 | exact model, SL0 by: \
          row-sum step | CG 4 | exact projection | exact model, oracle | nearest - aligned, SL0 | \
          row-sum - aligned | CG 4 - aligned | exact - aligned, SL0 | exact - aligned, oracle (the light) |"
-    );
-    println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
+        );
+        println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
+    }
     let mut model_rows = Vec::new();
     for g in &grids {
         let (rot, pitch) = g.split_once(':').context("ROTATION:PITCH")?;
@@ -366,7 +389,7 @@ fn main() -> Result<()> {
                 Measured { rows, y }
             },
             false,
-            &[Projection::Exact],
+            if noise { &[] } else { &[Projection::Exact] },
         );
         // Exact: every pixel whose square lies in the patch's cells, by its shares.
         let exact = score(
@@ -389,8 +412,13 @@ fn main() -> Result<()> {
                 Measured { rows, y }
             },
             true,
-            &[Projection::RowSum, Projection::Cg(4), Projection::Exact],
+            if noise { &[] } else { &[Projection::RowSum, Projection::Cg(4), Projection::Exact] },
         );
+        if noise {
+            let (a_or, e_or) = (db(a[0], n, peak), db(exact[0], n, peak));
+            println!("| {name} | {k} | {rot}:{pitch} | {a_or:.2} | {e_or:.2} | {:+.2} |", e_or - a_or);
+            continue;
+        }
         if decoder_model {
             // The pixels the decoder reads: the one under each view cell's centre.
             let nearest = |(s0, t0): (usize, usize), row: &mut dyn FnMut(usize, usize, (usize, usize), usize)| {

@@ -389,12 +389,12 @@ impl DecodeOptions {
     /// disparities only behind a lenslet grid. There a patch at a half-pixel disparity reads
     /// the grid by the view cells' shares, a half view's cell the mean of two grid positions
     /// ([`slf_firmware::shares`]): on a plane at half a pixel it beats whole disparities by
-    /// 7 dB (`tests/grid.rs`), but on the realistic scenes at pixel k = 1 the halves lost to
-    /// whole disparities on 6 of 8 decodes, by up to 0.45 dB, and won up to 0.24 (outdoor,
-    /// tungsten, office and led at 64 x 64 lenslets behind grids turned 0.3 degrees at 5.04
-    /// px and 1 degree at 5.1 px, `docs/results-grid-halves.md`); the shear trial kept them
-    /// on every one. Read at the cells' centres, as before the shares, they lost 0.35 to 2.1 dB
-    /// more.
+    /// 7 dB (`tests/grid.rs`), but at pixel k = 1 the halves were ahead of whole disparities
+    /// by more than 0.1 dB on 3 of 14 decodes (median -0.10 dB, worst -0.45, best +0.24:
+    /// the realistic scenes at 64 x 64 lenslets and the HCI crops, behind grids turned 0.3
+    /// degrees at 5.04 px and 1 degree at 5.1 px, `docs/results-grid-halves.md`); the shear
+    /// trial kept them on every one. Read at the cells' centres, as before the shares, they
+    /// were 0.35 to 2.37 dB lower still.
     pub fn disparities_for(&self, capture: &Capture) -> DisparityRange {
         let d = &capture.description;
         let snapshots = u8::try_from(d.frames.len()).unwrap_or(u8::MAX);
