@@ -69,17 +69,20 @@ fn taps(
     shares: &CellShares,
     half: HalfViews,
 ) -> Vec<(usize, f64)> {
+    // A share outside the patch: taken out of the measurement (known outside), or given to
+    // the pixel's own cell.
+    let own = if shares.known_outside { 0.0 } else { 1.0 };
     let p = (s as i64 + i64::from(shares.shift.0[u])) * PU as i64 + u as i64;
     let q = (t as i64 + i64::from(shares.shift.1[v])) * PV as i64 + v as i64;
     let mut rows = box_1d(p as f64 + 0.5 + place.0, p, f64::from(shares.width.0));
     let mut cols = box_1d(q as f64 + 0.5 + place.1, q, f64::from(shares.width.1));
     for (k, d) in [(0usize, -1i64), (2, 1)] {
         if cell(p + d, PU, PS, &shares.shift.0, half.rows).is_none() {
-            rows[1] += rows[k];
+            rows[1] += own * rows[k];
             rows[k] = 0.0;
         }
         if cell(q + d, PV, PT, &shares.shift.1, half.cols).is_none() {
-            cols[1] += cols[k];
+            cols[1] += own * cols[k];
             cols[k] = 0.0;
         }
     }
@@ -195,6 +198,9 @@ fn the_projection_matches_the_dense_definition() {
         // One measurement a band: none shares a cell with another, the step is the exact
         // projection.
         (4, shares_of((3.0 / 3.04, 3.0 / 3.04), [0; 3], [0; 3]), 1),
+        // Sheared, the shares outside the patch taken out of the measurements (known
+        // outside): no part of the model.
+        (5, CellShares { known_outside: true, ..shares_of((3.0 / 2.9, 3.0 / 3.1), [1, 0, -1], [-1, 0, 1]) }, 20),
     ] {
         let (m, rows, y) = measure(&shares, per_band, 10 + case, None);
         assert_eq!(m.count(), rows.len());
@@ -382,6 +388,34 @@ fn the_share_outside_the_patch_is_the_definitions() {
             let want = 1.0 - ir * ic;
             let got = f64::from(reach.outside((s, t, u, v), (place.0 as f32, place.1 as f32)));
             assert!((got - want).abs() < 1e-5, "{shares:?} pixel {:?} at {place:?}: {got} vs {want}", (s, t, u, v));
+            // Each cell outside, by its share of the square: the definition's box over the
+            // cells around the pixel's own, those not found in the patch.
+            let (br, bc) = (
+                box_1d(p as f64 + 0.5 + place.0, p, f64::from(width.0)),
+                box_1d(q as f64 + 0.5 + place.1, q, f64::from(width.1)),
+            );
+            let mut cells = Vec::new();
+            reach.outside_cells((s, t, u, v), (place.0 as f32, place.1 as f32), |d, w| cells.push((d, f64::from(w))));
+            let mut expected = Vec::new();
+            for (i, dr) in (-1i64..=1).enumerate() {
+                for (j, dc) in (-1i64..=1).enumerate() {
+                    let out = find(p + dr, PU, PS, &shares.shift.0).is_none()
+                        || find(q + dc, PV, PT, &shares.shift.1).is_none();
+                    if out && br[i] * bc[j] > 0.0 {
+                        expected.push(((dr as isize, dc as isize), br[i] * bc[j]));
+                    }
+                }
+            }
+            assert_eq!(cells.len(), expected.len(), "{shares:?} pixel {:?}: {cells:?} vs {expected:?}", (s, t, u, v));
+            for ((d, w), (e, x)) in cells.iter().zip(&expected) {
+                assert!(
+                    d == e && (w - x).abs() < 1e-5,
+                    "{shares:?} pixel {:?}: {cells:?} vs {expected:?}",
+                    (s, t, u, v)
+                );
+            }
+            let total: f64 = cells.iter().map(|(_, w)| w).sum();
+            assert!((total - got).abs() < 1e-5, "{shares:?}: the cells outside sum to {total}, the reach {got}");
             further |= got > f64::from(unsheared.outside((s, t, u, v), (place.0 as f32, place.1 as f32))) + 1e-3;
         }
         let sheared = rows != [0; 3] || cols != [0; 3];

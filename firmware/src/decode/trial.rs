@@ -13,7 +13,7 @@
 
 use core::ops::AddAssign;
 
-use crate::decode::tile::{PatchOrigin, SHEAR_MARGIN, TileDecoder, TileSource};
+use crate::decode::tile::{NoSeed, PatchOrigin, SHEAR_MARGIN, TileDecoder, TileSource};
 use crate::operators::shape::Shape;
 use crate::sensor::mask::MaskFamily;
 use crate::solver::choice::PatchModel;
@@ -235,9 +235,11 @@ impl<S: Shape> TileDecoder<'_, S> {
         if bands_measured::<S>(ws.measurements()) < u32::from(self.config().sl0.min_bands) {
             return Ok(none);
         }
-        let (a, solves_a) = self.estimate_error(first, &HoldOut::DEFAULT, origin, source, ws, true)?;
+        let (a, solves_a) =
+            self.estimate_error::<_, _, NoSeed>(first, &HoldOut::DEFAULT, (origin, None), source, ws, true)?;
         // The estimate read the patch again: the same held-out measurements for the second.
-        let (z, solves_z) = self.estimate_error(second, &HoldOut::DEFAULT, origin, source, ws, true)?;
+        let (z, solves_z) =
+            self.estimate_error::<_, _, NoSeed>(second, &HoldOut::DEFAULT, (origin, None), source, ws, true)?;
         let errors = match (a, z) {
             (Some(a), Some(z)) => PairedErrors::one(a * a, z * z),
             _ => PairedErrors::default(),

@@ -218,6 +218,9 @@ struct Layout<S: Shape> {
     halves: ([[bool; 3]; MAX_AXIS], [[bool; 3]; MAX_AXIS]),
     any_half: bool,
     gone: ([bool; MAX_AXIS], [bool; MAX_AXIS]),
+    /// Whether a share outside the patch is known (taken out of the measurement) rather
+    /// than given to the pixel's own cell ([`CellShares::known_outside`]).
+    known: bool,
     /// One over a pixel's side in cells, rows and columns; the side over 2.
     inv: (f32, f32),
     half: (f32, f32),
@@ -245,6 +248,7 @@ impl<S: Shape> Layout<S> {
             halves: ([[false; 3]; MAX_AXIS], [[false; 3]; MAX_AXIS]),
             any_half: false,
             gone: ([false; MAX_AXIS], [false; MAX_AXIS]),
+            known: false,
             inv: (1.0, 1.0),
             half: (0.5, 0.5),
             over: ([[0.0; 2]; PLACES], [[0.0; 2]; PLACES]),
@@ -272,6 +276,7 @@ impl<S: Shape> Layout<S> {
         }
         let part = |x: Option<usize>| x.and_then(|x| u16::try_from(x).ok()).unwrap_or(OUTSIDE);
         self.any_half = !halves.is_none();
+        self.known = shares.known_outside;
         // A cell of a half view needs the grid position after its own too.
         let whole = |(s, u): (usize, usize), len: usize, is_half: &dyn Fn(usize) -> bool| !is_half(u) || s + 1 < len;
         let row_half = |u: usize| halves.row(u);
@@ -342,7 +347,7 @@ impl<S: Shape> Layout<S> {
             None => (OUTSIDE, OUTSIDE),
         };
         let col_parts = [before, (t * S::PU * S::PV + v) as u16, after];
-        (axis(over(&self.over.0, pr), row_parts), axis(over(&self.over.1, pc), col_parts))
+        (axis(over(&self.over.0, pr), row_parts, self.known), axis(over(&self.over.1, pc), col_parts, self.known))
     }
 }
 
@@ -395,6 +400,35 @@ impl<S: Shape> Reach<S> {
     }
 }
 
+impl<S: Shape> Reach<S> {
+    /// `f((dr, dc), share)` for each cell outside the patch that patch pixel `(s, t, u, v)`'s
+    /// square covers (its centre `place` cells off its cell's), `(dr, dc)` the cell's offset
+    /// on the sensor from the pixel's own (each -1, 0 or 1), `share` the part of the square
+    /// over it: what [`CellShares::known_outside`] takes out of the measurement.
+    pub fn outside_cells(
+        &self,
+        (s, t, u, v): (usize, usize, usize, usize),
+        place: (f32, f32),
+        mut f: impl FnMut((isize, isize), f32),
+    ) {
+        let l = &self.0;
+        let axis = |delta: f32, half: f32, inv: f32, nb: Option<&[u16; 2]>| {
+            let [b, a] = nb.copied().unwrap_or([OUTSIDE, OUTSIDE]);
+            let (before, after) = overhang(delta, half, inv);
+            [(before, b == OUTSIDE), (1.0 - before - after, false), (after, a == OUTSIDE)]
+        };
+        let r = axis(place.0, l.half.0, l.inv.0, l.rows.get(s * S::PU + u));
+        let c = axis(place.1, l.half.1, l.inv.1, l.cols.get(t * S::PV + v));
+        for (dr, &(wr, outr)) in (-1isize..=1).zip(&r) {
+            for (dc, &(wc, outc)) in (-1isize..=1).zip(&c) {
+                if (outr || outc) && wr * wc > 0.0 {
+                    f((dr, dc), wr * wc);
+                }
+            }
+        }
+    }
+}
+
 /// Grid position and view of sensor cell `p` along an axis of `views` views and `len`
 /// lenslets with per-view shifts `shift`; `None` outside the patch.
 #[inline(always)]
@@ -411,14 +445,14 @@ fn along(p: isize, views: usize, len: usize, shift: &[i8; MAX_SHARE_VIEWS]) -> O
 /// [`OUTSIDE`] beyond the patch: that share goes to its own cell). A box against unit
 /// cells: `half <= 1` and `|delta| <= 1/2`, so it reaches no further.
 #[inline(always)]
-fn axis([mut before, mut after]: [f32; 2], parts: [u16; 3]) -> AxisCells {
+fn axis([mut before, mut after]: [f32; 2], parts: [u16; 3], known: bool) -> AxisCells {
     let mut own = 1.0 - before - after;
     if parts[0] == OUTSIDE {
-        own += before;
+        own += if known { 0.0 } else { before };
         before = 0.0;
     }
     if parts[2] == OUTSIDE {
-        own += after;
+        own += if known { 0.0 } else { after };
         after = 0.0;
     }
     (parts, [before, own, after])

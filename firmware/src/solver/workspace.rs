@@ -77,12 +77,17 @@ pub struct CellShares {
     /// position `s` is sensor lenslet row `origin + s + rows[u]`. A pixel's neighbouring
     /// cells on the sensor are found through it.
     pub shift: ([i8; MAX_SHARE_VIEWS], [i8; MAX_SHARE_VIEWS]),
+    /// Whether the shares of cells outside the patch are already taken out of the
+    /// measurements (each value less those cells' estimates by their shares, read from a
+    /// decode of the frame): then they are no part of the model. Otherwise each such share
+    /// is given to the pixel's own cell.
+    pub known_outside: bool,
 }
 
 impl CellShares {
     /// An unsheared patch's shares for pixels `width` cells wide.
     pub const fn unsheared(width: (f32, f32)) -> Self {
-        Self { width, shift: ([0; MAX_SHARE_VIEWS], [0; MAX_SHARE_VIEWS]) }
+        Self { width, shift: ([0; MAX_SHARE_VIEWS], [0; MAX_SHARE_VIEWS]), known_outside: false }
     }
 }
 

@@ -353,6 +353,10 @@ impl<S: Shape> PatchSeed<S> for SeedPatches<'_, S> {
     fn seed(&mut self, o: PatchOrigin, patch: &mut PerValue<S, f32>) -> bool {
         self.seeds.patch::<S>(o, patch.as_mut(), self.lenslets)
     }
+
+    fn cell(&mut self, (y, x): (usize, usize), (u, v): (usize, usize), band: usize) -> Option<f32> {
+        self.seeds.spectrum(u, v, y, x)?.get(band).copied().filter(|x| x.is_finite())
+    }
 }
 
 /// A [`PatchSink`] adding each patch straight into a [`Strip`]'s rows.

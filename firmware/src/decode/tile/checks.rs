@@ -60,7 +60,8 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
         for (d, error) in &mut out {
             let origin = PatchOrigin { lenslet_row: row, lenslet_col: col, view_row, view_col, disparity: *d };
             self.read_patch(origin, source, ws)?;
-            let (e, n) = self.estimate_error(model, &HoldOut::DEFAULT, origin, source, ws, false)?;
+            let (e, n) =
+                self.estimate_error::<_, _, NoSeed>(model, &HoldOut::DEFAULT, (origin, None), source, ws, false)?;
             (*error, solves) = (e, solves + u32::from(n));
         }
         Ok((out, solves))

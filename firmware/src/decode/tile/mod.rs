@@ -427,17 +427,18 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
     /// The error estimate of the patch at `origin`, whose measurements are in `ws`
     /// ([`Self::with_error_estimate`]; `full`: from the model's whole decode, not its
     /// cheapest solve), and the solves it took; the measurements are read
-    /// again from `source` after the estimating solve, and `ws.patch()` is clobbered.
+    /// again from `source` after the estimating solve (with `seed`'s cells outside the patch,
+    /// as [`Self::read_patch_seeded`]), and `ws.patch()` is clobbered.
     /// Out of line: its frame is not on the decode's stack when the estimate is off.
     ///
     /// # Errors
     /// The source's error.
     #[inline(never)]
-    pub(super) fn estimate_error<M: PatchModel<S>, Src: TileSource>(
+    pub(super) fn estimate_error<M: PatchModel<S>, Src: TileSource, Q: PatchSeed<S> + ?Sized>(
         &self,
         model: &M,
         hold: &HoldOut,
-        origin: PatchOrigin,
+        (origin, seed): (PatchOrigin, Option<&mut Q>),
         source: &mut Src,
         ws: &mut Workspace<S>,
         full: bool,
@@ -451,7 +452,7 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
         } else {
             model.estimating_solve(&self.config.sl0, ws)
         };
-        self.read_patch(origin, source, ws)?;
+        self.read_patch_seeded(origin, source, ws, seed)?;
         let Ok(solves) = solved else { return Ok((None, 0)) };
         let half = ws.measurements().half_views();
         if !half.is_none() && ws.measurements().shares().is_none() {
@@ -662,13 +663,17 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
         report: &mut TileReport,
     ) -> Result<(), TileError<Src::Error, K::Error>> {
         let (lo, hi) = self.config.raw.range();
-        let (flags, excluded) = self.read_patch(origin, source, ws).map_err(TileError::Source)?;
+        // Whether the frame's decode holds this patch (its shifted patches' seeds): then its
+        // cells outside the patch are read from it too.
+        let seeded = self.grid.is_some() && seed.seed(origin, &mut ws.signal);
+        let (flags, excluded) =
+            self.read_patch_seeded(origin, source, ws, seeded.then_some(&mut *seed)).map_err(TileError::Source)?;
         let cfg = &self.config.sl0;
         let bands = bands_measured::<S>(ws.measurements());
         let (error, estimating) = match &self.holdout {
-            Some(hold) if bands >= u32::from(cfg.min_bands) => {
-                self.estimate_error(model, hold, origin, source, ws, false).map_err(TileError::Source)?
-            }
+            Some(hold) if bands >= u32::from(cfg.min_bands) => self
+                .estimate_error(model, hold, (origin, seeded.then_some(&mut *seed)), source, ws, false)
+                .map_err(TileError::Source)?,
             _ => (None, 0),
         };
         // No band at all is no measurement: the model reports it.

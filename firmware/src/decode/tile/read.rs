@@ -94,6 +94,24 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
         source: &mut Src,
         ws: &mut Workspace<S>,
     ) -> Result<(PatchFlags, u16), Src::Error> {
+        self.read_patch_seeded::<Src, super::NoSeed>(origin, source, ws, None)
+    }
+
+    /// [`Self::read_patch`] with a decode of the frame to read cells outside the patch from:
+    /// behind a lenslet grid, a sheared patch's pixel's shares of cells outside it are taken
+    /// out of its measurement by `seed`'s estimates of them
+    /// ([`CellShares::known_outside`]); a pixel with such a cell `seed` has no estimate of
+    /// is left out.
+    ///
+    /// # Errors
+    /// The source's error.
+    pub fn read_patch_seeded<Src: TileSource, Q: PatchSeed<S> + ?Sized>(
+        &self,
+        origin: PatchOrigin,
+        source: &mut Src,
+        ws: &mut Workspace<S>,
+        mut seed: Option<&mut Q>,
+    ) -> Result<(PatchFlags, u16), Src::Error> {
         let c = &self.config;
         let (lu, lv) = (c.sensor.lenslet.rows as usize, c.sensor.lenslet.cols as usize);
         let k = c.mask.snapshots();
@@ -111,15 +129,24 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
         // Behind a lenslet grid each pixel is the shares of the cells it covers (a half view's
         // cell the mean of two grid positions); with a response that mixes bands, the cell
         // under its centre.
-        let shares = self.cell_shares(origin);
+        let mut shares = self.cell_shares(origin);
+        let full = S::PU == lu && S::PV == lv;
+        let known = seed.is_some() && full && origin.disparity != Disparity::ZERO;
+        if let Some(c) = shares.as_mut() {
+            c.known_outside = known;
+        }
         if m.set_shares(shares).is_err() {
             let _ = m.set_shares(None);
         }
         let shared = m.shares().is_some();
         // A sheared patch's pixels that lie largely outside it are left out at k >= 2
         // (`MAX_OUTSIDE_SHARE`).
-        let reach =
-            m.shares().filter(|_| origin.disparity != Disparity::ZERO && k >= 2).map(|c| Reach::<S>::new(c, half));
+        let known = known && m.shares().is_some_and(|c| c.known_outside);
+        let reach = m
+            .shares()
+            .filter(|_| origin.disparity != Disparity::ZERO && (k >= 2 || known))
+            .map(|c| Reach::<S>::new(c, half));
+        let lenslets = (c.sensor.lenslets.0 as isize, c.sensor.lenslets.1 as isize);
         for s in 0..S::PS {
             for u in 0..S::PU {
                 for t in 0..S::PT {
@@ -148,19 +175,61 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
                             let Some(lenslet) = origin.lenslet::<S>(s, t, u, v, (lu, lv)) else { continue };
                             let Some((row, col)) = self.sensor_pixel(lenslet, vr, vc) else { continue };
                             let at = S::pixel_index(s, t, u, v);
+                            // Each snapshot's band's estimate of the cells outside the patch,
+                            // by their shares (known outside).
+                            let mut outside = [0.0f32; crate::sensor::mask::MAX_BANDS];
                             if shared {
                                 // The pixel's place in its cell; a pixel whose centre lies
                                 // in another cell is that cell's measurement, not this one's.
                                 let Some(place) = self.place_in_cell(lenslet, (vr, vc), (row, col)) else { continue };
-                                if reach.as_ref().is_some_and(|r| r.outside((s, t, u, v), place) > MAX_OUTSIDE_SHARE) {
+                                if !known
+                                    && reach
+                                        .as_ref()
+                                        .is_some_and(|r| r.outside((s, t, u, v), place) > MAX_OUTSIDE_SHARE)
+                                {
                                     continue;
                                 }
                                 let _ = m.set_place(at / S::B, place);
+                                if let (true, Some(r), Some(sd)) = (known, reach.as_ref(), seed.as_deref_mut()) {
+                                    let bands = c.mask.bands_at(row, col);
+                                    let (lui, lvi) = (lu as isize, lv as isize);
+                                    let (pr, pc) = (lenslet.0 * lui + vr as isize, lenslet.1 * lvi + vc as isize);
+                                    let mut whole = true;
+                                    r.outside_cells((s, t, u, v), place, |(dr, dc), w| {
+                                        let (qr, qc) = (pr + dr, pc + dc);
+                                        let l = (qr.div_euclid(lui), qc.div_euclid(lvi));
+                                        let view = (qr.rem_euclid(lui) as usize, qc.rem_euclid(lvi) as usize);
+                                        let inside = (0..lenslets.0).contains(&l.0) && (0..lenslets.1).contains(&l.1);
+                                        for (o, &b) in outside.iter_mut().zip(bands.iter()) {
+                                            let b = usize::from(b);
+                                            let est = if inside {
+                                                sd.cell((l.0 as usize, l.1 as usize), view, b)
+                                            } else {
+                                                None
+                                            };
+                                            match est {
+                                                Some(x) => *o += w * x / self.gains.get(b).copied().unwrap_or(1.0),
+                                                None => whole = false,
+                                            }
+                                        }
+                                    });
+                                    if !whole {
+                                        continue;
+                                    }
+                                }
                             }
                             for (j, r) in run.iter_mut().enumerate().take(k) {
                                 source.read(j, row, col, &mut r.as_mut()[..1])?;
                             }
                             self.put_pixel(m, at, row, col, |j| run.get(j).map(|r| r[0]), &mut flags, &mut excluded);
+                            if known {
+                                for (&b, &o) in c.mask.bands_at(row, col).iter().zip(outside.iter()) {
+                                    let e = at + usize::from(b);
+                                    if let Some(y) = m.get(e) {
+                                        let _ = m.set(e, y - o);
+                                    }
+                                }
+                            }
                         }
                     }
                 }

@@ -45,6 +45,15 @@ pub trait PatchSeed<S: Shape> {
     /// there is none. A patch without an estimate, or with a NaN or an infinity in it, is
     /// decoded from nothing.
     fn seed(&mut self, origin: PatchOrigin, patch: &mut PerValue<S, f32>) -> bool;
+
+    /// The estimate of band `band` of view `view` (of the lenslet's views) of sensor lenslet
+    /// `lenslet`, in the units of [`Self::seed`]; `None` where there is none (the default).
+    /// Behind a lenslet grid the read takes a pixel's share of a cell outside its patch out
+    /// of its measurement by it ([`crate::solver::workspace::CellShares::known_outside`]).
+    fn cell(&mut self, lenslet: (usize, usize), view: (usize, usize), band: usize) -> Option<f32> {
+        let _ = (lenslet, view, band);
+        None
+    }
 }
 
 /// No estimate anywhere: every patch decodes from nothing.
