@@ -197,8 +197,12 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
                                     let mut whole = true;
                                     r.outside_cells((s, t, u, v), place, |(dr, dc), w| {
                                         let (qr, qc) = (pr + dr, pc + dc);
-                                        let l = (qr.div_euclid(lui), qc.div_euclid(lvi));
-                                        let view = (qr.rem_euclid(lui) as usize, qc.rem_euclid(lvi) as usize);
+                                        let cell = qr
+                                            .checked_div_euclid(lui)
+                                            .zip(qc.checked_div_euclid(lvi))
+                                            .zip(qr.checked_rem_euclid(lui).zip(qc.checked_rem_euclid(lvi)));
+                                        let (l, view) = cell.unwrap_or(((-1, -1), (0, 0)));
+                                        let view = (view.0 as usize, view.1 as usize);
                                         let inside = (0..lenslets.0).contains(&l.0) && (0..lenslets.1).contains(&l.1);
                                         for (o, &b) in outside.iter_mut().zip(bands.iter()) {
                                             let b = usize::from(b);
