@@ -33,7 +33,12 @@
 //! elsewhere in the patch. A share of a cell outside the patch is given to the pixel's own
 //! cell (the light field taken as constant across that border): at the patch's edges
 //! unsheared, at micro-image borders too when sheared; there a pixel largely outside the
-//! patch is left out of its measurements ([`MAX_OUTSIDE_SHARE`]).
+//! patch is left out of its measurements ([`MAX_OUTSIDE_SHARE`]). Where a decode of the
+//! frame holds those cells (a sheared patch of the host's second pass, seeded by the
+//! first), the read takes their shares out of the measurement by its estimates instead
+//! ([`CellShares::known_outside`]): in a patch sheared by a whole lenslet the two outer
+//! views' neighbours across every micro-image border lie outside it, and the own-cell rule
+//! there cost those views up to 2.2 dB (`docs/results-grid-views.md`).
 //!
 //! A patch sheared to a half disparity has every other view half a lenslet off its grid
 //! ([`crate::solver::fractional`]): such a view's cell is the mean of two grid positions, so
