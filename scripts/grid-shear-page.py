@@ -4,17 +4,22 @@ rows.tsv files, then the BEFORE binary's name): per row the aligned sensor's, th
 the after decode's PSNR (interior) / SSIM / SA / seconds; a summary per k.
 
     python3 scripts/grid-shear-page.py OUT/rows.tsv [MORE/rows.tsv ...] BEFORE
+
+SLF_ABOUT, when set, is the sentence that says what before and after are (default: the
+change of docs/results-grid-shear.md).
 """
-import statistics, sys
+import os, statistics, sys
 
 rows = [l.rstrip("\n").split("\t") for f in sys.argv[1:-1] for l in open(f) if l.strip()]
 print(f"Before: `{sys.argv[-1]}`. Each cell: PSNR dB without")
 print("the 2 edge lenslets / SSIM / SA degrees, then the decode's seconds (one run on a shared")
-print("machine: compare within a row). *before*: a patch sheared by whole lenslets behind the grid")
-print("takes every pixel it reads as its measurement, a share of its square over a cell outside the")
-print("patch given to the pixel's own cell; *after*: at k >= 2 it leaves out the pixels more than")
-print("a quarter outside (`MAX_OUTSIDE_SHARE`, `firmware/src/solver/shares.rs`). Calibrated sensors")
-print("with 30 % vignetting, 1 % PRNU, shot and read noise, seed 1.")
+print("machine: compare within a row).")
+print(os.environ.get("SLF_ABOUT") or
+      "*before*: a patch sheared by whole lenslets behind the grid\n"
+      "takes every pixel it reads as its measurement, a share of its square over a cell outside the\n"
+      "patch given to the pixel's own cell; *after*: at k >= 2 it leaves out the pixels more than\n"
+      "a quarter outside (`MAX_OUTSIDE_SHARE`, `firmware/src/solver/shares.rs`).")
+print("Calibrated sensors with 30 % vignetting, 1 % PRNU, shot and read noise, seed 1.")
 print()
 print("| scene | k | grid (deg:px) | aligned sensor | before | after | after - before dB | after - aligned dB |")
 print("| --- | --- | --- | --- | --- | --- | --- | --- |")

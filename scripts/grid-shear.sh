@@ -15,7 +15,9 @@
 #
 # SLF_SCENES (default outdoor tungsten office led, 64 x 64 lenslets, and the HCI crops in
 # SLF_REAL when present), SLF_KS (1 3), SLF_GRIDS (0.3:5.04 1:5.1). OUT/rows.tsv keeps each row;
-# scripts/grid-shear-page.py makes the page's tables from one or more of them.
+# scripts/grid-shear-page.py makes the page's tables from one or more of them. SLF_TITLE and
+# SLF_ABOUT (what before and after are) make it another change's page with the same tables
+# (docs/results-grid-known.md: the cells outside a sheared patch from the first pass).
 set -euo pipefail
 out=${1:?usage: grid-shear.sh OUT_DIR}
 before=${SLF_BEFORE:?SLF_BEFORE: the binary to compare with}
@@ -54,5 +56,5 @@ for token in $scenes; do
   done
 done
 
-page_head "A sheared patch behind a lenslet grid" "SLF_BEFORE=... bash scripts/grid-shear.sh OUT_DIR"
+page_head "${SLF_TITLE:-A sheared patch behind a lenslet grid}" "SLF_BEFORE=... bash scripts/grid-shear.sh OUT_DIR"
 python3 scripts/grid-shear-page.py "$rows" "$before"
