@@ -647,3 +647,105 @@ fn pixels_outside_a_turned_array_are_no_part_of_the_decode() {
         "left out: not the lenslets past the sensor"
     );
 }
+
+/// The truth as a frame's first decode would give it (sensor units): a patch's values and
+/// each cell's, from the light field (a lenslet past the sensor has none).
+struct TruthSeed<'a>(&'a LightField);
+
+impl TruthSeed<'_> {
+    fn value(&self, (y, x): (isize, isize), (u, v): (usize, usize), b: usize) -> Option<f32> {
+        let l = self.0;
+        let (y, x) =
+            (usize::try_from(y).ok().filter(|&y| y < l.rows)?, usize::try_from(x).ok().filter(|&x| x < l.cols)?);
+        l.data.get((((u * l.views.1 + v) * l.rows + y) * l.cols + x) * l.bands + b).copied()
+    }
+}
+
+impl slf_firmware::PatchSeed<FullViewShape> for TruthSeed<'_> {
+    fn seed(&mut self, o: slf_firmware::PatchOrigin, patch: &mut [f32; 8125]) -> bool {
+        use slf_firmware::Shape;
+        for (s, t, u, v) in
+            (0..5).flat_map(|s| (0..5).flat_map(move |t| (0..5).flat_map(move |u| (0..5).map(move |v| (s, t, u, v)))))
+        {
+            let Some(l) = o.lenslet::<FullViewShape>(s, t, u, v, (5, 5)) else { continue };
+            for b in 0..13 {
+                let view = (o.view_row as usize + u, o.view_col as usize + v);
+                patch[FullViewShape::pixel_index(s, t, u, v) + b] = self.value(l, view, b).unwrap_or(0.0);
+            }
+        }
+        true
+    }
+
+    fn cell(&mut self, (y, x): (usize, usize), view: (usize, usize), band: usize) -> Option<f32> {
+        self.value((y as isize, x as isize), view, band)
+    }
+}
+
+/// Behind a turned grid a full-view patch with a seed takes each pixel's shares of the
+/// cells outside the patch out of its measurement by the seed (`CellShares::known_outside`),
+/// unsheared (its rim) or sheared (a whole view ring across a micro-image border). Seeded
+/// with the truth, on a noiseless capture, what is left of every measurement is the model
+/// (`shares::to_sensor`: the shares of the patch's own cells) applied to the truth, to the
+/// 16-bit frame's rounding and the turn the decoder's box leaves out; read without a seed
+/// (the share of a cell outside given to the pixel's own) the rim's measurements are off
+/// the model by far more, and a sheared patch leaves out the pixels mostly outside it.
+#[test]
+fn seeded_behind_a_grid_a_patch_takes_the_cells_outside_it_out_of_its_measurements() {
+    use slf_firmware::{Disparity, FrameSource, FullViewWorkspace, PatchOrigin, PatchSeed, Shape};
+    use slf_host::sim::scene::SceneSize;
+    let lf = slf_host::sim::realistic::named("office").unwrap().render(SceneSize { views: (5, 5), rows: 24, cols: 24 });
+    let mut cam = CameraConfig::pixel(5, 3).noiseless();
+    cam.grid = Some(GridSettings { rotation_deg: 0.3, pitch: Some([5.04, 5.04]), offset: None });
+    let cap = simulate(&lf, &cam).unwrap();
+    let dec = cap.decoder::<5, 5, 8125>(slf_firmware::Sl0Config::DEFAULT).unwrap();
+    let raw = cap.raw_frames().unwrap();
+    let gains: Vec<f32> = dec.gains().to_vec();
+    let mut ws = Box::new(FullViewWorkspace::new());
+    // The largest gap between a measurement and the model applied to the truth, over the
+    // brightest measurement, with the read seeded by the truth or not.
+    let mut gap = |o: PatchOrigin, seeded: bool| {
+        let mut src = FrameSource::new(&raw);
+        let mut truth = TruthSeed(&lf);
+        dec.read_patch_seeded(o, &mut src, &mut ws, seeded.then_some(&mut truth)).unwrap();
+        let m = ws.measurements();
+        assert_eq!(m.shares().map(|c| c.known_outside), Some(seeded), "{o:?}");
+        let mut patch = Box::new([0.0f32; 8125]);
+        TruthSeed(&lf).seed(o, &mut patch);
+        for (i, x) in patch.iter_mut().enumerate() {
+            *x /= gains[i % 13];
+        }
+        let mut scratch = Box::new([0.0f32; 8125]);
+        slf_firmware::shares::to_sensor::<FullViewShape>(m, &mut patch, &mut scratch);
+        let (mut worst, mut peak, mut count) = (0.0f32, 0.0f32, 0);
+        for e in 0..FullViewShape::N {
+            if let Some(y) = m.get(e) {
+                worst = worst.max((y - patch[e]).abs());
+                peak = peak.max(y.abs());
+                count += 1;
+            }
+        }
+        assert!(count > 800, "{o:?}: {count} measurements");
+        (worst / peak, count)
+    };
+    for (row, col, d) in [(5u16, 5u16, 0i8), (10, 5, 0), (5, 10, -1), (10, 10, 1)] {
+        let o = PatchOrigin {
+            lenslet_row: row,
+            lenslet_col: col,
+            view_row: 0,
+            view_col: 0,
+            disparity: Disparity::pixels(d),
+        };
+        let ((known, kept), (own, own_kept)) = (gap(o, true), gap(o, false));
+        eprintln!("{o:?}: seeded {known:.2e} ({kept} measurements), own cell {own:.2e} ({own_kept})");
+        assert!(known < 5e-3, "{o:?}: seeded, a measurement {known:.2e} of the brightest off the model");
+        if d == 0 {
+            // Every pixel read either way: the rim's shares outside are the gap.
+            assert_eq!(kept, own_kept, "{o:?}");
+            assert!(own > 20.0 * known, "{o:?}: own-cell rule {own:.2e}, seeded {known:.2e}");
+        } else {
+            // Unseeded, a sheared patch leaves out the pixels mostly outside it
+            // (`MAX_OUTSIDE_SHARE`); seeded, it keeps them.
+            assert!(kept > own_kept, "{o:?}: {kept} measurements seeded, {own_kept} not");
+        }
+    }
+}

@@ -34,8 +34,8 @@
 //! cell (the light field taken as constant across that border): at the patch's edges
 //! unsheared, at micro-image borders too when sheared; there a pixel largely outside the
 //! patch is left out of its measurements ([`MAX_OUTSIDE_SHARE`]). Where a decode of the
-//! frame holds those cells (a sheared patch of the host's second pass, seeded by the
-//! first), the read takes their shares out of the measurement by its estimates instead
+//! frame holds those cells (a full-view patch of the overlapped decode's shifted grids,
+//! seeded by the disjoint grid's decode, sheared or not), the read takes their shares out of the measurement by its estimates instead
 //! ([`CellShares::known_outside`]): in a patch sheared by a whole lenslet the two outer
 //! views' neighbours across every micro-image border lie outside it, and the own-cell rule
 //! there cost those views up to 2.2 dB (`docs/results-grid-views.md`).

@@ -670,12 +670,18 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
             self.read_patch_seeded(origin, source, ws, seeded.then_some(&mut *seed)).map_err(TileError::Source)?;
         let cfg = &self.config.sl0;
         let bands = bands_measured::<S>(ws.measurements());
-        let (error, estimating) = match &self.holdout {
-            Some(hold) if bands >= u32::from(cfg.min_bands) => self
-                .estimate_error(model, hold, (origin, seeded.then_some(&mut *seed)), source, ws, false)
-                .map_err(TileError::Source)?,
-            _ => (None, 0),
+        let (error, estimating, clobbered) = match &self.holdout {
+            Some(hold) if bands >= u32::from(cfg.min_bands) => {
+                let (error, solves) = self
+                    .estimate_error(model, hold, (origin, seeded.then_some(&mut *seed)), source, ws, false)
+                    .map_err(TileError::Source)?;
+                (error, solves, true)
+            }
+            _ => (None, 0, false),
         };
+        // Behind a grid the probe's seed is still in the patch unless the estimate's solve
+        // clobbered it: it is read once.
+        let reseed = self.grid.is_none() || clobbered;
         // No band at all is no measurement: the model reports it.
         let decoded = if bands > 0 && bands < u32::from(cfg.min_bands) {
             let Workspace { signal, measurements, .. } = ws;
@@ -683,7 +689,9 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
             // Each pixel's interpolated bands are as its filters saw them: `R x`.
             unmix_all::<S>(&self.solved_response().balanced(self.gains.as_ref()), signal);
             Ok(ModelOutcome { outcome: Outcome::interpolated(), member: None, solves: 0 })
-        } else if seed.seed(origin, &mut ws.signal) && ws.signal.iter().all(|x| x.is_finite()) {
+        } else if (if reseed { seed.seed(origin, &mut ws.signal) } else { seeded })
+            && ws.signal.iter().all(|x| x.is_finite())
+        {
             // (A seed with a NaN or an infinity is no estimate: the patch decodes from nothing.)
             let half = ws.measurements().half_views();
             if self.response_model == ResponseModel::Unmix {

@@ -98,8 +98,9 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
     }
 
     /// [`Self::read_patch`] with a decode of the frame to read cells outside the patch from:
-    /// behind a lenslet grid, a sheared patch's pixel's shares of cells outside it are taken
-    /// out of its measurement by `seed`'s estimates of them
+    /// behind a lenslet grid, a full-view patch's pixel's shares of cells outside it (an
+    /// unsheared patch's rim; a sheared one's too, and its outer views' cells across a
+    /// micro-image border) are taken out of its measurement by `seed`'s estimates of them
     /// ([`CellShares::known_outside`]); a pixel with such a cell `seed` has no estimate of
     /// is left out.
     ///
@@ -131,7 +132,7 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
         // under its centre.
         let mut shares = self.cell_shares(origin);
         let full = S::PU == lu && S::PV == lv;
-        let known = seed.is_some() && full && origin.disparity != Disparity::ZERO;
+        let known = seed.as_deref().is_some_and(|q| q.holds_cells()) && full;
         if let Some(c) = shares.as_mut() {
             c.known_outside = known;
         }
@@ -144,7 +145,7 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
         let known = known && m.shares().is_some_and(|c| c.known_outside);
         let reach = m
             .shares()
-            .filter(|_| origin.disparity != Disparity::ZERO && (k >= 2 || known))
+            .filter(|_| known || (origin.disparity != Disparity::ZERO && k >= 2))
             .map(|c| Reach::<S>::new(c, half));
         let lenslets = (c.sensor.lenslets.0 as isize, c.sensor.lenslets.1 as isize);
         for s in 0..S::PS {
