@@ -72,10 +72,14 @@ t = len(tiles)
 # the DCT's tiles, the overlapped frame, the disparity choice of one block, then each of
 # the DCT tiles' patches solved sheared to disparity 1, and to 1/2, then the real sensor's
 # tiles decoded by the ensemble uncalibrated and with the compact calibration, and
-# uncalibrated with the error estimate from held-out measurements. The model trial's pilots
+# uncalibrated with the error estimate from held-out measurements, and last the real
+# sensor's whole frame uncalibrated as the host's default decodes it. The model trial's pilots
 # (window 11, one a tile) come right after the DCT's tiles.
 patches = sum(tiles)
-assert len(wins) == 2 + 3 * t + 2 + 2 * patches + 3 * t, (len(wins), t, patches)
+assert len(wins) == 2 + 3 * t + 2 + 2 * patches + 3 * t + 1, (len(wins), t, patches)
+# The last window: the real sensor's whole frame behind its grid (window 12).
+sensor_frame, wins = wins[-1], wins[:-1]
+sensor_patches = int(re.search(r"^sensor overlap patches (\d+)", log, re.M).group(1))
 gains, wins = wins[0], wins[1:]
 # The model trial's pilots (one a tile, after the DCT's tiles): taken out, so the windows
 # after them keep their places.
@@ -115,6 +119,7 @@ print(f"| instructions per patch, ensemble, the real sensor's capture uncalibrat
 print(f"| instructions per pilot patch of the model trial (the DCT and the screened ensemble, each from 7/8 of the measurements; one pilot a tile, at most 256 a frame on the host) | {trial_pilot:,.0f} ({trial_pilot / ens:.2f}x a screened patch) | |")
 print(f"| instructions to choose one block's disparity (-1..1: 3 candidates x 625 pixels x k samples) | {choose:,} | |")
 print(f"| instructions per frame, the host's default (stride 2 tapered, seeded), disparities -1..1, the model trial's pick: {'the DCT' if trial_pick == 'dct' else 'the screened ensemble'} ({ov_patches} patch solves in {ov_bands} band; {frame_patches} with a full-width strip; disjoint: {patches}) | {frame:,} ({frame / patches:,.0f} per disjoint patch) | 3,000 M |")
+print(f"| instructions per frame behind the real sensor's grid (1 degree / 5.1 px, uncalibrated), the host's default (stride 2 tapered, seeded: each shifted patch takes its pixels' shares of the cells outside it by the seeds), the screened ensemble ({sensor_patches} patch solves) | {sensor_frame:,} ({sensor_frame / sensor_patches:,.0f} per patch solve) | |")
 # The frame figure of a camera-sized sensor: 100 x 100 lenslets, 5 x 5 views, 20 x 20
 # full-view blocks, sheared (-1..1), at 480 MHz and one instruction a cycle (a Cortex-M7
 # issues up to two), each patch solve at the screened ensemble's instructions from nothing

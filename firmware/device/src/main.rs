@@ -104,11 +104,15 @@ mod device {
     /// windows 8 (each tile as the ideal sensor's, uncalibrated) and 9 (each tile with the
     /// compact calibration: the dark level as the raw black, a flat per view, the hot
     /// pixels as defects, the response matrix unmixing each decoded spectrum), the calibrated patches printed
-    /// after a `calibrated` line for `slf device-check`. Returns the failures.
+    /// after a `calibrated` line for `slf device-check`; 10 (uncalibrated, with the error
+    /// estimate); 12 (the whole frame uncalibrated as the host's default decodes it, in
+    /// `strip`, its rows printed after a `sensor rows` line). Returns the failures.
     #[inline(never)]
     fn calibrated(
         config: &DecoderConfig<'static>,
         model: &EnsembleModel<'static, FullViewShape>,
+        frame_model: &Picked<'_, ScheduledDictionary<FullViewShape>, EnsembleModel<'static, FullViewShape>>,
+        strip: &mut [f32],
         ws: &mut FullViewWorkspace,
     ) -> u32 {
         static DEFECTS: [Pixel; SENSOR_DEFECTS.len()] = SENSOR_DEFECTS;
@@ -179,6 +183,33 @@ mod device {
                 failed += r.map_or(1, |t| t.failed);
             }
         }
+        // Window 12: the real sensor's whole frame behind the grid, uncalibrated, as the
+        // host's default decodes it (stride 2, tapered window, seeded: each shifted patch
+        // takes its pixels' shares of the cells outside it out of their measurements by the
+        // seeds), by the screened ensemble; its rows printed after a `sensor rows` line
+        // for `slf device-check`.
+        let search = DisparityRange::for_capture(config.mask.family(), SNAPSHOTS);
+        let mut rows = PrintRows { checksum: 0, rows: 0 };
+        hprintln!("sensor rows");
+        match OverlapDecoder::new(plain.with_disparities(search), Overlap::DEFAULT) {
+            Ok(overlapped) if overlapped.strip_len(STRIP_COLUMNS) <= strip.len() => {
+                bench_begin(12);
+                let r = overlapped.decode_frame(frame_model, &mut FrameSource::new(&frames), strip, &mut rows, ws);
+                bench_end(12);
+                match r {
+                    Ok(r) => {
+                        failed += r.patches.failed + r.source_failures;
+                        hprintln!("sensor overlap patches {}", r.patches.decoded);
+                    }
+                    Err(_) => failed += 1,
+                }
+            }
+            _ => {
+                hprintln!("error: the real sensor's overlapped decode does not fit the strip");
+                failed += 1;
+            }
+        }
+        hprintln!("sensor rows end {} checksum {:#010x}", rows.rows, rows.checksum);
         failed
     }
 
@@ -482,7 +513,10 @@ mod device {
             }
         }
         hprintln!("sheared dct steps whole {} half {}", steps[0], steps[1]);
-        failed += calibrated(&config, &model, ws);
+        // The real sensor's frame by the ensemble, through the same `Picked` as the frame
+        // above (one copy of the overlapped decode's code in flash).
+        let ensemble = Picked { first: picked.first, second: picked.second, pick: Pick::Second };
+        failed += calibrated(&config, &model, &ensemble, strip, ws);
         hprintln!("sheared stack peak bytes {}", crate::stack::peak());
         hprintln!("strip bytes {}", core::mem::size_of::<[f32; STRIP_LEN]>());
         hprintln!("disjoint stack peak bytes {}", disjoint_stack);

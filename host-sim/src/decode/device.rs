@@ -269,6 +269,8 @@ struct DevicePatch {
 struct DeviceLog {
     patches: HashMap<PatchOrigin, DevicePatch>,
     rows: HashMap<(usize, usize), Vec<f32>>,
+    /// The rows of its overlapped decode of the real sensor's capture, behind the grid.
+    sensor_rows: HashMap<(usize, usize), Vec<f32>>,
     count: usize,
     /// The white balance's band gains.
     gains: Vec<f32>,
@@ -293,6 +295,9 @@ enum Block {
 fn parse(log: &str) -> Result<DeviceLog> {
     let mut patches = HashMap::new();
     let mut rows: HashMap<(usize, usize), Vec<f32>> = HashMap::new();
+    let mut sensor_rows: HashMap<(usize, usize), Vec<f32>> = HashMap::new();
+    // After the `sensor rows` line, rows are the real sensor's overlapped decode.
+    let mut in_sensor = false;
     let mut current: Option<Block> = None;
     let mut done = None;
     let mut gains = Vec::new();
@@ -326,12 +331,14 @@ fn parse(log: &str) -> Result<DeviceLog> {
                 into.insert(o, DevicePatch { member: n(6)?, values: Vec::new() });
                 current = Some(Block::Patch(o));
             }
+            Some("sensor") if w.get(1) == Some(&"rows") => in_sensor = true,
             Some("row") => {
                 ensure!(w.len() >= 3, "line {}: short row line", i + 1);
                 let n =
                     |k: usize| w[k].parse::<usize>().with_context(|| format!("line {}: bad number {:?}", i + 1, w[k]));
                 let at = (n(1)?, n(2)?);
-                ensure!(rows.insert(at, Vec::new()).is_none(), "line {}: row {at:?} printed twice", i + 1);
+                let into = if in_sensor { &mut sensor_rows } else { &mut rows };
+                ensure!(into.insert(at, Vec::new()).is_none(), "line {}: row {at:?} printed twice", i + 1);
                 current = Some(Block::Row(at));
             }
             Some("data") => {
@@ -349,7 +356,9 @@ fn parse(log: &str) -> Result<DeviceLog> {
                         &mut calibrated.get_mut(o).ok_or_else(|| lost(patch_name(o)))?.values
                     }
                     Block::Patch(o) => &mut patches.get_mut(o).ok_or_else(|| lost(patch_name(o)))?.values,
-                    Block::Row(at) => rows.get_mut(at).ok_or_else(|| lost(format!("row {at:?}")))?,
+                    Block::Row(at) => if in_sensor { &mut sensor_rows } else { &mut rows }
+                        .get_mut(at)
+                        .ok_or_else(|| lost(format!("row {at:?}")))?,
                 };
                 for h in &w[1..] {
                     let bits = u32::from_str_radix(h, 16).with_context(|| format!("line {}: bad hex {h:?}", i + 1))?;
@@ -374,7 +383,7 @@ fn parse(log: &str) -> Result<DeviceLog> {
         }
     }
     let count = done.context("the device log has no `done` line: the run did not finish")?;
-    Ok(DeviceLog { patches, rows, count, gains, calibrated, calibrated_gains, trial })
+    Ok(DeviceLog { patches, rows, sensor_rows, count, gains, calibrated, calibrated_gains, trial })
 }
 
 struct Collect(HashMap<PatchOrigin, (u16, Vec<f32>)>);
@@ -409,7 +418,8 @@ pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
     // A log is read whole only if it is a regular file of a log's size: a FIFO would block,
     // /dev/zero never end.
     let text = crate::io::file_checks::read_small_file(log, MAX_LOG)?;
-    let DeviceLog { patches: device, rows, count, gains, calibrated, calibrated_gains, trial } = parse(&text)?;
+    let DeviceLog { patches: device, rows, sensor_rows, count, gains, calibrated, calibrated_gains, trial } =
+        parse(&text)?;
     let capture = Capture::load(capture_dir)?;
     // The device decodes full-view patches with the shipped full-view ensemble.
     let ensemble = HostEnsemble::<5, 5, 8125>::new(DEFAULT_FULL_VIEW_ENSEMBLE).map_err(|e| anyhow::anyhow!("{e}"))?;
@@ -481,9 +491,17 @@ pub fn check(log: &Path, capture_dir: &Path) -> Result<()> {
         host_trial.first,
         host_trial.second
     );
-    check_rows(&rows, &capture, &dct, &model, pick)?;
+    check_rows(&rows, &capture, &dct, &model, pick, "device strip")?;
     let dir = capture_dir.parent().unwrap_or(Path::new("."));
-    check_calibrated(&calibrated, &calibrated_gains, &dir.join(SENSOR_CAPTURE), &dir.join(CALIBRATION), &model)
+    check_calibrated(&calibrated, &calibrated_gains, &dir.join(SENSOR_CAPTURE), &dir.join(CALIBRATION), &model)?;
+    // The real sensor's frame behind the grid its calibration found (the device's
+    // constants), uncalibrated, by the screened ensemble: the host's default decode of the
+    // capture with that grid.
+    let mut sensor = Capture::load(&dir.join(SENSOR_CAPTURE))?;
+    let cal = Calibration::load(&dir.join(CALIBRATION))?;
+    ensure!(cal.description.lenslet_grid.is_some(), "{}: the calibration found no lenslet grid", CALIBRATION);
+    sensor.description.lenslet_grid = cal.description.lenslet_grid;
+    check_rows(&sensor_rows, &sensor, &dct, &model, Pick::Second, "device strip behind the real sensor's grid")
 }
 
 /// The device's calibrated decode of the real sensor's capture against the host's decode of
@@ -566,6 +584,7 @@ fn check_rows(
     dct: &HostScheduledDictionary<5, 5, 8125>,
     model: &HostEnsembleModel<'_, 5, 5, 8125>,
     pick: Pick,
+    what: &str,
 ) -> Result<()> {
     // The host's default, full-view patches (the device's), no flags; without the baseline
     // blend, which the device does not make (it has no PPID).
@@ -605,17 +624,17 @@ fn check_rows(
         }
     }
     let missing = covered.iter().filter(|&&c| !c).count();
-    ensure!(!rows.is_empty(), "the device printed no rows of its overlapped decode");
-    ensure!(missing == 0, "the device's overlapped decode left {missing} lenslets out");
+    ensure!(!rows.is_empty(), "{what}: the device printed no rows of its overlapped decode");
+    ensure!(missing == 0, "{what}: the device's overlapped decode left {missing} lenslets out");
     outln!(
-        "device strip vs host's default (stride {:?}, {:?}, seeded {}): {} rows, largest relative difference {worst:.2e} (limit 1e-5)",
+        "{what} vs host's default (stride {:?}, {:?}, seeded {}): {} rows, largest relative difference {worst:.2e} (limit 1e-5)",
         opts.stride,
         opts.window,
         opts.seeds(),
         rows.len()
     )?;
     if !within(worst) {
-        bail!("the device's overlapped rows differ from the host's by {worst:.2e} relative");
+        bail!("{what}: the device's overlapped rows differ from the host's by {worst:.2e} relative");
     }
     Ok(())
 }
@@ -633,6 +652,30 @@ mod tests {
         assert!(diffs.iter().copied().fold(0.0, f64::max) <= 1e-5, "f64::max drops the NaN");
         assert!(within([1e-7, 2e-7].iter().copied().fold(0.0, worse)));
         assert!(!within(2e-5));
+    }
+
+    /// The rows after a `sensor rows` line are the real sensor's frame's, kept apart from
+    /// the ideal capture's rows of the same places; each `data` line goes to its own row.
+    #[test]
+    fn rows_after_the_sensor_line_are_the_real_sensors() {
+        let one = 1.0f32.to_bits();
+        let two = 2.0f32.to_bits();
+        let log = format!(
+            "row 0 0 values 1\ndata {one:08x}\nsensor rows\nrow 0 0 values 1\ndata {two:08x}\nrow 1 0 values 1\n\
+             data {one:08x}\nsensor rows end 2 checksum 0x0\ndone patches=0\n"
+        );
+        let d = parse(&log).unwrap();
+        assert_eq!(d.rows.len(), 1);
+        assert_eq!(d.rows[&(0, 0)], [1.0]);
+        assert_eq!(d.sensor_rows.len(), 2);
+        assert_eq!(
+            (d.sensor_rows[&(0, 0)].as_slice(), d.sensor_rows[&(1, 0)].as_slice()),
+            ([2.0].as_slice(), [1.0].as_slice())
+        );
+        // A sensor row printed twice is refused as a row of the ideal capture is.
+        let twice = format!("sensor rows\nrow 0 0 values 1\ndata {one:08x}\nrow 0 0 values 1\ndone patches=0\n");
+        let e = parse(&twice).err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(e.contains("printed twice"), "{e}");
     }
 
     /// Issue 41, item 4: a FIFO or a device is refused, not read until memory runs out.

@@ -132,7 +132,7 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
         // under its centre.
         let mut shares = self.cell_shares(origin);
         let full = S::PU == lu && S::PV == lv;
-        let known = seed.as_deref().is_some_and(|q| q.holds_cells()) && full;
+        let known = seed.is_some() && full;
         if let Some(c) = shares.as_mut() {
             c.known_outside = known;
         }

@@ -54,13 +54,6 @@ pub trait PatchSeed<S: Shape> {
         let _ = (lenslet, view, band);
         None
     }
-
-    /// Whether [`Self::cell`] may give an estimate at all; `false` for [`NoSeed`], so a
-    /// decode without seeds (the device's tile decodes) has no code for the cells outside
-    /// a patch.
-    fn holds_cells(&self) -> bool {
-        true
-    }
 }
 
 /// No estimate anywhere: every patch decodes from nothing.
@@ -69,10 +62,6 @@ pub struct NoSeed;
 
 impl<S: Shape> PatchSeed<S> for NoSeed {
     fn seed(&mut self, _: PatchOrigin, _: &mut PerValue<S, f32>) -> bool {
-        false
-    }
-
-    fn holds_cells(&self) -> bool {
         false
     }
 }
