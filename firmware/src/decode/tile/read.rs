@@ -4,6 +4,7 @@
 use super::*;
 use crate::operators::shape::{PerBand, Shape};
 use crate::sensor::extent::{Array, Bands, Per};
+use crate::sensor::mask::{BandList, MAX_BANDS};
 use crate::solver::shares::{MAX_OUTSIDE_SHARE, Reach};
 
 impl<'a, S: Shape> TileDecoder<'a, S> {
@@ -176,9 +177,11 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
                             let Some(lenslet) = origin.lenslet::<S>(s, t, u, v, (lu, lv)) else { continue };
                             let Some((row, col)) = self.sensor_pixel(lenslet, vr, vc) else { continue };
                             let at = S::pixel_index(s, t, u, v);
-                            // Each snapshot's band's estimate of the cells outside the patch,
-                            // by their shares (known outside).
-                            let mut outside = [0.0f32; crate::sensor::mask::MAX_BANDS];
+                            // With the cells outside the patch known: the pixel's bands, and
+                            // each one's estimate of those cells by their shares (empty
+                            // otherwise: nothing to take out).
+                            let mut outside_bands = BandList::new();
+                            let mut outside = heapless::Vec::<f32, MAX_BANDS>::new();
                             if shared {
                                 // The pixel's place in its cell; a pixel whose centre lies
                                 // in another cell is that cell's measurement, not this one's.
@@ -192,7 +195,10 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
                                 }
                                 let _ = m.set_place(at / S::B, place);
                                 if let (true, Some(r), Some(sd)) = (known, reach.as_ref(), seed.as_deref_mut()) {
-                                    let bands = c.mask.bands_at(row, col);
+                                    outside_bands = c.mask.bands_at(row, col);
+                                    let bands = &outside_bands;
+                                    // At most `MAX_BANDS` bands: the resize cannot fail.
+                                    let _ = outside.resize(bands.len(), 0.0);
                                     let (lui, lvi) = (lu as isize, lv as isize);
                                     let (pr, pc) = (lenslet.0 * lui + vr as isize, lenslet.1 * lvi + vc as isize);
                                     let mut whole = true;
@@ -227,12 +233,10 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
                                 source.read(j, row, col, &mut r.as_mut()[..1])?;
                             }
                             self.put_pixel(m, at, row, col, |j| run.get(j).map(|r| r[0]), &mut flags, &mut excluded);
-                            if known {
-                                for (&b, &o) in c.mask.bands_at(row, col).iter().zip(outside.iter()) {
-                                    let e = at + usize::from(b);
-                                    if let Some(y) = m.get(e) {
-                                        let _ = m.set(e, y - o);
-                                    }
+                            for (&b, &o) in outside_bands.iter().zip(outside.iter()) {
+                                let e = at + usize::from(b);
+                                if let Some(y) = m.get(e) {
+                                    let _ = m.set(e, y - o);
                                 }
                             }
                         }
