@@ -70,11 +70,11 @@
 //! pass saved 1.7 % more for 22 KB of stack: not kept. The row sums' two passes work on
 //! whole 13-band fibres (a 0 / 1 mask of the measured bands, then every band's sum at once),
 //! not band by band: the same sums, and the decode from 4.97 to 4.79 G instructions (office
-//! 32 x 32, k = 3, the DCT; its time within this machine's noise). Tried and not kept: each
-//! footprint's covered cells packed to the front (no test per cell in the steps' loops),
-//! 6.5 % more instructions and 1.10 times the time (`farm-bench`); a step that solves
-//! `M M^T` by 4 conjugate-gradient steps, which gains noiseless and loses on noisy captures
-//! (`docs/design.md`).
+//! 32 x 32, k = 3, the DCT) and a paired median of 0.95 times the time (`farm-bench`, 11
+//! pairs, office 64 x 64). Tried and not kept: each footprint's covered cells packed to
+//! the front (no test per cell in the steps' loops), 6.5 % more instructions and 1.10 times
+//! the time (`farm-bench`); a step that solves `M M^T` by 4 conjugate-gradient steps, which
+//! gains noiseless and loses on noisy captures (`docs/design.md`).
 
 use crate::operators::dictionary::Dictionary;
 use crate::operators::disparity::HalfViews;
