@@ -114,12 +114,32 @@ impl<const N: usize> Footprint<N> {
         }
     }
 
-    /// Band `b` of the entries read, each by its weight, summed (`cells` by patch pixel).
+    /// The entries read, each by its weight, summed a whole fibre at a time (`cells` by
+    /// patch pixel): every band's sum in the footprint's order.
     #[inline(always)]
-    fn band_sum<C: Bands>(&self, cells: &[C::Per<f32>], b: usize) -> f32 {
-        let mut sum = 0.0f32;
-        self.each(|c, w| sum += w * cells.get(c).and_then(|f| f.get(b)).copied().unwrap_or(0.0));
+    fn gather<C: Bands>(&self, cells: &[C::Per<f32>]) -> C::Per<f32> {
+        let mut sum = C::Per::<f32>::splat(0.0);
+        self.each(|c, w| {
+            if let Some(f) = cells.get(c) {
+                for (o, &x) in sum.iter_mut().zip(f.iter()) {
+                    *o += w * x;
+                }
+            }
+        });
         sum
+    }
+
+    /// `fibre` added to each entry read, by the entry's weight: [`Self::gather`]'s
+    /// transpose.
+    #[inline(always)]
+    fn scatter<C: Bands>(&self, cells: &mut [C::Per<f32>], fibre: &C::Per<f32>) {
+        self.each(|c, w| {
+            if let Some(f) = cells.get_mut(c) {
+                for (o, &x) in f.iter_mut().zip(fibre.iter()) {
+                    *o += w * x;
+                }
+            }
+        });
     }
 }
 
@@ -627,15 +647,7 @@ where
     let (mut r2, mut w2) = (0.0f32, 0.0f32);
     let weighted = ball.is_weighted();
     each_measured::<S>(m, layout, |at, pixel, bits| {
-        let fp = Footprint::<N>::of(layout, m, at, pixel);
-        let mut sum = <PerBand<S, f32>>::splat(0.0);
-        fp.each(|c, w| {
-            if let Some(f) = fibres.get(c) {
-                for (o, &x) in sum.iter_mut().zip(f.iter()) {
-                    *o += w * x;
-                }
-            }
-        });
+        let sum = Footprint::<N>::of(layout, m, at, pixel).gather::<S::Bands>(fibres);
         for b in bands(bits) {
             let i = pixel * S::B + b;
             let (Some(row), Some(&y), Some(r)) = (m5.get(b), m.values.get(i), res.get_mut(i)) else { continue };
@@ -662,14 +674,7 @@ where
                 *o += z * w;
             }
         }
-        let fp = Footprint::<N>::of(layout, m, at, pixel);
-        fp.each(|c, w| {
-            if let Some(f) = fibres.get_mut(c) {
-                for (o, &x) in f.iter_mut().zip(correction.iter()) {
-                    *o += w * x;
-                }
-            }
-        });
+        Footprint::<N>::of(layout, m, at, pixel).scatter::<S::Bands>(fibres, &correction);
     });
     (r2, w2)
 }
@@ -699,27 +704,11 @@ fn row_sums<S: Shape, const N: usize>(
                 *x = 1.0;
             }
         }
-        let fp = Footprint::<N>::of(layout, m, at, pixel);
-        fp.each(|c, w| {
-            if let Some(f) = fibres.get_mut(c) {
-                for (x, &k) in f.iter_mut().zip(measured.iter()) {
-                    *x += w * k;
-                }
-            }
-        });
+        Footprint::<N>::of(layout, m, at, pixel).scatter::<S::Bands>(fibres, &measured);
     });
     each_measured::<S>(m, layout, |at, pixel, bits| {
-        // Every band's row sum at once, in the footprint's order (the same sums band by
-        // band as `Footprint::band_sum`), then the measured bands' read off.
-        let fp = Footprint::<N>::of(layout, m, at, pixel);
-        let mut rows = <PerBand<S, f32>>::splat(0.0);
-        fp.each(|c, w| {
-            if let Some(f) = fibres.get(c) {
-                for (o, &x) in rows.iter_mut().zip(f.iter()) {
-                    *o += w * x;
-                }
-            }
-        });
+        // Every band's row sum at once, then the measured bands' read off.
+        let rows = Footprint::<N>::of(layout, m, at, pixel).gather::<S::Bands>(fibres);
         for b in bands(bits) {
             let row = rows.get(b).copied().unwrap_or(0.0);
             if let Some(x) = inv.get_mut(pixel * S::B + b) {
@@ -756,10 +745,9 @@ fn predict<S: Shape, const N: usize>(
 {
     let cells = S::Bands::chunks(cells.as_ref());
     each_measured::<S>(m, layout, |at, pixel, bits| {
-        let fp = Footprint::<N>::of(layout, m, at, pixel);
+        let sums = Footprint::<N>::of(layout, m, at, pixel).gather::<S::Bands>(cells);
         for b in bands(bits) {
-            let x = fp.band_sum::<S::Bands>(cells, b);
-            if let Some(y) = patch.get_mut(pixel * S::B + b) {
+            if let (Some(y), Some(&x)) = (patch.get_mut(pixel * S::B + b), sums.get(b)) {
                 *y = x;
             }
         }
