@@ -132,12 +132,19 @@ secs_100 = ens * solves_100 / 480e6
 print(f"| projected seconds, 100 x 100-lenslet frame at 480 MHz, the host's default (stride 2, seeded), screened ensemble ({solves_100:,} patch solves of at most {ens / 1e6:.1f} M; a full-width strip of {seeded_rows} rows, {full_bytes / 2**20:.2f} MiB: external RAM, no band fits the 512 KiB) | {secs_100:,.0f} s ({secs_100 / 60:.1f} min) | target 60 s, not met (issue 62; why: docs/results-roofline.md) |")
 secs_unseeded = ens * camera_solves / 480e6
 print(f"| projected seconds, the same frame unseeded in the part's RAM ({camera_solves:,} patch solves in bands of {camera_band} columns; {unseeded_full:,} at full width) | {secs_unseeded:,.0f} s ({secs_unseeded / 60:.1f} min) | |")
+# Behind a turned lenslet grid (issue 66): the same solves at the real sensor's frame's
+# instructions per patch solve behind its grid (its reads, seeds and frame overheads
+# included, so an upper bound beside the aligned row's), over the aligned row's.
+grid_solve = sensor_frame / sensor_patches
+secs_grid = grid_solve * solves_100 / 480e6
+print(f"| projected seconds, the same frame behind a lenslet grid turned 1 degree at 5.1 px (the real sensor's gridded frame above: {grid_solve / 1e6:.1f} M a patch solve, its frame's overheads included) | {secs_grid:,.0f} s ({secs_grid / 60:.1f} min; {secs_grid / secs_100:.2f}x the aligned frame) | target 60 s, not met (issue 62) |")
 secs_dct = dct * 20 * 20 / 480e6
 print(f"| projected seconds, the same frame, 5D DCT on the disjoint grid (the preview's kind of decode, from the minimum-norm start; no strip) | {secs_dct:,.0f} s | |")
-# The same two figures for `slf bench --device` (eval/device_frame.rs reads this header).
+# The same figures for `slf bench --device` (eval/device_frame.rs reads this header).
 with open(sys.argv[5], "w") as f:
     f.write("decode,patch_solves,instructions_per_solve,clock_mhz\n")
     f.write(f'"default kind: screened ensemble, full-view patches, stride 2, seeded, full-width strip",{solves_100:.0f},{ens:.0f},480\n')
+    f.write(f'"default kind behind a lenslet grid turned 1 degree at 5.1 px",{solves_100:.0f},{grid_solve:.0f},480\n')
     f.write(f'"preview kind: 5D DCT, full-view patches, disjoint grid, from the minimum-norm start",{20 * 20},{dct:.0f},480\n')
 # Flash: 320 KiB since issue 52 (a real lenslet array: the grid's read and the projection of
 # pixels that share view cells), which allows it; before, 256 KiB.
