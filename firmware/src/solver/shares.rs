@@ -38,7 +38,8 @@
 //! seeded by the disjoint grid's decode, sheared or not), the read takes their shares out of the measurement by its estimates instead
 //! ([`CellShares::known_outside`]): in a patch sheared by a whole lenslet the two outer
 //! views' neighbours across every micro-image border lie outside it, and the own-cell rule
-//! there cost those views up to 2.2 dB (`docs/results-grid-views.md`).
+//! there cost those views up to 2.2 dB (`docs/results-grid-views.md`). A seeded pixel more
+//! than half outside is left out ([`MAX_SEEDED_OUTSIDE_SHARE`]).
 //!
 //! A patch sheared to a half disparity has every other view half a lenslet off its grid
 //! ([`crate::solver::fractional`]): such a view's cell is the mean of two grid positions, so
@@ -402,6 +403,22 @@ impl<S: Shape> Layout<S> {
 /// decodes stay as they were). At k = 1, short of measurements more than of a fit, it lost
 /// up to 2.2 dB (and won up to 1.5), so one snapshot keeps every pixel.
 pub const MAX_OUTSIDE_SHARE: f32 = 0.25;
+
+/// The most of a pixel's square a seeded patch keeps outside itself
+/// ([`CellShares::known_outside`]): a pixel past it is more the seeds' estimate of the cells
+/// outside than a measurement of the patch, and is left out, sheared or not, at any number
+/// of snapshots ([`Reach`]).
+///
+/// A seeded read takes the outside cells' shares out of a measurement by the seeds (the
+/// disjoint grid's decode), so what is left carries the seeds' error times those shares,
+/// over a part of the pixel inside of less than a half. Measured on 2026-12-01
+/// (`docs/results-grid-known.md`'s calibrated captures, the default decode): picked on 7 of
+/// /// its 28 decodes (0.25 lowered 6 of them, by up to 0.36 dB; 0.4 raised 6 by at most 0.17
+/// and lowered one by 0.05; 0.5 and 0.6 raised all 7, by at most 0.12 and 0.10 dB); on the
+/// other 21, 0.5 raised 20 by 0.01 to 0.09 dB and lowered one by 0.04 (dino, k = 1, 0.3
+/// degrees). A small gain: the loss behind a grid is elsewhere
+/// (`docs/results-grid-target.md`).
+pub const MAX_SEEDED_OUTSIDE_SHARE: f32 = 0.5;
 
 /// How much of each pixel's square lies over cells outside a patch: built once a patch from
 /// its shares.

@@ -5,7 +5,7 @@ use super::*;
 use crate::operators::shape::{PerBand, Shape};
 use crate::sensor::extent::{Array, Bands, Per};
 use crate::sensor::mask::{BandList, MAX_BANDS};
-use crate::solver::shares::{MAX_OUTSIDE_SHARE, Reach};
+use crate::solver::shares::{MAX_OUTSIDE_SHARE, MAX_SEEDED_OUTSIDE_SHARE, Reach};
 
 impl<'a, S: Shape> TileDecoder<'a, S> {
     /// Grey-world band gains of a frame: every valid sample of the sensor (defects and
@@ -103,7 +103,8 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
     /// unsheared patch's rim; a sheared one's too, and its outer views' cells across a
     /// micro-image border) are taken out of its measurement by `seed`'s estimates of them
     /// ([`CellShares::known_outside`]); a pixel with such a cell `seed` has no estimate of
-    /// is left out.
+    /// is left out, and so is one more than half of whose square lies outside
+    /// ([`crate::solver::shares::MAX_SEEDED_OUTSIDE_SHARE`]).
     ///
     /// # Errors
     /// The source's error.
@@ -142,7 +143,8 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
         }
         let shared = m.shares().is_some();
         // A sheared patch's pixels that lie largely outside it are left out at k >= 2
-        // (`MAX_OUTSIDE_SHARE`).
+        // (`MAX_OUTSIDE_SHARE`); a seeded patch's, sheared or not, past half outside
+        // (`MAX_SEEDED_OUTSIDE_SHARE`).
         let known = known && m.shares().is_some_and(|c| c.known_outside);
         let reach = m
             .shares()
@@ -186,11 +188,8 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
                                 // The pixel's place in its cell; a pixel whose centre lies
                                 // in another cell is that cell's measurement, not this one's.
                                 let Some(place) = self.place_in_cell(lenslet, (vr, vc), (row, col)) else { continue };
-                                if !known
-                                    && reach
-                                        .as_ref()
-                                        .is_some_and(|r| r.outside((s, t, u, v), place) > MAX_OUTSIDE_SHARE)
-                                {
+                                let most = if known { MAX_SEEDED_OUTSIDE_SHARE } else { MAX_OUTSIDE_SHARE };
+                                if reach.as_ref().is_some_and(|r| r.outside((s, t, u, v), place) > most) {
                                     continue;
                                 }
                                 let _ = m.set_place(at / S::B, place);
