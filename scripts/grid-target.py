@@ -13,9 +13,9 @@ noisy), else the noiseless one's. The bound is 16 patches a scene in f64; the de
 whole calibrated frames, so a row near its target is a tie, not a pass or a miss."""
 import datetime
 import statistics
-import textwrap
 import subprocess
 import sys
+import textwrap
 
 
 def table(path, key_cols=3):

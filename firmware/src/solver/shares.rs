@@ -413,11 +413,11 @@ pub const MAX_OUTSIDE_SHARE: f32 = 0.25;
 /// disjoint grid's decode), so what is left carries the seeds' error times those shares,
 /// over a part of the pixel inside of less than a half. Measured on 2026-12-01
 /// (`docs/results-grid-known.md`'s calibrated captures, the default decode): picked on 7 of
-/// /// its 28 decodes (0.25 lowered 6 of them, by up to 0.36 dB; 0.4 raised 6 by at most 0.17
+/// its 28 decodes (0.25 lowered 6 of them, by up to 0.36 dB; 0.4 raised 6 by at most 0.17
 /// and lowered one by 0.05; 0.5 and 0.6 raised all 7, by at most 0.12 and 0.10 dB); on the
 /// other 21, 0.5 raised 20 by 0.01 to 0.09 dB and lowered one by 0.04 (dino, k = 1, 0.3
-/// degrees). A small gain: the loss behind a grid is elsewhere
-/// (`docs/results-grid-target.md`).
+/// degrees); all 28 in `docs/results-grid-seeded.md`. A small gain: the loss behind a grid
+/// is elsewhere (`docs/results-grid-target.md`).
 pub const MAX_SEEDED_OUTSIDE_SHARE: f32 = 0.5;
 
 /// How much of each pixel's square lies over cells outside a patch: built once a patch from

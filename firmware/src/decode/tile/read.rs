@@ -150,6 +150,7 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
             .shares()
             .filter(|_| known || (origin.disparity != Disparity::ZERO && k >= 2))
             .map(|c| Reach::<S>::new(c, half));
+        let most = if known { MAX_SEEDED_OUTSIDE_SHARE } else { MAX_OUTSIDE_SHARE };
         let lenslets = (c.sensor.lenslets.0 as isize, c.sensor.lenslets.1 as isize);
         for s in 0..S::PS {
             for u in 0..S::PU {
@@ -188,7 +189,6 @@ impl<'a, S: Shape> TileDecoder<'a, S> {
                                 // The pixel's place in its cell; a pixel whose centre lies
                                 // in another cell is that cell's measurement, not this one's.
                                 let Some(place) = self.place_in_cell(lenslet, (vr, vc), (row, col)) else { continue };
-                                let most = if known { MAX_SEEDED_OUTSIDE_SHARE } else { MAX_OUTSIDE_SHARE };
                                 if reach.as_ref().is_some_and(|r| r.outside((s, t, u, v), place) > most) {
                                     continue;
                                 }
