@@ -49,9 +49,10 @@ else
 page_head "The bound behind a turned lenslet array" "bash scripts/grid-bound.sh"
 cat <<'TEXT'
 How much of the turned array's loss is the light's, and how much the decoder's (issue 66)?
-Each row: 16 disjoint 5 x 5-lenslet full-view patches (25 x 25 view cells x 13 bands) of a
-30 x 30-lenslet scene, pixel mask, noiseless 16-bit frames, decoded in f64. PSNR in dB over
-the patches' values together, peak the light field's maximum.
+Each row: 16 disjoint 5 x 5-lenslet full-view patches (25 x 25 view cells x 13 bands), 4 x 4
+spread over the scene the decode tables decode (a realistic scene at 64 x 64 lenslets, an HCI
+crop whole), pixel mask, noiseless 16-bit frames, decoded in f64. PSNR in dB over the patches'
+values together, peak the light field's maximum.
 
 - **aligned**: the aligned sensor's capture (each pixel one view cell's value);
 - **nearest**: the grid's capture read as the decoder reads it today (each view cell from the

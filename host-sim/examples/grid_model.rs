@@ -14,7 +14,9 @@
 //!   cells it covers (pixels reaching outside the patch left out): the box-share model.
 //!
 //! and by two solvers, each in f64 on 5 x 5-lenslet full-view patches (25 x 25 cells x 13
-//! bands, 8,125 values; disjoint, away from the frame's edge) of a 30 x 30-lenslet scene:
+//! bands, 8,125 values; disjoint, 4 x 4 of them spread over the scene away from its edge)
+//! of the scene the decode tables decode (`scripts/scene-tables.sh`: a named one at 64 x 64
+//! lenslets, an HCI crop whole):
 //!
 //! - **SL0**: the 5D DCT, the hand-set schedule's numbers (mu 2, sigma_f 0.7, 3 steps, down
 //!   to sigma 1e-3), grey-world gains from the light field's band means, the projection
@@ -34,8 +36,11 @@
 //!
 //!     cargo run --release -p slf-host --example grid_model -- office 3 0.3:5.04 1:5.1 0:5.02
 //!
-//! (a scene slf names, or a light field's `.npy` of 5 x 5 views and 13 bands whose middle
-//! 30 x 30 lenslets are taken; snapshots; then `ROTATION:PITCH` grids). With
+//! (a scene slf names, or a light field's `.npy` of 5 x 5 views and 13 bands; snapshots;
+//! then `ROTATION:PITCH` grids). `--size N` renders the scene at N x N lenslets (an `.npy`'s
+//! middle N x N) instead: a realistic scene's shapes scale with its size, so a scene at
+//! 30 x 30 (this example's size before 2026-12-01's third stop) is not the tables' 64 x 64
+//! one. With
 //! `--decoder-model` last, a second table: the pixels the decoder reads (the one under
 //! each cell's centre) modelled as the decoder models them (`solver/shares.rs`: a separable
 //! box, the turn left out, a share outside the patch given to the pixel's own cell), and
@@ -262,21 +267,40 @@ fn main() -> Result<()> {
     // `--noise`: the decoder tables' sensor noise (shot noise of a 20,000-electron well,
     // read noise of 2 DN of a 12-bit range 90 % full), the oracle alone.
     let noise = args.iter().any(|a| a == "--noise");
-    let grids: Vec<&String> = args[2..].iter().filter(|a| !a.starts_with("--")).collect();
-    let size = 30;
+    // `--size N` (30 or more): the scene's lenslets (an .npy's middle N x N), the 16 patches
+    // spread over it. By default the decode tables' own: a named scene at 64 x 64
+    // (`scripts/scene-tables.sh`), an .npy whole (its smaller side).
+    let size: Option<usize> = match args.iter().position(|a| a == "--size") {
+        Some(i) => Some(args.get(i + 1).context("--size N")?.parse().context("--size N: lenslets")?),
+        None => None,
+    };
+    ensure!(size.is_none_or(|n| (30..=4096).contains(&n)), "--size: 30 to 4096 lenslets");
+    let grids: Vec<&String> = args[2..]
+        .iter()
+        .enumerate()
+        .filter(|&(i, a)| !a.starts_with("--") && args[1 + i] != "--size")
+        .map(|(_, a)| a)
+        .collect();
     let (lf, name): (LightField, String) = if args[0].ends_with(".npy") {
-        // A light field's file (an HCI crop): its middle 30 x 30 lenslets.
+        // A light field's file (an HCI crop): its middle size x size lenslets.
         let whole = slf_host::io::lightfield::read_npy(std::path::Path::new(&args[0]))?;
         ensure!(whole.views == (5, 5) && whole.bands == B, "{}: 5 x 5 views and 13 bands", args[0]);
-        ensure!(whole.rows >= size && whole.cols >= size, "{}: at least {size} x {size} lenslets", args[0]);
+        let size = size.unwrap_or(whole.rows.min(whole.cols));
+        ensure!(
+            whole.rows >= size && whole.cols >= size && size >= 30,
+            "{}: at least {size} x {size} lenslets, and 30",
+            args[0]
+        );
         let name = std::path::Path::new(&args[0]).file_stem().map_or(String::new(), |s| s.to_string_lossy().into());
         (whole.window((whole.rows - size) / 2, (whole.cols - size) / 2, size, size), name)
     } else {
         let scene = slf_host::sim::realistic::named(&args[0])
             .or_else(|| slf_host::sim::scene::named(&args[0]))
             .context("a scene slf names, or a light field's .npy")?;
+        let size = size.unwrap_or(64);
         (scene.render(SceneSize { views: (5, 5), rows: size, cols: size }), args[0].clone())
     };
+    let size = lf.rows.min(lf.cols);
     let peak = f64::from(lf.max());
     let camera = |grid: Option<GridSettings>| {
         let mut cam = CameraConfig::pixel(5, k);
@@ -301,7 +325,11 @@ fn main() -> Result<()> {
     }
     let all = means.iter().sum::<f64>() / B as f64;
     let gains: [f64; B] = means.map(|m| (m / all).max(1e-3));
-    let origins: Vec<(usize, usize)> = [5, 10, 15, 20].iter().flat_map(|&a| [5, 10, 15, 20].map(|b| (a, b))).collect();
+    // 4 x 4 patches 5 lenslets from the edges, a whole number of patches apart (at 30
+    // lenslets: 5, 10, 15, 20).
+    let step = (size - 10) / 3 / 5 * 5;
+    let at = [5, 5 + step, 5 + 2 * step, 5 + 3 * step];
+    let origins: Vec<(usize, usize)> = at.iter().flat_map(|&a| at.map(|b| (a, b))).collect();
     let truth = |(s0, t0): (usize, usize)| {
         let mut x = vec![0.0; N];
         for i in 0..P {
