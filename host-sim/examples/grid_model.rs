@@ -48,8 +48,8 @@
 //! `--noise`, the captures carry the sensor noise of the decode tables (`scripts/scene-tables.sh`:
 //! shot noise of a 20,000-electron well, 2 DN of read noise on a 12-bit range, scaled to the
 //! 16-bit frames) and only the oracles are found: what the light loses behind the grid when
-//! the measurements are noisy (office, k = 3, 0.3 degrees / 5.04 px: aligned 37.42, exact
-//! 35.66 dB, -1.76 against -1.33 noiseless; 3.4 minutes a grid on 2 cores). `scripts/grid-bound.sh` runs it over
+//! the measurements are noisy (office 64 x 64, k = 3, 0.3 degrees / 5.04 px: aligned 40.50,
+//! exact 38.56 dB, -1.94 against -1.53 noiseless; about 1.6 minutes a grid on 2 cores). `scripts/grid-bound.sh` runs it over
 //! scenes and writes `docs/results-grid-bound.md`.
 
 use anyhow::{Context, Result, ensure};
