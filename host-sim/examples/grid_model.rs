@@ -66,6 +66,9 @@ use slf_host::sim::scene::SceneSize;
 const P: usize = 25; // cells along each axis of a patch: 5 lenslets x 5 views
 const B: usize = 13;
 const N: usize = P * P * B;
+/// The lenslets of a named scene by default: the decode tables' (`scripts/scene-tables.sh`'s
+/// `grid_table_setup`), so the bound is measured on the picture they decode.
+const TABLES_SIZE: usize = 64;
 
 /// A patch's measurements: rows of `(entry, weight)` and the values they measured.
 struct Measured {
@@ -297,7 +300,7 @@ fn main() -> Result<()> {
         let scene = slf_host::sim::realistic::named(&args[0])
             .or_else(|| slf_host::sim::scene::named(&args[0]))
             .context("a scene slf names, or a light field's .npy")?;
-        let size = size.unwrap_or(64);
+        let size = size.unwrap_or(TABLES_SIZE);
         (scene.render(SceneSize { views: (5, 5), rows: size, cols: size }), args[0].clone())
     };
     let size = lf.rows.min(lf.cols);
