@@ -5,12 +5,17 @@ light itself loses there (docs/results-grid-bound.md: `exact - aligned, oracle (
 and, given a third page, the same with the decodes' noise, docs/results-grid-bound-noise.md).
 
     python3 scripts/grid-target.py docs/results-grid-bound.md docs/results-grid-seeded.md \
-        docs/results-grid-bound-noise.md > docs/results-grid-target.md
+        docs/results-grid-bound-noise.md --before docs/results-grid.md > docs/results-grid-target.md
 
 The target: within 1 dB of the aligned sensor at k = 3 and 0.5 dB at k = 1, or the bound's
 figure where the light itself loses more: the noisy bound's when given (the decodes are
 noisy), else the noiseless one's. The bound is 16 patches a scene in f64; the decodes are
-whole calibrated frames, so a row near its target is a tie, not a pass or a miss."""
+whole calibrated frames, so a row near its target is a tie, not a pass or a miss.
+
+`--before PAGE` (a page of scripts/grid-results.sh, per scene a table by k, rotation and
+pitch: docs/results-grid.md, the figures the issue was filed on) adds each decode's loss
+there, so the page shows the issue's before and after side by side: its measure is the loss
+interior (`(c) - ref dB, interior`), both pages scored with `slf eval --border 2`."""
 import datetime
 import statistics
 import subprocess
@@ -34,9 +39,37 @@ def table(path, key_cols=3):
     return rows
 
 
-bound = table(sys.argv[1])
-decodes = table(sys.argv[2])
-noisy = table(sys.argv[3]) if len(sys.argv) > 3 else None
+def per_scene(path):
+    """A grid-results page: {(scene, k, "deg:px"): loss interior} from each scene's table."""
+    rows, scene, header = {}, None, None
+    for line in open(path):
+        if line.startswith("## "):
+            scene, header = line[3:].strip(), None
+        elif line.startswith("|") and scene:
+            cells = [c.strip() for c in line.strip().strip("|").split("|")]
+            if cells[0] == "k":
+                # A scene's table; the page's other tables (summary, blur, calibration) are not.
+                wanted = {"rotation deg", "pitch px", "(c) - ref dB, interior"}
+                header = cells if wanted <= set(cells) else None
+            elif header and not cells[0].startswith("---") and len(cells) == len(header):
+                row = dict(zip(header, cells))
+                key = (scene, row["k"], f"{row['rotation deg']}:{row['pitch px']}")
+                rows[key] = float(row["(c) - ref dB, interior"])
+    return rows
+
+
+args = sys.argv[1:]
+before_page = None
+if "--before" in args:
+    i = args.index("--before")
+    if i + 1 >= len(args):
+        sys.exit("grid-target.py: --before needs a page")
+    before_page = args[i + 1]
+    del args[i : i + 2]
+bound = table(args[0])
+decodes = table(args[1])
+noisy = table(args[2]) if len(args) > 2 else None
+before = per_scene(before_page) if before_page else None
 light_col = "exact - aligned, oracle (the light)"
 commit = subprocess.run(["git", "rev-parse", "--short=7", "HEAD"], capture_output=True, text=True).stdout.strip()
 made = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M")
@@ -45,8 +78,8 @@ print()
 print(f"> Made by `python3 scripts/grid-target.py {' '.join(sys.argv[1:])}` at {commit} ({made} UTC).")
 print()
 about = (
-    f"Each decode's loss to the aligned sensor (`{sys.argv[2]}`, its *after - aligned* column) against "
-    f"what the light itself loses behind the same grid (`{sys.argv[1]}`: the exact box-share model's "
+    f"Each decode's loss to the aligned sensor (`{args[1]}`, its *after - aligned* column) against "
+    f"what the light itself loses behind the same grid (`{args[0]}`: the exact box-share model's "
     "oracle against the aligned sensor's, 16 noiseless patches a scene)"
 )
 if noisy is None:
@@ -56,7 +89,7 @@ if noisy is None:
     )
 else:
     about += (
-        f", and with the decodes' noise (`{sys.argv[3]}`), the figure the target takes: the decodes are "
+        f", and with the decodes' noise (`{args[2]}`), the figure the target takes: the decodes are "
         "noisy. A row a little short is a tie."
     )
 about += (
@@ -100,3 +133,41 @@ print("| --- | --- | --- | --- |")
 for k in sorted(short):
     g = short[k]
     print(f"| {k} | {len(g)} | {sum(x == 0 for x in g)} | {statistics.median(g):.2f} / {max(g):.2f} |")
+
+if before is not None:
+    print()
+    print("## Before and after: the issue's measure, decode by decode")
+    print()
+    print(
+        textwrap.fill(
+            f"The loss to the aligned sensor, interior, when the issue was filed (`{before_page}`, the "
+            f"decode of its commit, its *(c) - ref dB, interior* column) and now (`{args[1]}`, *after - "
+            "aligned*). Each page's aligned reference is its own decoder's. dB.",
+            100,
+            break_on_hyphens=False,
+            break_long_words=False,
+        )
+    )
+    print()
+    print("| scene | k | grid (deg:px) | before | after | after - before |")
+    print("| --- | --- | --- | --- | --- | --- |")
+    by_k = {}
+    for key, d in decodes.items():
+        then = before.get(key)
+        now = float(d["after - aligned dB"])
+        if then is None:
+            print(f"| {' | '.join(key)} | (not on the page) | {now:+.2f} | |")
+            continue
+        by_k.setdefault(int(key[1]), []).append((then, now))
+        print(f"| {' | '.join(key)} | {then:+.2f} | {now:+.2f} | {now - then:+.2f} |")
+    print()
+    print("| k | decodes | before: median / worst | after: median / worst | rose on |")
+    print("| --- | --- | --- | --- | --- |")
+    for k in sorted(by_k):
+        then = [t for t, _ in by_k[k]]
+        now = [n for _, n in by_k[k]]
+        rose = sum(n > t for t, n in by_k[k])
+        print(
+            f"| {k} | {len(now)} | {statistics.median(then):+.2f} / {min(then):+.2f} | "
+            f"{statistics.median(now):+.2f} / {min(now):+.2f} | {rose} of {len(now)} |"
+        )
