@@ -39,6 +39,16 @@ def table(path, key_cols=3):
     return rows
 
 
+def header(*cols):
+    """A markdown table's header and rule."""
+    print("| " + " | ".join(cols) + " |")
+    print("|" + " --- |" * len(cols))
+
+
+def wrap(text):
+    print(textwrap.fill(text, 100, break_on_hyphens=False, break_long_words=False))
+
+
 def per_scene(path):
     """A grid-results page: {(scene, k, "deg:px"): loss interior} from each scene's table."""
     rows, scene, header = {}, None, None
@@ -96,14 +106,12 @@ about += (
     " dB. *target*: the issue's limit (-1 at k = 3, -0.5 at k = 1) or the light's own loss where it is "
     "larger; *short by*: how far the decode's loss is past it (0: met)."
 )
-print(textwrap.fill(about, 100, break_on_hyphens=False, break_long_words=False))
+wrap(about)
 print()
 if noisy is None:
-    print("| scene | k | grid (deg:px) | decode - aligned | the light (bound) | target | short by |")
-    print("| --- | --- | --- | --- | --- | --- | --- |")
+    header("scene", "k", "grid (deg:px)", "decode - aligned", "the light (bound)", "target", "short by")
 else:
-    print("| scene | k | grid (deg:px) | decode - aligned | the light, noiseless | the light, noisy | target | short by |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+    header("scene", "k", "grid (deg:px)", "decode - aligned", "the light, noiseless", "the light, noisy", "target", "short by")
 short = {}
 for key, d in decodes.items():
     b = bound.get(key)
@@ -128,8 +136,7 @@ for key, d in decodes.items():
     short.setdefault(k, []).append(gap)
     print(f"| {' | '.join(key)} | {loss:+.2f} | {cells} | {target:+.2f} | {gap:.2f} |")
 print()
-print("| k | decodes | target met | short by: median / worst |")
-print("| --- | --- | --- | --- |")
+header("k", "decodes", "target met", "short by: median / worst")
 for k in sorted(short):
     g = short[k]
     print(f"| {k} | {len(g)} | {sum(x == 0 for x in g)} | {statistics.median(g):.2f} / {max(g):.2f} |")
@@ -138,19 +145,13 @@ if before is not None:
     print()
     print("## Before and after: the issue's measure, decode by decode")
     print()
-    print(
-        textwrap.fill(
-            f"The loss to the aligned sensor, interior, when the issue was filed (`{before_page}`, the "
-            f"decode of its commit, its *(c) - ref dB, interior* column) and now (`{args[1]}`, *after - "
-            "aligned*). Each page's aligned reference is its own decoder's. dB.",
-            100,
-            break_on_hyphens=False,
-            break_long_words=False,
-        )
+    wrap(
+        f"The loss to the aligned sensor, interior, when the issue was filed (`{before_page}`, the "
+        f"decode of its commit, its *(c) - ref dB, interior* column) and now (`{args[1]}`, *after - "
+        "aligned*). Each page's aligned reference is its own decoder's. dB."
     )
     print()
-    print("| scene | k | grid (deg:px) | before | after | after - before |")
-    print("| --- | --- | --- | --- | --- | --- |")
+    header("scene", "k", "grid (deg:px)", "before", "after", "after - before")
     by_k = {}
     for key, d in decodes.items():
         then = before.get(key)
@@ -161,8 +162,7 @@ if before is not None:
         by_k.setdefault(int(key[1]), []).append((then, now))
         print(f"| {' | '.join(key)} | {then:+.2f} | {now:+.2f} | {now - then:+.2f} |")
     print()
-    print("| k | decodes | before: median / worst | after: median / worst | rose on |")
-    print("| --- | --- | --- | --- | --- |")
+    header("k", "decodes", "before: median / worst", "after: median / worst", "rose on")
     for k in sorted(by_k):
         then = [t for t, _ in by_k[k]]
         now = [n for _, n in by_k[k]]
