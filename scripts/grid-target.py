@@ -112,13 +112,19 @@ if noisy is None:
     header("scene", "k", "grid (deg:px)", "decode - aligned", "the light (bound)", "target", "short by")
 else:
     header("scene", "k", "grid (deg:px)", "decode - aligned", "the light, noiseless", "the light, noisy", "target", "short by")
+def beside(other, missing):
+    """Each decode (its key and loss to the aligned sensor) with its row of `other`; a row for
+    a decode `other` lacks, saying `missing`."""
+    for key, d in decodes.items():
+        loss = float(d["after - aligned dB"])
+        if key not in other:
+            print(f"| {' | '.join(key)} | {loss:+.2f} | ({missing}) | | |")
+            continue
+        yield key, loss, other[key]
+
+
 short = {}
-for key, d in decodes.items():
-    b = bound.get(key)
-    loss = float(d["after - aligned dB"])
-    if b is None:
-        print(f"| {' | '.join(key)} | {loss:+.2f} | (not in the bound) | | |")
-        continue
+for key, loss, b in beside(bound, "not in the bound"):
     light = float(b[light_col])
     k = int(key[1])
     if noisy is None:
@@ -153,12 +159,7 @@ if before is not None:
     print()
     header("scene", "k", "grid (deg:px)", "before", "after", "after - before")
     by_k = {}
-    for key, d in decodes.items():
-        then = before.get(key)
-        now = float(d["after - aligned dB"])
-        if then is None:
-            print(f"| {' | '.join(key)} | (not on the page) | {now:+.2f} | |")
-            continue
+    for key, now, then in beside(before, "not on the page"):
         by_k.setdefault(int(key[1]), []).append((then, now))
         print(f"| {' | '.join(key)} | {then:+.2f} | {now:+.2f} | {now - then:+.2f} |")
     print()
