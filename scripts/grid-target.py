@@ -51,18 +51,18 @@ def wrap(text):
 
 def per_scene(path):
     """A grid-results page: {(scene, k, "deg:px"): loss interior} from each scene's table."""
-    rows, scene, header = {}, None, None
+    rows, scene, names = {}, None, None
     for line in open(path):
         if line.startswith("## "):
-            scene, header = line[3:].strip(), None
+            scene, names = line[3:].strip(), None
         elif line.startswith("|") and scene:
             cells = [c.strip() for c in line.strip().strip("|").split("|")]
             if cells[0] == "k":
                 # A scene's table; the page's other tables (summary, blur, calibration) are not.
                 wanted = {"rotation deg", "pitch px", "(c) - ref dB, interior"}
-                header = cells if wanted <= set(cells) else None
-            elif header and not cells[0].startswith("---") and len(cells) == len(header):
-                row = dict(zip(header, cells))
+                names = cells if wanted <= set(cells) else None
+            elif names and not cells[0].startswith("---") and len(cells) == len(names):
+                row = dict(zip(names, cells))
                 key = (scene, row["k"], f"{row['rotation deg']}:{row['pitch px']}")
                 rows[key] = float(row["(c) - ref dB, interior"])
     return rows
