@@ -25,17 +25,17 @@ import textwrap
 
 def table(path, key_cols=3):
     """The first markdown table of `path` whose header starts with `scene`: {(scene, k, grid): {column: cell}}."""
-    rows, header = {}, None
+    rows, names = {}, None
     for line in open(path):
         if not line.startswith("|"):
-            if header and rows:
+            if names and rows:
                 break
             continue
         cells = [c.strip() for c in line.strip().strip("|").split("|")]
         if cells[0] == "scene":
-            header = cells
-        elif header and not cells[0].startswith("---"):
-            rows[tuple(cells[:key_cols])] = dict(zip(header, cells))
+            names = cells
+        elif names and not cells[0].startswith("---"):
+            rows[tuple(cells[:key_cols])] = dict(zip(names, cells))
     return rows
 
 
