@@ -23,6 +23,11 @@ import sys
 import textwrap
 
 
+def cells_of(line):
+    """A markdown table row's cells, stripped."""
+    return [c.strip() for c in line.strip().strip("|").split("|")]
+
+
 def table(path, key_cols=3):
     """The first markdown table of `path` whose header starts with `scene`: {(scene, k, grid): {column: cell}}."""
     rows, names = {}, None
@@ -31,7 +36,7 @@ def table(path, key_cols=3):
             if names and rows:
                 break
             continue
-        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        cells = cells_of(line)
         if cells[0] == "scene":
             names = cells
         elif names and not cells[0].startswith("---"):
@@ -56,7 +61,7 @@ def per_scene(path):
         if line.startswith("## "):
             scene, names = line[3:].strip(), None
         elif line.startswith("|") and scene:
-            cells = [c.strip() for c in line.strip().strip("|").split("|")]
+            cells = cells_of(line)
             if cells[0] == "k":
                 # A scene's table; the page's other tables (summary, blur, calibration) are not.
                 wanted = {"rotation deg", "pitch px", "(c) - ref dB, interior"}
@@ -66,6 +71,17 @@ def per_scene(path):
                 key = (scene, row["k"], f"{row['rotation deg']}:{row['pitch px']}")
                 rows[key] = float(row["(c) - ref dB, interior"])
     return rows
+
+
+def beside(decodes, other, missing):
+    """Each decode (its key and loss to the aligned sensor) with its row of `other`; a row for
+    a decode `other` lacks, saying `missing`."""
+    for key, d in decodes.items():
+        loss = float(d["after - aligned dB"])
+        if key not in other:
+            print(f"| {' | '.join(key)} | {loss:+.2f} | ({missing}) | | |")
+            continue
+        yield key, loss, other[key]
 
 
 args = sys.argv[1:]
@@ -112,19 +128,8 @@ if noisy is None:
     header("scene", "k", "grid (deg:px)", "decode - aligned", "the light (bound)", "target", "short by")
 else:
     header("scene", "k", "grid (deg:px)", "decode - aligned", "the light, noiseless", "the light, noisy", "target", "short by")
-def beside(other, missing):
-    """Each decode (its key and loss to the aligned sensor) with its row of `other`; a row for
-    a decode `other` lacks, saying `missing`."""
-    for key, d in decodes.items():
-        loss = float(d["after - aligned dB"])
-        if key not in other:
-            print(f"| {' | '.join(key)} | {loss:+.2f} | ({missing}) | | |")
-            continue
-        yield key, loss, other[key]
-
-
 short = {}
-for key, loss, b in beside(bound, "not in the bound"):
+for key, loss, b in beside(decodes, bound, "not in the bound"):
     light = float(b[light_col])
     k = int(key[1])
     if noisy is None:
@@ -159,7 +164,7 @@ if before is not None:
     print()
     header("scene", "k", "grid (deg:px)", "before", "after", "after - before")
     by_k = {}
-    for key, now, then in beside(before, "not on the page"):
+    for key, now, then in beside(decodes, before, "not on the page"):
         by_k.setdefault(int(key[1]), []).append((then, now))
         print(f"| {' | '.join(key)} | {then:+.2f} | {now:+.2f} | {now - then:+.2f} |")
     print()
